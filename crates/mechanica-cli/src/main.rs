@@ -1,0 +1,55 @@
+//! The `mechanica` command line: runs a scene (at first, the built-in default scene) and
+//! prints a readable report, or JSON with `--json`.
+
+mod default_scene;
+mod report;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Analytical mechanics for simulators.
+#[derive(Debug, Parser)]
+#[command(name = "mechanica", version, about, long_about = None)]
+struct Cli {
+    /// Print the machine-readable JSON report instead of the text report.
+    #[arg(long, global = true)]
+    json: bool,
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run the built-in default scene and print its report (also what a bare `mechanica` does).
+    Run,
+    /// Print the library version, the C ABI version and the compiled-in features.
+    Version,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let report = match cli.command.unwrap_or(Command::Run) {
+        Command::Run => default_scene::run(),
+        Command::Version => report::version_report(),
+    };
+    match report {
+        Ok(report) => {
+            if cli.json {
+                match serde_json::to_string_pretty(&report) {
+                    Ok(text) => println!("{text}"),
+                    Err(error) => {
+                        eprintln!("mechanica: could not encode the report as JSON: {error}");
+                        return ExitCode::FAILURE;
+                    }
+                }
+            } else {
+                print!("{}", report.to_text());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(error) => {
+            eprintln!("mechanica: {error}");
+            ExitCode::FAILURE
+        }
+    }
+}

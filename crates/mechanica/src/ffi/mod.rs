@@ -1,0 +1,38 @@
+//! The C ABI: status codes, versioning, the panic boundary, input validation and one
+//! module of entry points per capability crate.
+//!
+//! Conventions (see DESIGN.md, "C ABI conventions"):
+//! - every fallible call returns [`mech_status_t`] and writes its outputs only on success;
+//! - enums arriving from C are plain integers and are validated;
+//! - n×n matrices are caller-owned, column-major `double` arrays;
+//! - no panic crosses the boundary: each entry point runs inside [`boundary`].
+#![allow(non_camel_case_types)]
+
+mod boundary;
+mod status;
+mod types;
+mod validate;
+mod version;
+
+#[cfg(feature = "impulse")]
+mod impulse;
+#[cfg(feature = "kinematics")]
+mod kinematics;
+#[cfg(feature = "mass")]
+mod mass;
+#[cfg(feature = "modal")]
+mod modal;
+
+pub use boundary::*;
+pub use status::*;
+pub use types::*;
+pub use version::*;
+
+#[cfg(feature = "impulse")]
+pub use impulse::*;
+#[cfg(feature = "kinematics")]
+pub use kinematics::*;
+#[cfg(feature = "mass")]
+pub use mass::*;
+#[cfg(feature = "modal")]
+pub use modal::*;

@@ -1,0 +1,29 @@
+//! mechanica: analytical mechanics for simulators.
+//!
+//! Rust users reach each capability crate through this facade, one cargo feature each:
+//!
+//! | feature      | module                   | crate                   |
+//! |--------------|--------------------------|-------------------------|
+//! | `kinematics` | [`kinematics`]           | `mechanica-kinematics`  |
+//! | `mass`       | [`mass`]                 | `mechanica-mass`        |
+//! | `impulse`    | [`impulse`]              | `mechanica-impulse`     |
+//! | `modal`      | [`modal`]                | `mechanica-modal`       |
+//!
+//! C and C++ programs use the same capabilities through [`ffi`], declared in the generated
+//! header `include/mechanica.h`.
+
+#[cfg(feature = "impulse")]
+pub use mechanica_impulse as impulse;
+#[cfg(feature = "kinematics")]
+pub use mechanica_kinematics as kinematics;
+#[cfg(feature = "mass")]
+pub use mechanica_mass as mass;
+#[cfg(feature = "modal")]
+pub use mechanica_modal as modal;
+
+pub mod ffi;
+
+/// The crate version, `MAJOR.MINOR.PATCH`, as in Cargo.toml.
+pub fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
