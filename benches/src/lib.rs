@@ -43,7 +43,18 @@ pub fn plot_error_vs_time(name: &str, title: &str, series: &[Series]) -> Result<
     if t_min > t_max || e_min > e_max {
         return Err("no positive points to plot".into());
     }
-    let root = SVGBackend::new(&path, (800, 520)).into_drawing_area();
+    draw_log_log(&path, title, series, (t_min, t_max), (e_min, e_max))?;
+    Ok(path)
+}
+
+fn draw_log_log(
+    path: &std::path::Path,
+    title: &str,
+    series: &[Series],
+    (t_min, t_max): (f64, f64),
+    (e_min, e_max): (f64, f64),
+) -> Result<(), Box<dyn std::error::Error>> {
+    let root = SVGBackend::new(path, (800, 520)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))
@@ -63,5 +74,5 @@ pub fn plot_error_vs_time(name: &str, title: &str, series: &[Series]) -> Result<
     }
     chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
     root.present()?;
-    Ok(path)
+    Ok(())
 }
