@@ -17,7 +17,10 @@ impl log::Log for WarningCollector {
     }
     fn log(&self, record: &log::Record<'_>) {
         if self.enabled(record.metadata()) {
-            WARNINGS.lock().unwrap_or_else(|p| p.into_inner()).push(format!("{}: {}", record.level(), record.args()));
+            WARNINGS
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push(format!("{}: {}", record.level(), record.args()));
         }
     }
     fn flush(&self) {}
@@ -56,7 +59,11 @@ fn header_is_fresh_and_generated_without_warnings() {
     }
     let checked_in = std::fs::read_to_string(header_path()).unwrap_or_else(|e| panic!("{e}"));
     if checked_in != generated {
-        let line = checked_in.lines().zip(generated.lines()).position(|(a, b)| a != b).map_or(0, |i| i + 1);
+        let line = checked_in
+            .lines()
+            .zip(generated.lines())
+            .position(|(a, b)| a != b)
+            .map_or(0, |i| i + 1);
         panic!(
             "include/mechanica.h is stale (first difference at line {line}). Regenerate it with\n  \
              MECH_BLESS_HEADER=1 cargo test -p mechanica-ffi-tests --test header\nand commit it."
@@ -72,8 +79,11 @@ fn header_compiles_alone_and_twice_as_c11_and_cxx17() {
     for (file, compiler, standard) in [("twice.c", "gcc", "-std=c11"), ("twice.cpp", "g++", "-std=c++17")] {
         for defines in [&[][..], &["-DMECH_FEATURES_EXPLICIT"][..]] {
             let source = dir.join(file);
-            std::fs::write(&source, body.replace("(void)", if file.ends_with("cpp") { "()" } else { "(void)" }))
-                .unwrap_or_else(|e| panic!("{e}"));
+            std::fs::write(
+                &source,
+                body.replace("(void)", if file.ends_with("cpp") { "()" } else { "(void)" }),
+            )
+            .unwrap_or_else(|e| panic!("{e}"));
             let output = std::process::Command::new(compiler)
                 .arg(standard)
                 .args(["-Wall", "-Wextra", "-Werror", "-pedantic", "-fsyntax-only"])
@@ -83,7 +93,8 @@ fn header_compiles_alone_and_twice_as_c11_and_cxx17() {
                 .arg(&source)
                 .output()
                 .unwrap_or_else(|e| panic!("could not run {compiler}: {e}"));
-            check_success(&format!("{compiler} {standard} {defines:?} {file}"), &output).unwrap_or_else(|e| panic!("{e}"));
+            check_success(&format!("{compiler} {standard} {defines:?} {file}"), &output)
+                .unwrap_or_else(|e| panic!("{e}"));
         }
     }
 }
@@ -92,11 +103,48 @@ fn header_compiles_alone_and_twice_as_c11_and_cxx17() {
 fn every_declared_function_is_called_by_an_ffi_test() {
     let header = std::fs::read_to_string(header_path()).unwrap_or_else(|e| panic!("{e}"));
     let functions = declared_functions(&header);
-    assert!(functions.len() >= 8, "parsed too few functions from the header: {functions:?}");
+    assert!(
+        functions.len() >= 8,
+        "parsed too few functions from the header: {functions:?}"
+    );
     let mut sources = String::new();
     for path in sources_in("c").into_iter().chain(sources_in("cpp")) {
         sources.push_str(&std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{e}")));
     }
-    let untested: Vec<&String> = functions.iter().filter(|f| !sources.contains(&format!("{f}("))).collect();
-    assert!(untested.is_empty(), "exported functions without a C/C++ test: {untested:?}");
+    let untested: Vec<&String> = functions
+        .iter()
+        .filter(|f| !sources.contains(&format!("{f}(")))
+        .collect();
+    assert!(
+        untested.is_empty(),
+        "exported functions without a C/C++ test: {untested:?}"
+    );
+}
+
+#[test]
+fn every_declaration_in_the_header_has_a_doxygen_comment() {
+    let header = std::fs::read_to_string(header_path()).unwrap_or_else(|e| panic!("{e}"));
+    let lines: Vec<&str> = header.lines().collect();
+    let mut undocumented = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let starts_declaration = line.starts_with("#define MECH_")
+            || line.starts_with("typedef ")
+            || (!line.starts_with(' ') && !declared_functions(line).is_empty());
+        if !starts_declaration {
+            continue;
+        }
+        let previous = lines[..i]
+            .iter()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .map_or("", |l| l.trim());
+        if !previous.ends_with("*/") {
+            undocumented.push(format!("line {}: {line}", i + 1));
+        }
+    }
+    assert!(
+        undocumented.is_empty(),
+        "declarations without a doc comment:\n{}",
+        undocumented.join("\n")
+    );
 }
