@@ -74,6 +74,21 @@
  */
 #define MECH_FEATURE_BIT_MODAL (1 << 3)
 
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * The opaque result of mech_modal_solve. Free it with mech_modal_result_destroy.
+ */
+typedef struct mech_modal_result_t mech_modal_result_t;
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * A kinematic tree (opaque). Created empty by mech_tree_create, filled with
+ * mech_tree_add_body, validated by mech_tree_finalize, then queried; freed by mech_tree_destroy.
+ */
+typedef struct mech_tree_t mech_tree_t;
+#endif
+
 /**
  * Result code of every fallible call. Fixed width (int32_t); 0 is success.
  * Values are stable across versions and never reused.
@@ -105,6 +120,64 @@ typedef struct mech_collinear_impact_t {
 #endif
 
 /**
+ * A 3-vector of doubles (x, y, z). Its frame is stated by each function that uses it.
+ */
+typedef struct mech_vec3_t {
+    /**
+     * x component.
+     */
+    double x;
+    /**
+     * y component.
+     */
+    double y;
+    /**
+     * z component.
+     */
+    double z;
+} mech_vec3_t;
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The response of a point mass to an impulse (5.13, 7.106).
+ */
+typedef struct mech_point_impulse_t {
+    /**
+     * Velocity just after, V = v + S/m (m/s).
+     */
+    struct mech_vec3_t velocity_after;
+    /**
+     * ΔT = ½ S·(V + v) (J).
+     */
+    double energy_change;
+} mech_point_impulse_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The outcome of a 3-D collision of two smooth point masses along a normal.
+ */
+typedef struct mech_point_impact_t {
+    /**
+     * Velocity of point 1 after the impact (m/s).
+     */
+    struct mech_vec3_t velocity_after_1;
+    /**
+     * Velocity of point 2 after the impact (m/s).
+     */
+    struct mech_vec3_t velocity_after_2;
+    /**
+     * Impulse on point 2, along the normal (N·s); point 1 receives its negative.
+     */
+    struct mech_vec3_t impulse_on_2;
+    /**
+     * Kinetic-energy change (J), −½(1 − λ²) μ (approach speed)² (5.23).
+     */
+    double energy_change;
+} mech_point_impact_t;
+#endif
+
+/**
  * A 3×3 matrix of doubles in column-major order: m[row + 3*col].
  */
 typedef struct mech_mat3_t {
@@ -113,6 +186,232 @@ typedef struct mech_mat3_t {
      */
     double m[9];
 } mech_mat3_t;
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Mass properties: mass (kg), centre of mass (m, in the body's reference frame) and the
+ * inertia tensor about the centre of mass (kg·m², same frame).
+ */
+typedef struct mech_mass_properties_t {
+    /**
+     * Total mass.
+     */
+    double mass;
+    /**
+     * Centre of mass.
+     */
+    struct mech_vec3_t center_of_mass;
+    /**
+     * Inertia tensor about the centre of mass, column-major.
+     */
+    struct mech_mat3_t inertia_about_com;
+} mech_mass_properties_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * How a body is held during an impact (int32).
+ */
+typedef int32_t mech_body_constraint_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * A rigid body at the instant of an impact, in inverse form (world frame W). Infinite mass
+ * is `inverse_mass = 0`; a locked rotation axis is a zero eigenvalue of `inverse_inertia`; a
+ * static body has both zero. For rods and point masses use the pseudo-inverse of the central
+ * inertia (see mech_impulse_body_from_mass_properties): the zero-inertia axis then acts as
+ * locked, which is exact when every impulse passes through that axis.
+ */
+typedef struct mech_impulse_body_t {
+    /**
+     * 1/m (1/kg), ≥ 0.
+     */
+    double inverse_mass;
+    /**
+     * Inverse central inertia J₀⁻¹ in world axes (1/(kg·m²)), symmetric positive semidefinite, column-major.
+     */
+    struct mech_mat3_t inverse_inertia;
+    /**
+     * Centre of mass p_WC (m).
+     */
+    struct mech_vec3_t center_of_mass;
+    /**
+     * Velocity of the centre of mass just before the impact (m/s).
+     */
+    struct mech_vec3_t velocity;
+    /**
+     * Angular velocity just before the impact (rad/s).
+     */
+    struct mech_vec3_t angular_velocity;
+    /**
+     * A MECH_BODY_* value: free or hinged.
+     */
+    mech_body_constraint_t constraint;
+    /**
+     * The world-fixed hinge point (used by MECH_BODY_HINGE_POINT and MECH_BODY_HINGE_AXIS).
+     */
+    struct mech_vec3_t hinge_point;
+    /**
+     * The unit hinge axis (used by MECH_BODY_HINGE_AXIS).
+     */
+    struct mech_vec3_t hinge_axis;
+} mech_impulse_body_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The response of one body to an impulse.
+ */
+typedef struct mech_body_response_t {
+    /**
+     * Velocity of the centre of mass just after (m/s).
+     */
+    struct mech_vec3_t velocity_after;
+    /**
+     * Angular velocity just after (rad/s).
+     */
+    struct mech_vec3_t angular_velocity_after;
+    /**
+     * ΔT = ½ S·(V₀ + v₀) + ½ M₀S·(Ω + ω) (7.107) (J).
+     */
+    double energy_change;
+} mech_body_response_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The outcome of fixing a body point (7.100–7.108).
+ */
+typedef struct mech_fixation_t {
+    /**
+     * The impulse S applied at the fixed point (N·s).
+     */
+    struct mech_vec3_t impulse;
+    /**
+     * Velocity of the centre of mass after (m/s).
+     */
+    struct mech_vec3_t velocity_after;
+    /**
+     * Angular velocity after, Ω (rad/s).
+     */
+    struct mech_vec3_t angular_velocity_after;
+    /**
+     * ΔT = ½ S·v (7.108) (J).
+     */
+    double energy_change;
+    /**
+     * |velocity of the point| after, as computed (m/s): a check of the solve.
+     */
+    double residual;
+} mech_fixation_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Which relation ends restitution in a frictional impact (int32).
+ */
+typedef int32_t mech_restitution_law_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * A point contact between body 1 and body 2 and its material law.
+ */
+typedef struct mech_impulse_contact_t {
+    /**
+     * The contact point R (world frame, m).
+     */
+    struct mech_vec3_t point;
+    /**
+     * The unit normal pointing from body 1 into body 2 (|n| = 1 within 1e-9).
+     */
+    struct mech_vec3_t normal;
+    /**
+     * Coefficient of restitution e ∈ [0, 1].
+     */
+    double restitution;
+    /**
+     * Coulomb friction coefficient f ≥ 0; +INFINITY means the contact cannot slip.
+     */
+    double friction;
+    /**
+     * A MECH_RESTITUTION_* value.
+     */
+    mech_restitution_law_t law;
+    /**
+     * Relative tolerance of the 3-D swerving-slip integration (> 0, e.g. 1e-10).
+     */
+    double tolerance;
+} mech_impulse_contact_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The contact mode of an impact (int32), as reported in ::mech_impact_result_t.
+ */
+typedef int32_t mech_contact_mode_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The outcome of a two-body point impact.
+ */
+typedef struct mech_impact_result_t {
+    /**
+     * Impulse P on body 2 (body 1 receives −P) (N·s).
+     */
+    struct mech_vec3_t impulse;
+    /**
+     * Normal impulse P·n ≥ 0 (N·s).
+     */
+    double normal_impulse;
+    /**
+     * Tangential (friction) impulse P − (P·n) n (N·s).
+     */
+    struct mech_vec3_t tangential_impulse;
+    /**
+     * Normal impulse at the end of compression (N·s).
+     */
+    double compression_impulse;
+    /**
+     * Relative velocity of the contact point (body 2 minus body 1) after the impact (m/s).
+     */
+    struct mech_vec3_t relative_velocity_after;
+    /**
+     * A MECH_CONTACT_* value.
+     */
+    mech_contact_mode_t mode;
+    /**
+     * Body 1 centre-of-mass velocity after (m/s).
+     */
+    struct mech_vec3_t velocity_after_1;
+    /**
+     * Body 1 angular velocity after (rad/s).
+     */
+    struct mech_vec3_t angular_velocity_after_1;
+    /**
+     * Body 2 centre-of-mass velocity after (m/s).
+     */
+    struct mech_vec3_t velocity_after_2;
+    /**
+     * Body 2 angular velocity after (rad/s).
+     */
+    struct mech_vec3_t angular_velocity_after_2;
+    /**
+     * Total kinetic-energy change ΔT = P·(u⁻ + ½ W P) (J).
+     */
+    double energy_change;
+    /**
+     * Estimated error of the impulse from the swerving-slip integration (N·s); 0 if exact.
+     */
+    double integration_error;
+    /**
+     * Integration steps plus closed-form segments used.
+     */
+    uint64_t steps;
+} mech_impact_result_t;
+#endif
 
 /**
  * A unit quaternion w + x i + y j + z k (scalar first), representing a rotation.
@@ -136,24 +435,6 @@ typedef struct mech_quat_t {
     double z;
 } mech_quat_t;
 
-/**
- * A 3-vector of doubles (x, y, z). Its frame is stated by each function that uses it.
- */
-typedef struct mech_vec3_t {
-    /**
-     * x component.
-     */
-    double x;
-    /**
-     * y component.
-     */
-    double y;
-    /**
-     * z component.
-     */
-    double z;
-} mech_vec3_t;
-
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
  * How mech_rotation_matrix_from_quat treats a quaternion that is not of unit length.
@@ -161,25 +442,394 @@ typedef struct mech_vec3_t {
 typedef int32_t mech_quat_norm_t;
 #endif
 
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * An intrinsic Euler axis sequence: R = R_i(a) R_j(b) R_k(c), angles = {a, b, c}.
+ * The EB1911 angles (θ, φ, ψ) of the seed are MECH_EULER_ZYZ with {a, b, c} = {ψ, θ, φ}.
+ */
+typedef int32_t mech_euler_sequence_t;
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The frame in which an angular velocity is expressed.
+ */
+typedef int32_t mech_frame_t;
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The state of a rigid motion x = R X + c (syllabus 1.5), all world components.
+ */
+typedef struct mech_rigid_motion_t {
+    /**
+     * Orientation R (body → world), column-major; must be a rotation.
+     */
+    struct mech_mat3_t rotation;
+    /**
+     * Position c of the reference point.
+     */
+    struct mech_vec3_t c;
+    /**
+     * Velocity ċ of the reference point.
+     */
+    struct mech_vec3_t c_dot;
+    /**
+     * Acceleration c̈ of the reference point.
+     */
+    struct mech_vec3_t c_ddot;
+    /**
+     * Angular velocity ω.
+     */
+    struct mech_vec3_t omega;
+    /**
+     * Angular acceleration ω̇.
+     */
+    struct mech_vec3_t omega_dot;
+} mech_rigid_motion_t;
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * A point's absolute motion decomposed relative to a moving frame (world components,
+ * syllabus 2.22–2.32): v = v_drag + v_rel, a = a_drag + a_coriolis + a_rel.
+ */
+typedef struct mech_relative_decomposition_t {
+    /**
+     * Position x = R ξ + c.
+     */
+    struct mech_vec3_t position;
+    /**
+     * Drag velocity ω × (x − c) + ċ.
+     */
+    struct mech_vec3_t v_drag;
+    /**
+     * Relative velocity R ξ̇.
+     */
+    struct mech_vec3_t v_rel;
+    /**
+     * Drag acceleration ω̇ × (x − c) + ω × (ω × (x − c)) + c̈.
+     */
+    struct mech_vec3_t a_drag;
+    /**
+     * Coriolis acceleration 2 ω × v_rel.
+     */
+    struct mech_vec3_t a_coriolis;
+    /**
+     * Relative acceleration R ξ̈.
+     */
+    struct mech_vec3_t a_rel;
+} mech_relative_decomposition_t;
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The joint type of a tree body.
+ */
+typedef int32_t mech_joint_type_t;
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Which Jacobian mech_tree_jacobian computes.
+ */
+typedef int32_t mech_jacobian_kind_t;
+#endif
+
 #if defined(MECH_FEATURE_MASS)
 /**
- * Mass properties: mass (kg), centre of mass (m, in the body's reference frame) and the
- * inertia tensor about the centre of mass (kg·m², same frame).
+ * Kinds of primitive bodies for mech_mass_primitive. Each lists its `dimensions` (metres) and
+ * the frame it is built in; "centred" means the origin is the centre of mass.
  */
-typedef struct mech_mass_properties_t {
+typedef int32_t mech_primitive_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * How the `amount` argument of mech_mass_primitive and mech_mass_mesh is read.
+ */
+typedef int32_t mech_amount_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Bit flags of mech_mass_validity_t.issues: what is wrong with mass properties.
+ */
+typedef uint32_t mech_mass_issue_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The kind of body valid mass properties describe.
+ */
+typedef int32_t mech_inertia_class_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The result of mech_mass_check.
+ */
+typedef struct mech_mass_validity_t {
     /**
-     * Total mass.
+     * OR of MECH_MASS_ISSUE_* flags; 0 when the properties are valid.
      */
-    double mass;
+    mech_mass_issue_t issues;
     /**
-     * Centre of mass.
+     * A mech_inertia_class_t: MECH_INERTIA_INVALID when `issues` ≠ 0.
      */
-    struct mech_vec3_t center_of_mass;
+    mech_inertia_class_t inertia_class;
     /**
-     * Inertia tensor about the centre of mass, column-major.
+     * Eigenvalues of the symmetric part of the tensor, ascending (zeros when non-finite).
      */
-    struct mech_mat3_t inertia_about_com;
-} mech_mass_properties_t;
+    struct mech_vec3_t moments;
+} mech_mass_validity_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The mass model of a mesh.
+ */
+typedef int32_t mech_mesh_model_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * What to do with an open mesh under MECH_MESH_SOLID.
+ */
+typedef int32_t mech_open_mesh_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * What to do with an inside-out closed mesh (negative signed volume).
+ */
+typedef int32_t mech_inside_out_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * What to do with degenerate triangles (repeated indices or zero area).
+ */
+typedef int32_t mech_degenerate_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Options of mech_mass_mesh. All zeros is the default: solid, reject open meshes, flip
+ * inside-out meshes, skip degenerate triangles.
+ */
+typedef struct mech_mesh_options_t {
+    /**
+     * A mech_mesh_model_t.
+     */
+    mech_mesh_model_t model;
+    /**
+     * A mech_open_mesh_t.
+     */
+    mech_open_mesh_t open_mesh;
+    /**
+     * A mech_inside_out_t.
+     */
+    mech_inside_out_t inside_out;
+    /**
+     * A mech_degenerate_t.
+     */
+    mech_degenerate_t degenerate;
+} mech_mesh_options_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * What mech_mass_mesh found and how accurate its integrals are.
+ */
+typedef struct mech_mesh_report_t {
+    /**
+     * The model used (a mech_mesh_model_t; an open solid may fall back to a shell).
+     */
+    mech_mesh_model_t model;
+    /**
+     * 1 when an inside-out mesh was reversed, else 0.
+     */
+    int32_t flipped;
+    /**
+     * Volume (m³) for a solid, area (m²) for a shell.
+     */
+    double measure;
+    /**
+     * Bound on the relative rounding error of `measure`.
+     */
+    double relative_error_bound;
+    /**
+     * Number of triangles given.
+     */
+    size_t triangles;
+    /**
+     * Triangles skipped as degenerate.
+     */
+    size_t degenerate_triangles;
+    /**
+     * Edges used by one triangle only.
+     */
+    size_t boundary_edges;
+    /**
+     * Edges used by more than two triangles.
+     */
+    size_t non_manifold_edges;
+    /**
+     * Edges used twice in the same direction.
+     */
+    size_t misoriented_edges;
+} mech_mesh_report_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Which modes a solve returns (int32_t; see MECH_MODAL_SELECTION_*).
+ */
+typedef int32_t mech_modal_selection_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Low-mode refinement policy (int32_t; see MECH_MODAL_REFINEMENT_*).
+ */
+typedef int32_t mech_modal_refinement_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Options of mech_modal_solve.
+ */
+typedef struct mech_modal_options_t {
+    /**
+     * A MECH_MODAL_SELECTION_* value.
+     */
+    mech_modal_selection_t selection;
+    /**
+     * Number of modes for MECH_MODAL_SELECTION_LOWEST (ignored otherwise).
+     */
+    size_t count;
+    /**
+     * Lower end of ω² (rad²/s²) for MECH_MODAL_SELECTION_INTERVAL (ignored otherwise).
+     */
+    double lower;
+    /**
+     * Upper end of ω² for MECH_MODAL_SELECTION_INTERVAL (ignored otherwise).
+     */
+    double upper;
+    /**
+     * 1: compute mode shapes; 0: values only.
+     */
+    int32_t vectors;
+    /**
+     * A MECH_MODAL_REFINEMENT_* value.
+     */
+    mech_modal_refinement_t refinement;
+} mech_modal_options_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Classification of a mode (int32_t; see MECH_MODAL_KIND_*).
+ */
+typedef int32_t mech_modal_kind_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Scalar data of one mode.
+ */
+typedef struct mech_modal_mode_t {
+    /**
+     * λ of det(λA + B) = 0 (= −ω²); −HUGE_VAL for an infinite mode.
+     */
+    double lambda;
+    /**
+     * ω² = −λ (rad²/s²); +HUGE_VAL for an infinite mode.
+     */
+    double omega_sq;
+    /**
+     * ω (rad/s) for an oscillatory mode, the growth rate √λ (1/s) for an unstable one, 0 for a
+     * zero mode, +HUGE_VAL for an infinite one.
+     */
+    double rate;
+    /**
+     * Bound on |ω²_computed − ω²_exact|.
+     */
+    double error_bound;
+    /**
+     * Backward error η of the pair, or −1 when not available (values only, infinite mode).
+     */
+    double backward_error;
+    /**
+     * A MECH_MODAL_KIND_* value.
+     */
+    mech_modal_kind_t kind;
+    /**
+     * Index of the mode's group of equal frequencies (modes of a group are consecutive).
+     */
+    size_t group;
+    /**
+     * Multiplicity of that group.
+     */
+    size_t multiplicity;
+} mech_modal_mode_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Summary of the accuracy report of a solve.
+ */
+typedef struct mech_modal_accuracy_t {
+    /**
+     * ‖A‖_F.
+     */
+    double norm_a;
+    /**
+     * ‖B‖_F.
+     */
+    double norm_b;
+    /**
+     * Largest backward error η of the pairs, or −1 for values only.
+     */
+    double max_backward_error;
+    /**
+     * max |(XᵀAX − I)_ij| over the finite modes, or −1 for values only.
+     */
+    double orthogonality_error;
+    /**
+     * Largest error bound of the modes (0 when there are none).
+     */
+    double max_error_bound;
+    /**
+     * Number of modes refined with extended-precision residuals.
+     */
+    size_t refined_modes;
+    /**
+     * 1 when a Sturm (LBLᵀ inertia) check was made.
+     */
+    int32_t inertia_checked;
+    /**
+     * 1 when that check agreed with the computed spectrum.
+     */
+    int32_t inertia_consistent;
+    /**
+     * The check's shift s (ω², rad²/s²).
+     */
+    double inertia_shift;
+    /**
+     * Modes with ω² < s by the inertia of B − sA.
+     */
+    size_t inertia_below;
+    /**
+     * Modes with ω² < s among the computed ones.
+     */
+    size_t computed_below;
+    /**
+     * Number of massless directions condensed out (infinite modes).
+     */
+    size_t massless;
+} mech_modal_accuracy_t;
 #endif
 
 /**
@@ -254,6 +904,91 @@ typedef struct mech_mass_properties_t {
  */
 #define MECH_STATUS_PANIC 100
 
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The body is free.
+ */
+#define MECH_BODY_FREE 0
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The body is held by a spherical hinge at `hinge_point` (world-fixed) (7.87*–7.91*).
+ */
+#define MECH_BODY_HINGE_POINT 1
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The body can only rotate about the unit `hinge_axis` through `hinge_point` (7.87*–7.91*).
+ */
+#define MECH_BODY_HINGE_AXIS 2
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Newton's kinematic law u_n⁺ = −e u_n⁻ (7.94); may gain energy with friction (Kane's paradox).
+ */
+#define MECH_RESTITUTION_NEWTON 0
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Poisson's kinetic law: restitution impulse = e × compression impulse.
+ */
+#define MECH_RESTITUTION_POISSON 1
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Stronge's energetic law: restitution work = −e² × compression work; never gains energy.
+ * The recommended default.
+ */
+#define MECH_RESTITUTION_STRONGE 2
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * No impulse: the contact was separating or grazing.
+ */
+#define MECH_CONTACT_NO_IMPACT 0
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Smooth contact (friction 0).
+ */
+#define MECH_CONTACT_FRICTIONLESS 1
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The contact stuck from the start (or friction = +inf).
+ */
+#define MECH_CONTACT_STICK 2
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The contact slipped throughout (possibly swerving in 3-D).
+ */
+#define MECH_CONTACT_SLIP 3
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The slip halted and the contact stuck for the rest of the impact.
+ */
+#define MECH_CONTACT_SLIP_THEN_STICK 4
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The slip halted and resumed in a new direction (reversal).
+ */
+#define MECH_CONTACT_REVERSED 5
+#endif
+
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
  * Accept only quaternions with |‖q‖ − 1| ≤ 1e-12; others give MECH_STATUS_INVALID_ARGUMENT.
@@ -266,6 +1001,475 @@ typedef struct mech_mass_properties_t {
  * Normalise any non-zero quaternion first (zero gives MECH_STATUS_INVALID_ARGUMENT).
  */
 #define MECH_QUAT_NORMALIZE 1
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Tait–Bryan XYZ (robotics / Cardan).
+ */
+#define MECH_EULER_XYZ 0
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Tait–Bryan XZY.
+ */
+#define MECH_EULER_XZY 1
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Tait–Bryan YXZ.
+ */
+#define MECH_EULER_YXZ 2
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Tait–Bryan YZX.
+ */
+#define MECH_EULER_YZX 3
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Tait–Bryan ZXY.
+ */
+#define MECH_EULER_ZXY 4
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Tait–Bryan ZYX (aerospace yaw, pitch, roll).
+ */
+#define MECH_EULER_ZYX 5
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Proper Euler XYX.
+ */
+#define MECH_EULER_XYX 6
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Proper Euler XZX.
+ */
+#define MECH_EULER_XZX 7
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Proper Euler YXY.
+ */
+#define MECH_EULER_YXY 8
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Proper Euler YZY.
+ */
+#define MECH_EULER_YZY 9
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Proper Euler ZXZ.
+ */
+#define MECH_EULER_ZXZ 10
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Proper Euler ZYZ (robotics ZYZ; EB1911 as {ψ, θ, φ}).
+ */
+#define MECH_EULER_ZYZ 11
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Fixed (world) frame components.
+ */
+#define MECH_FRAME_FIXED 0
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Body frame components (EB1911's p, q, r).
+ */
+#define MECH_FRAME_BODY 1
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * One rotation about a unit axis (q: angle).
+ */
+#define MECH_JOINT_REVOLUTE 0
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * One translation along a unit axis (q: distance).
+ */
+#define MECH_JOINT_PRISMATIC 1
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Three rotations about the joint origin (q: rotation vector about a reference orientation).
+ */
+#define MECH_JOINT_SPHERICAL 2
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Six degrees of freedom (q: translation in the joint frame, then rotation vector).
+ */
+#define MECH_JOINT_FREE 3
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Planar motion in the joint frame's xy plane (q: x, y, angle about z).
+ */
+#define MECH_JOINT_PLANAR 4
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Rigid attachment (no coordinates).
+ */
+#define MECH_JOINT_FIXED 5
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * ∂x/∂q of a body point (syllabus 1.37): 3×dof.
+ */
+#define MECH_JACOBIAN_POINT 0
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * ∂ω/∂q̇ of the body: 3×dof.
+ */
+#define MECH_JACOBIAN_ANGULAR 1
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * d/dt of MECH_JACOBIAN_POINT along the current (q, q̇): 3×dof.
+ */
+#define MECH_JACOBIAN_POINT_RATE 2
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * d/dt of MECH_JACOBIAN_ANGULAR: 3×dof.
+ */
+#define MECH_JACOBIAN_ANGULAR_RATE 3
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Point mass at the origin; 0 dimensions.
+ */
+#define MECH_PRIMITIVE_POINT 0
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Thin rod along z, centred; {length}; density per metre.
+ */
+#define MECH_PRIMITIVE_ROD 1
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Rectangular lamina in the xy plane, centred; {size_x, size_y}; density per m².
+ */
+#define MECH_PRIMITIVE_RECTANGLE_LAMINA 2
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Disc lamina in the xy plane, centred; {radius}; density per m².
+ */
+#define MECH_PRIMITIVE_DISC_LAMINA 3
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Solid sphere, centred; {radius}.
+ */
+#define MECH_PRIMITIVE_SPHERE 4
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Solid ellipsoid, centred; {semi-axis x, semi-axis y, semi-axis z}.
+ */
+#define MECH_PRIMITIVE_ELLIPSOID 5
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Solid box, centred; {size_x, size_y, size_z}.
+ */
+#define MECH_PRIMITIVE_BOX 6
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Solid cylinder along z, centred; {radius, height}.
+ */
+#define MECH_PRIMITIVE_CYLINDER 7
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Solid cone, base centre at the origin, apex at (0, 0, height); {radius, height}.
+ */
+#define MECH_PRIMITIVE_CONE 8
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Solid capsule along z, centred; {radius, cylinder length}.
+ */
+#define MECH_PRIMITIVE_CAPSULE 9
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Solid torus around z, centred; {ring radius, tube radius ≤ ring radius}.
+ */
+#define MECH_PRIMITIVE_TORUS 10
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Solid hemisphere, flat face centred at the origin, dome towards +z; {radius}.
+ */
+#define MECH_PRIMITIVE_HEMISPHERE 11
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * `amount` is the total mass in kg.
+ */
+#define MECH_AMOUNT_MASS 0
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * `amount` is the density: kg/m for rods, kg/m² for laminae and shells, kg/m³ for solids.
+ */
+#define MECH_AMOUNT_DENSITY 1
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The mass, centre or a tensor entry is NaN or infinite.
+ */
+#define MECH_MASS_ISSUE_NON_FINITE 1
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The mass is negative.
+ */
+#define MECH_MASS_ISSUE_NEGATIVE_MASS 2
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The mass is zero but the inertia is not.
+ */
+#define MECH_MASS_ISSUE_ZERO_MASS_WITH_INERTIA 4
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The tensor is not symmetric.
+ */
+#define MECH_MASS_ISSUE_NOT_SYMMETRIC 8
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The tensor has a negative eigenvalue.
+ */
+#define MECH_MASS_ISSUE_NOT_POSITIVE_SEMIDEFINITE 16
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The principal moments violate I₁ + I₂ ≥ I₃.
+ */
+#define MECH_MASS_ISSUE_TRIANGLE_INEQUALITY 32
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Not valid (see the issue flags).
+ */
+#define MECH_INERTIA_INVALID 0
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * A body with extent in three directions (positive definite, strict triangle inequality).
+ */
+#define MECH_INERTIA_SOLID 1
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * All mass in a plane: I₁ + I₂ = I₃ (laminae, flat shells).
+ */
+#define MECH_INERTIA_PLANAR 2
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * All mass on a line: one zero moment (rods). Semidefinite and valid.
+ */
+#define MECH_INERTIA_LINEAR 3
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * A point mass: zero central inertia. Valid.
+ */
+#define MECH_INERTIA_POINT 4
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * A closed surface bounding a solid of uniform volume density.
+ */
+#define MECH_MESH_SOLID 0
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * A thin shell with uniform surface density (kg/m²).
+ */
+#define MECH_MESH_SHELL 1
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Fail with MECH_STATUS_INVALID_ARGUMENT (the message gives the boundary-edge count).
+ */
+#define MECH_OPEN_MESH_REJECT 0
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Fall back to the shell model; a density amount is then read as kg/m².
+ */
+#define MECH_OPEN_MESH_SHELL 1
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Reverse the orientation and report `flipped` = 1.
+ */
+#define MECH_INSIDE_OUT_FLIP 0
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Fail with MECH_STATUS_INVALID_ARGUMENT.
+ */
+#define MECH_INSIDE_OUT_REJECT 1
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Count them in the report and leave them out of the integrals.
+ */
+#define MECH_DEGENERATE_SKIP 0
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Fail with MECH_STATUS_INVALID_ARGUMENT.
+ */
+#define MECH_DEGENERATE_REJECT 1
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Every finite mode, plus the infinite (massless) ones when A is singular.
+ */
+#define MECH_MODAL_SELECTION_ALL 0
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * The `count` finite modes of lowest ω² (unstable modes count as lowest).
+ */
+#define MECH_MODAL_SELECTION_LOWEST 1
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * The finite modes with `lower` ≤ ω² ≤ `upper`.
+ */
+#define MECH_MODAL_SELECTION_INTERVAL 2
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Refine modes whose reduction bound guarantees fewer than 8 digits (stiff problems).
+ */
+#define MECH_MODAL_REFINEMENT_AUTO 0
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Never refine.
+ */
+#define MECH_MODAL_REFINEMENT_OFF 1
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Refine every simple finite mode.
+ */
+#define MECH_MODAL_REFINEMENT_ALWAYS 2
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * λ < 0: oscillates at ω = √(−λ) rad/s.
+ */
+#define MECH_MODAL_KIND_OSCILLATORY 0
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * |λ| within its error bound: rigid-body (zero-frequency) mode.
+ */
+#define MECH_MODAL_KIND_ZERO 1
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * λ > 0: unstable equilibrium, growth rate √λ (1/s).
+ */
+#define MECH_MODAL_KIND_UNSTABLE 2
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Massless direction (A x = 0): infinite frequency.
+ */
+#define MECH_MODAL_KIND_INFINITE 3
 #endif
 
 #ifdef __cplusplus
@@ -329,6 +1533,101 @@ mech_status_t mech_collide_collinear(double m1,
                                      struct mech_collinear_impact_t *out);
 #endif
 
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Applies the impulse `impulse` (N·s) to a point of mass `mass` moving at `velocity`
+ * (5.10–5.15): the momentum jumps by the impulse; the position does not change.
+ *
+ * # Safety
+ * `velocity` and `impulse` must be readable, `out` writable.
+ */
+mech_status_t mech_impulse_on_point(double mass,
+                                    const struct mech_vec3_t *velocity,
+                                    const struct mech_vec3_t *impulse,
+                                    struct mech_point_impulse_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Collides two smooth point masses (spheres) along the unit `normal` pointing from point 1 to
+ * point 2, with restitution λ ∈ [0, 1] (5.16–5.23 on the normal components). Points that do
+ * not approach receive no impulse.
+ *
+ * # Safety
+ * `v1`, `v2` and `normal` must be readable, `out` writable.
+ */
+mech_status_t mech_collide_points(double m1,
+                                  const struct mech_vec3_t *v1,
+                                  double m2,
+                                  const struct mech_vec3_t *v2,
+                                  const struct mech_vec3_t *normal,
+                                  double restitution,
+                                  struct mech_point_impact_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Builds a free ::mech_impulse_body_t from mass properties expressed in the world frame
+ * (centre of mass p_WC, central inertia in W axes) and the velocities just before the impact.
+ * The inverse inertia is the pseudo-inverse (eigenvalues ≤ 1e-12·λ_max count as zero), so
+ * rods and point masses are accepted.
+ *
+ * # Safety
+ * `properties`, `velocity` and `angular_velocity` must be readable, `out` writable.
+ */
+mech_status_t mech_impulse_body_from_mass_properties(const struct mech_mass_properties_t *properties,
+                                                     const struct mech_vec3_t *velocity,
+                                                     const struct mech_vec3_t *angular_velocity,
+                                                     struct mech_impulse_body_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Applies the impulse `impulse` at the world point `point` together with the impulsive moment
+ * `moment_about_point` about that point to `body` (7.61–7.71). For a hinged body the hinge
+ * impulse is included (it does no work).
+ *
+ * # Safety
+ * All pointers must be readable, `out` writable.
+ */
+mech_status_t mech_impulse_apply(const struct mech_impulse_body_t *body,
+                                 const struct mech_vec3_t *impulse,
+                                 const struct mech_vec3_t *point,
+                                 const struct mech_vec3_t *moment_about_point,
+                                 struct mech_body_response_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Brings the body point at `point` to rest by a single impulse at that point (7.100–7.108).
+ * MECH_STATUS_SINGULAR if the point cannot be stopped (e.g. a moving body of infinite mass).
+ *
+ * # Safety
+ * `body` and `point` must be readable, `out` writable.
+ */
+mech_status_t mech_impulse_fix_point(const struct mech_impulse_body_t *body,
+                                     const struct mech_vec3_t *point,
+                                     struct mech_fixation_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Resolves the impact of `body1` and `body2` at `contact` (7.72–7.99): smooth or rough
+ * (isotropic Coulomb, with stick, slip, halting, reversal and 3-D swerving slip) with the
+ * selected restitution law. MECH_STATUS_INVALID_ARGUMENT for a non-unit normal, restitution
+ * outside [0, 1] or negative friction; MECH_STATUS_BAD_ENUM for an unknown law or constraint;
+ * MECH_STATUS_SINGULAR when neither body can move along the normal; MECH_STATUS_NOT_CONVERGED
+ * for a frictional jam.
+ *
+ * # Safety
+ * `body1`, `body2` and `contact` must be readable, `out` writable.
+ */
+mech_status_t mech_impulse_resolve_contact(const struct mech_impulse_body_t *body1,
+                                           const struct mech_impulse_body_t *body2,
+                                           const struct mech_impulse_contact_t *contact,
+                                           struct mech_impact_result_t *out);
+#endif
+
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
  * Converts a rotation matrix (column-major) into a unit quaternion.
@@ -370,6 +1669,321 @@ mech_status_t mech_rotation_matrix_from_quat(const struct mech_quat_t *quaternio
                                              struct mech_mat3_t *rotation_out);
 #endif
 
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation matrix exp([φ]×) of a rotation vector φ (Rodrigues, accurate for all |φ|,
+ * including |φ| → 0).
+ *
+ * # Safety
+ * `rotation_vector` must point to a readable mech_vec3_t and `rotation_out` to a writable mech_mat3_t.
+ */
+mech_status_t mech_rotation_exp(const struct mech_vec3_t *rotation_vector,
+                                struct mech_mat3_t *rotation_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation vector φ (|φ| ≤ π) of a rotation matrix: the logarithm map, accurate near the
+ * identity and near half turns. Fails with MECH_STATUS_INVALID_ARGUMENT for a non-rotation.
+ *
+ * # Safety
+ * `rotation` must point to a readable mech_mat3_t and `rotation_vector_out` to a writable mech_vec3_t.
+ */
+mech_status_t mech_rotation_log(const struct mech_mat3_t *rotation,
+                                struct mech_vec3_t *rotation_vector_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation by `angle` (rad) about the unit vector `axis`. A zero or non-unit axis
+ * (|‖a‖ − 1| > 1e-12) gives MECH_STATUS_INVALID_ARGUMENT.
+ *
+ * # Safety
+ * `axis` must point to a readable mech_vec3_t and `rotation_out` to a writable mech_mat3_t.
+ */
+mech_status_t mech_rotation_from_axis_angle(const struct mech_vec3_t *axis,
+                                            double angle,
+                                            struct mech_mat3_t *rotation_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation nearest (Frobenius norm) to a drifted matrix `matrix`: its orthogonal polar
+ * factor. `correction_out` receives ‖matrix − rotation‖_F. A matrix with det ≤ 0 gives
+ * MECH_STATUS_INVALID_ARGUMENT.
+ *
+ * # Safety
+ * `matrix` must point to a readable mech_mat3_t, `rotation_out` to a writable mech_mat3_t and
+ * `correction_out` to a writable double.
+ */
+mech_status_t mech_rotation_orthonormalize(const struct mech_mat3_t *matrix,
+                                           struct mech_mat3_t *rotation_out,
+                                           double *correction_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation matrix of Euler angles `angles` (3 doubles) in the sequence `sequence`.
+ *
+ * # Safety
+ * `angles` must point to 3 readable doubles and `rotation_out` to a writable mech_mat3_t.
+ */
+mech_status_t mech_rotation_from_euler(mech_euler_sequence_t sequence,
+                                       const double *angles,
+                                       struct mech_mat3_t *rotation_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The Euler angles {a, b, c} (into `angles_out`, 3 doubles) of a rotation in `sequence`.
+ * a, c ∈ (−π, π]; b ∈ [−π/2, π/2] (Tait–Bryan) or [0, π] (proper). `gimbal_lock_out` is set to
+ * 1 when |cos b| (Tait–Bryan) or |sin b| (proper) ≤ 1e-12, where only a ± c is determined (the
+ * returned angles still reproduce the rotation to a few ulps; exactly at the lock c = 0), else
+ * 0; `singularity_distance_out` receives that |cos b| or |sin b|.
+ *
+ * # Safety
+ * `rotation` must point to a readable mech_mat3_t, `angles_out` to 3 writable doubles,
+ * `gimbal_lock_out` to a writable int32_t and `singularity_distance_out` to a writable double.
+ */
+mech_status_t mech_euler_from_rotation(const struct mech_mat3_t *rotation,
+                                       mech_euler_sequence_t sequence,
+                                       double *angles_out,
+                                       int32_t *gimbal_lock_out,
+                                       double *singularity_distance_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The angular velocity ω = E(angles) rates (syllabus 2.7–2.12; EB1911 (13) for ZYZ in the body
+ * frame), in the frame `frame`.
+ *
+ * # Safety
+ * `angles` and `rates` must point to 3 readable doubles each, `omega_out` to a writable mech_vec3_t.
+ */
+mech_status_t mech_angular_velocity_from_euler_rates(mech_euler_sequence_t sequence,
+                                                     const double *angles,
+                                                     const double *rates,
+                                                     mech_frame_t frame,
+                                                     struct mech_vec3_t *omega_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The Euler rates (3 doubles into `rates_out`) that give the angular velocity `omega`
+ * (components in `frame`) at `angles`. At gimbal lock (|cos b| or |sin b| ≤ 1e-12) returns
+ * MECH_STATUS_SINGULAR and writes nothing.
+ *
+ * # Safety
+ * `angles` must point to 3 readable doubles, `omega` to a readable mech_vec3_t and
+ * `rates_out` to 3 writable doubles.
+ */
+mech_status_t mech_euler_rates_from_angular_velocity(mech_euler_sequence_t sequence,
+                                                     const double *angles,
+                                                     const struct mech_vec3_t *omega,
+                                                     mech_frame_t frame,
+                                                     double *rates_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The velocity v = ω × (x − c) + ċ (syllabus 2.13) of the body point at world position `x`.
+ *
+ * # Safety
+ * `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
+ * `velocity_out` to a writable mech_vec3_t.
+ */
+mech_status_t mech_velocity_field(const struct mech_rigid_motion_t *motion,
+                                  const struct mech_vec3_t *x,
+                                  struct mech_vec3_t *velocity_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The acceleration a = ω̇ × (x − c) + ω × (ω × (x − c)) + c̈ (syllabus 2.18) of the body point
+ * at world position `x`.
+ *
+ * # Safety
+ * `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
+ * `acceleration_out` to a writable mech_vec3_t.
+ */
+mech_status_t mech_acceleration_field(const struct mech_rigid_motion_t *motion,
+                                      const struct mech_vec3_t *x,
+                                      struct mech_vec3_t *acceleration_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Decomposes the motion of a point with relative position, velocity and acceleration `xi`,
+ * `xi_dot`, `xi_ddot` (moving-frame components) in the moving frame `frame`.
+ *
+ * # Safety
+ * `frame` must point to a readable mech_rigid_motion_t, `xi`, `xi_dot`, `xi_ddot` to readable
+ * mech_vec3_t values and `decomposition_out` to a writable mech_relative_decomposition_t.
+ */
+mech_status_t mech_relative_motion_decompose(const struct mech_rigid_motion_t *frame,
+                                             const struct mech_vec3_t *xi,
+                                             const struct mech_vec3_t *xi_dot,
+                                             const struct mech_vec3_t *xi_ddot,
+                                             struct mech_relative_decomposition_t *decomposition_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Creates an empty kinematic tree into `*tree_out`. Free it with mech_tree_destroy.
+ *
+ * # Safety
+ * `tree_out` must point to a writable mech_tree_t pointer.
+ */
+mech_status_t mech_tree_create(struct mech_tree_t **tree_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Frees a tree. NULL is accepted and ignored.
+ *
+ * # Safety
+ * `tree` must be NULL or a handle from mech_tree_create not yet destroyed.
+ */
+void mech_tree_destroy(struct mech_tree_t *tree);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Adds a body to a tree that is not finalized yet. `parent` is the parent's body index, or
+ * −1 for the root (attached to the base); it may name a body added later. `joint_type` is a
+ * mech_joint_type_t; `axis` (joint-frame components, unit length) is required for revolute and
+ * prismatic joints and ignored (may be NULL) otherwise. The joint frame sits at rotation
+ * `placement_rotation` (a rotation matrix, column-major) and translation `placement_translation`
+ * in the parent's body frame. The new body's index is written to `body_out`. Structural checks
+ * (one root, no cycles, unit axes) happen in mech_tree_finalize.
+ *
+ * # Safety
+ * `tree` must be a live handle; `axis` NULL or readable; `placement_rotation` and
+ * `placement_translation` readable; `body_out` writable.
+ */
+mech_status_t mech_tree_add_body(struct mech_tree_t *tree,
+                                 int64_t parent,
+                                 mech_joint_type_t joint_type,
+                                 const struct mech_vec3_t *axis,
+                                 const struct mech_mat3_t *placement_rotation,
+                                 const struct mech_vec3_t *placement_translation,
+                                 size_t *body_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Validates the tree (at least one body, exactly one root, parents in range, no cycles) and
+ * makes it ready for queries. Errors are MECH_STATUS_INVALID_ARGUMENT with the offending body
+ * index in mech_last_error. Finalizing twice is an error.
+ *
+ * # Safety
+ * `tree` must be a live handle.
+ */
+mech_status_t mech_tree_finalize(struct mech_tree_t *tree);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The number of bodies and of coordinates (= velocities) of a finalized tree.
+ *
+ * # Safety
+ * `tree` must be a live handle; `body_count_out` and `dof_out` writable.
+ */
+mech_status_t mech_tree_size(struct mech_tree_t *tree,
+                             size_t *body_count_out,
+                             size_t *dof_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Sets the coordinates q and velocities q̇ (each `n` = dof doubles; pass n = 0 and NULL for a
+ * tree without coordinates) and computes all body poses, velocities and Jacobian columns.
+ * Wrong n gives MECH_STATUS_BAD_DIMENSION; NaN/inf MECH_STATUS_NON_FINITE (the state is then
+ * left unset).
+ *
+ * # Safety
+ * `tree` must be a live handle; `q` and `q_dot` must point to `n` readable doubles.
+ */
+mech_status_t mech_tree_set_state(struct mech_tree_t *tree,
+                                  const double *q,
+                                  const double *q_dot,
+                                  size_t n);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Sets the accelerations q̈ (`n` = dof doubles) after mech_tree_set_state and computes body
+ * accelerations.
+ *
+ * # Safety
+ * `tree` must be a live handle; `q_ddot` must point to `n` readable doubles.
+ */
+mech_status_t mech_tree_set_accelerations(struct mech_tree_t *tree,
+                                          const double *q_ddot,
+                                          size_t n);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The pose of `body`: rotation R_WB (column-major) and origin position p_WB (world).
+ *
+ * # Safety
+ * `tree` must be a live handle; `rotation_out` and `position_out` writable.
+ */
+mech_status_t mech_tree_body_pose(struct mech_tree_t *tree,
+                                  size_t body,
+                                  struct mech_mat3_t *rotation_out,
+                                  struct mech_vec3_t *position_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The angular velocity of `body` and the velocity of its point with body coordinates `point`
+ * (world components), from the state of mech_tree_set_state.
+ *
+ * # Safety
+ * `tree` must be a live handle; `point` readable; `omega_out` and `velocity_out` writable.
+ */
+mech_status_t mech_tree_body_velocity(struct mech_tree_t *tree,
+                                      size_t body,
+                                      const struct mech_vec3_t *point,
+                                      struct mech_vec3_t *omega_out,
+                                      struct mech_vec3_t *velocity_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The angular acceleration of `body` and the acceleration of its point with body coordinates
+ * `point` (world), after mech_tree_set_accelerations.
+ *
+ * # Safety
+ * `tree` must be a live handle; `point` readable; both outputs writable.
+ */
+mech_status_t mech_tree_body_acceleration(struct mech_tree_t *tree,
+                                          size_t body,
+                                          const struct mech_vec3_t *point,
+                                          struct mech_vec3_t *omega_dot_out,
+                                          struct mech_vec3_t *acceleration_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * A 3×dof Jacobian of `body` (kind: a mech_jacobian_kind_t) into the caller's column-major
+ * buffer `out` of `capacity` doubles (≥ 3·dof, else MECH_STATUS_BUFFER_TOO_SMALL; exactly
+ * 3·dof are written). Column k belongs to coordinate k; world components. `point` (body
+ * coordinates) is used by the point kinds and ignored (may be NULL) by the angular kinds.
+ *
+ * # Safety
+ * `tree` must be a live handle; `point` NULL or readable; `out` must hold `capacity` writable doubles.
+ */
+mech_status_t mech_tree_jacobian(struct mech_tree_t *tree,
+                                 size_t body,
+                                 mech_jacobian_kind_t kind,
+                                 const struct mech_vec3_t *point,
+                                 double *out,
+                                 size_t capacity);
+#endif
+
 #if defined(MECH_FEATURE_MASS)
 /**
  * The mass properties of a point mass `mass` at `position` (zero central inertia).
@@ -395,6 +2009,203 @@ mech_status_t mech_mass_inertia_about(const struct mech_mass_properties_t *prope
                                       struct mech_mat3_t *inertia_out);
 #endif
 
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The closed-form mass properties of a primitive body `kind` (a mech_primitive_t) with
+ * `dimension_count` dimensions at `dimensions` (as listed for each MECH_PRIMITIVE_* value),
+ * and `amount` read as a mass or a density according to `amount_kind` (a mech_amount_t).
+ * Rods, laminae and points have semidefinite inertia, which is valid.
+ *
+ * Errors: BAD_ENUM for unknown `kind` or `amount_kind`, BAD_DIMENSION when
+ * `dimension_count` is not the count of `kind`, NON_FINITE, INVALID_ARGUMENT for a
+ * non-positive dimension, mass or density, or a torus tube radius above its ring radius.
+ *
+ * # Safety
+ * `dimensions` must point to `dimension_count` readable doubles (it may be NULL when the count
+ * is 0) and `out` to a writable mech_mass_properties_t.
+ */
+mech_status_t mech_mass_primitive(mech_primitive_t kind,
+                                  const double *dimensions,
+                                  size_t dimension_count,
+                                  mech_amount_t amount_kind,
+                                  double amount,
+                                  struct mech_mass_properties_t *out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The same body after the rigid motion x ↦ R x + t with R from the unit quaternion
+ * `rotation` (|‖q‖ − 1| ≤ 1e-12) and t = `translation`: the centre moves, the tensor becomes
+ * R J Rᵀ. Equivalently, re-expresses properties given in a body frame B in the frame F in
+ * which B has this pose.
+ *
+ * # Safety
+ * All pointers must be readable (inputs) or writable (`out`).
+ */
+mech_status_t mech_mass_transform(const struct mech_mass_properties_t *properties,
+                                  const struct mech_quat_t *rotation,
+                                  const struct mech_vec3_t *translation,
+                                  struct mech_mass_properties_t *out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The mass properties of the union of `count` ≥ 1 bodies: body i is `parts[i]` moved by the
+ * rigid motion (`rotations[i]`, `translations[i]`) as in mech_mass_transform. Pass NULL for
+ * both `rotations` and `translations` when the parts are already in one frame (passing only one
+ * of them NULL is an error). Steiner's theorem (3.27–3.29) sums the tensors about the common
+ * centre.
+ *
+ * # Safety
+ * `parts` (and, when non-NULL, `rotations` and `translations`) must point to `count` readable
+ * values and `out` to a writable mech_mass_properties_t.
+ */
+mech_status_t mech_mass_combine(const struct mech_mass_properties_t *parts,
+                                const struct mech_quat_t *rotations,
+                                const struct mech_vec3_t *translations,
+                                size_t count,
+                                struct mech_mass_properties_t *out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The body `body` with the material `hole` (same frame) removed. Fails with
+ * INVALID_ARGUMENT when the hole is at least as heavy as the body, and with
+ * NOT_POSITIVE_DEFINITE or INVALID_ARGUMENT when the remainder is not a valid body (a hole
+ * that does not fit inside).
+ *
+ * # Safety
+ * `body` and `hole` must be readable and `out` writable.
+ */
+mech_status_t mech_mass_subtract(const struct mech_mass_properties_t *body,
+                                 const struct mech_mass_properties_t *hole,
+                                 struct mech_mass_properties_t *out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The moment of inertia (e, J_A e) about the line through `point` with direction `direction`
+ * (any non-zero length; normalised internally), syllabus 3.22–3.23 and 3.30.
+ *
+ * # Safety
+ * The inputs must be readable and `moment_out` writable.
+ */
+mech_status_t mech_mass_moment_about_line(const struct mech_mass_properties_t *properties,
+                                          const struct mech_vec3_t *point,
+                                          const struct mech_vec3_t *direction,
+                                          double *moment_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Principal moments I₁ ≤ I₂ ≤ I₃ of the central tensor (3.20–3.21) and the principal axes as
+ * the columns of a right-handed rotation matrix R (column-major) with J = R diag(I) Rᵀ.
+ * Repeated moments (relative gap ≤ 1e-10) give a canonical frame: the identity for three equal
+ * moments; the exact symmetry axis and the coordinate axis least aligned with it for two.
+ *
+ * # Safety
+ * `properties` must be readable and `moments_out`, `axes_out` writable.
+ */
+mech_status_t mech_mass_principal_axes(const struct mech_mass_properties_t *properties,
+                                       struct mech_vec3_t *moments_out,
+                                       struct mech_mat3_t *axes_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Checks whether `properties` could belong to a real body, and reports every problem found
+ * as flags (the call itself succeeds whether or not they are valid). `relative_tolerance`
+ * (≥ 0; 0 selects the default 1e-9) is relative to the trace of the tensor and decides
+ * symmetry, semidefiniteness, the triangle inequality and the class (rods and laminae have
+ * exact equalities, which the tolerance accepts).
+ *
+ * # Safety
+ * `properties` must be readable and `validity_out` writable.
+ */
+mech_status_t mech_mass_check(const struct mech_mass_properties_t *properties,
+                              double relative_tolerance,
+                              struct mech_mass_validity_t *validity_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Repairs the tensor of `properties` when mech_mass_check finds it invalid: symmetrises it,
+ * clamps its principal second moments σ_k = (I_i + I_j − I_k)/2 to ≥ 0 and rebuilds
+ * I_k = σ_i + σ_j (which restores semidefiniteness and the triangle inequality). Valid input is
+ * copied unchanged. `relative_change_out` (may be NULL) receives ‖ΔJ‖_F/‖J‖_F. A non-finite
+ * value or a negative mass cannot be repaired (INVALID_ARGUMENT / NON_FINITE).
+ *
+ * # Safety
+ * `properties` must be readable, `out` writable, `relative_change_out` NULL or writable.
+ */
+mech_status_t mech_mass_repair(const struct mech_mass_properties_t *properties,
+                               double relative_tolerance,
+                               struct mech_mass_properties_t *out,
+                               double *relative_change_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The angular momentum D_A = J₀ ω + (x₀ − a) × m v₀ (syllabus 3.5–3.7) about the point `point`
+ * (fixed or moving; only its position enters) of a body whose properties are given in the
+ * inertial frame at this instant, moving with centre velocity `com_velocity` and angular
+ * velocity `omega` (both in that frame).
+ *
+ * # Safety
+ * The inputs must be readable and `angular_momentum_out` writable.
+ */
+mech_status_t mech_mass_angular_momentum(const struct mech_mass_properties_t *properties,
+                                         const struct mech_vec3_t *point,
+                                         const struct mech_vec3_t *com_velocity,
+                                         const struct mech_vec3_t *omega,
+                                         struct mech_vec3_t *angular_momentum_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The kinetic energy T = ½ m v₀·v₀ + ½ ω·J₀ ω (syllabus 3.37) and the momentum p = m v₀ (3.4)
+ * of a body moving with centre velocity `com_velocity` and angular velocity `omega` (in the
+ * frame of the properties). `momentum_out` may be NULL.
+ *
+ * # Safety
+ * The inputs must be readable, `energy_out` writable, `momentum_out` NULL or writable.
+ */
+mech_status_t mech_mass_kinetic_energy(const struct mech_mass_properties_t *properties,
+                                       const struct mech_vec3_t *com_velocity,
+                                       const struct mech_vec3_t *omega,
+                                       double *energy_out,
+                                       struct mech_vec3_t *momentum_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Mass properties of the triangle mesh with `vertex_count` vertices (x, y, z interleaved:
+ * 3·vertex_count doubles, metres) and `triangle_count` triangles (3·triangle_count vertex
+ * indices, counter-clockwise seen from outside), with `amount` read as a mass or a density per
+ * `amount_kind`. Closed solids use exact polynomial volume integrals relative to a point near
+ * the mesh, so far-from-origin meshes keep full accuracy. `options` may be NULL for the
+ * defaults; `report_out` may be NULL.
+ *
+ * Errors: NULL_POINTER, BAD_DIMENSION (0 triangles, sizes overflowing), BAD_ENUM,
+ * NON_FINITE (a vertex; the message names it), INVALID_ARGUMENT (index out of range, open,
+ * misoriented, inside-out or degenerate meshes under rejecting policies, zero volume,
+ * non-positive density or mass; the message says which and how many).
+ *
+ * # Safety
+ * `vertices` must point to 3·vertex_count readable doubles, `indices` to 3·triangle_count
+ * readable uint32_t, `options` NULL or readable, `out` writable, `report_out` NULL or writable.
+ */
+mech_status_t mech_mass_mesh(const double *vertices,
+                             size_t vertex_count,
+                             const uint32_t *indices,
+                             size_t triangle_count,
+                             mech_amount_t amount_kind,
+                             double amount,
+                             const struct mech_mesh_options_t *options,
+                             struct mech_mass_properties_t *out,
+                             struct mech_mesh_report_t *report_out);
+#endif
+
 #if defined(MECH_FEATURE_MODAL)
 /**
  * Checks that the n×n column-major matrices `a` (mass) and `b` (stiffness) form a valid
@@ -406,6 +2217,113 @@ mech_status_t mech_mass_inertia_about(const struct mech_mass_properties_t *prope
 mech_status_t mech_modal_check_pencil(size_t n,
                                       const double *a,
                                       const double *b);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Solves det(λA + B) = 0 (8.89) for the n×n column-major mass matrix `a` (symmetric positive
+ * semidefinite) and stiffness matrix `b` (symmetric), with the given options, and stores a new
+ * result handle in `*out`. Errors: MECH_STATUS_NOT_POSITIVE_DEFINITE when A is indefinite,
+ * MECH_STATUS_SINGULAR when det(λA + B) ≡ 0, MECH_STATUS_INVALID_ARGUMENT for an asymmetric
+ * matrix, a bad interval, `vectors` not 0/1 or more modes than exist.
+ *
+ * # Safety
+ * `a` and `b` must each point to n·n readable doubles; `options` to a readable
+ * mech_modal_options_t; `out` to a writable pointer.
+ */
+mech_status_t mech_modal_solve(size_t n,
+                               const double *a,
+                               const double *b,
+                               const struct mech_modal_options_t *options,
+                               struct mech_modal_result_t **out);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Frees a result of mech_modal_solve. NULL is accepted and ignored.
+ *
+ * # Safety
+ * `result` must be NULL or a handle from mech_modal_solve not yet destroyed.
+ */
+void mech_modal_result_destroy(struct mech_modal_result_t *result);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Stores the number of modes in `*modes` and the order n of the pencil in `*dim`.
+ *
+ * # Safety
+ * `result` must be a live handle; `modes` and `dim` writable.
+ */
+mech_status_t mech_modal_result_size(const struct mech_modal_result_t *result,
+                                     size_t *modes,
+                                     size_t *dim);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies λ_k (= −ω²_k) of every mode, ascending in ω², into `lambda` (capacity ≥ number of
+ * modes, else MECH_STATUS_BUFFER_TOO_SMALL and nothing written).
+ *
+ * # Safety
+ * `result` must be a live handle; `lambda` must have `capacity` writable doubles.
+ */
+mech_status_t mech_modal_result_eigenvalues(const struct mech_modal_result_t *result,
+                                            double *lambda,
+                                            size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies the scalar data of every mode into `modes` (capacity ≥ number of modes).
+ *
+ * # Safety
+ * `result` must be a live handle; `modes` must have `capacity` writable elements.
+ */
+mech_status_t mech_modal_result_modes(const struct mech_modal_result_t *result,
+                                      struct mech_modal_mode_t *modes,
+                                      size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies the mode shapes as an n × (number of modes) column-major matrix into `x`
+ * (capacity ≥ n·modes). Finite modes are A-orthonormal; infinite ones are unit null vectors
+ * of A. MECH_STATUS_INVALID_ARGUMENT if the solve was values only.
+ *
+ * # Safety
+ * `result` must be a live handle; `x` must have `capacity` writable doubles.
+ */
+mech_status_t mech_modal_result_vectors(const struct mech_modal_result_t *result,
+                                        double *x,
+                                        size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies the accuracy summary of the solve into `*accuracy`.
+ *
+ * # Safety
+ * `result` must be a live handle; `accuracy` writable.
+ */
+mech_status_t mech_modal_result_accuracy(const struct mech_modal_result_t *result,
+                                         struct mech_modal_accuracy_t *accuracy);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Stores in `*below` the number of modes with ω² < `shift`, certified by the inertia of an
+ * LBLᵀ factorization of B − shift·A (Sylvester's law; A must be positive definite for the
+ * count to equal the number of modes).
+ *
+ * # Safety
+ * `a` and `b` must each point to n·n readable doubles; `below` writable.
+ */
+mech_status_t mech_modal_count_below(size_t n,
+                                     const double *a,
+                                     const double *b,
+                                     double shift,
+                                     size_t *below);
 #endif
 
 #ifdef __cplusplus

@@ -1,8 +1,98 @@
-//! Criterion benchmarks: modal.
+//! Criterion benchmarks: the dense symmetric-definite solver of det(λA + B) = 0.
+//!
+//! Problem: a fixed–fixed spring chain with masses 1..2, rotated by a random orthogonal Q
+//! (dense A and B with a known spectrum), at n = 200 and 1000.
+//!
+//! Series, all in the same run:
+//! - `mechanica_all_pairs`: `solve` with all pairs, the full accuracy report and Sturm check;
+//! - `mechanica_values_only`: `solve` without vectors (a-priori bounds and Sturm check);
+//! - `faer_reduction_sygst` vs `faer_reduction_two_solves`: the symmetric (sygst-like)
+//!   reduction C = L⁻¹BL⁻ᵀ against two full triangular solves, both after the same Cholesky;
+//! - `faer_evd_of_c`: faer's self-adjoint eigensolver on the reduced C alone;
+//! - `nalgebra_all_pairs`: the peer pipeline in nalgebra (Cholesky, L⁻¹BL⁻ᵀ by two triangular
+//!   solves, SymmetricEigen, back-transform).
+//!
+//! LAPACK `dsygvd` (SciPy eigh) is timed by tools/modal_scipy_bench.py on the same family; its
+//! numbers are committed in tools/modal_scipy_bench.out.
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use mechanica::kinematics::nalgebra::{DMatrix, SymmetricEigen};
+use mechanica::modal::faer::{Mat, Par};
+use mechanica::modal::reduce::{cholesky_and_reduce, reduce_two_solves};
+use mechanica::modal::{PencilProblem, SolveOptions, families, solve};
+use std::hint::black_box;
 
-fn placeholder(_c: &mut Criterion) {}
+const SIZES: [usize; 2] = [200, 1000];
 
-criterion_group!(benches, placeholder);
+/// The benchmark pencil of order n.
+fn pencil(n: usize) -> (Mat<f64>, Mat<f64>) {
+    let a = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 / n as f64 } else { 0.0 });
+    let (_, b) = families::fixed_chain(n);
+    families::rotate(&a, &b, &families::random_orthogonal(n, 42))
+}
+
+fn to_nalgebra(m: &Mat<f64>) -> DMatrix<f64> {
+    DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)])
+}
+
+/// The nalgebra peer: all pairs of the definite pencil.
+fn nalgebra_all_pairs(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Option<(f64, f64)> {
+    let chol = a.clone().cholesky()?;
+    let l = chol.l();
+    let lb = l.solve_lower_triangular(b)?;
+    let c = l.solve_lower_triangular(&lb.transpose())?;
+    let eig = SymmetricEigen::new(c);
+    let x = l.transpose().solve_upper_triangular(&eig.eigenvectors)?;
+    Some((eig.eigenvalues[0], x[(0, 0)]))
+}
+
+fn dense(c: &mut Criterion) {
+    let mut group = c.benchmark_group("modal_dense");
+    group.sample_size(10);
+    let par = mechanica::modal::faer::get_global_parallelism();
+    for n in SIZES {
+        let (a, b) = pencil(n);
+        let problem = match PencilProblem::new(a.as_ref(), b.as_ref()) {
+            Ok(p) => p,
+            Err(e) => panic!("benchmark pencil is valid: {e}"),
+        };
+        group.bench_with_input(BenchmarkId::new("mechanica_all_pairs", n), &problem, |bch, p| {
+            bch.iter(|| solve(black_box(p), &SolveOptions::default()).map(|s| s.modes[0].omega_sq))
+        });
+        let values_only = SolveOptions {
+            vectors: false,
+            ..SolveOptions::default()
+        };
+        group.bench_with_input(BenchmarkId::new("mechanica_values_only", n), &problem, |bch, p| {
+            bch.iter(|| solve(black_box(p), &values_only).map(|s| s.modes[0].omega_sq))
+        });
+        let Some((l, reduced)) = cholesky_and_reduce(a.as_ref(), b.as_ref(), par) else {
+            panic!("benchmark mass matrix is positive definite")
+        };
+        group.bench_with_input(BenchmarkId::new("faer_reduction_sygst", n), &(), |bch, _| {
+            bch.iter(|| cholesky_and_reduce(black_box(a.as_ref()), b.as_ref(), par).map(|(_, c)| c[(0, 0)]))
+        });
+        group.bench_with_input(BenchmarkId::new("faer_reduction_two_solves", n), &(), |bch, _| {
+            bch.iter(|| {
+                a.as_ref()
+                    .llt(mechanica::modal::faer::Side::Lower)
+                    .map(|llt| reduce_two_solves(llt.L(), black_box(b.as_ref()), par)[(0, 0)])
+            })
+        });
+        group.bench_with_input(BenchmarkId::new("faer_evd_of_c", n), &reduced, |bch, cm| {
+            bch.iter(|| {
+                cm.self_adjoint_eigen(mechanica::modal::faer::Side::Lower)
+                    .map(|e| e.S()[0])
+            })
+        });
+        let (na, nb) = (to_nalgebra(&a), to_nalgebra(&b));
+        group.bench_with_input(BenchmarkId::new("nalgebra_all_pairs", n), &(), |bch, _| {
+            bch.iter(|| nalgebra_all_pairs(black_box(&na), &nb))
+        });
+        let _ = (&l, Par::Seq);
+    }
+    group.finish();
+}
+
+criterion_group!(benches, dense);
 criterion_main!(benches);

@@ -37,7 +37,12 @@ pub struct Series {
 /// Plots error against run time on log-log axes to `target/reports/<name>.svg`.
 pub fn plot_error_vs_time(name: &str, title: &str, series: &[Series]) -> Result<PathBuf, Box<dyn std::error::Error>> {
     let path = reports_dir()?.join(format!("{name}.svg"));
-    let points = || series.iter().flat_map(|s| s.points.iter().copied()).filter(|&(t, e)| t > 0.0 && e > 0.0);
+    let points = || {
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().copied())
+            .filter(|&(t, e)| t > 0.0 && e > 0.0)
+    };
     let (t_min, t_max) = points().fold((f64::MAX, f64::MIN), |(lo, hi), (t, _)| (lo.min(t), hi.max(t)));
     let (e_min, e_max) = points().fold((f64::MAX, f64::MIN), |(lo, hi), (_, e)| (lo.min(e), hi.max(e)));
     if t_min > t_max || e_min > e_max {
@@ -61,7 +66,10 @@ fn draw_log_log(
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(70)
-        .build_cartesian_2d((t_min * 0.8..t_max * 1.25).log_scale(), (e_min * 0.5..e_max * 2.0).log_scale())?;
+        .build_cartesian_2d(
+            (t_min * 0.8..t_max * 1.25).log_scale(),
+            (e_min * 0.5..e_max * 2.0).log_scale(),
+        )?;
     chart.configure_mesh().x_desc("run time [s]").y_desc("error").draw()?;
     for (i, s) in series.iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();
@@ -72,7 +80,11 @@ fn draw_log_log(
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
         chart.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
     }
-    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
     root.present()?;
     Ok(())
 }

@@ -15,12 +15,17 @@ static BUILD_LOCK: Mutex<()> = Mutex::new(());
 
 /// The workspace root (the parent of `ffi-tests/`).
 pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().map(Path::to_path_buf).unwrap_or_default()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default()
 }
 
 /// The cargo target directory in use (honours `CARGO_TARGET_DIR`).
 pub fn target_dir() -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| workspace_root().join("target"))
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace_root().join("target"))
 }
 
 /// A built copy of the library: a directory holding `libmechanica.a` and `libmechanica.so`.
@@ -41,26 +46,57 @@ impl BuiltLibrary {
     }
 }
 
-/// Builds the library with `cargo build -p mechanica --lib` and the given feature arguments,
-/// then copies the static and shared libraries into `target/ffi-tests/<label>/` so that
-/// later builds with other features cannot change them under a running test.
-pub fn build_library(label: &str, feature_args: &[&str]) -> Result<BuiltLibrary, String> {
+/// Which build directory a library build uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BuildDir {
+    /// `target/debug`, shared with `cargo test` (fast: the test build already compiled it).
+    Default,
+    /// `target/<host triple>/debug`, for builds with other features. Cargo names a cdylib
+    /// without a feature hash, so a subset build in the default directory would overwrite the
+    /// full library; the host-triple directory keeps them apart (cargo-c uses it too).
+    HostTriple,
+}
+
+/// The host target triple, from `rustc -vV`.
+fn host_triple() -> Result<String, String> {
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let output = Command::new(rustc)
+        .arg("-vV")
+        .output()
+        .map_err(|e| format!("could not run rustc: {e}"))?;
+    String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .find_map(|line| line.strip_prefix("host: ").map(str::to_string))
+        .ok_or_else(|| "rustc -vV printed no host triple".to_string())
+}
+
+/// Builds the library with `cargo build -p mechanica --lib` and the given feature arguments
+/// in `dir`, then copies the static and shared libraries into `target/ffi-tests/<label>/`, so
+/// that later builds cannot change them under a running test.
+pub fn build_library(label: &str, feature_args: &[&str], dir: BuildDir) -> Result<BuiltLibrary, String> {
     let _guard = BUILD_LOCK.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let output = Command::new(cargo)
+    let mut command = Command::new(cargo);
+    command
         .current_dir(workspace_root())
         .args(["build", "-p", "mechanica", "--lib"])
-        .args(feature_args)
-        .output()
-        .map_err(|e| format!("could not start cargo: {e}"))?;
+        .args(feature_args);
+    let built = match dir {
+        BuildDir::Default => target_dir().join("debug"),
+        BuildDir::HostTriple => {
+            let triple = host_triple()?;
+            command.args(["--target", &triple]);
+            target_dir().join(triple).join("debug")
+        }
+    };
+    let output = command.output().map_err(|e| format!("could not start cargo: {e}"))?;
     check_success("cargo build -p mechanica", &output)?;
-    let built = target_dir().join("debug");
-    let dir = target_dir().join("ffi-tests").join(label);
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let copy_dir = target_dir().join("ffi-tests").join(label);
+    std::fs::create_dir_all(&copy_dir).map_err(|e| format!("{}: {e}", copy_dir.display()))?;
     for file in ["libmechanica.a", "libmechanica.so"] {
-        std::fs::copy(built.join(file), dir.join(file)).map_err(|e| format!("copy {file}: {e}"))?;
+        std::fs::copy(built.join(file), copy_dir.join(file)).map_err(|e| format!("copy {file}: {e}"))?;
     }
-    Ok(BuiltLibrary { dir })
+    Ok(BuiltLibrary { dir: copy_dir })
 }
 
 /// How a test program links the library.
@@ -144,6 +180,8 @@ pub fn compile(
         LinkKind::Shared => {
             cmd.arg(format!("-L{}", library.dir.display()))
                 .arg("-lmechanica")
+                // DT_RPATH (not RUNPATH), so that no LD_LIBRARY_PATH can substitute another build.
+                .arg("-Wl,--disable-new-dtags")
                 .arg(format!("-Wl,-rpath,{}", library.dir.display()))
                 .arg("-lm");
         }
@@ -154,7 +192,10 @@ pub fn compile(
 
 /// Runs a compiled test program with leak detection and UBSan stack traces on.
 pub fn run(exe: &Path) -> Result<String, String> {
+    // cargo test puts target/debug on LD_LIBRARY_PATH; the program must load the library it
+    // was linked against (see `compile`), not whatever cargo built last.
     let output = Command::new(exe)
+        .env_remove("LD_LIBRARY_PATH")
         .env("ASAN_OPTIONS", "detect_leaks=1:halt_on_error=1")
         .env("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1")
         .output()
@@ -197,7 +238,10 @@ pub fn declared_functions(header: &str) -> Vec<String> {
         }
         for (start, _) in trimmed.match_indices("mech_") {
             let rest = &trimmed[start..];
-            let name: String = rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
             if rest[name.len()..].starts_with('(') && !names.contains(&name) {
                 names.push(name);
             }

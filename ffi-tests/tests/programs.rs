@@ -16,10 +16,13 @@ fn compile_and_run(source: &Path, library: &BuiltLibrary, link: LinkKind, define
 
 #[test]
 fn every_c_and_cpp_program_passes_with_static_and_shared_library() {
-    let library = build_library("full", &[]).unwrap_or_else(|e| panic!("{e}"));
+    let library = build_library("full", &[], BuildDir::Default).unwrap_or_else(|e| panic!("{e}"));
     let mut sources = sources_in("c");
     sources.extend(sources_in("cpp"));
-    assert!(sources.len() >= 2, "expected C and C++ test programs, found {sources:?}");
+    assert!(
+        sources.len() >= 2,
+        "expected C and C++ test programs, found {sources:?}"
+    );
     let mut failures = Vec::new();
     for source in &sources {
         for link in [LinkKind::Static, LinkKind::Shared] {
@@ -29,13 +32,22 @@ fn every_c_and_cpp_program_passes_with_static_and_shared_library() {
             }
         }
     }
-    assert!(failures.is_empty(), "{} ffi-test run(s) failed:\n{}", failures.len(), failures.join("\n\n"));
+    assert!(
+        failures.is_empty(),
+        "{} ffi-test run(s) failed:\n{}",
+        failures.len(),
+        failures.join("\n\n")
+    );
 }
 
 #[test]
 fn a_modal_only_build_links_and_leaves_out_the_other_declarations() {
-    let library = build_library("modal-only", &["--no-default-features", "--features", "modal"])
-        .unwrap_or_else(|e| panic!("{e}"));
+    let library = build_library(
+        "modal-only",
+        &["--no-default-features", "--features", "modal"],
+        BuildDir::HostTriple,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     let subset_defines = ["-DMECH_FEATURES_EXPLICIT", "-DMECH_FEATURE_MODAL"];
     let subset = workspace_root().join("ffi-tests/subset");
 
@@ -46,8 +58,15 @@ fn a_modal_only_build_links_and_leaves_out_the_other_declarations() {
         .output()
         .unwrap_or_else(|e| panic!("could not run nm: {e}"));
     let symbols = String::from_utf8_lossy(&nm.stdout);
-    assert!(symbols.contains("mech_modal_check_pencil"), "modal symbols missing:\n{symbols}");
-    for absent in ["mech_quat_from_rotation_matrix", "mech_mass_point", "mech_collide_collinear"] {
+    assert!(
+        symbols.contains("mech_modal_check_pencil"),
+        "modal symbols missing:\n{symbols}"
+    );
+    for absent in [
+        "mech_quat_from_rotation_matrix",
+        "mech_mass_point",
+        "mech_collide_collinear",
+    ] {
         assert!(!symbols.contains(absent), "{absent} is exported by a modal-only build");
     }
 
@@ -59,13 +78,19 @@ fn a_modal_only_build_links_and_leaves_out_the_other_declarations() {
 
     // A program that calls a kinematics function does not compile: the declaration is guarded out.
     let exe = library.dir.join("uses_kinematics");
-    let result = compile(&subset.join("uses_kinematics.c"), &exe, &library, LinkKind::Static, &subset_defines);
+    let result = compile(
+        &subset.join("uses_kinematics.c"),
+        &exe,
+        &library,
+        LinkKind::Static,
+        &subset_defines,
+    );
     match result {
         Err(message) => assert!(message.contains("mech_quat"), "failed for another reason:\n{message}"),
         Ok(()) => panic!("uses_kinematics.c compiled although MECH_FEATURE_KINEMATICS is not defined"),
     }
     // ...and the same program compiles when the feature macro is defined (so the failure above
     // is due to the guard, not to a broken test program).
-    let full = build_library("full-for-subset", &[]).unwrap_or_else(|e| panic!("{e}"));
+    let full = build_library("full-for-subset", &[], BuildDir::Default).unwrap_or_else(|e| panic!("{e}"));
     compile_and_run(&subset.join("uses_kinematics.c"), &full, LinkKind::Static, &[]).unwrap_or_else(|e| panic!("{e}"));
 }

@@ -3,6 +3,8 @@
 
 mod default_scene;
 mod report;
+mod scene;
+mod scene_run;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -20,16 +22,23 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Run the built-in default scene and print its report (also what a bare `mechanica` does).
-    Run,
+    /// Run a scene file (TOML; see the format in the README), or the built-in default scene
+    /// when no file is given (also what a bare `mechanica` does).
+    Run {
+        /// The scene file.
+        scene: Option<std::path::PathBuf>,
+    },
     /// Print the library version, the C ABI version and the compiled-in features.
     Version,
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let report = match cli.command.unwrap_or(Command::Run) {
-        Command::Run => default_scene::run(),
+    let report = match cli.command.unwrap_or(Command::Run { scene: None }) {
+        Command::Run { scene: None } => default_scene::run(),
+        Command::Run { scene: Some(path) } => scene::Scene::load(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|scene| scene_run::run(&scene, &path)),
         Command::Version => report::version_report(),
     };
     match report {

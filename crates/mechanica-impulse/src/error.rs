@@ -21,7 +21,110 @@ pub enum ImpulseError {
         /// The offending value.
         value: f64,
     },
+    /// An inverse mass that must be ≥ 0 was negative.
+    #[error("{what} must be non-negative (0 means infinite mass), got {value}")]
+    NegativeInverseMass {
+        /// Which inverse mass.
+        what: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// An inertia tensor (or its inverse) was not symmetric positive semidefinite.
+    #[error("{what} is not symmetric positive semidefinite: {detail} = {value}")]
+    InvalidInertia {
+        /// Which tensor.
+        what: &'static str,
+        /// Which test failed ("asymmetry" or "smallest eigenvalue").
+        detail: &'static str,
+        /// The measured asymmetry or eigenvalue.
+        value: f64,
+    },
     /// The coefficient of restitution is outside [0, 1].
     #[error("restitution coefficient must lie in [0, 1], got {0}")]
     RestitutionOutOfRange(f64),
+    /// The coefficient of friction is negative (NaN is reported as NonFinite; +∞ is allowed).
+    #[error("friction coefficient must be ≥ 0 (or +inf), got {0}")]
+    NegativeFriction(f64),
+    /// A direction that must be a unit vector (contact normal, hinge axis) is not.
+    #[error("{what} must be a unit vector, but its length is {norm}")]
+    NotUnit {
+        /// Which vector.
+        what: &'static str,
+        /// Its Euclidean length.
+        norm: f64,
+    },
+    /// An impulse would excite a rotation about an axis with zero moment of inertia (a rod's
+    /// own axis, any axis of a point mass): the contact point is off that axis.
+    #[error(
+        "{what}: the impulsive moment excites the zero-inertia axis ({}, {}, {}) (moment component {moment})",
+        axis[0], axis[1], axis[2]
+    )]
+    ZeroInertiaAxisExcited {
+        /// Which body or call.
+        what: &'static str,
+        /// The unit axis with zero moment of inertia, world frame.
+        axis: [f64; 3],
+        /// The component of the (unit-impulse) moment along that axis.
+        moment: f64,
+    },
+    /// The pre-impact velocity violates a hinge constraint of the body.
+    #[error("{what}: the velocity violates the hinge constraint by {residual} m/s (tolerance {tolerance})")]
+    ConstraintViolated {
+        /// Which body.
+        what: &'static str,
+        /// The norm of the constraint velocity C·(v, ω).
+        residual: f64,
+        /// The accepted tolerance.
+        tolerance: f64,
+    },
+    /// The problem has no solution at this input: e.g. both bodies are immovable along the
+    /// contact normal while approaching, or a fixation is asked of an immovable point.
+    #[error("{what}: singular ({value})")]
+    Singular {
+        /// What could not be solved.
+        what: &'static str,
+        /// The measured quantity (pivot, residual) that shows it.
+        value: f64,
+    },
+    /// The impact process did not terminate: the normal velocity stops increasing with the
+    /// normal impulse (frictional jam, Painlevé-type), or the step budget ran out.
+    #[error("impact process did not terminate: {reason} (after {steps} steps, normal impulse {normal_impulse})")]
+    NotConverged {
+        /// Why it stopped.
+        reason: &'static str,
+        /// Integration steps and segments taken.
+        steps: usize,
+        /// Normal impulse accumulated when it stopped (N·s).
+        normal_impulse: f64,
+    },
+    /// A matrix or vector argument had the wrong size.
+    #[error("{what} has the wrong size: expected {expected}, got {got}")]
+    DimensionMismatch {
+        /// Which argument.
+        what: &'static str,
+        /// Expected number of entries (or rows, as the message says).
+        expected: usize,
+        /// Actual number.
+        got: usize,
+    },
+}
+
+/// Fails with [`ImpulseError::NonFinite`] if `value` is NaN or ±∞.
+pub(crate) fn check_finite(what: &'static str, value: f64) -> Result<(), ImpulseError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(ImpulseError::NonFinite { what, value })
+    }
+}
+
+/// Fails with [`ImpulseError::NonFinite`] if any entry of `values` is NaN or ±∞.
+pub(crate) fn check_all_finite<'a>(
+    what: &'static str,
+    values: impl IntoIterator<Item = &'a f64>,
+) -> Result<(), ImpulseError> {
+    for &value in values {
+        check_finite(what, value)?;
+    }
+    Ok(())
 }

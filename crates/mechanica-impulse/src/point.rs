@@ -1,6 +1,77 @@
-//! Collinear collision of two point masses (5.16–5.23).
+//! Point masses: an impulse on a point (5.10–5.15, 7.106) and collisions of two points,
+//! collinear (5.16–5.23) and in 3-D along a contact normal.
 
 use crate::ImpulseError;
+use crate::body::unit_vector;
+use crate::error::{check_all_finite, check_finite};
+use nalgebra::Vector3;
+
+/// The response of a point mass to an impulse.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointImpulse {
+    /// Velocity just after, V = v + S/m (5.13), m/s.
+    pub v_after: Vector3<f64>,
+    /// ΔT = ½ S·(V + v) (7.106), J.
+    pub energy_change: f64,
+}
+
+/// Applies the impulse `s` to a point of mass `mass` moving at `v`: the momentum jumps by S
+/// (5.13) while the position is continuous (5.15).
+pub fn impulse_on_point(mass: f64, v: &Vector3<f64>, s: &Vector3<f64>) -> Result<PointImpulse, ImpulseError> {
+    check_finite("mass", mass)?;
+    if mass <= 0.0 {
+        return Err(ImpulseError::NonPositiveMass {
+            what: "mass",
+            value: mass,
+        });
+    }
+    check_all_finite("velocity", v.iter())?;
+    check_all_finite("impulse", s.iter())?;
+    let v_after = v + s / mass;
+    Ok(PointImpulse {
+        v_after,
+        energy_change: 0.5 * s.dot(&(v_after + v)),
+    })
+}
+
+/// The outcome of a 3-D collision of two smooth point masses (spheres) along a normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointImpact {
+    /// Velocity of point 1 after the impact.
+    pub v1_after: Vector3<f64>,
+    /// Velocity of point 2 after the impact.
+    pub v2_after: Vector3<f64>,
+    /// Impulse on point 2 (point 1 receives its negative), along n (7.95), N·s.
+    pub impulse_on_2: Vector3<f64>,
+    /// ΔT = −½ (1 − λ²) μ (v_n,1 − v_n,2)² (5.23 with normal components), J.
+    pub energy_change: f64,
+}
+
+/// Collides point 1 (`m1`, `v1`) with point 2 (`m2`, `v2`) along the unit normal `n` pointing
+/// from point 1 to point 2 (the line of centres of two spheres), with restitution λ ∈ [0, 1].
+/// The impulse is along n (smooth contact, 7.95); the normal components follow (5.21–5.22)
+/// and the tangential components are unchanged. Points that do not approach
+/// ((v1 − v2)·n ≤ 0) receive no impulse.
+pub fn collide_points(
+    m1: f64,
+    v1: &Vector3<f64>,
+    m2: f64,
+    v2: &Vector3<f64>,
+    n: &Vector3<f64>,
+    restitution: f64,
+) -> Result<PointImpact, ImpulseError> {
+    check_all_finite("v1", v1.iter())?;
+    check_all_finite("v2", v2.iter())?;
+    let n = unit_vector("normal", n)?;
+    let line = collide_collinear(m1, v1.dot(&n), m2, v2.dot(&n), restitution)?;
+    let impulse_on_2 = n * line.impulse_on_2;
+    Ok(PointImpact {
+        v1_after: v1 - impulse_on_2 / m1,
+        v2_after: v2 + impulse_on_2 / m2,
+        impulse_on_2,
+        energy_change: line.energy_change,
+    })
+}
 
 /// The outcome of a collinear two-point collision.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,6 +164,49 @@ mod tests {
     fn a_wall_of_mass_1e12_reflects_the_ball() {
         let out = collide_collinear(1.0, 1.0, 1e12, 0.0, 1.0).expect("valid");
         assert!((out.v1_after + 1.0).abs() < 1e-11);
+    }
+
+    #[test]
+    fn an_impulse_on_a_point_changes_its_momentum_by_the_impulse() {
+        let (m, v, s) = (2.0, Vector3::new(1.0, -2.0, 0.5), Vector3::new(0.4, 1.0, -3.0));
+        let r = impulse_on_point(m, &v, &s).expect("valid");
+        assert!((m * (r.v_after - v) - s).norm() < 1e-15);
+        let direct = 0.5 * m * (r.v_after.norm_squared() - v.norm_squared());
+        assert!((r.energy_change - direct).abs() < 1e-14);
+        assert!(matches!(
+            impulse_on_point(-1.0, &v, &s),
+            Err(ImpulseError::NonPositiveMass { .. })
+        ));
+        assert!(matches!(
+            impulse_on_point(1.0, &v, &Vector3::new(f64::INFINITY, 0.0, 0.0)),
+            Err(ImpulseError::NonFinite { .. })
+        ));
+    }
+
+    #[test]
+    fn oblique_elastic_billiard_balls_leave_at_right_angles() {
+        // Equal masses, elastic, target at rest: the velocities after are perpendicular and
+        // the cue ball keeps only its tangential component.
+        let n = Vector3::new(1.0, 1.0, 0.0).normalize();
+        let v1 = Vector3::new(2.0, 0.0, 0.0);
+        let r = collide_points(0.17, &v1, 0.17, &Vector3::zeros(), &n, 1.0).expect("valid");
+        assert!(r.v1_after.dot(&r.v2_after).abs() < 1e-15);
+        assert!((r.v2_after - n * v1.dot(&n)).norm() < 1e-15);
+        assert!((r.v1_after - (v1 - n * v1.dot(&n))).norm() < 1e-15);
+        assert_eq!(r.energy_change, 0.0);
+        // Momentum (5.17).
+        assert!((0.17 * (r.v1_after + r.v2_after) - 0.17 * v1).norm() < 1e-15);
+    }
+
+    #[test]
+    fn separating_and_grazing_points_and_bad_normals() {
+        let n = Vector3::x();
+        let r = collide_points(1.0, &Vector3::new(0.0, 1.0, 0.0), 1.0, &Vector3::zeros(), &n, 0.5).expect("ok");
+        assert_eq!(r.impulse_on_2, Vector3::zeros());
+        let bad = collide_points(1.0, &Vector3::x(), 1.0, &Vector3::zeros(), &Vector3::zeros(), 0.5);
+        assert!(matches!(bad, Err(ImpulseError::NotUnit { .. })));
+        let bad = collide_points(1.0, &Vector3::x(), 1.0, &Vector3::zeros(), &(n * 1.01), 0.5);
+        assert!(matches!(bad, Err(ImpulseError::NotUnit { .. })));
     }
 
     #[test]

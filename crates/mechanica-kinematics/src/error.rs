@@ -13,6 +13,16 @@ pub enum KinematicsError {
         /// The offending value.
         value: f64,
     },
+    /// An entry of an array (a coordinate, a velocity, a body's data) was NaN or infinite.
+    #[error("{what}[{index}] is not finite: {value}")]
+    NonFiniteEntry {
+        /// Which array held the value.
+        what: &'static str,
+        /// Index of the offending entry (coordinate index, or body index for body data).
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
     /// A matrix that must be a rotation is not orthogonal with det = +1.
     #[error("matrix is not a rotation: ‖RᵀR − I‖ = {orthogonality_error:.3e}, det = {determinant}")]
     NotARotation {
@@ -26,5 +36,91 @@ pub enum KinematicsError {
     NotAUnitQuaternion {
         /// Its Euclidean norm.
         norm: f64,
+    },
+    /// An axis that must be a unit vector is not (zero axes have norm 0).
+    #[error("{what} is not a unit vector: norm = {norm}")]
+    NotAUnitAxis {
+        /// Which axis.
+        what: &'static str,
+        /// Its Euclidean norm.
+        norm: f64,
+    },
+    /// The joint axis of a body in a kinematic tree is zero or not of unit length.
+    #[error("joint axis of body {body} is not a unit vector: norm = {norm}")]
+    JointAxisNotUnit {
+        /// The body whose joint holds the axis.
+        body: usize,
+        /// Its Euclidean norm.
+        norm: f64,
+    },
+    /// Euler rates cannot be recovered from ω at a gimbal lock of the sequence.
+    #[error(
+        "Euler-rate inversion is singular for {sequence}: |{measure}| = {distance:.3e} ≤ {tolerance:.1e} (gimbal lock)"
+    )]
+    EulerRateSingular {
+        /// The Euler sequence.
+        sequence: &'static str,
+        /// The quantity that vanishes at the lock: "cos(second angle)" or "sin(second angle)".
+        measure: &'static str,
+        /// Its value.
+        distance: f64,
+        /// The tolerance below which the inversion is refused.
+        tolerance: f64,
+    },
+    /// A kinematic tree was built with no body.
+    #[error("the kinematic tree has no bodies")]
+    EmptyTree,
+    /// A body names a parent index that does not exist.
+    #[error("body {body} names parent {parent}, but the tree has only {bodies} bodies")]
+    ParentOutOfRange {
+        /// The body.
+        body: usize,
+        /// The parent index it names.
+        parent: usize,
+        /// The number of bodies.
+        bodies: usize,
+    },
+    /// No body is attached to the base.
+    #[error("the kinematic tree has no root (no body is attached to the base)")]
+    NoRoot,
+    /// More than one body is attached to the base (a forest, i.e. a disconnected tree).
+    #[error("the kinematic tree has more than one root: bodies {first} and {second} are both attached to the base")]
+    MultipleRoots {
+        /// The first root found.
+        first: usize,
+        /// The second root found.
+        second: usize,
+    },
+    /// Following parents from a body never reaches the root: the body lies on a cycle or
+    /// hangs below one, disconnected from the root.
+    #[error("body {body} is on or below a cycle of parent links and is not connected to the root")]
+    Cycle {
+        /// A body on the cycle or in the disconnected part.
+        body: usize,
+    },
+    /// An array has the wrong length.
+    #[error("{what} has length {got}, expected {expected}")]
+    WrongLength {
+        /// Which array.
+        what: &'static str,
+        /// The length required.
+        expected: usize,
+        /// The length given.
+        got: usize,
+    },
+    /// A body index does not exist.
+    #[error("body index {body} is out of range (the tree has {bodies} bodies)")]
+    BodyOutOfRange {
+        /// The index given.
+        body: usize,
+        /// The number of bodies.
+        bodies: usize,
+    },
+    /// A workspace was used with a tree it was not made for, or before the stage it needs
+    /// (positions before velocities before accelerations) was computed.
+    #[error("workspace not ready: {what}")]
+    WorkspaceNotReady {
+        /// What was missing.
+        what: &'static str,
     },
 }

@@ -5,9 +5,19 @@
 //!
 //! Frames follow the Drake naming style: `p_AB_W` is the position of B relative to A,
 //! expressed in frame W. All quantities are SI and `f64`.
+//!
+//! - [`rotation`]: matrices, quaternions, axis–angle, exp/log of SO(3), re-orthonormalization, Ω = Ṙ Rᵀ.
+//! - [`euler`]: Euler angles (EB1911 and the twelve intrinsic sequences), gimbal lock, rate maps.
+//! - [`rigid_motion`]: x = R X + c and the velocity/acceleration fields (2.13–2.19).
+//! - [`relative_motion`]: drag, Coriolis and relative parts (2.22–2.35).
+//! - [`tree`]: kinematic trees, forward kinematics, Jacobians and their rates.
 
 pub mod error;
+pub mod euler;
+pub mod relative_motion;
+pub mod rigid_motion;
 pub mod rotation;
+pub mod tree;
 
 pub use error::KinematicsError;
 pub use nalgebra;

@@ -1,26 +1,62 @@
-//! Rotation matrices, quaternions and the angular velocity Ω = Ṙ Rᵀ (2.7–2.12).
+//! Rotation matrices, unit quaternions, axis–angle and rotation vectors, the exponential and
+//! logarithm maps of SO(3), re-orthonormalization, and the angular velocity Ω = Ṙ Rᵀ (2.7–2.12).
+//!
+//! A rotation R maps body components to fixed-frame components, x = R X + c (1.5), so
+//! `R = R_WB` in Drake naming. All conversions here stay accurate near the identity and near
+//! half turns: the exponential uses `sin θ/θ` and `2 sin²(θ/2)/θ²` (no cancellation), and the
+//! logarithm goes through Shepperd's quaternion extraction and `2 atan2(‖v‖, w)`.
 
 use crate::KinematicsError;
-use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Quaternion, Rotation3, Unit, UnitQuaternion, Vector3};
 
 /// Tolerance on ‖RᵀR − I‖_F for accepting a matrix as a rotation: a few hundred ulps,
 /// enough for matrices that went through a handful of products, small enough to reject
 /// anything that is visibly not orthogonal.
 pub const ROTATION_TOLERANCE: f64 = 1e-12;
 
+/// Tolerance on |‖a‖ − 1| for accepting a vector as a unit axis (same scale as
+/// [`ROTATION_TOLERANCE`]).
+pub const AXIS_TOLERANCE: f64 = 1e-12;
+
 /// The skew-symmetric matrix Ω with Ω x = ω × x (2.11).
 pub fn skew(w: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0)
 }
 
+/// The vector ω of the skew-symmetric part of `m`: ω = vee((m − mᵀ)/2), the inverse of [`skew`].
+pub fn vee(m: &Matrix3<f64>) -> Vector3<f64> {
+    Vector3::new(
+        0.5 * (m[(2, 1)] - m[(1, 2)]),
+        0.5 * (m[(0, 2)] - m[(2, 0)]),
+        0.5 * (m[(1, 0)] - m[(0, 1)]),
+    )
+}
+
+pub(crate) fn check_finite_vec(v: &Vector3<f64>, what: &'static str) -> Result<(), KinematicsError> {
+    match v.iter().copied().find(|x| !x.is_finite()) {
+        Some(value) => Err(KinematicsError::NonFinite { what, value }),
+        None => Ok(()),
+    }
+}
+
+pub(crate) fn check_finite_mat(m: &Matrix3<f64>, what: &'static str) -> Result<(), KinematicsError> {
+    match m.iter().copied().find(|x| !x.is_finite()) {
+        Some(value) => Err(KinematicsError::NonFinite { what, value }),
+        None => Ok(()),
+    }
+}
+
+pub(crate) fn check_finite(x: f64, what: &'static str) -> Result<(), KinematicsError> {
+    if x.is_finite() {
+        Ok(())
+    } else {
+        Err(KinematicsError::NonFinite { what, value: x })
+    }
+}
+
 /// Checks that `r` is finite and orthogonal with det = +1 (1.14) and returns it as a rotation.
 pub fn rotation_from_matrix(r: &Matrix3<f64>) -> Result<Rotation3<f64>, KinematicsError> {
-    if let Some(value) = r.iter().copied().find(|v| !v.is_finite()) {
-        return Err(KinematicsError::NonFinite {
-            what: "rotation matrix entry",
-            value,
-        });
-    }
+    check_finite_mat(r, "rotation matrix entry")?;
     let orthogonality_error = (r.transpose() * r - Matrix3::identity()).norm();
     let determinant = r.determinant();
     if orthogonality_error > ROTATION_TOLERANCE || determinant <= 0.0 {
@@ -32,9 +68,272 @@ pub fn rotation_from_matrix(r: &Matrix3<f64>) -> Result<Rotation3<f64>, Kinemati
     Ok(Rotation3::from_matrix_unchecked(*r))
 }
 
-/// The unit quaternion of a rotation matrix (checked as in [`rotation_from_matrix`]).
+/// The unit quaternion of a rotation matrix (checked as in [`rotation_from_matrix`]), by
+/// Shepperd's method, with the sign chosen so that w ≥ 0.
 pub fn quaternion_from_matrix(r: &Matrix3<f64>) -> Result<UnitQuaternion<f64>, KinematicsError> {
-    rotation_from_matrix(r).map(|rot| UnitQuaternion::from_rotation_matrix(&rot))
+    rotation_from_matrix(r).map(|rot| quaternion_from_rotation(&rot))
+}
+
+/// The unit quaternion (w ≥ 0) of a rotation, by Shepperd's method: the component of largest
+/// magnitude is taken from a square root of the largest of (trace, R₀₀, R₁₁, R₂₂) and the others
+/// from sums/differences of off-diagonal entries divided by it, so the result is accurate to a
+/// few ulps for every rotation, including half turns.
+pub fn quaternion_from_rotation(r: &Rotation3<f64>) -> UnitQuaternion<f64> {
+    let m = r.matrix();
+    let (r00, r11, r22) = (m[(0, 0)], m[(1, 1)], m[(2, 2)]);
+    let trace = r00 + r11 + r22;
+    let q = if trace >= r00 && trace >= r11 && trace >= r22 {
+        let s = 2.0 * (1.0 + trace).max(0.0).sqrt();
+        Quaternion::new(
+            0.25 * s,
+            (m[(2, 1)] - m[(1, 2)]) / s,
+            (m[(0, 2)] - m[(2, 0)]) / s,
+            (m[(1, 0)] - m[(0, 1)]) / s,
+        )
+    } else if r00 >= r11 && r00 >= r22 {
+        let s = 2.0 * (1.0 + r00 - r11 - r22).max(0.0).sqrt();
+        Quaternion::new(
+            (m[(2, 1)] - m[(1, 2)]) / s,
+            0.25 * s,
+            (m[(0, 1)] + m[(1, 0)]) / s,
+            (m[(0, 2)] + m[(2, 0)]) / s,
+        )
+    } else if r11 >= r22 {
+        let s = 2.0 * (1.0 + r11 - r00 - r22).max(0.0).sqrt();
+        Quaternion::new(
+            (m[(0, 2)] - m[(2, 0)]) / s,
+            (m[(0, 1)] + m[(1, 0)]) / s,
+            0.25 * s,
+            (m[(1, 2)] + m[(2, 1)]) / s,
+        )
+    } else {
+        let s = 2.0 * (1.0 + r22 - r00 - r11).max(0.0).sqrt();
+        Quaternion::new(
+            (m[(1, 0)] - m[(0, 1)]) / s,
+            (m[(0, 2)] + m[(2, 0)]) / s,
+            (m[(1, 2)] + m[(2, 1)]) / s,
+            0.25 * s,
+        )
+    };
+    let q = if q.w < 0.0 { -q } else { q };
+    UnitQuaternion::new_normalize(q)
+}
+
+/// The rotation matrix of a unit quaternion: R = (w² − v·v) I + 2 v vᵀ + 2 w \[v\]×.
+pub fn rotation_from_quaternion(q: &UnitQuaternion<f64>) -> Rotation3<f64> {
+    q.to_rotation_matrix()
+}
+
+/// The exponential map of SO(3): the rotation by |φ| about φ/|φ| (Rodrigues),
+/// R = I + (sin θ/θ) \[φ\]× + (2 sin²(θ/2)/θ²) \[φ\]×², θ = |φ|. Exact to rounding for all θ,
+/// including θ → 0 (no cancellation) and θ ≥ π.
+pub fn exp_map(phi: &Vector3<f64>) -> Result<Rotation3<f64>, KinematicsError> {
+    check_finite_vec(phi, "rotation vector component")?;
+    Ok(exp_unchecked(phi))
+}
+
+/// The coefficients (sin θ/θ, (1 − cos θ)/θ²) of Rodrigues' formula, without cancellation.
+pub(crate) fn rodrigues_coefficients(theta: f64) -> (f64, f64) {
+    if theta == 0.0 {
+        (1.0, 0.5)
+    } else {
+        let h = (0.5 * theta).sin() / theta;
+        (theta.sin() / theta, 2.0 * h * h)
+    }
+}
+
+/// [`exp_map`] for an input already known to be finite.
+pub(crate) fn exp_unchecked(phi: &Vector3<f64>) -> Rotation3<f64> {
+    let theta = phi.norm();
+    let (a, b) = rodrigues_coefficients(theta);
+    let k = skew(phi);
+    Rotation3::from_matrix_unchecked(Matrix3::identity() + k * a + k * k * b)
+}
+
+/// Series Σ_{n≥0} (−1)ⁿ x^n / (2n + m)! in x = θ², for the small-angle branches below.
+fn alt_series(x: f64, m: u32) -> f64 {
+    let mut fact = 1.0;
+    for i in 1..=m {
+        fact *= f64::from(i);
+    }
+    let (mut sum, mut term, mut k) = (0.0, 1.0 / fact, m);
+    for n in 0..14 {
+        sum += if n % 2 == 0 { term } else { -term };
+        term *= x / (f64::from(k + 1) * f64::from(k + 2));
+        k += 2;
+    }
+    sum
+}
+
+/// Series Σ_{n≥1} (−1)ⁿ 2n x^{n−1} / (2n + m)! (the derivative coefficients divided by θ).
+fn alt_series_derivative(x: f64, m: u32) -> f64 {
+    let mut fact = 1.0;
+    for i in 1..=(m + 2) {
+        fact *= f64::from(i);
+    }
+    let (mut sum, mut term, mut k) = (0.0, 1.0 / fact, m + 2);
+    for n in 1..15 {
+        let signed = if n % 2 == 1 { -term } else { term };
+        sum += 2.0 * f64::from(n) * signed;
+        term *= x / (f64::from(k + 1) * f64::from(k + 2));
+        k += 2;
+    }
+    sum
+}
+
+/// (α, β, α′/θ, β′/θ) with α = (1 − cos θ)/θ², β = (θ − sin θ)/θ³: the coefficients of the
+/// right Jacobian of SO(3) and of their derivatives. Series below θ = 2 (13 terms, truncation
+/// < 1e-17 relative), closed forms above, where their cancellation costs less than ~16 ulps.
+fn jacobian_coefficients(theta: f64) -> (f64, f64, f64, f64) {
+    let x = theta * theta;
+    if theta < 2.0 {
+        (
+            alt_series(x, 2),
+            alt_series(x, 3),
+            alt_series_derivative(x, 2),
+            alt_series_derivative(x, 3),
+        )
+    } else {
+        let (s, c) = theta.sin_cos();
+        let h = (0.5 * theta).sin() / theta;
+        let one_minus_cos = 2.0 * (0.5 * theta).sin().powi(2);
+        (
+            2.0 * h * h,
+            (theta - s) / (x * theta),
+            (theta * s - 2.0 * one_minus_cos) / (x * x),
+            (theta * (1.0 - c) - 3.0 * (theta - s)) / (x * x * theta),
+        )
+    }
+}
+
+/// The right Jacobian of SO(3): with R(t) = exp(φ(t)), the body-frame angular velocity is
+/// ω_B = J_r(φ) φ̇, J_r = I − ((1 − cos θ)/θ²)\[φ\]× + ((θ − sin θ)/θ³)\[φ\]×², θ = |φ|.
+/// det J_r = 2(1 − cos θ)/θ², so J_r is invertible for θ < 2π.
+pub fn right_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
+    let (alpha, beta, _, _) = jacobian_coefficients(phi.norm());
+    let k = skew(phi);
+    Matrix3::identity() - k * alpha + k * k * beta
+}
+
+/// The time derivative dJ_r/dt of [`right_jacobian`] along φ(t) with rate φ̇:
+/// −α̇\[φ\] − α\[φ̇\] + β̇\[φ\]² + β(\[φ̇\]\[φ\] + \[φ\]\[φ̇\]), α̇ = (α′/θ)(φ·φ̇), β̇ = (β′/θ)(φ·φ̇).
+pub fn right_jacobian_rate(phi: &Vector3<f64>, phi_dot: &Vector3<f64>) -> Matrix3<f64> {
+    let (alpha, beta, dalpha, dbeta) = jacobian_coefficients(phi.norm());
+    let d = phi.dot(phi_dot);
+    let k = skew(phi);
+    let kd = skew(phi_dot);
+    -k * (dalpha * d) - kd * alpha + k * k * (dbeta * d) + (kd * k + k * kd) * beta
+}
+
+/// The logarithm map of SO(3): the rotation vector φ with exp(φ) = R and |φ| ∈ [0, π].
+///
+/// Computed from the quaternion q = (w, v) of R (Shepperd, w ≥ 0) as φ = 2 atan2(|v|, w) v/|v|,
+/// which is accurate to a few ulps of |φ| near the identity and near half turns. At exactly
+/// |φ| = π both ±φ are valid; the one with w ≥ 0 from Shepperd's branch is returned.
+pub fn log_map(r: &Rotation3<f64>) -> Vector3<f64> {
+    log_quaternion(&quaternion_from_rotation(r))
+}
+
+/// The rotation vector φ (|φ| ≤ π) of a unit quaternion: φ = 2 atan2(|v|, |w|) sign(w) v/|v|.
+pub fn log_quaternion(q: &UnitQuaternion<f64>) -> Vector3<f64> {
+    let (w, v) = if q.w < 0.0 { (-q.w, -q.imag()) } else { (q.w, q.imag()) };
+    let n = v.norm();
+    if n == 0.0 {
+        return Vector3::zeros();
+    }
+    v * (2.0 * n.atan2(w) / n)
+}
+
+/// An axis–angle pair. `axis` is a unit vector and `angle` ∈ [0, π]; for the identity the
+/// angle is 0 and the axis is, by convention, e_x.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AxisAngle {
+    /// Unit rotation axis (fixed-frame and body-frame components agree: R a = a).
+    pub axis: Unit<Vector3<f64>>,
+    /// Rotation angle in radians, in [0, π].
+    pub angle: f64,
+}
+
+/// The axis–angle pair of a rotation (from [`log_map`]).
+pub fn axis_angle_from_rotation(r: &Rotation3<f64>) -> AxisAngle {
+    let phi = log_map(r);
+    let angle = phi.norm();
+    if angle == 0.0 {
+        AxisAngle {
+            axis: Vector3::x_axis(),
+            angle: 0.0,
+        }
+    } else {
+        AxisAngle {
+            axis: Unit::new_unchecked(phi / angle),
+            angle,
+        }
+    }
+}
+
+/// Checks that `axis` is finite and of unit length within [`AXIS_TOLERANCE`]; `what` names it.
+pub fn unit_axis(axis: &Vector3<f64>, what: &'static str) -> Result<Unit<Vector3<f64>>, KinematicsError> {
+    check_finite_vec(axis, what)?;
+    let norm = axis.norm();
+    if (norm - 1.0).abs() > AXIS_TOLERANCE {
+        return Err(KinematicsError::NotAUnitAxis { what, norm });
+    }
+    Ok(Unit::new_normalize(*axis))
+}
+
+/// The rotation by `angle` about the unit vector `axis` (rejects non-unit, zero or non-finite axes).
+pub fn rotation_from_axis_angle(axis: &Vector3<f64>, angle: f64) -> Result<Rotation3<f64>, KinematicsError> {
+    let axis = unit_axis(axis, "rotation axis")?;
+    check_finite(angle, "rotation angle")?;
+    Ok(exp_unchecked(&(axis.into_inner() * angle)))
+}
+
+/// A rotation repaired from a drifted input, with the size of the repair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Orthonormalized {
+    /// The nearest rotation.
+    pub rotation: Rotation3<f64>,
+    /// ‖input − rotation‖_F for matrices, |‖q‖ − 1| for quaternions: how far the input had drifted.
+    pub correction: f64,
+}
+
+/// The rotation nearest to `m` in the Frobenius norm: the orthogonal polar factor U Vᵀ of the
+/// SVD m = U Σ Vᵀ. Fails for non-finite input and for det m ≤ 0 (a reflection or a singular
+/// matrix is not a drifted rotation).
+pub fn orthonormalize_matrix(m: &Matrix3<f64>) -> Result<Orthonormalized, KinematicsError> {
+    check_finite_mat(m, "matrix entry")?;
+    let determinant = m.determinant();
+    if determinant <= 0.0 {
+        return Err(KinematicsError::NotARotation {
+            orthogonality_error: (m.transpose() * m - Matrix3::identity()).norm(),
+            determinant,
+        });
+    }
+    let svd = m.svd(true, true);
+    let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return Err(KinematicsError::NotARotation {
+            orthogonality_error: f64::INFINITY,
+            determinant,
+        });
+    };
+    let r = u * v_t;
+    Ok(Orthonormalized {
+        rotation: Rotation3::from_matrix_unchecked(r),
+        correction: (m - r).norm(),
+    })
+}
+
+/// The unit quaternion nearest to a drifted q = (w, x, y, z): q/‖q‖, with correction |‖q‖ − 1|.
+/// Fails for a zero or non-finite q.
+pub fn orthonormalize_quaternion(q: &Quaternion<f64>) -> Result<(UnitQuaternion<f64>, f64), KinematicsError> {
+    for value in q.coords.iter().copied() {
+        check_finite(value, "quaternion component")?;
+    }
+    let norm = q.norm();
+    if norm == 0.0 || !norm.is_finite() {
+        return Err(KinematicsError::NotAUnitQuaternion { norm });
+    }
+    Ok((UnitQuaternion::new_unchecked(q / norm), (norm - 1.0).abs()))
 }
 
 /// The angular velocity ω, expressed in the fixed frame, from R and Ṙ: Ω = Ṙ Rᵀ (2.7–2.12).
@@ -42,18 +341,17 @@ pub fn quaternion_from_matrix(r: &Matrix3<f64>) -> Result<UnitQuaternion<f64>, K
 /// Ω is skew-symmetric for an exact rotation; the symmetric part that rounding leaves is
 /// discarded by averaging the two off-diagonal entries.
 pub fn angular_velocity_from_rate(r: &Rotation3<f64>, r_dot: &Matrix3<f64>) -> Result<Vector3<f64>, KinematicsError> {
-    if let Some(value) = r_dot.iter().copied().find(|v| !v.is_finite()) {
-        return Err(KinematicsError::NonFinite {
-            what: "rotation rate entry",
-            value,
-        });
-    }
-    let omega = r_dot * r.matrix().transpose();
-    Ok(Vector3::new(
-        0.5 * (omega[(2, 1)] - omega[(1, 2)]),
-        0.5 * (omega[(0, 2)] - omega[(2, 0)]),
-        0.5 * (omega[(1, 0)] - omega[(0, 1)]),
-    ))
+    check_finite_mat(r_dot, "rotation rate entry")?;
+    Ok(vee(&(r_dot * r.matrix().transpose())))
+}
+
+/// The angular velocity expressed in the body frame, ω_B = Rᵀ ω = vee(Rᵀ Ṙ).
+pub fn body_angular_velocity_from_rate(
+    r: &Rotation3<f64>,
+    r_dot: &Matrix3<f64>,
+) -> Result<Vector3<f64>, KinematicsError> {
+    check_finite_mat(r_dot, "rotation rate entry")?;
+    Ok(vee(&(r.matrix().transpose() * r_dot)))
 }
 
 /// How a quaternion that is not exactly of unit length is treated.
@@ -94,12 +392,17 @@ pub fn unit_quaternion(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+    use std::f64::consts::PI;
+
+    const EPS: f64 = f64::EPSILON;
 
     #[test]
     fn skew_is_the_cross_product() {
         let w = Vector3::new(0.3, -1.2, 2.5);
         let x = Vector3::new(-0.7, 0.4, 1.1);
         assert!((skew(&w) * x - w.cross(&x)).norm() < 1e-15);
+        assert_eq!(vee(&skew(&w)), w);
     }
 
     #[test]
@@ -111,6 +414,28 @@ mod tests {
         let r_dot = skew(&Vector3::new(0.0, 0.0, w)) * r.matrix();
         let omega = angular_velocity_from_rate(&r, &r_dot).expect("finite input");
         assert!((omega - Vector3::new(0.0, 0.0, w)).norm() < 1e-15);
+        let omega_b = body_angular_velocity_from_rate(&r, &r_dot).expect("finite input");
+        assert!((omega_b - Vector3::new(0.0, 0.0, w)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn angular_velocity_matches_finite_differences_of_exp() {
+        // R(t) = exp(φ0 + t φ1); ω from Ω = Ṙ Rᵀ with Ṙ by central differences, step h:
+        // truncation O(h²·|R'''|) ≈ h², rounding O(eps/h).
+        let phi0 = Vector3::new(0.4, -1.1, 0.7);
+        let phi1 = Vector3::new(-0.3, 0.5, 0.9);
+        let h = 1e-5;
+        let r = exp_unchecked(&phi0);
+        let r_dot =
+            (exp_unchecked(&(phi0 + phi1 * h)).matrix() - exp_unchecked(&(phi0 - phi1 * h)).matrix()) / (2.0 * h);
+        let omega = angular_velocity_from_rate(&r, &r_dot).expect("finite");
+        // Independent closed form: ω_W = R J_r(φ0) φ1, J_r = I − ((1−cos)/θ²)[φ] + ((θ−sin)/θ³)[φ]².
+        let th = phi0.norm();
+        let k = skew(&phi0);
+        let jr = Matrix3::identity() - k * ((1.0 - th.cos()) / (th * th)) + k * k * ((th - th.sin()) / th.powi(3));
+        let expected = r * (jr * phi1);
+        let tol = 10.0 * (h * h + EPS / h);
+        assert!((omega - expected).norm() < tol, "{omega} vs {expected}");
     }
 
     #[test]
@@ -118,6 +443,10 @@ mod tests {
         let m = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
         assert!(matches!(
             quaternion_from_matrix(&m),
+            Err(KinematicsError::NotARotation { .. })
+        ));
+        assert!(matches!(
+            orthonormalize_matrix(&m),
             Err(KinematicsError::NotARotation { .. })
         ));
     }
@@ -145,5 +474,168 @@ mod tests {
             rotation_from_matrix(&m),
             Err(KinematicsError::NonFinite { .. })
         ));
+        assert!(exp_map(&Vector3::new(0.0, f64::INFINITY, 0.0)).is_err());
+        assert!(orthonormalize_matrix(&m).is_err());
+        assert!(orthonormalize_quaternion(&Quaternion::new(f64::NAN, 0.0, 0.0, 0.0)).is_err());
+        assert!(matches!(
+            orthonormalize_quaternion(&Quaternion::new(0.0, 0.0, 0.0, 0.0)),
+            Err(KinematicsError::NotAUnitQuaternion { norm: 0.0 })
+        ));
+    }
+
+    #[test]
+    fn exp_of_tiny_vectors_is_first_order_exact() {
+        // exp(φ) = I + [φ] + ½[φ]² + O(|φ|³): for |φ| = 1e-9 the matrix equals I + [φ] to rounding.
+        for &s in &[1e-300, 1e-100, 1e-9, 1e-5] {
+            let phi = Vector3::new(0.6, -0.8, 0.0) * s;
+            let r = exp_map(&phi).expect("finite");
+            let k = skew(&phi);
+            let series = Matrix3::identity() + k + k * k * 0.5 - k * k * k / 6.0;
+            assert!((r.matrix() - series).norm() <= 4.0 * EPS + s.powi(4), "s = {s}");
+            // The logarithm recovers φ to a relative accuracy eps/|φ| (the information the
+            // matrix holds about φ is absolute, ~eps).
+            let back = log_map(&r);
+            assert!((back - phi).norm() <= 4.0 * EPS, "s = {s}: {back} vs {phi}");
+        }
+        assert_eq!(log_map(&Rotation3::identity()), Vector3::zeros());
+    }
+
+    #[test]
+    fn log_near_and_at_a_half_turn() {
+        let axis = Vector3::new(2.0, -1.0, 3.0).normalize();
+        for &d in &[0.0, 1e-15, 1e-12, 1e-8, 1e-4] {
+            let phi = axis * (PI - d);
+            let r = exp_map(&phi).expect("finite");
+            let back = log_map(&r);
+            assert!(back.norm() <= PI + 4.0 * EPS);
+            // exp(log R) = R always; log(exp φ) = φ up to the ±axis ambiguity at exactly π.
+            assert!(
+                (exp_unchecked(&back).matrix() - r.matrix()).norm() <= 8.0 * EPS,
+                "d = {d}"
+            );
+            let err = (back - phi).norm().min((back + phi).norm());
+            assert!(err <= 16.0 * EPS, "d = {d}: error {err}");
+            if d >= 1e-8 {
+                assert!((back - phi).norm() <= 16.0 * EPS, "d = {d}: sign");
+            }
+        }
+        // Exact half turns about the coordinate axes (the trace-branch fails here).
+        for i in 0..3 {
+            let mut phi = Vector3::zeros();
+            phi[i] = PI;
+            let r = exp_map(&phi).expect("finite");
+            let back = log_map(&r);
+            assert!((back.norm() - PI).abs() <= 4.0 * EPS);
+            assert!((back.abs() - phi).norm() <= 8.0 * EPS);
+        }
+    }
+
+    #[test]
+    fn axis_angle_round_trip_and_bad_axes() {
+        let r = rotation_from_axis_angle(&Vector3::new(0.0, 0.6, 0.8), 2.0).expect("unit axis");
+        let aa = axis_angle_from_rotation(&r);
+        assert!((aa.angle - 2.0).abs() < 4.0 * EPS);
+        assert!((aa.axis.into_inner() - Vector3::new(0.0, 0.6, 0.8)).norm() < 4.0 * EPS);
+        assert_eq!(axis_angle_from_rotation(&Rotation3::identity()).angle, 0.0);
+        assert!(matches!(
+            rotation_from_axis_angle(&Vector3::zeros(), 1.0),
+            Err(KinematicsError::NotAUnitAxis { norm: 0.0, .. })
+        ));
+        assert!(matches!(
+            rotation_from_axis_angle(&Vector3::new(1.0, 1.0, 0.0), 1.0),
+            Err(KinematicsError::NotAUnitAxis { .. })
+        ));
+        assert!(matches!(
+            rotation_from_axis_angle(&Vector3::x(), f64::NAN),
+            Err(KinematicsError::NonFinite { .. })
+        ));
+    }
+
+    #[test]
+    fn orthonormalize_a_drifted_matrix() {
+        // R + E with small E: the polar factor is within O(|E|²) of R, and the correction is
+        // |E_sym|-sized; a rotation itself comes back unchanged.
+        let r = exp_unchecked(&Vector3::new(0.3, 1.9, -0.4));
+        let fixed = orthonormalize_matrix(r.matrix()).expect("rotation");
+        assert!(fixed.correction < 8.0 * EPS);
+        let e = Matrix3::new(1.0, -2.0, 0.5, 0.3, 0.7, -1.1, 0.2, 0.9, -0.4) * 1e-6;
+        let fixed = orthonormalize_matrix(&(r.matrix() + e)).expect("near rotation");
+        let q = fixed.rotation.matrix();
+        assert!((q.transpose() * q - Matrix3::identity()).norm() < 8.0 * EPS);
+        assert!((q.determinant() - 1.0).abs() < 8.0 * EPS);
+        assert!((q - r.matrix()).norm() < 2.0 * e.norm());
+        // Polar factor property: Qᵀ M is symmetric.
+        let s = q.transpose() * (r.matrix() + e);
+        assert!((s - s.transpose()).norm() < 16.0 * EPS);
+        let (uq, drift) = orthonormalize_quaternion(&Quaternion::new(1.0 + 1e-7, 0.0, 0.0, 0.0)).expect("finite");
+        assert_eq!(uq.w, 1.0);
+        assert!((drift - 1e-7).abs() < 1e-15);
+    }
+
+    #[test]
+    fn right_jacobian_and_its_rate_match_finite_differences() {
+        // ω_B = vee(Rᵀ Ṙ) with Ṙ by central differences of exp along φ(t) = φ0 + t φ1; and
+        // dJ_r/dt against differences of J_r. Angles on both sides of the series switch (θ = 2).
+        for phi0 in [
+            Vector3::new(1e-3, -2e-3, 5e-4),
+            Vector3::new(0.4, -1.1, 0.7),
+            Vector3::new(1.2, 1.1, -0.9),
+            Vector3::new(2.5, -1.0, 2.0),
+        ] {
+            let phi1 = Vector3::new(-0.3, 0.5, 0.9);
+            let h = 1e-5;
+            let r = exp_unchecked(&phi0);
+            let r_dot =
+                (exp_unchecked(&(phi0 + phi1 * h)).matrix() - exp_unchecked(&(phi0 - phi1 * h)).matrix()) / (2.0 * h);
+            let w_fd = vee(&(r.matrix().transpose() * r_dot));
+            let tol = 10.0 * (h * h + EPS / h);
+            assert!((right_jacobian(&phi0) * phi1 - w_fd).norm() < tol, "{phi0}");
+            let jd_fd = (right_jacobian(&(phi0 + phi1 * h)) - right_jacobian(&(phi0 - phi1 * h))) / (2.0 * h);
+            assert!((right_jacobian_rate(&phi0, &phi1) - jd_fd).norm() < tol, "{phi0}");
+        }
+        // The series and the closed forms agree where both are accurate (θ ∈ [1.5, 3]):
+        // the closed forms lose ~eps·θ⁵/|numerator| there, a few dozen ulps at most.
+        for theta in [1.5f64, 2.0, 2.5, 3.0] {
+            let x = theta * theta;
+            let (s, c) = theta.sin_cos();
+            let closed = [
+                (1.0 - c) / x,
+                (theta - s) / (x * theta),
+                (theta * s - 2.0 * (1.0 - c)) / (x * x),
+                (theta * (1.0 - c) - 3.0 * (theta - s)) / (x * x * theta),
+            ];
+            let series = [
+                alt_series(x, 2),
+                alt_series(x, 3),
+                alt_series_derivative(x, 2),
+                alt_series_derivative(x, 3),
+            ];
+            for (a, b) in closed.iter().zip(series) {
+                assert!((a - b).abs() <= 64.0 * EPS * a.abs(), "θ = {theta}: {a} vs {b}");
+            }
+        }
+        assert_eq!(right_jacobian(&Vector3::zeros()), Matrix3::identity());
+    }
+
+    proptest! {
+        #[test]
+        fn exp_log_round_trip(x in -3.0f64..3.0, y in -3.0f64..3.0, z in -3.0f64..3.0) {
+            let phi = Vector3::new(x, y, z);
+            prop_assume!(phi.norm() < PI - 1e-6);
+            let r = exp_map(&phi).expect("finite");
+            let m = r.matrix();
+            let ortho = (m.transpose() * m - Matrix3::identity()).norm();
+            // Rodrigues sums terms of size up to 1, |sin θ| and (1 − cos θ) ≤ 2 built from
+            // entries of [φ]² (size θ²): entry errors ~ 4 eps (1 + θ²·b) with b ≤ 1/2, so the
+            // bound 2‖δR‖_F on ‖RᵀR − I‖_F is about 8 eps (1 + θ²).
+            prop_assert!(ortho < 8.0 * EPS * (1.0 + phi.norm_squared()), "orthogonality {}", ortho / EPS);
+            prop_assert!((log_map(&r) - phi).norm() < 32.0 * EPS * (1.0 + phi.norm()));
+            // Quaternion <-> matrix round trip and agreement with nalgebra's independent formula.
+            let q = quaternion_from_rotation(&r);
+            let q_ref = UnitQuaternion::from_scaled_axis(phi);
+            let d = (q.coords - q_ref.coords).norm().min((q.coords + q_ref.coords).norm());
+            prop_assert!(d < 8.0 * EPS);
+            prop_assert!((rotation_from_quaternion(&q).matrix() - m).norm() < 8.0 * EPS);
+        }
     }
 }

@@ -1,9 +1,29 @@
 //! Mass properties of points, rods, laminae, solids, meshes, composites and mechanisms.
 //!
 //! Equation numbers refer to the syllabus (`seeds/000`, chapter 3), see THEORY.md.
+//! - [`properties`]: the [`MassProperties`] value, composition, holes, transformation, Steiner;
+//! - [`principal`]: principal moments and a canonical principal frame;
+//! - [`validity`]: the physical validity check and repair;
+//! - [`primitives`]: closed forms for points, rods, laminae and solids;
+//! - [`mesh`] and [`io`]: triangle meshes and their file formats;
+//! - [`mechanism`]: the mass matrix A(q) of a kinematic tree (composite-rigid-body recursion);
+//! - [`momenta`]: momentum, angular momentum and kinetic energy of a rigid body.
 
 pub mod error;
+#[cfg(feature = "io")]
+pub mod io;
+pub mod mechanism;
+pub mod mesh;
+pub mod momenta;
+pub mod primitives;
+pub mod principal;
 pub mod properties;
+pub mod tessellation;
+pub mod validity;
 
 pub use error::MassError;
+pub use mesh::{MeshMassProperties, MeshOptions, TriangleMesh, mesh_mass_properties};
+pub use primitives::Amount;
+pub use principal::PrincipalAxes;
 pub use properties::MassProperties;
+pub use validity::{InertiaClass, InertiaIssue, ValidityTolerance};

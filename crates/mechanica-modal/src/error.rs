@@ -45,4 +45,51 @@ pub enum ModalError {
         /// The tolerance it exceeds.
         tolerance: f64,
     },
+    /// The mass matrix A has a negative eigenvalue (it is indefinite, not merely semidefinite).
+    #[error(
+        "mass matrix A is indefinite: Cholesky pivot {pivot} failed and A has eigenvalue {min_eigenvalue:.3e} < −{tolerance:.3e}"
+    )]
+    IndefiniteMass {
+        /// Index of the first Cholesky pivot that was not positive.
+        pivot: usize,
+        /// The most negative eigenvalue of A.
+        min_eigenvalue: f64,
+        /// The tolerance n·u·‖A‖ below which a negative eigenvalue counts as rounding of zero.
+        tolerance: f64,
+    },
+    /// A is singular and B is singular on the null space of A: det(λA + B) vanishes for every λ.
+    #[error(
+        "the pencil is singular: B restricted to the {nullity}-dimensional null space of A has a zero pivot at {pivot}"
+    )]
+    SingularPencil {
+        /// Dimension of the null space of A.
+        nullity: usize,
+        /// Index (within the null space) of the failing pivot.
+        pivot: usize,
+    },
+    /// More modes were requested than the pencil has.
+    #[error("{requested} modes requested but the pencil has only {available}")]
+    TooManyModes {
+        /// Number requested.
+        requested: usize,
+        /// Number of finite modes available.
+        available: usize,
+    },
+    /// An interval [lower, upper] of ω² was empty, reversed or not finite.
+    #[error("interval [{lower}, {upper}] of ω² is not a finite interval with lower ≤ upper")]
+    BadInterval {
+        /// Lower end.
+        lower: f64,
+        /// Upper end.
+        upper: f64,
+    },
+    /// A shift for the inertia count was not finite.
+    #[error("shift {0} is not finite")]
+    BadShift(f64),
+    /// faer's eigensolver did not converge.
+    #[error("the symmetric eigensolver did not converge on the reduced {n}×{n} matrix")]
+    NoConvergence {
+        /// Order of the reduced problem.
+        n: usize,
+    },
 }

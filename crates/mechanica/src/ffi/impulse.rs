@@ -1,18 +1,37 @@
-//! C entry points of the impulse-dynamics crate.
+//! C entry points of the impulse-dynamics crate: impulses on points and bodies, point
+//! collisions, fixation and two-body frictional impacts (syllabus 5c–d, 7h–j).
+//!
+//! Bodies cross the boundary as plain data in *inverse* form ([`mech_impulse_body_t`]):
+//! inverse mass and inverse central inertia in world axes, so an infinite mass or a locked
+//! axis is a zero, plus an optional hinge. All vectors are in the world frame W.
 
 use super::boundary::{FfiError, boundary};
+use super::mass::mech_mass_properties_t;
 use super::status::*;
+use super::types::*;
 use super::validate::*;
-use mechanica_impulse::ImpulseError;
-use mechanica_impulse::point::collide_collinear;
+use mechanica_impulse::point::{collide_collinear, collide_points, impulse_on_point};
+use mechanica_impulse::{
+    ContactLaw, ContactMode, ImpactOptions, ImpulseError, RestitutionLaw, RigidBody, fix_point, resolve_contact,
+};
+use mechanica_kinematics::nalgebra::{Matrix3, Vector3};
+use mechanica_mass::MassProperties;
 
 impl From<ImpulseError> for FfiError {
     fn from(error: ImpulseError) -> Self {
         let status = match error {
             ImpulseError::NonFinite { .. } => MECH_STATUS_NON_FINITE,
-            ImpulseError::NonPositiveMass { .. } | ImpulseError::RestitutionOutOfRange(_) => {
-                MECH_STATUS_INVALID_ARGUMENT
-            }
+            ImpulseError::NonPositiveMass { .. }
+            | ImpulseError::NegativeInverseMass { .. }
+            | ImpulseError::RestitutionOutOfRange(_)
+            | ImpulseError::NegativeFriction(_)
+            | ImpulseError::NotUnit { .. }
+            | ImpulseError::ZeroInertiaAxisExcited { .. }
+            | ImpulseError::ConstraintViolated { .. } => MECH_STATUS_INVALID_ARGUMENT,
+            ImpulseError::InvalidInertia { .. } => MECH_STATUS_NOT_POSITIVE_DEFINITE,
+            ImpulseError::Singular { .. } => MECH_STATUS_SINGULAR,
+            ImpulseError::NotConverged { .. } => MECH_STATUS_NOT_CONVERGED,
+            ImpulseError::DimensionMismatch { .. } => MECH_STATUS_BAD_DIMENSION,
         };
         FfiError::new(status, error.to_string())
     }
@@ -55,6 +74,465 @@ pub unsafe extern "C" fn mech_collide_collinear(
             v2_after: r.v2_after,
             impulse_on_2: r.impulse_on_2,
             energy_change: r.energy_change,
+        };
+        // SAFETY: caller's contract.
+        unsafe { out.write(value) };
+        Ok(())
+    })
+}
+
+/// The response of a point mass to an impulse (5.13, 7.106).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_point_impulse_t {
+    /// Velocity just after, V = v + S/m (m/s).
+    pub velocity_after: mech_vec3_t,
+    /// ΔT = ½ S·(V + v) (J).
+    pub energy_change: f64,
+}
+
+/// Applies the impulse `impulse` (N·s) to a point of mass `mass` moving at `velocity`
+/// (5.10–5.15): the momentum jumps by the impulse; the position does not change.
+///
+/// # Safety
+/// `velocity` and `impulse` must be readable, `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_impulse_on_point(
+    mass: f64,
+    velocity: *const mech_vec3_t,
+    impulse: *const mech_vec3_t,
+    out: *mut mech_point_impulse_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let (v, s) = unsafe { (read(velocity, "velocity")?, read(impulse, "impulse")?) };
+        let out = Out::new(out, "out")?;
+        let r = impulse_on_point(mass, &v.into(), &s.into())?;
+        let value = mech_point_impulse_t {
+            velocity_after: r.v_after.into(),
+            energy_change: r.energy_change,
+        };
+        // SAFETY: caller's contract.
+        unsafe { out.write(value) };
+        Ok(())
+    })
+}
+
+/// The outcome of a 3-D collision of two smooth point masses along a normal.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_point_impact_t {
+    /// Velocity of point 1 after the impact (m/s).
+    pub velocity_after_1: mech_vec3_t,
+    /// Velocity of point 2 after the impact (m/s).
+    pub velocity_after_2: mech_vec3_t,
+    /// Impulse on point 2, along the normal (N·s); point 1 receives its negative.
+    pub impulse_on_2: mech_vec3_t,
+    /// Kinetic-energy change (J), −½(1 − λ²) μ (approach speed)² (5.23).
+    pub energy_change: f64,
+}
+
+/// Collides two smooth point masses (spheres) along the unit `normal` pointing from point 1 to
+/// point 2, with restitution λ ∈ [0, 1] (5.16–5.23 on the normal components). Points that do
+/// not approach receive no impulse.
+///
+/// # Safety
+/// `v1`, `v2` and `normal` must be readable, `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_collide_points(
+    m1: f64,
+    v1: *const mech_vec3_t,
+    m2: f64,
+    v2: *const mech_vec3_t,
+    normal: *const mech_vec3_t,
+    restitution: f64,
+    out: *mut mech_point_impact_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let (a, b, n) = unsafe { (read(v1, "v1")?, read(v2, "v2")?, read(normal, "normal")?) };
+        let out = Out::new(out, "out")?;
+        let r = collide_points(m1, &a.into(), m2, &b.into(), &n.into(), restitution)?;
+        let value = mech_point_impact_t {
+            velocity_after_1: r.v1_after.into(),
+            velocity_after_2: r.v2_after.into(),
+            impulse_on_2: r.impulse_on_2.into(),
+            energy_change: r.energy_change,
+        };
+        // SAFETY: caller's contract.
+        unsafe { out.write(value) };
+        Ok(())
+    })
+}
+
+/// How a body is held during an impact (int32).
+pub type mech_body_constraint_t = i32;
+/// The body is free.
+pub const MECH_BODY_FREE: mech_body_constraint_t = 0;
+/// The body is held by a spherical hinge at `hinge_point` (world-fixed) (7.87*–7.91*).
+pub const MECH_BODY_HINGE_POINT: mech_body_constraint_t = 1;
+/// The body can only rotate about the unit `hinge_axis` through `hinge_point` (7.87*–7.91*).
+pub const MECH_BODY_HINGE_AXIS: mech_body_constraint_t = 2;
+
+/// Which relation ends restitution in a frictional impact (int32).
+pub type mech_restitution_law_t = i32;
+/// Newton's kinematic law u_n⁺ = −e u_n⁻ (7.94); may gain energy with friction (Kane's paradox).
+pub const MECH_RESTITUTION_NEWTON: mech_restitution_law_t = 0;
+/// Poisson's kinetic law: restitution impulse = e × compression impulse.
+pub const MECH_RESTITUTION_POISSON: mech_restitution_law_t = 1;
+/// Stronge's energetic law: restitution work = −e² × compression work; never gains energy.
+/// The recommended default.
+pub const MECH_RESTITUTION_STRONGE: mech_restitution_law_t = 2;
+
+/// The contact mode of an impact (int32), as reported in ::mech_impact_result_t.
+pub type mech_contact_mode_t = i32;
+/// No impulse: the contact was separating or grazing.
+pub const MECH_CONTACT_NO_IMPACT: mech_contact_mode_t = 0;
+/// Smooth contact (friction 0).
+pub const MECH_CONTACT_FRICTIONLESS: mech_contact_mode_t = 1;
+/// The contact stuck from the start (or friction = +inf).
+pub const MECH_CONTACT_STICK: mech_contact_mode_t = 2;
+/// The contact slipped throughout (possibly swerving in 3-D).
+pub const MECH_CONTACT_SLIP: mech_contact_mode_t = 3;
+/// The slip halted and the contact stuck for the rest of the impact.
+pub const MECH_CONTACT_SLIP_THEN_STICK: mech_contact_mode_t = 4;
+/// The slip halted and resumed in a new direction (reversal).
+pub const MECH_CONTACT_REVERSED: mech_contact_mode_t = 5;
+
+struct Constraint(mech_body_constraint_t);
+impl CEnum for Constraint {
+    fn from_c(raw: i32) -> Option<Self> {
+        matches!(raw, MECH_BODY_FREE | MECH_BODY_HINGE_POINT | MECH_BODY_HINGE_AXIS).then_some(Constraint(raw))
+    }
+}
+impl CEnum for RestitutionLaw {
+    fn from_c(raw: i32) -> Option<Self> {
+        match raw {
+            MECH_RESTITUTION_NEWTON => Some(RestitutionLaw::Newton),
+            MECH_RESTITUTION_POISSON => Some(RestitutionLaw::Poisson),
+            MECH_RESTITUTION_STRONGE => Some(RestitutionLaw::Stronge),
+            _ => None,
+        }
+    }
+}
+
+fn mode_to_c(mode: ContactMode) -> mech_contact_mode_t {
+    match mode {
+        ContactMode::NoImpact => MECH_CONTACT_NO_IMPACT,
+        ContactMode::Frictionless => MECH_CONTACT_FRICTIONLESS,
+        ContactMode::Stick => MECH_CONTACT_STICK,
+        ContactMode::Slip => MECH_CONTACT_SLIP,
+        ContactMode::SlipThenStick => MECH_CONTACT_SLIP_THEN_STICK,
+        ContactMode::Reversed => MECH_CONTACT_REVERSED,
+    }
+}
+
+/// A rigid body at the instant of an impact, in inverse form (world frame W). Infinite mass
+/// is `inverse_mass = 0`; a locked rotation axis is a zero eigenvalue of `inverse_inertia`; a
+/// static body has both zero. For rods and point masses use the pseudo-inverse of the central
+/// inertia (see mech_impulse_body_from_mass_properties): the zero-inertia axis then acts as
+/// locked, which is exact when every impulse passes through that axis.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_impulse_body_t {
+    /// 1/m (1/kg), ≥ 0.
+    pub inverse_mass: f64,
+    /// Inverse central inertia J₀⁻¹ in world axes (1/(kg·m²)), symmetric positive semidefinite, column-major.
+    pub inverse_inertia: mech_mat3_t,
+    /// Centre of mass p_WC (m).
+    pub center_of_mass: mech_vec3_t,
+    /// Velocity of the centre of mass just before the impact (m/s).
+    pub velocity: mech_vec3_t,
+    /// Angular velocity just before the impact (rad/s).
+    pub angular_velocity: mech_vec3_t,
+    /// A MECH_BODY_* value: free or hinged.
+    pub constraint: mech_body_constraint_t,
+    /// The world-fixed hinge point (used by MECH_BODY_HINGE_POINT and MECH_BODY_HINGE_AXIS).
+    pub hinge_point: mech_vec3_t,
+    /// The unit hinge axis (used by MECH_BODY_HINGE_AXIS).
+    pub hinge_axis: mech_vec3_t,
+}
+
+/// Validates a C body description and builds the Rust body.
+fn body_from_c(b: &mech_impulse_body_t, what: &str) -> Result<RigidBody, FfiError> {
+    finite(&b.inverse_mass, &format!("{what}.inverse_mass"))?;
+    finite(&b.inverse_inertia, &format!("{what}.inverse_inertia"))?;
+    finite(&b.center_of_mass, &format!("{what}.center_of_mass"))?;
+    finite(&b.velocity, &format!("{what}.velocity"))?;
+    finite(&b.angular_velocity, &format!("{what}.angular_velocity"))?;
+    let Constraint(kind) = enum_value::<Constraint>(b.constraint, &format!("{what}.constraint"))?;
+    let body = RigidBody::from_inverse(
+        b.inverse_mass,
+        &Matrix3::from(b.inverse_inertia),
+        b.center_of_mass.into(),
+        b.velocity.into(),
+        b.angular_velocity.into(),
+    )?;
+    let body = match kind {
+        MECH_BODY_HINGE_POINT => {
+            finite(&b.hinge_point, &format!("{what}.hinge_point"))?;
+            body.hinged_at_point(&b.hinge_point.into())?
+        }
+        MECH_BODY_HINGE_AXIS => {
+            finite(&b.hinge_point, &format!("{what}.hinge_point"))?;
+            finite(&b.hinge_axis, &format!("{what}.hinge_axis"))?;
+            body.hinged_on_axis(&b.hinge_point.into(), &b.hinge_axis.into())?
+        }
+        _ => body,
+    };
+    Ok(body)
+}
+
+/// Builds a free ::mech_impulse_body_t from mass properties expressed in the world frame
+/// (centre of mass p_WC, central inertia in W axes) and the velocities just before the impact.
+/// The inverse inertia is the pseudo-inverse (eigenvalues ≤ 1e-12·λ_max count as zero), so
+/// rods and point masses are accepted.
+///
+/// # Safety
+/// `properties`, `velocity` and `angular_velocity` must be readable, `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_impulse_body_from_mass_properties(
+    properties: *const mech_mass_properties_t,
+    velocity: *const mech_vec3_t,
+    angular_velocity: *const mech_vec3_t,
+    out: *mut mech_impulse_body_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let (m, v, w) = unsafe {
+            (
+                read(properties, "properties")?,
+                read(velocity, "velocity")?,
+                read(angular_velocity, "angular_velocity")?,
+            )
+        };
+        let out = Out::new(out, "out")?;
+        finite(&m.mass, "properties.mass")?;
+        finite(&m.center_of_mass, "properties.center_of_mass")?;
+        finite(&m.inertia_about_com, "properties.inertia_about_com")?;
+        finite(&v, "velocity")?;
+        finite(&w, "angular_velocity")?;
+        let mut props = MassProperties::point(m.mass, m.center_of_mass.into())?;
+        props.inertia_c = Matrix3::from(m.inertia_about_com);
+        let body = RigidBody::from_mass_properties(&props, v.into(), w.into())?;
+        let g = body.mobility();
+        let value = mech_impulse_body_t {
+            inverse_mass: g[(0, 0)],
+            inverse_inertia: Matrix3::from(g.fixed_view::<3, 3>(3, 3)).into(),
+            center_of_mass: body.p_wc().into(),
+            velocity: v,
+            angular_velocity: w,
+            constraint: MECH_BODY_FREE,
+            hinge_point: mech_vec3_t::default(),
+            hinge_axis: mech_vec3_t::default(),
+        };
+        // SAFETY: caller's contract.
+        unsafe { out.write(value) };
+        Ok(())
+    })
+}
+
+/// The response of one body to an impulse.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_body_response_t {
+    /// Velocity of the centre of mass just after (m/s).
+    pub velocity_after: mech_vec3_t,
+    /// Angular velocity just after (rad/s).
+    pub angular_velocity_after: mech_vec3_t,
+    /// ΔT = ½ S·(V₀ + v₀) + ½ M₀S·(Ω + ω) (7.107) (J).
+    pub energy_change: f64,
+}
+
+/// Applies the impulse `impulse` at the world point `point` together with the impulsive moment
+/// `moment_about_point` about that point to `body` (7.61–7.71). For a hinged body the hinge
+/// impulse is included (it does no work).
+///
+/// # Safety
+/// All pointers must be readable, `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_impulse_apply(
+    body: *const mech_impulse_body_t,
+    impulse: *const mech_vec3_t,
+    point: *const mech_vec3_t,
+    moment_about_point: *const mech_vec3_t,
+    out: *mut mech_body_response_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let (b, s, p, m) = unsafe {
+            (
+                read(body, "body")?,
+                read(impulse, "impulse")?,
+                read(point, "point")?,
+                read(moment_about_point, "moment_about_point")?,
+            )
+        };
+        let out = Out::new(out, "out")?;
+        let body = body_from_c(&b, "body")?;
+        let r = body.apply_impulse_at(&s.into(), &p.into(), &m.into())?;
+        let value = mech_body_response_t {
+            velocity_after: r.v_wc_after.into(),
+            angular_velocity_after: r.w_w_after.into(),
+            energy_change: r.energy_change,
+        };
+        // SAFETY: caller's contract.
+        unsafe { out.write(value) };
+        Ok(())
+    })
+}
+
+/// The outcome of fixing a body point (7.100–7.108).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_fixation_t {
+    /// The impulse S applied at the fixed point (N·s).
+    pub impulse: mech_vec3_t,
+    /// Velocity of the centre of mass after (m/s).
+    pub velocity_after: mech_vec3_t,
+    /// Angular velocity after, Ω (rad/s).
+    pub angular_velocity_after: mech_vec3_t,
+    /// ΔT = ½ S·v (7.108) (J).
+    pub energy_change: f64,
+    /// |velocity of the point| after, as computed (m/s): a check of the solve.
+    pub residual: f64,
+}
+
+/// Brings the body point at `point` to rest by a single impulse at that point (7.100–7.108).
+/// MECH_STATUS_SINGULAR if the point cannot be stopped (e.g. a moving body of infinite mass).
+///
+/// # Safety
+/// `body` and `point` must be readable, `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_impulse_fix_point(
+    body: *const mech_impulse_body_t,
+    point: *const mech_vec3_t,
+    out: *mut mech_fixation_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let (b, p) = unsafe { (read(body, "body")?, read(point, "point")?) };
+        let out = Out::new(out, "out")?;
+        finite(&p, "point")?;
+        let body = body_from_c(&b, "body")?;
+        let r = fix_point(&body, &p.into())?;
+        let value = mech_fixation_t {
+            impulse: r.impulse_w.into(),
+            velocity_after: r.v_wc_after.into(),
+            angular_velocity_after: r.w_w_after.into(),
+            energy_change: r.energy_change,
+            residual: r.residual,
+        };
+        // SAFETY: caller's contract.
+        unsafe { out.write(value) };
+        Ok(())
+    })
+}
+
+/// A point contact between body 1 and body 2 and its material law.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_impulse_contact_t {
+    /// The contact point R (world frame, m).
+    pub point: mech_vec3_t,
+    /// The unit normal pointing from body 1 into body 2 (|n| = 1 within 1e-9).
+    pub normal: mech_vec3_t,
+    /// Coefficient of restitution e ∈ [0, 1].
+    pub restitution: f64,
+    /// Coulomb friction coefficient f ≥ 0; +INFINITY means the contact cannot slip.
+    pub friction: f64,
+    /// A MECH_RESTITUTION_* value.
+    pub law: mech_restitution_law_t,
+    /// Relative tolerance of the 3-D swerving-slip integration (> 0, e.g. 1e-10).
+    pub tolerance: f64,
+}
+
+/// The outcome of a two-body point impact.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_impact_result_t {
+    /// Impulse P on body 2 (body 1 receives −P) (N·s).
+    pub impulse: mech_vec3_t,
+    /// Normal impulse P·n ≥ 0 (N·s).
+    pub normal_impulse: f64,
+    /// Tangential (friction) impulse P − (P·n) n (N·s).
+    pub tangential_impulse: mech_vec3_t,
+    /// Normal impulse at the end of compression (N·s).
+    pub compression_impulse: f64,
+    /// Relative velocity of the contact point (body 2 minus body 1) after the impact (m/s).
+    pub relative_velocity_after: mech_vec3_t,
+    /// A MECH_CONTACT_* value.
+    pub mode: mech_contact_mode_t,
+    /// Body 1 centre-of-mass velocity after (m/s).
+    pub velocity_after_1: mech_vec3_t,
+    /// Body 1 angular velocity after (rad/s).
+    pub angular_velocity_after_1: mech_vec3_t,
+    /// Body 2 centre-of-mass velocity after (m/s).
+    pub velocity_after_2: mech_vec3_t,
+    /// Body 2 angular velocity after (rad/s).
+    pub angular_velocity_after_2: mech_vec3_t,
+    /// Total kinetic-energy change ΔT = P·(u⁻ + ½ W P) (J).
+    pub energy_change: f64,
+    /// Estimated error of the impulse from the swerving-slip integration (N·s); 0 if exact.
+    pub integration_error: f64,
+    /// Integration steps plus closed-form segments used.
+    pub steps: u64,
+}
+
+/// Resolves the impact of `body1` and `body2` at `contact` (7.72–7.99): smooth or rough
+/// (isotropic Coulomb, with stick, slip, halting, reversal and 3-D swerving slip) with the
+/// selected restitution law. MECH_STATUS_INVALID_ARGUMENT for a non-unit normal, restitution
+/// outside [0, 1] or negative friction; MECH_STATUS_BAD_ENUM for an unknown law or constraint;
+/// MECH_STATUS_SINGULAR when neither body can move along the normal; MECH_STATUS_NOT_CONVERGED
+/// for a frictional jam.
+///
+/// # Safety
+/// `body1`, `body2` and `contact` must be readable, `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_impulse_resolve_contact(
+    body1: *const mech_impulse_body_t,
+    body2: *const mech_impulse_body_t,
+    contact: *const mech_impulse_contact_t,
+    out: *mut mech_impact_result_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let (b1, b2, c) = unsafe { (read(body1, "body1")?, read(body2, "body2")?, read(contact, "contact")?) };
+        let out = Out::new(out, "out")?;
+        let body1 = body_from_c(&b1, "body1")?;
+        let body2 = body_from_c(&b2, "body2")?;
+        finite(&c.point, "contact.point")?;
+        finite(&c.normal, "contact.normal")?;
+        finite(&c.restitution, "contact.restitution")?;
+        finite(&c.tolerance, "contact.tolerance")?;
+        let law = enum_value::<RestitutionLaw>(c.law, "contact.law")?;
+        let law = ContactLaw::new(c.restitution, c.friction, law)?;
+        if c.tolerance <= 0.0 {
+            return Err(FfiError::new(
+                MECH_STATUS_INVALID_ARGUMENT,
+                format!("contact.tolerance must be positive, got {}", c.tolerance),
+            ));
+        }
+        let options = ImpactOptions {
+            tolerance: c.tolerance,
+            ..ImpactOptions::default()
+        };
+        let point: Vector3<f64> = c.point.into();
+        let r = resolve_contact(&body1, &body2, &point, &c.normal.into(), &law, &options)?;
+        let value = mech_impact_result_t {
+            impulse: r.contact.impulse_w.into(),
+            normal_impulse: r.contact.normal_impulse,
+            tangential_impulse: r.contact.tangential_impulse_w.into(),
+            compression_impulse: r.contact.compression_impulse,
+            relative_velocity_after: r.contact.u_after_w.into(),
+            mode: mode_to_c(r.contact.mode),
+            velocity_after_1: r.body1.v_wc_after.into(),
+            angular_velocity_after_1: r.body1.w_w_after.into(),
+            velocity_after_2: r.body2.v_wc_after.into(),
+            angular_velocity_after_2: r.body2.w_w_after.into(),
+            energy_change: r.contact.energy_change,
+            integration_error: r.contact.integration_error,
+            steps: r.contact.steps as u64,
         };
         // SAFETY: caller's contract.
         unsafe { out.write(value) };

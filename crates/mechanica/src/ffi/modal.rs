@@ -1,20 +1,170 @@
-//! C entry points of the modal-analysis crate.
+//! C entry points of the modal-analysis crate: det(λA + B) = 0 (8.89) on caller matrices,
+//! an opaque result handle, and accessors that copy into caller buffers.
 
 use super::boundary::{FfiError, boundary};
 use super::status::*;
 use super::validate::*;
 use mechanica_modal::faer::MatRef;
-use mechanica_modal::{ModalError, PencilProblem};
+use mechanica_modal::{
+    Method, ModalError, ModalSolution, ModeKind, PencilProblem, Refinement, Selection, SolveOptions, count_below, solve,
+};
 
 impl From<ModalError> for FfiError {
     fn from(error: ModalError) -> Self {
         let status = match error {
             ModalError::BadShape { .. } => MECH_STATUS_BAD_DIMENSION,
-            ModalError::NonFinite { .. } => MECH_STATUS_NON_FINITE,
-            ModalError::NotSymmetric { .. } => MECH_STATUS_INVALID_ARGUMENT,
+            ModalError::NonFinite { .. } | ModalError::BadShift(_) => MECH_STATUS_NON_FINITE,
+            ModalError::NotSymmetric { .. } | ModalError::BadInterval { .. } | ModalError::TooManyModes { .. } => {
+                MECH_STATUS_INVALID_ARGUMENT
+            }
+            ModalError::IndefiniteMass { .. } => MECH_STATUS_NOT_POSITIVE_DEFINITE,
+            ModalError::SingularPencil { .. } => MECH_STATUS_SINGULAR,
+            ModalError::NoConvergence { .. } => MECH_STATUS_NOT_CONVERGED,
         };
         FfiError::new(status, error.to_string())
     }
+}
+
+/// Which modes a solve returns (int32_t; see MECH_MODAL_SELECTION_*).
+pub type mech_modal_selection_t = i32;
+/// Every finite mode, plus the infinite (massless) ones when A is singular.
+pub const MECH_MODAL_SELECTION_ALL: mech_modal_selection_t = 0;
+/// The `count` finite modes of lowest ω² (unstable modes count as lowest).
+pub const MECH_MODAL_SELECTION_LOWEST: mech_modal_selection_t = 1;
+/// The finite modes with `lower` ≤ ω² ≤ `upper`.
+pub const MECH_MODAL_SELECTION_INTERVAL: mech_modal_selection_t = 2;
+
+/// Low-mode refinement policy (int32_t; see MECH_MODAL_REFINEMENT_*).
+pub type mech_modal_refinement_t = i32;
+/// Refine modes whose reduction bound guarantees fewer than 8 digits (stiff problems).
+pub const MECH_MODAL_REFINEMENT_AUTO: mech_modal_refinement_t = 0;
+/// Never refine.
+pub const MECH_MODAL_REFINEMENT_OFF: mech_modal_refinement_t = 1;
+/// Refine every simple finite mode.
+pub const MECH_MODAL_REFINEMENT_ALWAYS: mech_modal_refinement_t = 2;
+
+/// Classification of a mode (int32_t; see MECH_MODAL_KIND_*).
+pub type mech_modal_kind_t = i32;
+/// λ < 0: oscillates at ω = √(−λ) rad/s.
+pub const MECH_MODAL_KIND_OSCILLATORY: mech_modal_kind_t = 0;
+/// |λ| within its error bound: rigid-body (zero-frequency) mode.
+pub const MECH_MODAL_KIND_ZERO: mech_modal_kind_t = 1;
+/// λ > 0: unstable equilibrium, growth rate √λ (1/s).
+pub const MECH_MODAL_KIND_UNSTABLE: mech_modal_kind_t = 2;
+/// Massless direction (A x = 0): infinite frequency.
+pub const MECH_MODAL_KIND_INFINITE: mech_modal_kind_t = 3;
+
+struct SelectionTag(i32);
+impl CEnum for SelectionTag {
+    fn from_c(raw: i32) -> Option<Self> {
+        matches!(
+            raw,
+            MECH_MODAL_SELECTION_ALL | MECH_MODAL_SELECTION_LOWEST | MECH_MODAL_SELECTION_INTERVAL
+        )
+        .then_some(SelectionTag(raw))
+    }
+}
+
+impl CEnum for Refinement {
+    fn from_c(raw: i32) -> Option<Self> {
+        match raw {
+            MECH_MODAL_REFINEMENT_AUTO => Some(Refinement::Auto),
+            MECH_MODAL_REFINEMENT_OFF => Some(Refinement::Off),
+            MECH_MODAL_REFINEMENT_ALWAYS => Some(Refinement::Always),
+            _ => None,
+        }
+    }
+}
+
+/// Options of mech_modal_solve.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct mech_modal_options_t {
+    /// A MECH_MODAL_SELECTION_* value.
+    pub selection: mech_modal_selection_t,
+    /// Number of modes for MECH_MODAL_SELECTION_LOWEST (ignored otherwise).
+    pub count: usize,
+    /// Lower end of ω² (rad²/s²) for MECH_MODAL_SELECTION_INTERVAL (ignored otherwise).
+    pub lower: f64,
+    /// Upper end of ω² for MECH_MODAL_SELECTION_INTERVAL (ignored otherwise).
+    pub upper: f64,
+    /// 1: compute mode shapes; 0: values only.
+    pub vectors: i32,
+    /// A MECH_MODAL_REFINEMENT_* value.
+    pub refinement: mech_modal_refinement_t,
+}
+
+/// Scalar data of one mode.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_modal_mode_t {
+    /// λ of det(λA + B) = 0 (= −ω²); −HUGE_VAL for an infinite mode.
+    pub lambda: f64,
+    /// ω² = −λ (rad²/s²); +HUGE_VAL for an infinite mode.
+    pub omega_sq: f64,
+    /// ω (rad/s) for an oscillatory mode, the growth rate √λ (1/s) for an unstable one, 0 for a
+    /// zero mode, +HUGE_VAL for an infinite one.
+    pub rate: f64,
+    /// Bound on |ω²_computed − ω²_exact|.
+    pub error_bound: f64,
+    /// Backward error η of the pair, or −1 when not available (values only, infinite mode).
+    pub backward_error: f64,
+    /// A MECH_MODAL_KIND_* value.
+    pub kind: mech_modal_kind_t,
+    /// Index of the mode's group of equal frequencies (modes of a group are consecutive).
+    pub group: usize,
+    /// Multiplicity of that group.
+    pub multiplicity: usize,
+}
+
+/// Summary of the accuracy report of a solve.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_modal_accuracy_t {
+    /// ‖A‖_F.
+    pub norm_a: f64,
+    /// ‖B‖_F.
+    pub norm_b: f64,
+    /// Largest backward error η of the pairs, or −1 for values only.
+    pub max_backward_error: f64,
+    /// max |(XᵀAX − I)_ij| over the finite modes, or −1 for values only.
+    pub orthogonality_error: f64,
+    /// Largest error bound of the modes (0 when there are none).
+    pub max_error_bound: f64,
+    /// Number of modes refined with extended-precision residuals.
+    pub refined_modes: usize,
+    /// 1 when a Sturm (LBLᵀ inertia) check was made.
+    pub inertia_checked: i32,
+    /// 1 when that check agreed with the computed spectrum.
+    pub inertia_consistent: i32,
+    /// The check's shift s (ω², rad²/s²).
+    pub inertia_shift: f64,
+    /// Modes with ω² < s by the inertia of B − sA.
+    pub inertia_below: usize,
+    /// Modes with ω² < s among the computed ones.
+    pub computed_below: usize,
+    /// Number of massless directions condensed out (infinite modes).
+    pub massless: usize,
+}
+
+/// The opaque result of mech_modal_solve. Free it with mech_modal_result_destroy.
+pub struct mech_modal_result_t {
+    n: usize,
+    solution: ModalSolution,
+}
+
+/// Reads the pencil (A, B) of order n from caller column-major arrays.
+///
+/// # Safety
+/// `a` and `b` must each point to n·n readable doubles.
+unsafe fn read_pencil(n: usize, a: *const f64, b: *const f64) -> Result<PencilProblem, FfiError> {
+    let len = square_len(n, "n")?;
+    // SAFETY: caller's contract.
+    let (a, b) = unsafe { (read_slice(a, len, "a")?, read_slice(b, len, "b")?) };
+    Ok(PencilProblem::new(
+        MatRef::from_column_major_slice(a, n, n),
+        MatRef::from_column_major_slice(b, n, n),
+    )?)
 }
 
 /// Checks that the n×n column-major matrices `a` (mass) and `b` (stiffness) form a valid
@@ -25,13 +175,293 @@ impl From<ModalError> for FfiError {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mech_modal_check_pencil(n: usize, a: *const f64, b: *const f64) -> mech_status_t {
     boundary(|| {
-        let len = square_len(n, "n")?;
         // SAFETY: caller's contract.
-        let (a, b) = unsafe { (read_slice(a, len, "a")?, read_slice(b, len, "b")?) };
-        PencilProblem::new(
-            MatRef::from_column_major_slice(a, n, n),
-            MatRef::from_column_major_slice(b, n, n),
+        unsafe { read_pencil(n, a, b) }?;
+        Ok(())
+    })
+}
+
+/// Solves det(λA + B) = 0 (8.89) for the n×n column-major mass matrix `a` (symmetric positive
+/// semidefinite) and stiffness matrix `b` (symmetric), with the given options, and stores a new
+/// result handle in `*out`. Errors: MECH_STATUS_NOT_POSITIVE_DEFINITE when A is indefinite,
+/// MECH_STATUS_SINGULAR when det(λA + B) ≡ 0, MECH_STATUS_INVALID_ARGUMENT for an asymmetric
+/// matrix, a bad interval, `vectors` not 0/1 or more modes than exist.
+///
+/// # Safety
+/// `a` and `b` must each point to n·n readable doubles; `options` to a readable
+/// mech_modal_options_t; `out` to a writable pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_modal_solve(
+    n: usize,
+    a: *const f64,
+    b: *const f64,
+    options: *const mech_modal_options_t,
+    out: *mut *mut mech_modal_result_t,
+) -> mech_status_t {
+    boundary(|| {
+        let out = Out::new(out, "out")?;
+        // SAFETY: caller's contract.
+        let opts = unsafe { read(options, "options") }?;
+        let SelectionTag(tag) = enum_value(opts.selection, "options.selection")?;
+        let refinement = enum_value(opts.refinement, "options.refinement")?;
+        let selection = match tag {
+            MECH_MODAL_SELECTION_LOWEST => Selection::Lowest(opts.count),
+            MECH_MODAL_SELECTION_INTERVAL => {
+                finite(&opts.lower, "options.lower")?;
+                finite(&opts.upper, "options.upper")?;
+                Selection::Interval {
+                    lower: opts.lower,
+                    upper: opts.upper,
+                }
+            }
+            _ => Selection::All,
+        };
+        let vectors = match opts.vectors {
+            0 => false,
+            1 => true,
+            other => {
+                return Err(FfiError::new(
+                    MECH_STATUS_INVALID_ARGUMENT,
+                    format!("options.vectors must be 0 or 1, got {other}"),
+                ));
+            }
+        };
+        // SAFETY: caller's contract.
+        let problem = unsafe { read_pencil(n, a, b) }?;
+        let solution = solve(
+            &problem,
+            &SolveOptions {
+                selection,
+                vectors,
+                refinement,
+            },
         )?;
+        let handle = Box::into_raw(Box::new(mech_modal_result_t { n, solution }));
+        // SAFETY: `out` was checked writable by the caller's contract.
+        unsafe { out.write(handle) };
+        Ok(())
+    })
+}
+
+/// Frees a result of mech_modal_solve. NULL is accepted and ignored.
+///
+/// # Safety
+/// `result` must be NULL or a handle from mech_modal_solve not yet destroyed.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_modal_result_destroy(result: *mut mech_modal_result_t) {
+    if !result.is_null() {
+        // SAFETY: the handle came from Box::into_raw in mech_modal_solve (caller's contract).
+        drop(unsafe { Box::from_raw(result) });
+    }
+}
+
+/// Borrows the result behind a handle.
+///
+/// # Safety
+/// A non-NULL `result` must be a live handle from mech_modal_solve.
+unsafe fn borrow<'a>(result: *const mech_modal_result_t) -> Result<&'a mech_modal_result_t, FfiError> {
+    if result.is_null() {
+        return Err(FfiError::new(MECH_STATUS_NULL_POINTER, "result is NULL"));
+    }
+    // SAFETY: non-NULL; live by the caller's contract.
+    Ok(unsafe { &*result })
+}
+
+fn check_capacity(capacity: usize, needed: usize, what: &str) -> Result<(), FfiError> {
+    if capacity < needed {
+        return Err(FfiError::new(
+            MECH_STATUS_BUFFER_TOO_SMALL,
+            format!("{what}: capacity {capacity} < {needed} needed"),
+        ));
+    }
+    Ok(())
+}
+
+/// Stores the number of modes in `*modes` and the order n of the pencil in `*dim`.
+///
+/// # Safety
+/// `result` must be a live handle; `modes` and `dim` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_modal_result_size(
+    result: *const mech_modal_result_t,
+    modes: *mut usize,
+    dim: *mut usize,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let r = unsafe { borrow(result) }?;
+        let (m_out, d_out) = (Out::new(modes, "modes")?, Out::new(dim, "dim")?);
+        // SAFETY: checked writable.
+        unsafe {
+            m_out.write(r.solution.modes.len());
+            d_out.write(r.n);
+        }
+        Ok(())
+    })
+}
+
+/// Copies λ_k (= −ω²_k) of every mode, ascending in ω², into `lambda` (capacity ≥ number of
+/// modes, else MECH_STATUS_BUFFER_TOO_SMALL and nothing written).
+///
+/// # Safety
+/// `result` must be a live handle; `lambda` must have `capacity` writable doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_modal_result_eigenvalues(
+    result: *const mech_modal_result_t,
+    lambda: *mut f64,
+    capacity: usize,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let r = unsafe { borrow(result) }?;
+        let m = r.solution.modes.len();
+        check_capacity(capacity, m, "lambda")?;
+        let out = OutSlice::new(lambda, m, "lambda")?;
+        let values: Vec<f64> = r.solution.modes.iter().map(|mode| mode.lambda).collect();
+        // SAFETY: checked for m writable elements.
+        unsafe { out.write(&values) };
+        Ok(())
+    })
+}
+
+/// Copies the scalar data of every mode into `modes` (capacity ≥ number of modes).
+///
+/// # Safety
+/// `result` must be a live handle; `modes` must have `capacity` writable elements.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_modal_result_modes(
+    result: *const mech_modal_result_t,
+    modes: *mut mech_modal_mode_t,
+    capacity: usize,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let r = unsafe { borrow(result) }?;
+        let s = &r.solution;
+        check_capacity(capacity, s.modes.len(), "modes")?;
+        let out = OutSlice::new(modes, s.modes.len(), "modes")?;
+        let values: Vec<mech_modal_mode_t> = s
+            .modes
+            .iter()
+            .map(|m| {
+                let (kind, rate) = match m.kind {
+                    ModeKind::Oscillatory { omega } => (MECH_MODAL_KIND_OSCILLATORY, omega),
+                    ModeKind::Zero => (MECH_MODAL_KIND_ZERO, 0.0),
+                    ModeKind::Unstable { growth_rate } => (MECH_MODAL_KIND_UNSTABLE, growth_rate),
+                    ModeKind::Infinite => (MECH_MODAL_KIND_INFINITE, f64::INFINITY),
+                };
+                mech_modal_mode_t {
+                    lambda: m.lambda,
+                    omega_sq: m.omega_sq,
+                    rate,
+                    error_bound: m.error_bound,
+                    backward_error: m.backward_error.unwrap_or(-1.0),
+                    kind,
+                    group: m.group,
+                    multiplicity: s.groups.get(m.group).map_or(1, |g| g.multiplicity),
+                }
+            })
+            .collect();
+        // SAFETY: checked for the number of modes.
+        unsafe { out.write(&values) };
+        Ok(())
+    })
+}
+
+/// Copies the mode shapes as an n × (number of modes) column-major matrix into `x`
+/// (capacity ≥ n·modes). Finite modes are A-orthonormal; infinite ones are unit null vectors
+/// of A. MECH_STATUS_INVALID_ARGUMENT if the solve was values only.
+///
+/// # Safety
+/// `result` must be a live handle; `x` must have `capacity` writable doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_modal_result_vectors(
+    result: *const mech_modal_result_t,
+    x: *mut f64,
+    capacity: usize,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let r = unsafe { borrow(result) }?;
+        let Some(v) = r.solution.vectors.as_ref() else {
+            return Err(FfiError::new(
+                MECH_STATUS_INVALID_ARGUMENT,
+                "the solve computed values only (options.vectors = 0)",
+            ));
+        };
+        let len = v.nrows() * v.ncols();
+        check_capacity(capacity, len, "x")?;
+        let out = OutSlice::new(x, len, "x")?;
+        let mut values = Vec::with_capacity(len);
+        for j in 0..v.ncols() {
+            values.extend((0..v.nrows()).map(|i| v[(i, j)]));
+        }
+        // SAFETY: checked for len writable elements.
+        unsafe { out.write(&values) };
+        Ok(())
+    })
+}
+
+/// Copies the accuracy summary of the solve into `*accuracy`.
+///
+/// # Safety
+/// `result` must be a live handle; `accuracy` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_modal_result_accuracy(
+    result: *const mech_modal_result_t,
+    accuracy: *mut mech_modal_accuracy_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let r = unsafe { borrow(result) }?;
+        let out = Out::new(accuracy, "accuracy")?;
+        let rep = &r.solution.accuracy;
+        let check = rep.inertia_check;
+        let summary = mech_modal_accuracy_t {
+            norm_a: rep.norm_a,
+            norm_b: rep.norm_b,
+            max_backward_error: rep.max_backward_error.unwrap_or(-1.0),
+            orthogonality_error: rep.orthogonality_error.unwrap_or(-1.0),
+            max_error_bound: rep.error_bounds.iter().copied().fold(0.0, f64::max),
+            refined_modes: rep.refinement_steps.iter().filter(|&&s| s > 0).count(),
+            inertia_checked: i32::from(check.is_some()),
+            inertia_consistent: i32::from(check.is_some_and(|c| c.consistent)),
+            inertia_shift: check.map_or(0.0, |c| c.count.shift),
+            inertia_below: check.map_or(0, |c| c.count.below),
+            computed_below: check.map_or(0, |c| c.computed_below),
+            massless: match r.solution.method {
+                Method::CondensedReduction { massless } => massless,
+                Method::CholeskyReduction => 0,
+            },
+        };
+        // SAFETY: checked writable.
+        unsafe { out.write(summary) };
+        Ok(())
+    })
+}
+
+/// Stores in `*below` the number of modes with ω² < `shift`, certified by the inertia of an
+/// LBLᵀ factorization of B − shift·A (Sylvester's law; A must be positive definite for the
+/// count to equal the number of modes).
+///
+/// # Safety
+/// `a` and `b` must each point to n·n readable doubles; `below` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_modal_count_below(
+    n: usize,
+    a: *const f64,
+    b: *const f64,
+    shift: f64,
+    below: *mut usize,
+) -> mech_status_t {
+    boundary(|| {
+        let out = Out::new(below, "below")?;
+        finite(&shift, "shift")?;
+        // SAFETY: caller's contract.
+        let problem = unsafe { read_pencil(n, a, b) }?;
+        let count = count_below(&problem, shift)?;
+        // SAFETY: checked writable.
+        unsafe { out.write(count.below) };
         Ok(())
     })
 }

@@ -1,0 +1,441 @@
+//! Scene files: a TOML description of a mechanism and of the analyses requested on it.
+//!
+//! ```toml
+//! title = "double pendulum"
+//! gravity = [0.0, 0.0, -9.81]          # m/s², world frame; optional (default: none)
+//!
+//! [[body]]
+//! name = "upper"
+//! # exactly one of: mass_properties, primitive, mesh
+//! primitive = { shape = "rod", length = 1.0, mass = 1.0 }
+//! offset = [0.0, 0.0, -0.5]            # shape centre in the body (= joint) frame, m
+//!
+//! [[body]]
+//! name = "lower"
+//! mass_properties = { mass = 1.0, com = [0.0, 0.0, -0.5], inertia = [0.1, 0.1, 0.0, 0.0, 0.0, 0.0] }
+//!
+//! [[joint]]
+//! name = "shoulder"
+//! type = "revolute"                    # revolute | prismatic | spherical | free | planar | fixed
+//! parent = "ground"                    # "ground" or a body name
+//! child = "upper"
+//! axis = [0.0, 1.0, 0.0]               # revolute / prismatic / planar normal, parent frame
+//! origin = [0.0, 0.0, 0.0]             # joint frame origin in the parent frame, m
+//! q0 = [0.1]                           # initial coordinates (length = joint's q size)
+//!
+//! [analyses]                           # only what is listed is computed
+//! mass_properties = true
+//! ```
+//!
+//! `inertia` lists the six independent entries (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) about the centre
+//! of mass, in the body frame. Unknown fields are errors. Every error names the file, the line
+//! and column, and the field.
+
+use serde::Deserialize;
+use std::collections::HashMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// A scene as written in the file, after syntax and schema checks.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// The scene's title, shown in the report.
+    pub title: String,
+    /// Gravitational acceleration in the world frame, m/s².
+    pub gravity: Option<[f64; 3]>,
+    /// The bodies.
+    #[serde(default, rename = "body")]
+    pub bodies: Vec<BodySpec>,
+    /// The joints connecting them.
+    #[serde(default, rename = "joint")]
+    pub joints: Vec<JointSpec>,
+    /// The analyses requested; nothing else is computed.
+    #[serde(default)]
+    pub analyses: Analyses,
+}
+
+/// One body and the source of its mass properties.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Unique name, referenced by joints.
+    pub name: Spanned<String>,
+    /// Explicit mass properties.
+    pub mass_properties: Option<ExplicitMass>,
+    /// A primitive shape.
+    pub primitive: Option<Primitive>,
+    /// A triangle mesh file with a density.
+    pub mesh: Option<MeshSpec>,
+    /// Where the shape's own frame (its centre, for primitives) sits in the body frame, m.
+    /// The body frame is the joint frame, so a pendulum rod hanging from its hinge has
+    /// `offset = [0, 0, -L/2]`.
+    #[serde(default)]
+    pub offset: [f64; 3],
+}
+
+/// Mass, centre of mass and central inertia given explicitly, in the body frame.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExplicitMass {
+    /// Mass, kg.
+    pub mass: f64,
+    /// Centre of mass, m.
+    pub com: [f64; 3],
+    /// (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) about the centre of mass, kg·m².
+    pub inertia: [f64; 6],
+}
+
+/// A primitive body, by mass or by density (exactly one of the two).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Primitive {
+    /// rod | sphere | box | cylinder | disc | point.
+    pub shape: Spanned<String>,
+    /// Total mass, kg.
+    pub mass: Option<f64>,
+    /// Density (per length, area or volume, by the shape's dimension).
+    pub density: Option<f64>,
+    /// Length of a rod or cylinder, m.
+    pub length: Option<f64>,
+    /// Radius of a sphere, cylinder or disc, m.
+    pub radius: Option<f64>,
+    /// Edge lengths of a box, m.
+    pub size: Option<[f64; 3]>,
+}
+
+/// A mesh body: a file (STL or OBJ, relative to the scene file) and its density, kg/m³.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// Path of the mesh file.
+    pub file: Spanned<String>,
+    /// Volume density, kg/m³.
+    pub density: f64,
+}
+
+/// One joint between a parent ("ground" or a body) and a child body.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    /// Name, for reports.
+    pub name: String,
+    /// Joint type.
+    #[serde(rename = "type")]
+    pub kind: Spanned<JointKind>,
+    /// Parent body name, or "ground".
+    pub parent: Spanned<String>,
+    /// Child body name.
+    pub child: Spanned<String>,
+    /// Axis (revolute, prismatic) or plane normal (planar), in the parent frame.
+    pub axis: Option<Spanned<[f64; 3]>>,
+    /// Joint-frame origin in the parent frame, m.
+    #[serde(default)]
+    pub origin: [f64; 3],
+    /// Initial generalized coordinates.
+    pub q0: Option<Spanned<Vec<f64>>>,
+}
+
+/// The joint types of a kinematic tree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JointKind {
+    /// One rotation about an axis.
+    Revolute,
+    /// One translation along an axis.
+    Prismatic,
+    /// Three rotations about a point.
+    Spherical,
+    /// Six degrees of freedom.
+    Free,
+    /// Two translations in a plane and one rotation about its normal.
+    Planar,
+    /// No motion.
+    Fixed,
+}
+
+/// The analyses a scene asks for.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Analyses {
+    /// Mass properties of every body and of the whole mechanism.
+    #[serde(default)]
+    pub mass_properties: bool,
+}
+
+/// A scene error, located in its file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneError {
+    /// The scene file.
+    pub file: PathBuf,
+    /// 1-based line and column, when known.
+    pub position: Option<(usize, usize)>,
+    /// The field concerned, e.g. `joint[2].parent`.
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file.display())?;
+        if let Some((line, column)) = self.position {
+            write!(f, ":{line}:{column}")?;
+        }
+        if !self.field.is_empty() {
+            write!(f, ": field {}", self.field)?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// The 1-based (line, column) of a byte offset in `text`.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rfind('\n').map_or(before.len(), |nl| before.len() - nl - 1) + 1;
+    (line, column)
+}
+
+impl Scene {
+    /// Reads and validates the scene file at `path`.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+            file: path.to_path_buf(),
+            position: None,
+            field: String::new(),
+            message: format!("cannot read the scene file: {e}"),
+        })?;
+        Scene::parse(&text, path)
+    }
+
+    /// Parses and validates scene text; `file` is used in error messages.
+    pub fn parse(text: &str, file: &Path) -> Result<Scene, SceneError> {
+        let scene: Scene = toml::from_str(text).map_err(|e| SceneError {
+            file: file.to_path_buf(),
+            position: e.span().map(|s| line_column(text, s.start)),
+            field: String::new(),
+            message: e.message().trim().to_string(),
+        })?;
+        scene.validate(text, file)?;
+        Ok(scene)
+    }
+
+    /// Checks what the schema cannot: unique names, resolvable references, one parent per body,
+    /// no cycles, one mass source per body, finite numbers and unit axes.
+    fn validate(&self, text: &str, file: &Path) -> Result<(), SceneError> {
+        let error = |span: Option<std::ops::Range<usize>>, field: String, message: String| SceneError {
+            file: file.to_path_buf(),
+            position: span.map(|s| line_column(text, s.start)),
+            field,
+            message,
+        };
+        let mut index_of: HashMap<&str, usize> = HashMap::new();
+        for (i, body) in self.bodies.iter().enumerate() {
+            let name = body.name.get_ref().as_str();
+            if name == "ground" {
+                return Err(error(
+                    Some(body.name.span()),
+                    format!("body[{i}].name"),
+                    "\"ground\" is reserved".into(),
+                ));
+            }
+            if index_of.insert(name, i).is_some() {
+                return Err(error(
+                    Some(body.name.span()),
+                    format!("body[{i}].name"),
+                    format!("duplicate body name \"{name}\""),
+                ));
+            }
+            let sources = [
+                body.mass_properties.is_some(),
+                body.primitive.is_some(),
+                body.mesh.is_some(),
+            ];
+            if sources.iter().filter(|&&s| s).count() != 1 {
+                return Err(error(
+                    Some(body.name.span()),
+                    format!("body[{i}]"),
+                    "give exactly one of mass_properties, primitive, mesh".into(),
+                ));
+            }
+        }
+        let mut parent_of: Vec<Option<usize>> = vec![None; self.bodies.len()];
+        let mut has_parent = vec![false; self.bodies.len()];
+        for (j, joint) in self.joints.iter().enumerate() {
+            let child_name = joint.child.get_ref().as_str();
+            let child = *index_of.get(child_name).ok_or_else(|| {
+                error(
+                    Some(joint.child.span()),
+                    format!("joint[{j}].child"),
+                    format!("no body named \"{child_name}\""),
+                )
+            })?;
+            let parent_name = joint.parent.get_ref().as_str();
+            let parent = if parent_name == "ground" {
+                None
+            } else {
+                Some(*index_of.get(parent_name).ok_or_else(|| {
+                    error(
+                        Some(joint.parent.span()),
+                        format!("joint[{j}].parent"),
+                        format!("no body named \"{parent_name}\""),
+                    )
+                })?)
+            };
+            if has_parent[child] {
+                return Err(error(
+                    Some(joint.child.span()),
+                    format!("joint[{j}].child"),
+                    format!("body \"{child_name}\" already has a parent joint (a tree gives each body one)"),
+                ));
+            }
+            has_parent[child] = true;
+            parent_of[child] = parent;
+            let needs_axis = matches!(
+                joint.kind.get_ref(),
+                JointKind::Revolute | JointKind::Prismatic | JointKind::Planar
+            );
+            match (&joint.axis, needs_axis) {
+                (None, true) => {
+                    return Err(error(
+                        Some(joint.kind.span()),
+                        format!("joint[{j}].axis"),
+                        "this joint type needs an axis".into(),
+                    ));
+                }
+                (Some(axis), _) => {
+                    let norm = axis.get_ref().iter().map(|a| a * a).sum::<f64>().sqrt();
+                    if !norm.is_finite() || (norm - 1.0).abs() > 1e-9 {
+                        return Err(error(
+                            Some(axis.span()),
+                            format!("joint[{j}].axis"),
+                            format!("axis must be a unit vector, |axis| = {norm}"),
+                        ));
+                    }
+                }
+                (None, false) => {}
+            }
+        }
+        if let Some((i, _)) = has_parent.iter().enumerate().find(|(_, has)| !**has) {
+            return Err(error(
+                Some(self.bodies[i].name.span()),
+                format!("body[{i}]"),
+                format!(
+                    "body \"{}\" is connected by no joint (give it a parent, e.g. \"ground\")",
+                    self.bodies[i].name.get_ref()
+                ),
+            ));
+        }
+        for start in 0..self.bodies.len() {
+            let mut steps = 0;
+            let mut at = Some(start);
+            while let Some(b) = at {
+                steps += 1;
+                if steps > self.bodies.len() {
+                    return Err(error(
+                        Some(self.bodies[start].name.span()),
+                        format!("body[{start}]"),
+                        format!(
+                            "the joints form a cycle through body \"{}\"",
+                            self.bodies[start].name.get_ref()
+                        ),
+                    ));
+                }
+                at = parent_of[b];
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PENDULUM: &str = r#"
+title = "double pendulum"
+gravity = [0.0, 0.0, -9.81]
+
+[[body]]
+name = "upper"
+primitive = { shape = "rod", length = 1.0, mass = 1.0 }
+
+[[body]]
+name = "lower"
+mass_properties = { mass = 1.0, com = [0.0, 0.0, -0.5], inertia = [0.1, 0.1, 0.0, 0.0, 0.0, 0.0] }
+
+[[joint]]
+name = "shoulder"
+type = "revolute"
+parent = "ground"
+child = "upper"
+axis = [0.0, 1.0, 0.0]
+
+[[joint]]
+name = "elbow"
+type = "revolute"
+parent = "upper"
+child = "lower"
+axis = [0.0, 1.0, 0.0]
+origin = [0.0, 0.0, -1.0]
+
+[analyses]
+mass_properties = true
+"#;
+
+    fn parse(text: &str) -> Result<Scene, SceneError> {
+        Scene::parse(text, Path::new("scene.toml"))
+    }
+
+    #[test]
+    fn a_valid_scene_parses() {
+        let scene = parse(PENDULUM).expect("valid scene");
+        assert_eq!(scene.bodies.len(), 2);
+        assert_eq!(*scene.joints[1].kind.get_ref(), JointKind::Revolute);
+        assert!(scene.analyses.mass_properties);
+    }
+
+    #[test]
+    fn an_unknown_field_is_located() {
+        let text = PENDULUM.replace("origin = [0.0, 0.0, -1.0]", "orgin = [0.0, 0.0, -1.0]");
+        let e = parse(&text).expect_err("unknown field");
+        let line = text.lines().position(|l| l.starts_with("orgin")).map(|i| i + 1);
+        assert_eq!(e.position.map(|p| p.0), line, "{e}");
+        assert!(e.message.contains("orgin"), "{e}");
+    }
+
+    #[test]
+    fn a_missing_body_is_located() {
+        let text = PENDULUM.replace("parent = \"upper\"", "parent = \"uper\"");
+        let e = parse(&text).expect_err("missing body");
+        assert_eq!(e.field, "joint[1].parent");
+        let line = text.lines().position(|l| l.contains("\"uper\"")).map(|i| i + 1);
+        assert_eq!(e.position.map(|p| p.0), line);
+        assert!(e.to_string().starts_with("scene.toml:"), "{e}");
+    }
+
+    #[test]
+    fn cyclic_joints_are_rejected() {
+        let text = PENDULUM.replace("parent = \"ground\"", "parent = \"lower\"");
+        let e = parse(&text).expect_err("cycle");
+        assert!(e.message.contains("cycle"), "{e}");
+    }
+
+    #[test]
+    fn non_unit_axes_and_double_parents_are_rejected() {
+        let text = PENDULUM.replacen("axis = [0.0, 1.0, 0.0]", "axis = [0.0, 2.0, 0.0]", 1);
+        assert_eq!(parse(&text).expect_err("axis").field, "joint[0].axis");
+        let text = PENDULUM.replace("child = \"lower\"", "child = \"upper\"");
+        assert_eq!(parse(&text).expect_err("two parents").field, "joint[1].child");
+    }
+
+    #[test]
+    fn a_missing_file_is_reported_with_its_path() {
+        let e = Scene::load(Path::new("/nonexistent/scene.toml")).expect_err("missing");
+        assert!(e.to_string().contains("/nonexistent/scene.toml"), "{e}");
+    }
+}

@@ -1,0 +1,259 @@
+//! Runs the analyses a scene asks for, and only those, timing each step.
+
+use crate::report::{Quantity, Report, Step, timed_step};
+use crate::scene::{BodySpec, JointKind, JointSpec, Scene};
+use mechanica::kinematics::nalgebra::{Isometry3, Matrix3, Vector3};
+use mechanica::kinematics::tree::{Joint, KinematicTree, TreeBuilder};
+use mechanica::mass::MassProperties;
+use mechanica::mass::mesh::MeshOptions;
+use mechanica::mass::primitives::{self, Amount};
+use std::path::Path;
+
+/// A scene turned into library objects: the tree, each body's mass properties in its own
+/// frame, and the initial coordinates.
+struct Model {
+    tree: KinematicTree,
+    bodies: Vec<MassProperties>,
+    q0: Vec<f64>,
+}
+
+/// Runs `scene` (loaded from `file`) and returns its report.
+pub fn run(scene: &Scene, file: &Path) -> Result<Report, String> {
+    let mut steps: Vec<Step> = Vec::new();
+    let mut model = None;
+    steps.push(timed_step("build: bodies and kinematic tree", || {
+        let built = build_model(scene, file)?;
+        let quantities = vec![
+            quantity("bodies", vec![built.bodies.len() as f64], "", None),
+            quantity("degrees of freedom", vec![built.tree.dof() as f64], "", None),
+        ];
+        model = Some(built);
+        Ok::<_, String>(quantities)
+    })?);
+    let model = model.ok_or("internal: model not built")?;
+    if scene.analyses.mass_properties {
+        let gravity = scene.gravity.map(Vector3::from);
+        steps.push(timed_step("mass properties at q0", || mass_report(&model, gravity))?);
+    }
+    Ok(Report {
+        title: scene.title.clone(),
+        version: mechanica::version().into(),
+        steps,
+    })
+}
+
+fn quantity(name: &str, values: Vec<f64>, unit: &str, accuracy: Option<String>) -> Quantity {
+    Quantity {
+        name: name.into(),
+        values,
+        unit: unit.into(),
+        accuracy,
+    }
+}
+
+/// The mass properties of one body in its own frame, from the scene's description.
+fn body_mass(body: &BodySpec, index: usize, file: &Path) -> Result<MassProperties, String> {
+    let name = body.name.get_ref();
+    let located = |e: &dyn std::fmt::Display| format!("{}: body[{index}] \"{name}\": {e}", file.display());
+    if let Some(m) = &body.mass_properties {
+        let [ixx, iyy, izz, ixy, ixz, iyz] = m.inertia;
+        let inertia = Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
+        return MassProperties::new(m.mass, Vector3::from(m.com), inertia).map_err(|e| located(&e));
+    }
+    if let Some(p) = &body.primitive {
+        let amount = match (p.mass, p.density) {
+            (Some(m), None) => Amount::Mass(m),
+            (None, Some(rho)) => Amount::Density(rho),
+            _ => return Err(located(&"give exactly one of primitive.mass, primitive.density")),
+        };
+        let need =
+            |value: Option<f64>, field: &str| value.ok_or_else(|| located(&format!("primitive.{field} is required")));
+        let shape = p.shape.get_ref().as_str();
+        let result = match shape {
+            "point" => primitives::point(amount),
+            "rod" => primitives::rod(need(p.length, "length")?, amount),
+            "sphere" => primitives::sphere(need(p.radius, "radius")?, amount),
+            "disc" => primitives::disc_lamina(need(p.radius, "radius")?, amount),
+            "cylinder" => primitives::cylinder(need(p.radius, "radius")?, need(p.length, "length")?, amount),
+            "box" => {
+                let [x, y, z] = p.size.ok_or_else(|| located(&"primitive.size is required"))?;
+                primitives::solid_box(x, y, z, amount)
+            }
+            other => {
+                return Err(located(&format!(
+                    "unknown primitive shape \"{other}\" (point, rod, sphere, disc, cylinder, box)"
+                )));
+            }
+        };
+        return result.map_err(|e| located(&e));
+    }
+    if let Some(mesh) = &body.mesh {
+        let path = file.parent().unwrap_or(Path::new(".")).join(mesh.file.get_ref());
+        let triangles =
+            mechanica::mass::io::load_mesh(&path).map_err(|e| located(&format!("{}: {e}", path.display())))?;
+        let result = triangles
+            .mass_properties(Amount::Density(mesh.density), &MeshOptions::default())
+            .map_err(|e| located(&e))?;
+        return Ok(result.properties);
+    }
+    Err(located(&"no mass source"))
+}
+
+/// The library joint for a scene joint.
+fn joint_of(spec: &JointSpec) -> Joint {
+    let axis = spec.axis.as_ref().map_or(Vector3::z(), |a| Vector3::from(*a.get_ref()));
+    match spec.kind.get_ref() {
+        JointKind::Revolute => Joint::Revolute { axis },
+        JointKind::Prismatic => Joint::Prismatic { axis },
+        JointKind::Spherical => Joint::Spherical,
+        JointKind::Free => Joint::Free,
+        JointKind::Planar => Joint::Planar,
+        JointKind::Fixed => Joint::Fixed,
+    }
+}
+
+fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
+    let bodies = scene
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let offset = Isometry3::translation(b.offset[0], b.offset[1], b.offset[2]);
+            body_mass(b, i, file).map(|m| m.transformed(&offset))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let index_of = |name: &str| scene.bodies.iter().position(|b| b.name.get_ref() == name);
+    // The scene guarantees one joint per body; add bodies in scene order so indices agree.
+    let mut builder = TreeBuilder::new();
+    let mut q0 = Vec::new();
+    for (i, body) in scene.bodies.iter().enumerate() {
+        let joint = scene
+            .joints
+            .iter()
+            .find(|j| j.child.get_ref() == body.name.get_ref())
+            .ok_or_else(|| format!("{}: body[{i}] has no joint", file.display()))?;
+        let parent = index_of(joint.parent.get_ref());
+        let lib_joint = joint_of(joint);
+        let index = builder.add_body(
+            parent,
+            lib_joint,
+            Isometry3::translation(joint.origin[0], joint.origin[1], joint.origin[2]),
+        );
+        debug_assert_eq!(index, i);
+        match &joint.q0 {
+            Some(values) if values.get_ref().len() != lib_joint.dof() => {
+                return Err(format!(
+                    "{}: joint \"{}\": q0 has {} values, the joint has {}",
+                    file.display(),
+                    joint.name,
+                    values.get_ref().len(),
+                    lib_joint.dof()
+                ));
+            }
+            Some(values) => q0.extend_from_slice(values.get_ref()),
+            None => q0.extend(std::iter::repeat_n(0.0, lib_joint.dof())),
+        }
+    }
+    // A tree with several bodies on the ground would have several roots; the tree needs one.
+    let tree = builder.build().map_err(|e| format!("{}: {e}", file.display()))?;
+    Ok(Model { tree, bodies, q0 })
+}
+
+/// Total mass properties in the world frame at q0, and the gravitational potential
+/// U = −m g·x₀ when the scene has gravity.
+fn mass_report(model: &Model, gravity: Option<Vector3<f64>>) -> Result<Vec<Quantity>, String> {
+    let mut ws = model.tree.workspace();
+    model
+        .tree
+        .update_positions(&mut ws, &model.q0)
+        .map_err(|e| e.to_string())?;
+    let mut world = Vec::with_capacity(model.bodies.len());
+    for (b, props) in model.bodies.iter().enumerate() {
+        let rotation = ws.rotation(b).map_err(|e| e.to_string())?;
+        let position = ws.position(b).map_err(|e| e.to_string())?;
+        let pose = Isometry3::from_parts(position.into(), rotation.into());
+        world.push(props.transformed(&pose));
+    }
+    let total = MassProperties::sum(world.iter()).map_err(|e| e.to_string())?;
+    let axes = total.principal_axes().map_err(|e| e.to_string())?;
+    let mut quantities = vec![
+        quantity("total mass", vec![total.mass], "kg", None),
+        quantity(
+            "centre of mass (world)",
+            total.p_oc.iter().copied().collect(),
+            "m",
+            None,
+        ),
+        quantity(
+            "principal moments about the centre of mass (3.20)",
+            axes.moments.iter().copied().collect(),
+            "kg·m²",
+            Some(format!("relative residual {:.1e}", axes.relative_residual)),
+        ),
+    ];
+    if let Some(g) = gravity {
+        let potential = -total.mass * g.dot(&total.p_oc);
+        quantities.push(quantity(
+            "gravitational potential U = −m g·x₀",
+            vec![potential],
+            "J",
+            None,
+        ));
+    }
+    Ok(quantities)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pendulum_at(q0: [f64; 2]) -> Model {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/double_pendulum.toml");
+        let text = std::fs::read_to_string(&path).expect("scene file");
+        let text = text
+            .replace(
+                "origin = [0.0, 0.0, 0.0]",
+                &format!("origin = [0.0, 0.0, 0.0]\nq0 = [{}]", q0[0]),
+            )
+            .replace(
+                "origin = [0.0, 0.0, -1.0]",
+                &format!("origin = [0.0, 0.0, -1.0]\nq0 = [{}]", q0[1]),
+            );
+        let scene = Scene::parse(&text, &path).expect("valid scene");
+        build_model(&scene, &path).expect("model")
+    }
+
+    #[test]
+    fn double_pendulum_centre_of_mass_matches_the_closed_form() {
+        let (t1, t2) = (0.3, -0.7);
+        let model = pendulum_at([t1, t2]);
+        let q = mass_report(&model, Some(Vector3::new(0.0, 0.0, -9.81))).expect("report");
+        // Rotation about +y maps (0, 0, -l) to (-l sin θ, 0, -l cos θ).
+        let upper = Vector3::new(-0.5 * t1.sin(), 0.0, -0.5 * t1.cos());
+        let elbow = Vector3::new(-t1.sin(), 0.0, -t1.cos());
+        let lower = elbow + Vector3::new(-0.5 * (t1 + t2).sin(), 0.0, -0.5 * (t1 + t2).cos());
+        let expected = (upper + lower) / 2.0;
+        assert_eq!(q[0].values, vec![2.0]);
+        assert!((q[3].values[0] - 2.0 * 9.81 * expected.z).abs() < 1e-13);
+        for k in 0..3 {
+            assert!(
+                (q[1].values[k] - expected[k]).abs() < 1e-15,
+                "{:?} vs {expected:?}",
+                q[1].values
+            );
+        }
+    }
+
+    #[test]
+    fn hanging_double_pendulum_principal_moments() {
+        // Both rods on the z axis, centre of mass at z = -1: I = 2·mL²/12 + 2·m·(1/2)² = 2/3 about
+        // x and y, and 0 about the rods' common axis.
+        let q = mass_report(&pendulum_at([0.0, 0.0]), None).expect("report");
+        let moments = &q[2].values;
+        assert!(
+            moments[0].abs() < 1e-15
+                && (moments[1] - 2.0 / 3.0).abs() < 1e-15
+                && (moments[2] - 2.0 / 3.0).abs() < 1e-15
+        );
+    }
+}

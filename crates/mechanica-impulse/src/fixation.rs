@@ -1,0 +1,136 @@
+//! Fixation of a body point (7.100–7.108): a single impulse S at the body point X brings X
+//! to rest at once.
+//!
+//! The seed solves J_X Ω = J₀ ω + (x₀ − x) × m v₀ (7.105) with J_X from Steiner. Here the
+//! same condition is written in contact space, which also covers hinged bodies and bodies
+//! with infinite mass or degenerate inertia: v_X⁺ = v_X⁻ + W_X S = 0 with the point mobility
+//! W_X = J_X G J_Xᵀ, solved by Cholesky (W_X is positive definite for any body of finite
+//! mass) or, when W_X is singular, by its pseudo-inverse with a residual check.
+
+use crate::ImpulseError;
+use crate::body::RigidBody;
+use crate::error::check_all_finite;
+use nalgebra::Vector3;
+
+/// The outcome of fixing a body point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fixation {
+    /// The impulse S applied at X (W frame, N·s) (7.100, 7.103).
+    pub impulse_w: Vector3<f64>,
+    /// Velocity of the centre of mass after fixation, V₀ (7.102).
+    pub v_wc_after: Vector3<f64>,
+    /// Angular velocity after fixation, Ω (7.105).
+    pub w_w_after: Vector3<f64>,
+    /// ΔT = ½ S·v (7.108), v the velocity of X before fixation, J.
+    pub energy_change: f64,
+    /// |v_X| after fixation as computed (a backward check of the solve, m/s).
+    pub residual: f64,
+}
+
+/// Brings the body point at `p_wx` to rest by a single impulse at that point (7.100–7.108).
+pub fn fix_point(body: &RigidBody, p_wx: &Vector3<f64>) -> Result<Fixation, ImpulseError> {
+    check_all_finite("fixed point", p_wx.iter())?;
+    body.check_impulse_point("fixed point", p_wx)?;
+    let w = body.point_mobility(p_wx);
+    let v = body.velocity_at(p_wx);
+    let impulse = match w.cholesky() {
+        Some(chol) => -chol.solve(&v),
+        None => {
+            let scale = w.amax();
+            let pinv = if scale > 0.0 {
+                w.svd(true, true)
+                    .pseudo_inverse(1e-12 * scale)
+                    .map_err(|_| ImpulseError::Singular {
+                        what: "fixation: point mobility SVD did not converge",
+                        value: scale,
+                    })?
+            } else {
+                nalgebra::Matrix3::zeros()
+            };
+            let s = -pinv * v;
+            let left = (v + w * s).norm();
+            if left > 1e-9 * v.norm() {
+                return Err(ImpulseError::Singular {
+                    what: "fixation: the point cannot be brought to rest by an impulse there (|v_X| left)",
+                    value: left,
+                });
+            }
+            s
+        }
+    };
+    let response = body.respond(&impulse, &(p_wx - body.p_wc()).cross(&impulse));
+    let residual = (response.v_wc_after + response.w_w_after.cross(&(p_wx - body.p_wc()))).norm();
+    Ok(Fixation {
+        impulse_w: impulse,
+        v_wc_after: response.v_wc_after,
+        w_w_after: response.w_w_after,
+        energy_change: 0.5 * impulse.dot(&v),
+        residual,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mechanica_mass::MassProperties;
+    use nalgebra::Matrix3;
+
+    fn rod_along_x(mass: f64, length: f64) -> MassProperties {
+        let mut props = MassProperties::point(mass, Vector3::zeros()).expect("valid");
+        props.inertia_c = Matrix3::from_diagonal(&Vector3::new(0.0, 1.0, 1.0)) * (mass * length * length / 12.0);
+        props
+    }
+
+    #[test]
+    fn fixing_the_end_of_a_translating_rod_gives_three_quarters_of_the_energy() {
+        // Classic: rod of length L translating at v ⟂ to itself; fix one end.
+        // J_X Ω = m (L/2) v with J_X = mL²/3 → Ω = 3v/(2L), T⁺/T⁻ = (½·mL²/3·Ω²)/(½mv²) = 3/4.
+        let (m, l, v) = (2.5, 1.6, 3.0);
+        let body = RigidBody::from_mass_properties(&rod_along_x(m, l), Vector3::new(0.0, v, 0.0), Vector3::zeros())
+            .expect("ok");
+        let fix = fix_point(&body, &Vector3::new(-l / 2.0, 0.0, 0.0)).expect("ok");
+        let omega = 3.0 * v / (2.0 * l);
+        assert!((fix.w_w_after - Vector3::new(0.0, 0.0, omega)).norm() < 1e-13 * omega);
+        let t_before = 0.5 * m * v * v;
+        let t_after = 0.5 * m * fix.v_wc_after.norm_squared() + 0.5 * (m * l * l / 12.0) * fix.w_w_after.norm_squared();
+        assert!((t_after / t_before - 0.75).abs() < 1e-14);
+        assert!((fix.energy_change - (t_after - t_before)).abs() < 1e-13 * t_before);
+        // The impulse: S = m(V₀ − v₀) = m(ΩL/2 − v) ŷ = −m v/4 ŷ.
+        assert!((fix.impulse_w - Vector3::new(0.0, -m * v / 4.0, 0.0)).norm() < 1e-13);
+        assert!(fix.residual < 1e-14 * v);
+    }
+
+    #[test]
+    fn general_fixation_satisfies_7_105_and_7_108() {
+        let mut props = MassProperties::point(1.7, Vector3::new(0.2, -0.1, 0.4)).expect("ok");
+        props.inertia_c = Matrix3::new(0.9, 0.1, -0.05, 0.1, 1.3, 0.2, -0.05, 0.2, 0.7);
+        let v0 = Vector3::new(0.5, -1.2, 0.8);
+        let w0 = Vector3::new(2.0, -0.3, 1.1);
+        let body = RigidBody::from_mass_properties(&props, v0, w0).expect("ok");
+        let x = Vector3::new(0.9, 0.4, -0.2);
+        let fix = fix_point(&body, &x).expect("ok");
+        // (7.105): J_X Ω = J₀ ω + (x₀ − x) × m v₀, with J_X by Steiner.
+        let j_x = props.inertia_about(&x);
+        let rhs = props.inertia_c * w0 + (props.p_oc - x).cross(&(props.mass * v0));
+        assert!((j_x * fix.w_w_after - rhs).norm() < 1e-13 * rhs.norm());
+        // (7.108) against the direct kinetic energies.
+        let t = |v: &Vector3<f64>, w: &Vector3<f64>| {
+            0.5 * props.mass * v.norm_squared() + 0.5 * w.dot(&(props.inertia_c * w))
+        };
+        let direct = t(&fix.v_wc_after, &fix.w_w_after) - t(&v0, &w0);
+        assert!((fix.energy_change - direct).abs() < 1e-13 * t(&v0, &w0));
+    }
+
+    #[test]
+    fn a_static_body_cannot_be_fixed_unless_it_is_at_rest() {
+        let ground = RigidBody::fixed(Vector3::zeros()).expect("ok");
+        let fix = fix_point(&ground, &Vector3::new(1.0, 0.0, 0.0)).expect("at rest");
+        assert_eq!(fix.impulse_w, Vector3::zeros());
+        let moving = RigidBody::from_inverse(0.0, &Matrix3::zeros(), Vector3::zeros(), Vector3::x(), Vector3::zeros())
+            .expect("ok");
+        assert!(matches!(
+            fix_point(&moving, &Vector3::zeros()),
+            Err(ImpulseError::Singular { .. })
+        ));
+    }
+}

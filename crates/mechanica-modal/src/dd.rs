@@ -1,0 +1,122 @@
+//! Double-double arithmetic (about 106 significant bits) for residuals and Rayleigh quotients
+//! that must survive cancellation, built on the error-free transformations TwoSum and TwoProd
+//! (Ogita, Rump & Oishi, "Accurate sum and dot product", SIAM J. Sci. Comput. 26, 2005).
+
+use faer::MatRef;
+
+/// An unevaluated sum hi + lo with |lo| ≤ ½ ulp(hi).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Dd {
+    pub hi: f64,
+    pub lo: f64,
+}
+
+/// a + b = s + e exactly (Knuth's TwoSum).
+#[inline]
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
+}
+
+/// a·b = p + e exactly (TwoProd with a fused multiply-add).
+#[inline]
+fn two_prod(a: f64, b: f64) -> (f64, f64) {
+    let p = a * b;
+    (p, a.mul_add(b, -p))
+}
+
+impl Dd {
+    /// The double-double value of a double.
+    pub fn of(x: f64) -> Self {
+        Self { hi: x, lo: 0.0 }
+    }
+
+    /// Rounded to the nearest double.
+    pub fn to_f64(self) -> f64 {
+        self.hi + self.lo
+    }
+
+    /// self + other.
+    pub fn plus(self, other: Self) -> Self {
+        let (s, e) = two_sum(self.hi, other.hi);
+        let e = e + self.lo + other.lo;
+        let (hi, lo) = two_sum(s, e);
+        Self { hi, lo }
+    }
+
+    /// self − other.
+    pub fn minus(self, other: Self) -> Self {
+        self.plus(Self {
+            hi: -other.hi,
+            lo: -other.lo,
+        })
+    }
+
+    /// self · other.
+    pub fn times(self, other: Self) -> Self {
+        let (p, e) = two_prod(self.hi, other.hi);
+        let e = e + (self.hi * other.lo + self.lo * other.hi);
+        let (hi, lo) = two_sum(p, e);
+        Self { hi, lo }
+    }
+
+    /// self / other (one Newton correction of the double quotient).
+    pub fn over(self, other: Self) -> Self {
+        let q1 = self.hi / other.hi;
+        let r = self.minus(other.times(Self::of(q1)));
+        let q2 = r.hi / other.hi;
+        let (hi, lo) = two_sum(q1, q2);
+        Self { hi, lo }
+    }
+}
+
+/// Σ_j m[i, j]·x[j] in double-double, for every row i (the product M x as if computed in twice
+/// the working precision, then kept unrounded).
+pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
+    let n = m.nrows();
+    let mut acc = vec![Dd::default(); n];
+    for (j, &xj) in x.iter().enumerate() {
+        let col = m.col(j);
+        for i in 0..n {
+            let (p, e) = two_prod(col[i], xj);
+            let (s, e2) = two_sum(acc[i].hi, p);
+            acc[i].hi = s;
+            acc[i].lo += e + e2;
+        }
+    }
+    acc
+}
+
+/// Σ_i x[i]·y[i] with y in double-double.
+pub(crate) fn dot(x: &[f64], y: &[Dd]) -> Dd {
+    let mut acc = Dd::default();
+    for (&xi, yi) in x.iter().zip(y) {
+        acc = acc.plus(Dd::of(xi).times(*yi));
+    }
+    acc
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cancellation_keeps_the_small_part() {
+        // (1e16 + 1) − 1e16 is 0 in double but 1 in double-double.
+        let a = Dd::of(1e16).plus(Dd::of(1.0));
+        assert_eq!(a.minus(Dd::of(1e16)).to_f64(), 1.0);
+        let third = Dd::of(1.0).over(Dd::of(3.0));
+        // 3·(1/3) − 1 is at the 1e-32 level.
+        assert!(third.times(Dd::of(3.0)).minus(Dd::of(1.0)).to_f64().abs() < 1e-31);
+    }
+
+    #[test]
+    fn matrix_vector_product_is_exact_on_a_cancelling_row() {
+        let m = faer::mat![[1e12 + 1.0, -1e12], [-1e12, 1e12]];
+        let y = mat_vec(m.as_ref(), &[1.0 + f64::EPSILON, 1.0]);
+        // Row 0: (1e12 + 1)(1 + u) − 1e12 = 1 + u + 1e12·u exactly.
+        let expected = 1.0 + f64::EPSILON + 1e12 * f64::EPSILON;
+        assert!((y[0].to_f64() - expected).abs() <= 2.0 * f64::EPSILON * expected);
+    }
+}

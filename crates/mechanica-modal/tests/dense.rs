@@ -1,0 +1,347 @@
+//! The dense solver against closed-form spectra, invariants and bad input.
+
+use mechanica_modal::faer::Mat;
+use mechanica_modal::{
+    BoundKind, Method, ModalError, ModeKind, PencilProblem, Refinement, Selection, SolveOptions, count_below, families,
+    solve,
+};
+use proptest::prelude::*;
+
+const U: f64 = f64::EPSILON;
+
+fn pencil(a: &Mat<f64>, b: &Mat<f64>) -> PencilProblem {
+    PencilProblem::new(a.as_ref(), b.as_ref()).expect("valid pencil")
+}
+
+fn all_pairs() -> SolveOptions {
+    SolveOptions::default()
+}
+
+/// Every computed ω² lies within its stated bound of the closed form, the backward errors meet
+/// 10·n·u, XᵀAX = I to a few n·u, and the Sturm check agrees.
+fn check_against(p: &PencilProblem, exact: &[f64]) {
+    let n = p.dim();
+    let sol = solve(p, &all_pairs()).expect("solve");
+    assert_eq!(sol.modes.len(), exact.len());
+    for (m, &w) in sol.modes.iter().zip(exact) {
+        assert!(
+            (m.omega_sq - w).abs() <= m.error_bound,
+            "ω² {} vs exact {w}: error {:e} > bound {:e}",
+            m.omega_sq,
+            (m.omega_sq - w).abs(),
+            m.error_bound
+        );
+    }
+    let eta = sol.accuracy.max_backward_error.expect("vectors were computed");
+    assert!(eta <= 10.0 * n as f64 * U, "η = {eta:e}");
+    assert!(sol.accuracy.meets_backward_error_target(n));
+    let orth = sol.accuracy.orthogonality_error.expect("vectors");
+    assert!(orth <= 10.0 * n as f64 * U, "‖XᵀAX − I‖ = {orth:e}");
+    let check = sol.accuracy.inertia_check.expect("sturm check");
+    assert!(check.consistent, "{check:?}");
+}
+
+#[test]
+fn fixed_chain_matches_closed_form() {
+    for n in [1, 2, 7, 60, 130] {
+        let (a, b) = families::fixed_chain(n);
+        check_against(&pencil(&a, &b), &families::fixed_chain_omega_sq(n));
+    }
+}
+
+#[test]
+fn rotated_chain_keeps_its_spectrum() {
+    let n = 90;
+    let (a0, b0) = families::fixed_chain(n);
+    // Mass matrix diag(1..2) makes A non-trivial; rotate by a random orthogonal Q.
+    let (a1, b1) = (
+        Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 / n as f64 } else { 0.0 }),
+        b0.clone(),
+    );
+    let reference = solve(&pencil(&a1, &b1), &all_pairs()).expect("diagonal problem");
+    let q = families::random_orthogonal(n, 7);
+    let (a, b) = families::rotate(&a1, &b1, &q);
+    let sol = solve(&pencil(&a, &b), &all_pairs()).expect("rotated problem");
+    for (m, r) in sol.modes.iter().zip(&reference.modes) {
+        assert!((m.omega_sq - r.omega_sq).abs() <= m.error_bound + r.error_bound);
+    }
+    assert!(sol.accuracy.meets_backward_error_target(n));
+    let _ = a0;
+    let (ar, br) = families::rotate(&Mat::identity(n, n), &families::fixed_chain(n).1, &q);
+    check_against(&pencil(&ar, &br), &families::fixed_chain_omega_sq(n));
+}
+
+#[test]
+fn free_chain_has_one_rigid_body_mode() {
+    let n = 40;
+    let (a, b) = families::free_chain(n);
+    let p = pencil(&a, &b);
+    check_against(&p, &families::free_chain_omega_sq(n));
+    let sol = solve(&p, &all_pairs()).expect("solve");
+    assert_eq!(sol.modes[0].kind, ModeKind::Zero);
+    for m in &sol.modes[1..] {
+        assert!(
+            matches!(m.kind, ModeKind::Oscillatory { omega } if (omega * omega - m.omega_sq).abs() <= 4.0 * U * m.omega_sq)
+        );
+    }
+    // The rigid-body mode is a uniform translation: x ∝ (1, …, 1).
+    let x = sol.vectors.expect("vectors");
+    let x0 = x[(0, 0)];
+    for i in 0..n {
+        assert!((x[(i, 0)] - x0).abs() <= 100.0 * n as f64 * U * x0.abs());
+    }
+}
+
+#[test]
+fn ring_eigenvalues_come_in_groups_with_orthonormal_bases() {
+    let n = 12;
+    let (a, b) = families::ring(n);
+    let p = pencil(&a, &b);
+    check_against(&p, &families::ring_omega_sq(n));
+    let sol = solve(&p, &all_pairs()).expect("solve");
+    // k = 0 and k = n/2 are simple; every other frequency is double.
+    let mult: Vec<usize> = sol.groups.iter().map(|g| g.multiplicity).collect();
+    assert_eq!(mult.len(), n / 2 + 1);
+    assert_eq!(mult[0], 1);
+    assert_eq!(*mult.last().expect("groups"), 1);
+    assert!(mult[1..mult.len() - 1].iter().all(|&m| m == 2), "{mult:?}");
+    let x = sol.vectors.expect("vectors");
+    for g in &sol.groups {
+        let cols = x.as_ref().subcols(g.first, g.multiplicity);
+        // Basis of the eigenspace: (B − ω²A)X_g = 0 and X_gᵀ A X_g = I.
+        let r = &b * cols - (&a * cols) * g.omega_sq;
+        assert!(r.norm_max() <= 100.0 * n as f64 * U, "group at {}", g.omega_sq);
+        let gram = cols.transpose() * &a * cols;
+        let e = &gram - Mat::<f64>::identity(g.multiplicity, g.multiplicity);
+        assert!(e.norm_max() <= 10.0 * n as f64 * U);
+    }
+}
+
+#[test]
+fn unstable_modes_report_their_growth_rate() {
+    // A = I, B = diag(−4, 1, 9): one unstable mode with growth rate 2 (λ = 4 > 0).
+    let a = Mat::<f64>::identity(3, 3);
+    let b = Mat::from_fn(3, 3, |i, j| if i == j { [-4.0, 1.0, 9.0][i] } else { 0.0 });
+    let q = families::random_orthogonal(3, 1);
+    let (a, b) = families::rotate(&a, &b, &q);
+    let sol = solve(&pencil(&a, &b), &all_pairs()).expect("solve");
+    match sol.modes[0].kind {
+        ModeKind::Unstable { growth_rate } => assert!((growth_rate - 2.0).abs() <= 10.0 * U * 2.0),
+        other => panic!("expected unstable, got {other:?}"),
+    }
+    assert!((sol.modes[0].lambda - 4.0).abs() <= sol.modes[0].error_bound);
+    assert!(matches!(sol.modes[2].kind, ModeKind::Oscillatory { omega } if (omega - 3.0).abs() < 1e-14));
+    assert_eq!(count_below(&pencil(&a, &b), 0.0).expect("shift").below, 1);
+}
+
+#[test]
+fn massless_coordinate_is_condensed_and_reported_infinite() {
+    // ground –1– m=1 –1– (massless) –1– m=1 –1– ground: condensing the middle node leaves the
+    // pencil (I, [[1.5, −0.5], [−0.5, 1.5]]) with ω² = 1 and 2, plus one infinite mode.
+    let a = Mat::from_fn(3, 3, |i, j| if i == j && i != 1 { 1.0 } else { 0.0 });
+    let (_, b) = families::fixed_chain(3);
+    let sol = solve(&pencil(&a, &b), &all_pairs()).expect("solve");
+    assert_eq!(sol.method, Method::CondensedReduction { massless: 1 });
+    assert_eq!(sol.modes.len(), 3);
+    assert!((sol.modes[0].omega_sq - 1.0).abs() <= sol.modes[0].error_bound);
+    assert!((sol.modes[1].omega_sq - 2.0).abs() <= sol.modes[1].error_bound);
+    assert_eq!(sol.modes[2].kind, ModeKind::Infinite);
+    assert_eq!(sol.modes[2].lambda, f64::NEG_INFINITY);
+    let x = sol.vectors.expect("vectors");
+    // Lifted shapes satisfy the full pencil: the middle node sits at the mean of its neighbours.
+    for k in 0..2 {
+        assert!((x[(1, k)] - 0.5 * (x[(0, k)] + x[(2, k)])).abs() <= 10.0 * U);
+    }
+    assert!(sol.accuracy.max_backward_error.expect("vectors") <= 30.0 * U);
+    // The infinite mode is the massless direction e₂.
+    assert!((x[(1, 2)].abs() - 1.0).abs() <= 10.0 * U);
+}
+
+#[test]
+fn indefinite_mass_names_the_pivot() {
+    let a = Mat::from_fn(3, 3, |i, j| if i == j { [1.0, -2.0, 1.0][i] } else { 0.0 });
+    let b = Mat::<f64>::identity(3, 3);
+    match solve(&pencil(&a, &b), &all_pairs()) {
+        Err(ModalError::IndefiniteMass {
+            pivot: 1,
+            min_eigenvalue,
+            ..
+        }) => assert_eq!(min_eigenvalue, -2.0),
+        other => panic!("expected IndefiniteMass at pivot 1, got {other:?}"),
+    }
+}
+
+#[test]
+fn singular_pencil_is_rejected() {
+    let a = Mat::from_fn(2, 2, |i, j| if i == j && i == 0 { 1.0 } else { 0.0 });
+    let b = a.clone();
+    assert!(matches!(
+        solve(&pencil(&a, &b), &all_pairs()),
+        Err(ModalError::SingularPencil { nullity: 1, .. })
+    ));
+}
+
+#[test]
+fn subsets_agree_with_the_full_spectrum() {
+    let n = 70;
+    let (a, b) = families::fixed_chain(n);
+    let p = pencil(&a, &b);
+    let exact = families::fixed_chain_omega_sq(n);
+    let lowest = solve(
+        &p,
+        &SolveOptions {
+            selection: Selection::Lowest(5),
+            ..all_pairs()
+        },
+    )
+    .expect("lowest");
+    assert_eq!(lowest.modes.len(), 5);
+    assert_eq!(lowest.vectors.as_ref().map(|x| x.ncols()), Some(5));
+    for (m, w) in lowest.modes.iter().zip(&exact) {
+        assert!((m.omega_sq - w).abs() <= m.error_bound);
+    }
+    assert!(lowest.accuracy.inertia_check.expect("check").consistent);
+    let interval = solve(
+        &p,
+        &SolveOptions {
+            selection: Selection::Interval { lower: 1.0, upper: 2.0 },
+            vectors: false,
+            refinement: Refinement::Auto,
+        },
+    )
+    .expect("interval");
+    let expected: Vec<f64> = exact.iter().copied().filter(|w| (1.0..=2.0).contains(w)).collect();
+    assert_eq!(interval.modes.len(), expected.len());
+    assert!(interval.vectors.is_none());
+    for (m, w) in interval.modes.iter().zip(&expected) {
+        assert_eq!(interval.accuracy.bound_kinds[0], BoundKind::APriori);
+        assert!((m.omega_sq - w).abs() <= m.error_bound);
+    }
+    assert!(matches!(
+        solve(
+            &p,
+            &SolveOptions {
+                selection: Selection::Lowest(n + 1),
+                ..all_pairs()
+            }
+        ),
+        Err(ModalError::TooManyModes {
+            requested: 71,
+            available: 70
+        })
+    ));
+    for (lower, upper) in [(2.0, 1.0), (f64::NAN, 1.0), (0.0, f64::INFINITY)] {
+        assert!(matches!(
+            solve(
+                &p,
+                &SolveOptions {
+                    selection: Selection::Interval { lower, upper },
+                    ..all_pairs()
+                }
+            ),
+            Err(ModalError::BadInterval { .. })
+        ));
+    }
+}
+
+#[test]
+fn bad_input_is_located() {
+    let mut a = Mat::<f64>::identity(4, 4);
+    a[(2, 3)] = f64::NAN;
+    let b = Mat::<f64>::identity(4, 4);
+    assert!(matches!(
+        PencilProblem::new(a.as_ref(), b.as_ref()),
+        Err(ModalError::NonFinite {
+            what: "A",
+            row: 2,
+            col: 3,
+            ..
+        })
+    ));
+    let rect = Mat::<f64>::zeros(3, 4);
+    assert!(matches!(
+        PencilProblem::new(rect.as_ref(), rect.as_ref()),
+        Err(ModalError::BadShape { what: "A", .. })
+    ));
+}
+
+fn spd_and_symmetric(n: usize, entries: &[f64]) -> (Mat<f64>, Mat<f64>) {
+    let g = Mat::from_fn(n, n, |i, j| entries[(i * n + j) % entries.len()]);
+    let h = Mat::from_fn(n, n, |i, j| entries[(i * 7 + j * 3 + 1) % entries.len()]);
+    let mut a = &g * g.transpose();
+    for i in 0..n {
+        a[(i, i)] += 1.0;
+    }
+    let b = Mat::from_fn(n, n, |i, j| h[(i, j)] + h[(j, i)]);
+    (a, b)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// Random definite pencils: backward error ≤ 10·n·u, A-orthonormal modes, the Sturm
+    /// check, and Σ ω² = trace(A⁻¹B) within the summed bounds.
+    #[test]
+    fn random_pencils_are_solved_backward_stably(n in 1usize..14, entries in prop::collection::vec(-1.0f64..1.0, 30)) {
+        let (a, b) = spd_and_symmetric(n, &entries);
+        let p = pencil(&a, &b);
+        let sol = solve(&p, &all_pairs()).expect("definite pencil");
+        let eta = sol.accuracy.max_backward_error.expect("vectors");
+        prop_assert!(eta <= 10.0 * n as f64 * U, "η = {:e}", eta);
+        let cond_a = {
+            let s = a.self_adjoint_eigenvalues(mechanica_modal::faer::Side::Lower).expect("evd");
+            s[n - 1] / s[0]
+        };
+        prop_assert!(sol.accuracy.orthogonality_error.expect("vectors") <= 10.0 * n as f64 * U * cond_a);
+        prop_assert!(sol.accuracy.inertia_check.expect("check").consistent);
+        let llt = a.llt(mechanica_modal::faer::Side::Lower).expect("spd");
+        use mechanica_modal::faer::linalg::solvers::Solve;
+        let ainv_b = llt.solve(&b);
+        let trace: f64 = (0..n).map(|i| ainv_b[(i, i)]).sum();
+        let sum: f64 = sol.modes.iter().map(|m| m.omega_sq).sum();
+        let bound: f64 = sol.modes.iter().map(|m| m.error_bound).sum::<f64>()
+            + 10.0 * n as f64 * U * ainv_b.norm_l2() * cond_a;
+        prop_assert!((trace - sum).abs() <= bound, "trace {} vs Σ {}", trace, sum);
+    }
+}
+
+#[test]
+fn zero_mass_matrix_gives_only_infinite_modes() {
+    // A = 0, B = I: every direction is massless; det(λ·0 + I) = 1 has no finite root.
+    let n = 4;
+    let a = Mat::<f64>::zeros(n, n);
+    let b = Mat::<f64>::identity(n, n);
+    let sol = solve(&pencil(&a, &b), &all_pairs()).expect("solve");
+    assert_eq!(sol.method, Method::CondensedReduction { massless: n });
+    assert_eq!(sol.modes.len(), n);
+    assert!(sol.modes.iter().all(|m| m.kind == ModeKind::Infinite));
+    assert_eq!(sol.groups.len(), 1);
+    assert_eq!(sol.groups[0].multiplicity, n);
+}
+
+#[test]
+fn tiny_orders_do_not_reach_faer_size_limits() {
+    for n in 1..=3 {
+        let (a, b) = families::free_chain(n);
+        let p = pencil(&a, &b);
+        for selection in [Selection::All, Selection::Lowest(0), Selection::Lowest(n)] {
+            for vectors in [false, true] {
+                for refinement in [Refinement::Auto, Refinement::Off, Refinement::Always] {
+                    let sol = solve(
+                        &p,
+                        &SolveOptions {
+                            selection,
+                            vectors,
+                            refinement,
+                        },
+                    )
+                    .expect("solve");
+                    assert!(
+                        sol.modes
+                            .iter()
+                            .all(|m| m.omega_sq.is_finite() && m.error_bound.is_finite())
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,263 @@
+/* C11 test of the impulse-dynamics entry points: closed-form results and every error path,
+ * checking with sentinels that nothing is written on failure. */
+#include "check.h"
+
+static mech_vec3_t v3(double x, double y, double z) {
+    mech_vec3_t v = {x, y, z};
+    return v;
+}
+
+static mech_mat3_t diag3(double a, double b, double c) {
+    mech_mat3_t m;
+    memset(&m, 0, sizeof m);
+    m.m[0] = a;
+    m.m[4] = b;
+    m.m[8] = c;
+    return m;
+}
+
+/* A free sphere (mass m, radius r) in inverse form. */
+static mech_impulse_body_t sphere(double m, double r, mech_vec3_t c, mech_vec3_t v, mech_vec3_t w) {
+    mech_impulse_body_t b;
+    memset(&b, 0, sizeof b);
+    double j = 0.4 * m * r * r;
+    b.inverse_mass = 1.0 / m;
+    b.inverse_inertia = diag3(1.0 / j, 1.0 / j, 1.0 / j);
+    b.center_of_mass = c;
+    b.velocity = v;
+    b.angular_velocity = w;
+    b.constraint = MECH_BODY_FREE;
+    return b;
+}
+
+static mech_impulse_body_t ground(void) {
+    mech_impulse_body_t b;
+    memset(&b, 0, sizeof b);
+    b.constraint = MECH_BODY_FREE;
+    return b;
+}
+
+static void test_points(void) {
+    mech_point_impulse_t pi;
+    mech_vec3_t v = v3(1.0, -2.0, 0.5), s = v3(0.4, 1.0, -3.0);
+    CHECK_STATUS(mech_impulse_on_point(2.0, &v, &s, &pi), MECH_STATUS_OK);
+    CHECK_NEAR(pi.velocity_after.x, 1.2, 1e-15);
+    CHECK_NEAR(pi.velocity_after.z, -1.0, 1e-15);
+    /* ½ m (|V|² − |v|²) */
+    double dt = 0.5 * 2.0 * ((1.2 * 1.2 + 1.5 * 1.5 + 1.0) - (1.0 + 4.0 + 0.25));
+    CHECK_NEAR(pi.energy_change, dt, 1e-14);
+
+    FILL_SENTINEL(&pi, sizeof pi);
+    CHECK_STATUS(mech_impulse_on_point(-1.0, &v, &s, &pi), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_impulse_on_point(NAN, &v, &s, &pi), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_impulse_on_point(1.0, NULL, &s, &pi), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_on_point(1.0, &v, NULL, &pi), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&pi, sizeof pi));
+    CHECK_STATUS(mech_impulse_on_point(1.0, &v, &s, NULL), MECH_STATUS_NULL_POINTER);
+
+    /* Oblique elastic billiard balls: they leave at right angles. */
+    mech_point_impact_t pc;
+    double h = sqrt(0.5);
+    mech_vec3_t n = v3(h, h, 0.0), a = v3(2.0, 0.0, 0.0), zero = v3(0, 0, 0);
+    CHECK_STATUS(mech_collide_points(0.17, &a, 0.17, &zero, &n, 1.0, &pc), MECH_STATUS_OK);
+    CHECK_NEAR(pc.velocity_after_1.x * pc.velocity_after_2.x + pc.velocity_after_1.y * pc.velocity_after_2.y, 0.0,
+               1e-15);
+    CHECK_NEAR(pc.velocity_after_2.x, 1.0, 1e-15);
+    CHECK_NEAR(pc.energy_change, 0.0, 1e-15);
+
+    FILL_SENTINEL(&pc, sizeof pc);
+    mech_vec3_t bad = v3(2.0, 0.0, 0.0);
+    CHECK_STATUS(mech_collide_points(0.17, &a, 0.17, &zero, &bad, 1.0, &pc), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_collide_points(0.17, &a, 0.17, &zero, &n, 1.5, &pc), MECH_STATUS_INVALID_ARGUMENT);
+    mech_vec3_t inf = v3(INFINITY, 0.0, 0.0);
+    CHECK_STATUS(mech_collide_points(0.17, &inf, 0.17, &zero, &n, 1.0, &pc), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_collide_points(0.17, &a, 0.17, &zero, NULL, 1.0, &pc), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&pc, sizeof pc));
+
+    mech_collinear_impact_t ci;
+    CHECK_STATUS(mech_collide_collinear(1.0, 1.0, 1.0, 0.0, 1.0, &ci), MECH_STATUS_OK);
+    CHECK_NEAR(ci.v2_after, 1.0, 1e-15);
+}
+
+static void test_bodies(void) {
+    /* A rod (mass 2.5, length 1.6) along x through the mass-properties path: pseudo-inverse. */
+    double m = 2.5, l = 1.6, v = 3.0;
+    mech_mass_properties_t props;
+    memset(&props, 0, sizeof props);
+    props.mass = m;
+    props.inertia_about_com = diag3(0.0, m * l * l / 12.0, m * l * l / 12.0);
+    mech_vec3_t vel = v3(0.0, v, 0.0), zero = v3(0, 0, 0);
+    mech_impulse_body_t rod;
+    CHECK_STATUS(mech_impulse_body_from_mass_properties(&props, &vel, &zero, &rod), MECH_STATUS_OK);
+    CHECK_NEAR(rod.inverse_mass, 1.0 / m, 1e-15);
+    CHECK_NEAR(rod.inverse_inertia.m[0], 0.0, 0.0);
+    CHECK_NEAR(rod.inverse_inertia.m[8], 12.0 / (m * l * l), 1e-13);
+
+    /* Fixation of the end of the translating rod: Ω = 3v/(2L), T⁺/T⁻ = 3/4. */
+    mech_fixation_t fx;
+    mech_vec3_t end = v3(-l / 2.0, 0.0, 0.0);
+    CHECK_STATUS(mech_impulse_fix_point(&rod, &end, &fx), MECH_STATUS_OK);
+    CHECK_NEAR(fx.angular_velocity_after.z, 3.0 * v / (2.0 * l), 1e-13);
+    CHECK_NEAR(fx.energy_change, -0.25 * 0.5 * m * v * v, 1e-12);
+    CHECK_NEAR(fx.impulse.y, -m * v / 4.0, 1e-13);
+
+    /* An impulse at the rod end: ΔV = S/m, ΔΩ = 6S/(mL). */
+    mech_body_response_t br;
+    mech_vec3_t s = v3(0.0, 1.5, 0.0), tip = v3(l / 2.0, 0.0, 0.0);
+    CHECK_STATUS(mech_impulse_apply(&rod, &s, &tip, &zero, &br), MECH_STATUS_OK);
+    CHECK_NEAR(br.velocity_after.y, v + 1.5 / m, 1e-14);
+    CHECK_NEAR(br.angular_velocity_after.z, 6.0 * 1.5 / (m * l), 1e-13);
+
+    /* Hinged at the end about z, at rest: the same impulse gives ΔΩ = 3S/(mL). */
+    mech_impulse_body_t pendulum = rod;
+    pendulum.velocity = zero;
+    pendulum.constraint = MECH_BODY_HINGE_AXIS;
+    pendulum.hinge_point = end;
+    pendulum.hinge_axis = v3(0.0, 0.0, 1.0);
+    CHECK_STATUS(mech_impulse_apply(&pendulum, &s, &tip, &zero, &br), MECH_STATUS_OK);
+    CHECK_NEAR(br.angular_velocity_after.z, 3.0 * 1.5 / (m * l), 1e-13);
+    pendulum.constraint = MECH_BODY_HINGE_POINT;
+    CHECK_STATUS(mech_impulse_apply(&pendulum, &s, &tip, &zero, &br), MECH_STATUS_OK);
+    CHECK_NEAR(br.angular_velocity_after.z, 3.0 * 1.5 / (m * l), 1e-13);
+
+    /* Error paths. */
+    FILL_SENTINEL(&br, sizeof br);
+    mech_impulse_body_t bad = rod;
+    bad.constraint = 7;
+    CHECK_STATUS(mech_impulse_apply(&bad, &s, &tip, &zero, &br), MECH_STATUS_BAD_ENUM);
+    bad = rod;
+    bad.inverse_mass = -1.0;
+    CHECK_STATUS(mech_impulse_apply(&bad, &s, &tip, &zero, &br), MECH_STATUS_INVALID_ARGUMENT);
+    bad = rod;
+    bad.inverse_inertia.m[4] = -1.0;
+    CHECK_STATUS(mech_impulse_apply(&bad, &s, &tip, &zero, &br), MECH_STATUS_NOT_POSITIVE_DEFINITE);
+    bad = rod;
+    bad.velocity.x = NAN;
+    CHECK_STATUS(mech_impulse_apply(&bad, &s, &tip, &zero, &br), MECH_STATUS_NON_FINITE);
+    bad = pendulum;
+    bad.constraint = MECH_BODY_HINGE_AXIS;
+    bad.hinge_axis = v3(0.0, 0.0, 3.0);
+    CHECK_STATUS(mech_impulse_apply(&bad, &s, &tip, &zero, &br), MECH_STATUS_INVALID_ARGUMENT);
+    bad = rod; /* moving rod, hinge at a moving point */
+    bad.constraint = MECH_BODY_HINGE_POINT;
+    bad.hinge_point = end;
+    CHECK_STATUS(mech_impulse_apply(&bad, &s, &tip, &zero, &br), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_impulse_apply(NULL, &s, &tip, &zero, &br), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_apply(&rod, &s, &tip, NULL, &br), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&br, sizeof br));
+    CHECK_STATUS(mech_impulse_apply(&rod, &s, &tip, &zero, NULL), MECH_STATUS_NULL_POINTER);
+
+    mech_impulse_body_t out_body;
+    FILL_SENTINEL(&out_body, sizeof out_body);
+    props.mass = -2.0;
+    CHECK_STATUS(mech_impulse_body_from_mass_properties(&props, &vel, &zero, &out_body), MECH_STATUS_INVALID_ARGUMENT);
+    props.mass = m;
+    props.inertia_about_com.m[3] = 5.0; /* asymmetric */
+    CHECK_STATUS(mech_impulse_body_from_mass_properties(&props, &vel, &zero, &out_body),
+                 MECH_STATUS_NOT_POSITIVE_DEFINITE);
+    props.inertia_about_com.m[3] = NAN;
+    CHECK_STATUS(mech_impulse_body_from_mass_properties(&props, &vel, &zero, &out_body), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_impulse_body_from_mass_properties(NULL, &vel, &zero, &out_body), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&out_body, sizeof out_body));
+
+    FILL_SENTINEL(&fx, sizeof fx);
+    mech_impulse_body_t moving_wall = ground();
+    moving_wall.velocity = v3(1.0, 0.0, 0.0);
+    CHECK_STATUS(mech_impulse_fix_point(&moving_wall, &zero, &fx), MECH_STATUS_SINGULAR);
+    mech_vec3_t nan_point = v3(NAN, 0.0, 0.0);
+    CHECK_STATUS(mech_impulse_fix_point(&rod, &nan_point, &fx), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_impulse_fix_point(&rod, NULL, &fx), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&fx, sizeof fx));
+}
+
+static void test_contacts(void) {
+    /* A spinning sphere hits the ground and ends up rolling (sticking case):
+     * p = (1 + e) m v_y, P_x = −(2m/7)(v_x + R ω_z). */
+    double m = 2.0, r = 0.1, e = 0.6, vx = 1.0, vy = 3.0, wz = 25.0;
+    mech_impulse_body_t ball = sphere(m, r, v3(0.0, r, 0.0), v3(vx, -vy, 0.0), v3(0.0, 0.0, wz));
+    mech_impulse_body_t g = ground();
+    mech_impulse_contact_t c;
+    memset(&c, 0, sizeof c);
+    c.point = v3(0, 0, 0);
+    c.normal = v3(0.0, 1.0, 0.0);
+    c.restitution = e;
+    c.friction = 0.6;
+    c.law = MECH_RESTITUTION_STRONGE;
+    c.tolerance = 1e-10;
+    mech_impact_result_t res;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &c, &res), MECH_STATUS_OK);
+    CHECK_NEAR(res.normal_impulse, (1.0 + e) * m * vy, 1e-12);
+    CHECK_NEAR(res.impulse.x, -2.0 * m * (vx + r * wz) / 7.0, 1e-12);
+    CHECK(res.mode == MECH_CONTACT_SLIP_THEN_STICK);
+    CHECK_NEAR(res.velocity_after_2.x + r * res.angular_velocity_after_2.z, 0.0, 1e-12);
+    CHECK(res.energy_change < 0.0);
+    CHECK(res.integration_error == 0.0);
+
+    /* Sliding case and the other laws (decoupled W: all laws agree). */
+    c.friction = 0.1;
+    int laws[3] = {MECH_RESTITUTION_NEWTON, MECH_RESTITUTION_POISSON, MECH_RESTITUTION_STRONGE};
+    for (int k = 0; k < 3; ++k) {
+        c.law = laws[k];
+        CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &c, &res), MECH_STATUS_OK);
+        CHECK(res.mode == MECH_CONTACT_SLIP);
+        CHECK_NEAR(res.impulse.x, -0.1 * (1.0 + e) * m * vy, 1e-12);
+    }
+    /* Infinite friction: no slip after the impact. */
+    c.friction = INFINITY;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &c, &res), MECH_STATUS_OK);
+    CHECK(res.mode == MECH_CONTACT_STICK);
+    CHECK_NEAR(res.relative_velocity_after.x, 0.0, 1e-12);
+    /* Separating: no impulse. */
+    c.friction = 0.5;
+    mech_impulse_body_t up = ball;
+    up.velocity.y = 1.0;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &up, &c, &res), MECH_STATUS_OK);
+    CHECK(res.mode == MECH_CONTACT_NO_IMPACT);
+    CHECK(res.normal_impulse == 0.0);
+
+    /* Error paths: nothing written. */
+    FILL_SENTINEL(&res, sizeof res);
+    mech_impulse_contact_t bad = c;
+    bad.law = 3;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_BAD_ENUM);
+    bad = c;
+    bad.law = -1;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_BAD_ENUM);
+    bad = c;
+    bad.restitution = 1.5;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_INVALID_ARGUMENT);
+    bad = c;
+    bad.friction = -0.1;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_INVALID_ARGUMENT);
+    bad = c;
+    bad.friction = NAN;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_NON_FINITE);
+    bad = c;
+    bad.normal = v3(0.0, 0.0, 0.0);
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_INVALID_ARGUMENT);
+    bad = c;
+    bad.normal = v3(0.0, 1.01, 0.0);
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_INVALID_ARGUMENT);
+    bad = c;
+    bad.point.x = INFINITY;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_NON_FINITE);
+    bad = c;
+    bad.tolerance = 0.0;
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_INVALID_ARGUMENT);
+    /* Two immovable bodies approaching. */
+    mech_impulse_body_t wall = ground();
+    wall.velocity = v3(0.0, -1.0, 0.0);
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &wall, &c, &res), MECH_STATUS_SINGULAR);
+    CHECK_STATUS(mech_impulse_resolve_contact(NULL, &ball, &c, &res), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, NULL, &c, &res), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, NULL, &res), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&res, sizeof res));
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &c, NULL), MECH_STATUS_NULL_POINTER);
+}
+
+int main(void) {
+    test_points();
+    test_bodies();
+    test_contacts();
+    return CHECK_DONE();
+}

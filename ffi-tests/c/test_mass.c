@@ -1,0 +1,418 @@
+/* The mass-properties C ABI: primitives, Steiner, composition, holes, transformation, principal
+ * axes, validity and repair, momenta and energy, and triangle meshes, with their error paths.
+ * Reference values are textbook closed forms. */
+#include "check.h"
+
+#include <stdint.h>
+
+static const double EPS = 2.220446049250313e-16;
+
+static double entry(const mech_mat3_t *m, int row, int col) { return m->m[row + 3 * col]; }
+
+static mech_mass_properties_t make_box(double m, double a, double b, double c, double x, double y, double z) {
+    mech_mass_properties_t p;
+    memset(&p, 0, sizeof p);
+    p.mass = m;
+    p.center_of_mass.x = x;
+    p.center_of_mass.y = y;
+    p.center_of_mass.z = z;
+    p.inertia_about_com.m[0] = m * (b * b + c * c) / 12.0;
+    p.inertia_about_com.m[4] = m * (a * a + c * c) / 12.0;
+    p.inertia_about_com.m[8] = m * (a * a + b * b) / 12.0;
+    return p;
+}
+
+static void point_and_steiner(void) {
+    mech_vec3_t pos = {3.0, 0.0, 0.0};
+    mech_mass_properties_t p;
+    CHECK_STATUS(mech_mass_point(2.0, &pos, &p), MECH_STATUS_OK);
+    mech_vec3_t origin = {0.0, 0.0, 0.0};
+    mech_mat3_t j;
+    CHECK_STATUS(mech_mass_inertia_about(&p, &origin, &j), MECH_STATUS_OK);
+    CHECK_NEAR(entry(&j, 0, 0), 0.0, 0.0);
+    CHECK_NEAR(entry(&j, 1, 1), 18.0, 0.0);
+    CHECK_NEAR(entry(&j, 2, 2), 18.0, 0.0);
+
+    mech_mass_properties_t sentinel;
+    FILL_SENTINEL(&sentinel, sizeof sentinel);
+    CHECK_STATUS(mech_mass_point(-1.0, &pos, &sentinel), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_point(NAN, &pos, &sentinel), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_point(1.0, NULL, &sentinel), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&sentinel, sizeof sentinel));
+    CHECK_STATUS(mech_mass_point(1.0, &pos, NULL), MECH_STATUS_NULL_POINTER);
+
+    mech_mat3_t js;
+    FILL_SENTINEL(&js, sizeof js);
+    mech_vec3_t bad = {INFINITY, 0.0, 0.0};
+    CHECK_STATUS(mech_mass_inertia_about(&p, &bad, &js), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_inertia_about(NULL, &origin, &js), MECH_STATUS_NULL_POINTER);
+    mech_mass_properties_t neg = p;
+    neg.mass = -2.0;
+    CHECK_STATUS(mech_mass_inertia_about(&neg, &origin, &js), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(&js, sizeof js));
+    CHECK_STATUS(mech_mass_inertia_about(&p, &origin, NULL), MECH_STATUS_NULL_POINTER);
+}
+
+static void primitives(void) {
+    mech_mass_properties_t p;
+    double r = 0.5;
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &r, 1, MECH_AMOUNT_MASS, 3.0, &p), MECH_STATUS_OK);
+    CHECK_NEAR(p.mass, 3.0, 0.0);
+    CHECK_NEAR(entry(&p.inertia_about_com, 0, 0), 0.4 * 3.0 * 0.25, 4 * EPS);
+
+    double cyl[2] = {0.5, 2.0};
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_CYLINDER, cyl, 2, MECH_AMOUNT_DENSITY, 1000.0, &p),
+                 MECH_STATUS_OK);
+    double m = 1000.0 * 3.14159265358979323846 * 0.25 * 2.0;
+    CHECK_NEAR(p.mass, m, 1e-12 * m);
+    CHECK_NEAR(entry(&p.inertia_about_com, 0, 0), m * (3 * 0.25 + 4.0) / 12.0, 1e-12 * m);
+    CHECK_NEAR(entry(&p.inertia_about_com, 2, 2), m * 0.25 / 2.0, 1e-12 * m);
+
+    double cone[2] = {1.0, 4.0};
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_CONE, cone, 2, MECH_AMOUNT_MASS, 2.0, &p), MECH_STATUS_OK);
+    CHECK_NEAR(p.center_of_mass.z, 1.0, 0.0);
+    CHECK_NEAR(entry(&p.inertia_about_com, 2, 2), 0.3 * 2.0, 4 * EPS);
+
+    double torus[2] = {2.0, 0.5};
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_TORUS, torus, 2, MECH_AMOUNT_MASS, 1.0, &p), MECH_STATUS_OK);
+    CHECK_NEAR(entry(&p.inertia_about_com, 2, 2), 4.0 + 0.75 * 0.25, 8 * EPS);
+
+    /* Each kind with its dimension count builds a valid body. */
+    const int kinds[12] = {MECH_PRIMITIVE_POINT,     MECH_PRIMITIVE_ROD,      MECH_PRIMITIVE_RECTANGLE_LAMINA,
+                           MECH_PRIMITIVE_DISC_LAMINA, MECH_PRIMITIVE_SPHERE, MECH_PRIMITIVE_ELLIPSOID,
+                           MECH_PRIMITIVE_BOX,       MECH_PRIMITIVE_CYLINDER, MECH_PRIMITIVE_CONE,
+                           MECH_PRIMITIVE_CAPSULE,   MECH_PRIMITIVE_TORUS,    MECH_PRIMITIVE_HEMISPHERE};
+    const size_t counts[12] = {0, 1, 2, 1, 1, 3, 3, 2, 2, 2, 2, 1};
+    const int classes[12] = {MECH_INERTIA_POINT, MECH_INERTIA_LINEAR, MECH_INERTIA_PLANAR, MECH_INERTIA_PLANAR,
+                             MECH_INERTIA_SOLID, MECH_INERTIA_SOLID,  MECH_INERTIA_SOLID,  MECH_INERTIA_SOLID,
+                             MECH_INERTIA_SOLID, MECH_INERTIA_SOLID,  MECH_INERTIA_SOLID,  MECH_INERTIA_SOLID};
+    double dims[3] = {2.0, 1.0, 0.5};
+    for (int k = 0; k < 12; ++k) {
+        CHECK_STATUS(mech_mass_primitive(kinds[k], counts[k] ? dims : NULL, counts[k], MECH_AMOUNT_MASS, 1.5, &p),
+                     MECH_STATUS_OK);
+        CHECK_NEAR(p.mass, 1.5, 0.0);
+        mech_mass_validity_t v;
+        CHECK_STATUS(mech_mass_check(&p, 0.0, &v), MECH_STATUS_OK);
+        CHECK(v.issues == 0);
+        CHECK(v.inertia_class == classes[k]);
+    }
+
+    mech_mass_properties_t s;
+    FILL_SENTINEL(&s, sizeof s);
+    CHECK_STATUS(mech_mass_primitive(99, &r, 1, MECH_AMOUNT_MASS, 1.0, &s), MECH_STATUS_BAD_ENUM);
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &r, 1, 7, 1.0, &s), MECH_STATUS_BAD_ENUM);
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, cyl, 2, MECH_AMOUNT_MASS, 1.0, &s),
+                 MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, NULL, 1, MECH_AMOUNT_MASS, 1.0, &s),
+                 MECH_STATUS_NULL_POINTER);
+    double neg = -1.0, nan = NAN;
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &neg, 1, MECH_AMOUNT_MASS, 1.0, &s),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &nan, 1, MECH_AMOUNT_MASS, 1.0, &s),
+                 MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &r, 1, MECH_AMOUNT_DENSITY, 0.0, &s),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &r, 1, MECH_AMOUNT_MASS, INFINITY, &s),
+                 MECH_STATUS_NON_FINITE);
+    double bad_torus[2] = {1.0, 2.0};
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_TORUS, bad_torus, 2, MECH_AMOUNT_MASS, 1.0, &s),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(&s, sizeof s));
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &r, 1, MECH_AMOUNT_MASS, 1.0, NULL),
+                 MECH_STATUS_NULL_POINTER);
+}
+
+static void combine_subtract_transform(void) {
+    /* Three stacked unit cubes equal one 1×3×1 box. */
+    mech_mass_properties_t cube = make_box(1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0);
+    mech_mass_properties_t parts[3] = {cube, cube, cube};
+    mech_quat_t q[3] = {{1, 0, 0, 0}, {1, 0, 0, 0}, {1, 0, 0, 0}};
+    mech_vec3_t t[3] = {{0.5, 0.5, 0.5}, {0.5, 1.5, 0.5}, {0.5, 2.5, 0.5}};
+    mech_mass_properties_t sum;
+    CHECK_STATUS(mech_mass_combine(parts, q, t, 3, &sum), MECH_STATUS_OK);
+    mech_mass_properties_t tall = make_box(3.0, 1.0, 3.0, 1.0, 0.5, 1.5, 0.5);
+    CHECK_NEAR(sum.mass, 3.0, 0.0);
+    CHECK_NEAR(sum.center_of_mass.y, 1.5, 4 * EPS);
+    for (int i = 0; i < 9; ++i) CHECK_NEAR(sum.inertia_about_com.m[i], tall.inertia_about_com.m[i], 16 * EPS);
+
+    /* Without poses: the same parts already placed. */
+    for (int i = 0; i < 3; ++i) parts[i].center_of_mass = t[i];
+    mech_mass_properties_t sum2;
+    CHECK_STATUS(mech_mass_combine(parts, NULL, NULL, 3, &sum2), MECH_STATUS_OK);
+    for (int i = 0; i < 9; ++i) CHECK_NEAR(sum2.inertia_about_com.m[i], tall.inertia_about_com.m[i], 16 * EPS);
+
+    /* Removing the top cube leaves a 1×2×1 box. */
+    mech_mass_properties_t rest;
+    CHECK_STATUS(mech_mass_subtract(&sum, &parts[2], &rest), MECH_STATUS_OK);
+    mech_mass_properties_t two = make_box(2.0, 1.0, 2.0, 1.0, 0.5, 1.0, 0.5);
+    CHECK_NEAR(rest.center_of_mass.y, 1.0, 8 * EPS);
+    for (int i = 0; i < 9; ++i) CHECK_NEAR(rest.inertia_about_com.m[i], two.inertia_about_com.m[i], 32 * EPS);
+
+    /* A quarter turn about z swaps I_xx and I_yy and moves the centre. */
+    mech_mass_properties_t b = make_box(1.0, 1.0, 2.0, 3.0, 1.0, 0.0, 0.0);
+    mech_quat_t qz = {sqrt(0.5), 0.0, 0.0, sqrt(0.5)};
+    mech_vec3_t tz = {0.0, 0.0, 5.0};
+    mech_mass_properties_t moved;
+    CHECK_STATUS(mech_mass_transform(&b, &qz, &tz, &moved), MECH_STATUS_OK);
+    CHECK_NEAR(moved.center_of_mass.x, 0.0, 4 * EPS);
+    CHECK_NEAR(moved.center_of_mass.y, 1.0, 4 * EPS);
+    CHECK_NEAR(moved.center_of_mass.z, 5.0, 0.0);
+    CHECK_NEAR(entry(&moved.inertia_about_com, 0, 0), entry(&b.inertia_about_com, 1, 1), 8 * EPS);
+    CHECK_NEAR(entry(&moved.inertia_about_com, 1, 1), entry(&b.inertia_about_com, 0, 0), 8 * EPS);
+
+    mech_mass_properties_t s;
+    FILL_SENTINEL(&s, sizeof s);
+    CHECK_STATUS(mech_mass_combine(parts, q, t, 0, &s), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_mass_combine(NULL, NULL, NULL, 3, &s), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_mass_combine(parts, q, NULL, 3, &s), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_mass_combine(parts, NULL, t, 3, &s), MECH_STATUS_NULL_POINTER);
+    mech_quat_t qbad[3] = {{1, 0, 0, 0}, {2, 0, 0, 0}, {1, 0, 0, 0}};
+    CHECK_STATUS(mech_mass_combine(parts, qbad, t, 3, &s), MECH_STATUS_INVALID_ARGUMENT);
+    mech_vec3_t tnan[3] = {{0, 0, 0}, {NAN, 0, 0}, {0, 0, 0}};
+    CHECK_STATUS(mech_mass_combine(parts, q, tnan, 3, &s), MECH_STATUS_NON_FINITE);
+    parts[1].mass = 0.0;
+    CHECK_STATUS(mech_mass_combine(parts, q, t, 3, &s), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_subtract(&cube, &sum, &s), MECH_STATUS_INVALID_ARGUMENT);
+    mech_mass_properties_t far_hole = make_box(0.5, 1.0, 1.0, 1.0, 10.0, 0.0, 0.0);
+    CHECK_STATUS(mech_mass_subtract(&cube, &far_hole, &s), MECH_STATUS_NOT_POSITIVE_DEFINITE);
+    CHECK_STATUS(mech_mass_subtract(&cube, NULL, &s), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_mass_transform(&b, &qbad[1], &tz, &s), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_transform(&b, &qz, NULL, &s), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&s, sizeof s));
+    CHECK_STATUS(mech_mass_transform(&b, &qz, &tz, NULL), MECH_STATUS_NULL_POINTER);
+}
+
+static void lines_and_principal_axes(void) {
+    /* Rod of length 2 along z about a perpendicular axis through its end: m L²/3. */
+    double len = 2.0;
+    mech_mass_properties_t rod;
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_ROD, &len, 1, MECH_AMOUNT_MASS, 3.0, &rod), MECH_STATUS_OK);
+    mech_vec3_t end = {0, 0, -1}, dir = {0, 7, 0}, zero = {0, 0, 0};
+    double i;
+    CHECK_STATUS(mech_mass_moment_about_line(&rod, &end, &dir, &i), MECH_STATUS_OK);
+    CHECK_NEAR(i, 4.0, 8 * EPS);
+    double is = 0;
+    FILL_SENTINEL(&is, sizeof is);
+    CHECK_STATUS(mech_mass_moment_about_line(&rod, &end, &zero, &is), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_moment_about_line(&rod, NULL, &dir, &is), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&is, sizeof is));
+
+    /* Disc in the xy plane: moments m r²/4, m r²/4, m r²/2 and the identity frame. */
+    double r = 1.0;
+    mech_mass_properties_t disc;
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_DISC_LAMINA, &r, 1, MECH_AMOUNT_MASS, 4.0, &disc),
+                 MECH_STATUS_OK);
+    mech_vec3_t moments;
+    mech_mat3_t axes;
+    CHECK_STATUS(mech_mass_principal_axes(&disc, &moments, &axes), MECH_STATUS_OK);
+    CHECK_NEAR(moments.x, 1.0, 0.0);
+    CHECK_NEAR(moments.y, 1.0, 0.0);
+    CHECK_NEAR(moments.z, 2.0, 0.0);
+    for (int k = 0; k < 9; ++k) CHECK_NEAR(axes.m[k], (k % 4 == 0) ? 1.0 : 0.0, 0.0);
+    /* A box with distinct moments: sorted, right-handed. */
+    mech_mass_properties_t b = make_box(1.0, 3.0, 1.0, 2.0, 0, 0, 0);
+    CHECK_STATUS(mech_mass_principal_axes(&b, &moments, &axes), MECH_STATUS_OK);
+    CHECK(moments.x <= moments.y && moments.y <= moments.z);
+    CHECK_NEAR(moments.x, 5.0 / 12.0, 4 * EPS);
+    CHECK_NEAR(fabs(entry(&axes, 1, 2)), 1.0, 4 * EPS); /* largest moment about y (the short side 1) */
+
+    mech_vec3_t ms;
+    mech_mat3_t as;
+    FILL_SENTINEL(&ms, sizeof ms);
+    FILL_SENTINEL(&as, sizeof as);
+    mech_mass_properties_t nanp = b;
+    nanp.inertia_about_com.m[3] = NAN;
+    CHECK_STATUS(mech_mass_principal_axes(&nanp, &ms, &as), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_principal_axes(&b, NULL, &as), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_mass_principal_axes(&b, &ms, NULL), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&ms, sizeof ms) && mech_untouched(&as, sizeof as));
+}
+
+static void validity_and_repair(void) {
+    mech_mass_properties_t p = make_box(1.0, 1.0, 1.0, 1.0, 0, 0, 0);
+    p.inertia_about_com.m[8] = 3.0; /* I_zz too large: triangle inequality */
+    p.inertia_about_com.m[3] = 0.01; /* J_01 without J_10: not symmetric */
+    mech_mass_validity_t v;
+    CHECK_STATUS(mech_mass_check(&p, 0.0, &v), MECH_STATUS_OK);
+    CHECK(v.issues == (MECH_MASS_ISSUE_TRIANGLE_INEQUALITY | MECH_MASS_ISSUE_NOT_SYMMETRIC));
+    CHECK(v.inertia_class == MECH_INERTIA_INVALID);
+    mech_mass_properties_t neg = make_box(-1.0, 1.0, 1.0, 1.0, 0, 0, 0);
+    CHECK_STATUS(mech_mass_check(&neg, 0.0, &v), MECH_STATUS_OK);
+    CHECK(v.issues & MECH_MASS_ISSUE_NEGATIVE_MASS);
+    CHECK(v.issues & MECH_MASS_ISSUE_NOT_POSITIVE_SEMIDEFINITE);
+    mech_mass_properties_t nanp = make_box(1.0, 1.0, 1.0, 1.0, 0, 0, 0);
+    nanp.inertia_about_com.m[0] = NAN;
+    CHECK_STATUS(mech_mass_check(&nanp, 0.0, &v), MECH_STATUS_OK);
+    CHECK(v.issues == MECH_MASS_ISSUE_NON_FINITE);
+
+    mech_mass_properties_t fixed;
+    double change = -1.0;
+    CHECK_STATUS(mech_mass_repair(&p, 0.0, &fixed, &change), MECH_STATUS_OK);
+    CHECK(change > 0.0);
+    CHECK_STATUS(mech_mass_check(&fixed, 0.0, &v), MECH_STATUS_OK);
+    CHECK(v.issues == 0);
+    CHECK(v.inertia_class == MECH_INERTIA_PLANAR); /* clamped onto I1 + I2 = I3 */
+    CHECK_STATUS(mech_mass_repair(&fixed, 0.0, &fixed, NULL), MECH_STATUS_OK);
+
+    mech_mass_validity_t vs;
+    mech_mass_properties_t s;
+    FILL_SENTINEL(&vs, sizeof vs);
+    FILL_SENTINEL(&s, sizeof s);
+    CHECK_STATUS(mech_mass_check(&p, -1.0, &vs), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_check(&p, NAN, &vs), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_check(NULL, 0.0, &vs), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&vs, sizeof vs));
+    CHECK_STATUS(mech_mass_check(&p, 0.0, NULL), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_mass_repair(&neg, 0.0, &s, NULL), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_repair(&nanp, 0.0, &s, NULL), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_repair(&p, 0.0, NULL, NULL), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&s, sizeof s));
+}
+
+static void momenta_and_energy(void) {
+    /* Unit-mass sphere spinning about z while its centre moves along x. */
+    double r = 1.0;
+    mech_mass_properties_t s;
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &r, 1, MECH_AMOUNT_MASS, 1.0, &s), MECH_STATUS_OK);
+    mech_vec3_t v = {2.0, 0.0, 0.0}, w = {0.0, 0.0, 5.0}, a = {0.0, -1.0, 0.0};
+    double t;
+    mech_vec3_t p;
+    CHECK_STATUS(mech_mass_kinetic_energy(&s, &v, &w, &t, &p), MECH_STATUS_OK);
+    CHECK_NEAR(t, 0.5 * 4.0 + 0.5 * 0.4 * 25.0, 8 * EPS);
+    CHECK_NEAR(p.x, 2.0, 0.0);
+    CHECK_STATUS(mech_mass_kinetic_energy(&s, &v, &w, &t, NULL), MECH_STATUS_OK);
+    /* Rolling without slipping on the plane y = −1 ... D_A = J0 ω + (x0 − a) × m v0 */
+    mech_vec3_t d;
+    CHECK_STATUS(mech_mass_angular_momentum(&s, &a, &v, &w, &d), MECH_STATUS_OK);
+    CHECK_NEAR(d.x, 0.0, 0.0);
+    CHECK_NEAR(d.z, 0.4 * 5.0 - 2.0, 8 * EPS);
+
+    double ts;
+    mech_vec3_t ds;
+    FILL_SENTINEL(&ts, sizeof ts);
+    FILL_SENTINEL(&ds, sizeof ds);
+    mech_vec3_t bad = {NAN, 0, 0};
+    CHECK_STATUS(mech_mass_kinetic_energy(&s, &bad, &w, &ts, NULL), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_kinetic_energy(&s, &v, &w, NULL, NULL), MECH_STATUS_NULL_POINTER);
+    mech_vec3_t huge = {1e200, 0, 0};
+    CHECK_STATUS(mech_mass_kinetic_energy(&s, &huge, &w, &ts, NULL), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_angular_momentum(&s, &a, &v, &bad, &ds), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_angular_momentum(&s, NULL, &v, &w, &ds), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&ts, sizeof ts) && mech_untouched(&ds, sizeof ds));
+    CHECK_STATUS(mech_mass_angular_momentum(&s, &a, &v, &w, NULL), MECH_STATUS_NULL_POINTER);
+}
+
+/* A 1×2×3 box centred at (c, c, c): 8 vertices, 12 outward triangles. */
+static void box_mesh(double c, double v[24], uint32_t tri[36]) {
+    const double size[3] = {1.0, 2.0, 3.0};
+    for (int k = 0; k < 8; ++k) {
+        for (int axis = 0; axis < 3; ++axis) {
+            double sign = (k & (1 << axis)) ? 0.5 : -0.5;
+            v[3 * k + axis] = c + sign * size[axis];
+        }
+    }
+    const uint32_t t[36] = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                            2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
+    memcpy(tri, t, sizeof t);
+}
+
+static void meshes(void) {
+    double v[24];
+    uint32_t tri[36];
+    box_mesh(1e6, v, tri);
+    mech_mass_properties_t p;
+    mech_mesh_report_t rep;
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &p, &rep), MECH_STATUS_OK);
+    CHECK_NEAR(p.mass, 12.0, 64 * EPS);
+    CHECK_NEAR(p.center_of_mass.x, 1e6, 4 * EPS * 1e6);
+    CHECK_NEAR(entry(&p.inertia_about_com, 0, 0), 12.0 * (4.0 + 9.0) / 12.0, 64 * EPS * 13.0);
+    CHECK_NEAR(entry(&p.inertia_about_com, 2, 2), 12.0 * (1.0 + 4.0) / 12.0, 64 * EPS * 13.0);
+    CHECK_NEAR(entry(&p.inertia_about_com, 0, 1), 0.0, 64 * EPS * 13.0);
+    CHECK(rep.model == MECH_MESH_SOLID && rep.flipped == 0);
+    CHECK_NEAR(rep.measure, 6.0, 64 * EPS);
+    CHECK(rep.triangles == 12 && rep.boundary_edges == 0 && rep.degenerate_triangles == 0);
+    CHECK(rep.relative_error_bound > 0.0 && rep.relative_error_bound < 1e-10);
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_MASS, 5.0, NULL, &p, NULL), MECH_STATUS_OK);
+    CHECK_NEAR(p.mass, 5.0, 0.0);
+
+    /* Inside out: flipped by default, rejected on request. */
+    uint32_t inv[36];
+    for (int k = 0; k < 12; ++k) {
+        inv[3 * k] = tri[3 * k];
+        inv[3 * k + 1] = tri[3 * k + 2];
+        inv[3 * k + 2] = tri[3 * k + 1];
+    }
+    CHECK_STATUS(mech_mass_mesh(v, 8, inv, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &p, &rep), MECH_STATUS_OK);
+    CHECK(rep.flipped == 1);
+    CHECK_NEAR(p.mass, 12.0, 64 * EPS);
+    mech_mesh_options_t opts = {MECH_MESH_SOLID, MECH_OPEN_MESH_REJECT, MECH_INSIDE_OUT_REJECT, MECH_DEGENERATE_SKIP};
+    mech_mass_properties_t s;
+    mech_mesh_report_t rs;
+    FILL_SENTINEL(&s, sizeof s);
+    FILL_SENTINEL(&rs, sizeof rs);
+    CHECK_STATUS(mech_mass_mesh(v, 8, inv, 12, MECH_AMOUNT_DENSITY, 2.0, &opts, &s, &rs),
+                 MECH_STATUS_INVALID_ARGUMENT);
+
+    /* Open: rejected by default (3 boundary edges in the message), or taken as a shell. */
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 11, MECH_AMOUNT_DENSITY, 2.0, NULL, &s, &rs),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    char msg[256];
+    mech_last_error(msg, sizeof msg);
+    CHECK(strstr(msg, "3 boundary edges") != NULL);
+    mech_mesh_options_t shell = {MECH_MESH_SOLID, MECH_OPEN_MESH_SHELL, MECH_INSIDE_OUT_FLIP, MECH_DEGENERATE_SKIP};
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 11, MECH_AMOUNT_DENSITY, 1.0, &shell, &p, &rep), MECH_STATUS_OK);
+    CHECK(rep.model == MECH_MESH_SHELL && rep.boundary_edges == 3);
+    CHECK_NEAR(rep.measure, 22.0 - 3.0, 64 * EPS * 22.0); /* the box area 22 minus half the 2×3 face at x = +0.5 */
+
+    /* Bad input. */
+    double vnan[24];
+    memcpy(vnan, v, sizeof v);
+    vnan[7] = NAN;
+    CHECK_STATUS(mech_mass_mesh(vnan, 8, tri, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, &s, &rs), MECH_STATUS_NON_FINITE);
+    uint32_t range[36];
+    memcpy(range, tri, sizeof range);
+    range[20] = 8;
+    CHECK_STATUS(mech_mass_mesh(v, 8, range, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, &s, &rs),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, -1.0, NULL, &s, &rs),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, 5, 1.0, NULL, &s, &rs), MECH_STATUS_BAD_ENUM);
+    mech_mesh_options_t bad_opts = {MECH_MESH_SOLID, 9, MECH_INSIDE_OUT_FLIP, MECH_DEGENERATE_SKIP};
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 1.0, &bad_opts, &s, &rs), MECH_STATUS_BAD_ENUM);
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 0, MECH_AMOUNT_DENSITY, 1.0, NULL, &s, &rs), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_mass_mesh(NULL, 8, tri, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, &s, &rs),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_mass_mesh(v, 8, NULL, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, &s, &rs),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_mass_mesh(v, SIZE_MAX, tri, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, &s, &rs),
+                 MECH_STATUS_BAD_DIMENSION);
+    /* A closed, two-sided flat triangle encloses no volume. */
+    double flat_v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    uint32_t flat_t[6] = {0, 1, 2, 0, 2, 1};
+    CHECK_STATUS(mech_mass_mesh(flat_v, 3, flat_t, 2, MECH_AMOUNT_DENSITY, 1.0, NULL, &s, &rs),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    /* Degenerate triangles: skipped and counted, or rejected. */
+    uint32_t with_deg[39];
+    memcpy(with_deg, tri, sizeof tri);
+    with_deg[36] = 3;
+    with_deg[37] = 3;
+    with_deg[38] = 5;
+    CHECK_STATUS(mech_mass_mesh(v, 8, with_deg, 13, MECH_AMOUNT_DENSITY, 2.0, NULL, &p, &rep), MECH_STATUS_OK);
+    CHECK(rep.degenerate_triangles == 1);
+    mech_mesh_options_t strict = {MECH_MESH_SOLID, MECH_OPEN_MESH_REJECT, MECH_INSIDE_OUT_FLIP, MECH_DEGENERATE_REJECT};
+    CHECK_STATUS(mech_mass_mesh(v, 8, with_deg, 13, MECH_AMOUNT_DENSITY, 2.0, &strict, &s, &rs),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(&s, sizeof s) && mech_untouched(&rs, sizeof rs));
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, NULL, &rs), MECH_STATUS_NULL_POINTER);
+}
+
+int main(void) {
+    point_and_steiner();
+    primitives();
+    combine_subtract_transform();
+    lines_and_principal_axes();
+    validity_and_repair();
+    momenta_and_energy();
+    meshes();
+    return CHECK_DONE();
+}

@@ -1,0 +1,228 @@
+/* C test of the modal entry points: det(λA + B) = 0 on a fixed–fixed unit spring chain
+ * (closed form ω²_k = 4 sin²(kπ/(2(n+1)))), a massless coordinate, and every error path. */
+#include "check.h"
+
+#define N 6
+
+static void fixed_chain(double *a, double *b) {
+    for (int j = 0; j < N; ++j) {
+        for (int i = 0; i < N; ++i) {
+            a[i + N * j] = (i == j) ? 1.0 : 0.0;
+            b[i + N * j] = (i == j) ? 2.0 : ((i - j == 1 || j - i == 1) ? -1.0 : 0.0);
+        }
+    }
+}
+
+static mech_modal_options_t default_options(void) {
+    mech_modal_options_t o;
+    memset(&o, 0, sizeof o);
+    o.selection = MECH_MODAL_SELECTION_ALL;
+    o.vectors = 1;
+    o.refinement = MECH_MODAL_REFINEMENT_AUTO;
+    return o;
+}
+
+static void all_pairs(void) {
+    double a[N * N], b[N * N];
+    fixed_chain(a, b);
+    mech_modal_options_t o = default_options();
+    mech_modal_result_t *r = NULL;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &o, &r), MECH_STATUS_OK);
+    CHECK(r != NULL);
+    size_t m = 0, dim = 0;
+    CHECK_STATUS(mech_modal_result_size(r, &m, &dim), MECH_STATUS_OK);
+    CHECK(m == N && dim == N);
+
+    double lambda[N];
+    CHECK_STATUS(mech_modal_result_eigenvalues(r, lambda, N), MECH_STATUS_OK);
+    mech_modal_mode_t modes[N];
+    CHECK_STATUS(mech_modal_result_modes(r, modes, N), MECH_STATUS_OK);
+    const double pi = 3.14159265358979323846;
+    for (int k = 0; k < N; ++k) {
+        double s = sin((k + 1) * pi / (2.0 * (N + 1)));
+        double w2 = 4.0 * s * s;
+        CHECK_NEAR(-lambda[k], w2, modes[k].error_bound + 1e-15);
+        CHECK(modes[k].kind == MECH_MODAL_KIND_OSCILLATORY);
+        CHECK_NEAR(modes[k].rate, sqrt(w2), 1e-14);
+        CHECK(modes[k].backward_error >= 0.0 && modes[k].backward_error <= 10.0 * N * 2.2e-16);
+        CHECK(modes[k].multiplicity == 1);
+    }
+
+    double x[N * N];
+    CHECK_STATUS(mech_modal_result_vectors(r, x, N * N), MECH_STATUS_OK);
+    /* A = I: the columns are orthonormal and satisfy B x = ω² x. */
+    for (int k = 0; k < N; ++k) {
+        double nrm = 0.0;
+        for (int i = 0; i < N; ++i) nrm += x[i + N * k] * x[i + N * k];
+        CHECK_NEAR(nrm, 1.0, 1e-14);
+        for (int i = 0; i < N; ++i) {
+            double bx = 0.0;
+            for (int j = 0; j < N; ++j) bx += b[i + N * j] * x[j + N * k];
+            CHECK_NEAR(bx, -lambda[k] * x[i + N * k], 1e-14);
+        }
+    }
+
+    mech_modal_accuracy_t acc;
+    CHECK_STATUS(mech_modal_result_accuracy(r, &acc), MECH_STATUS_OK);
+    CHECK(acc.max_backward_error >= 0.0 && acc.max_backward_error <= 10.0 * N * 2.2e-16);
+    CHECK(acc.orthogonality_error >= 0.0 && acc.orthogonality_error <= 10.0 * N * 2.2e-16);
+    CHECK(acc.inertia_checked == 1 && acc.inertia_consistent == 1);
+    CHECK(acc.inertia_below == acc.computed_below);
+    CHECK(acc.massless == 0);
+
+    /* Buffers too small: error, nothing written. */
+    double small[N * N];
+    FILL_SENTINEL(small, sizeof small);
+    CHECK_STATUS(mech_modal_result_eigenvalues(r, small, N - 1), MECH_STATUS_BUFFER_TOO_SMALL);
+    CHECK_STATUS(mech_modal_result_vectors(r, small, N * N - 1), MECH_STATUS_BUFFER_TOO_SMALL);
+    mech_modal_mode_t small_modes[N];
+    FILL_SENTINEL(small_modes, sizeof small_modes);
+    CHECK_STATUS(mech_modal_result_modes(r, small_modes, 2), MECH_STATUS_BUFFER_TOO_SMALL);
+    CHECK(mech_untouched(small, sizeof small));
+    CHECK(mech_untouched(small_modes, sizeof small_modes));
+    /* NULL outputs. */
+    CHECK_STATUS(mech_modal_result_eigenvalues(r, NULL, N), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_result_accuracy(r, NULL), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_result_size(r, NULL, &dim), MECH_STATUS_NULL_POINTER);
+    mech_modal_result_destroy(r);
+}
+
+static void subsets_and_values_only(void) {
+    double a[N * N], b[N * N];
+    fixed_chain(a, b);
+    mech_modal_options_t o = default_options();
+    o.selection = MECH_MODAL_SELECTION_LOWEST;
+    o.count = 2;
+    mech_modal_result_t *r = NULL;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &o, &r), MECH_STATUS_OK);
+    size_t m = 0, dim = 0;
+    CHECK_STATUS(mech_modal_result_size(r, &m, &dim), MECH_STATUS_OK);
+    CHECK(m == 2);
+    double x[N * 2];
+    CHECK_STATUS(mech_modal_result_vectors(r, x, N * 2), MECH_STATUS_OK);
+    mech_modal_result_destroy(r);
+
+    o.selection = MECH_MODAL_SELECTION_INTERVAL;
+    o.lower = 1.0;
+    o.upper = 3.0;
+    o.vectors = 0;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &o, &r), MECH_STATUS_OK);
+    CHECK_STATUS(mech_modal_result_size(r, &m, &dim), MECH_STATUS_OK);
+    /* ω² = 4 sin²(kπ/14) = 1.55 (k = 3) and 2.45 (k = 4) lie in [1, 3]; k = 2, 5 give 0.75, 3.25. */
+    CHECK(m == 2);
+    mech_modal_mode_t modes[2];
+    CHECK_STATUS(mech_modal_result_modes(r, modes, 2), MECH_STATUS_OK);
+    CHECK(modes[0].backward_error == -1.0);
+    CHECK_STATUS(mech_modal_result_vectors(r, x, N * 2), MECH_STATUS_INVALID_ARGUMENT);
+    mech_modal_accuracy_t acc;
+    CHECK_STATUS(mech_modal_result_accuracy(r, &acc), MECH_STATUS_OK);
+    CHECK(acc.max_backward_error == -1.0 && acc.orthogonality_error == -1.0);
+    mech_modal_result_destroy(r);
+
+    size_t below = 0;
+    CHECK_STATUS(mech_modal_count_below(N, a, b, 2.0, &below), MECH_STATUS_OK);
+    CHECK(below == 3);
+}
+
+static void massless_coordinate(void) {
+    /* ground–m–(massless)–m–ground with unit springs: ω² = 1, 2 and one infinite mode. */
+    double a[9] = {1, 0, 0, 0, 0, 0, 0, 0, 1};
+    double b[9] = {2, -1, 0, -1, 2, -1, 0, -1, 2};
+    mech_modal_options_t o = default_options();
+    mech_modal_result_t *r = NULL;
+    CHECK_STATUS(mech_modal_solve(3, a, b, &o, &r), MECH_STATUS_OK);
+    mech_modal_mode_t modes[3];
+    CHECK_STATUS(mech_modal_result_modes(r, modes, 3), MECH_STATUS_OK);
+    CHECK_NEAR(modes[0].omega_sq, 1.0, modes[0].error_bound);
+    CHECK_NEAR(modes[1].omega_sq, 2.0, modes[1].error_bound);
+    CHECK(modes[2].kind == MECH_MODAL_KIND_INFINITE);
+    CHECK(isinf(modes[2].omega_sq) && modes[2].omega_sq > 0.0);
+    mech_modal_accuracy_t acc;
+    CHECK_STATUS(mech_modal_result_accuracy(r, &acc), MECH_STATUS_OK);
+    CHECK(acc.massless == 1);
+    mech_modal_result_destroy(r);
+}
+
+static void error_paths(void) {
+    double a[N * N], b[N * N];
+    fixed_chain(a, b);
+    mech_modal_options_t o = default_options();
+    mech_modal_result_t *r;
+    FILL_SENTINEL(&r, sizeof r);
+
+    CHECK_STATUS(mech_modal_solve(N, NULL, b, &o, &r), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_solve(N, a, b, NULL, &r), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_solve(N, a, b, &o, NULL), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_solve(0, a, b, &o, &r), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_modal_solve((size_t)-1, a, b, &o, &r), MECH_STATUS_BAD_DIMENSION);
+
+    mech_modal_options_t bad = o;
+    bad.selection = 7;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &bad, &r), MECH_STATUS_BAD_ENUM);
+    bad = o;
+    bad.refinement = -1;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &bad, &r), MECH_STATUS_BAD_ENUM);
+    bad = o;
+    bad.vectors = 2;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &bad, &r), MECH_STATUS_INVALID_ARGUMENT);
+    bad = o;
+    bad.selection = MECH_MODAL_SELECTION_LOWEST;
+    bad.count = N + 1;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &bad, &r), MECH_STATUS_INVALID_ARGUMENT);
+    bad = o;
+    bad.selection = MECH_MODAL_SELECTION_INTERVAL;
+    bad.lower = NAN;
+    bad.upper = 1.0;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &bad, &r), MECH_STATUS_NON_FINITE);
+    bad.lower = 2.0;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &bad, &r), MECH_STATUS_INVALID_ARGUMENT);
+
+    double saved = b[3];
+    b[3] = INFINITY;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &o, &r), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_modal_check_pencil(N, a, b), MECH_STATUS_NON_FINITE);
+    b[3] = 0.5; /* b[3 + 0·N] ≠ b[0 + 3·N]: asymmetric */
+    CHECK_STATUS(mech_modal_solve(N, a, b, &o, &r), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_modal_check_pencil(N, a, b), MECH_STATUS_INVALID_ARGUMENT);
+    b[3] = saved;
+    CHECK_STATUS(mech_modal_check_pencil(N, a, b), MECH_STATUS_OK);
+
+    a[2 + 2 * N] = -1.0; /* indefinite mass */
+    CHECK_STATUS(mech_modal_solve(N, a, b, &o, &r), MECH_STATUS_NOT_POSITIVE_DEFINITE);
+    {
+        char msg[256];
+        mech_last_error(msg, sizeof msg);
+        CHECK(strstr(msg, "pivot 2") != NULL);
+    }
+    a[2 + 2 * N] = 1.0;
+
+    double sa[4] = {1, 0, 0, 0}, sb[4] = {1, 0, 0, 0}; /* det(λA + B) ≡ 0 */
+    CHECK_STATUS(mech_modal_solve(2, sa, sb, &o, &r), MECH_STATUS_SINGULAR);
+    CHECK(mech_untouched(&r, sizeof r));
+
+    size_t below;
+    FILL_SENTINEL(&below, sizeof below);
+    CHECK_STATUS(mech_modal_count_below(N, a, b, NAN, &below), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_modal_count_below(N, a, NULL, 1.0, &below), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_count_below(N, a, b, 1.0, NULL), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&below, sizeof below));
+
+    double lambda[N];
+    size_t m;
+    mech_modal_mode_t modes[N];
+    mech_modal_accuracy_t acc;
+    CHECK_STATUS(mech_modal_result_size(NULL, &m, &m), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_result_eigenvalues(NULL, lambda, N), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_result_modes(NULL, modes, N), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_result_vectors(NULL, lambda, N), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_result_accuracy(NULL, &acc), MECH_STATUS_NULL_POINTER);
+    mech_modal_result_destroy(NULL);
+}
+
+int main(void) {
+    all_pairs();
+    subsets_and_values_only();
+    massless_coordinate();
+    error_paths();
+    return CHECK_DONE();
+}
