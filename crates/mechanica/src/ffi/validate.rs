@@ -68,13 +68,11 @@ impl<T> Out<T> {
 }
 
 /// A checked output array of fixed length, written once, after all computation succeeded.
-#[allow(dead_code)] // for entry points that return arrays; the first ones land with the modal solver
 pub(crate) struct OutSlice<T> {
     ptr: NonNull<T>,
     len: usize,
 }
 
-#[allow(dead_code)]
 impl<T: Copy> OutSlice<T> {
     /// Checks a required output array of `len` elements without writing to it.
     pub fn new(ptr: *mut T, len: usize, what: &str) -> Result<Self, FfiError> {
