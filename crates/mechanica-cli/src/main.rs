@@ -2,6 +2,7 @@
 //! prints a readable report, or JSON with `--json`.
 
 mod default_scene;
+mod mass_command;
 mod report;
 mod scene;
 mod scene_run;
@@ -28,6 +29,9 @@ enum Command {
         /// The scene file.
         scene: Option<std::path::PathBuf>,
     },
+    /// The inertia calculator: mass, centre of mass, inertia, principal moments and axes of a
+    /// triangle mesh file (STL or OBJ), with the mesh's diagnostics.
+    Mass(mass_command::MassArgs),
     /// Print the library version, the C ABI version and the compiled-in features.
     Version,
 }
@@ -39,6 +43,7 @@ fn main() -> ExitCode {
         Command::Run { scene: Some(path) } => scene::Scene::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| scene_run::run(&scene, &path)),
+        Command::Mass(args) => mass_command::run(&args),
         Command::Version => report::version_report(),
     };
     match report {

@@ -8,6 +8,7 @@
 //! | `mass`       | [`mass`]                 | `mechanica-mass`        |
 //! | `impulse`    | [`impulse`]              | `mechanica-impulse`     |
 //! | `modal`      | [`modal`]                | `mechanica-modal`       |
+//! | `mechanism`  | [`mechanism`]            | `mechanica-mechanism`   |
 //!
 //! C and C++ programs use the same capabilities through [`ffi`], declared in the generated
 //! header `include/mechanica.h`.
@@ -18,6 +19,8 @@ pub use mechanica_impulse as impulse;
 pub use mechanica_kinematics as kinematics;
 #[cfg(feature = "mass")]
 pub use mechanica_mass as mass;
+#[cfg(feature = "mechanism")]
+pub use mechanica_mechanism as mechanism;
 #[cfg(feature = "modal")]
 pub use mechanica_modal as modal;
 

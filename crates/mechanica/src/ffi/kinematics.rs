@@ -612,15 +612,15 @@ impl CEnum for JointKind {
 /// A kinematic tree (opaque). Created empty by mech_tree_create, filled with
 /// mech_tree_add_body, validated by mech_tree_finalize, then queried; freed by mech_tree_destroy.
 pub struct mech_tree_t {
-    builder: TreeBuilder,
-    built: Option<(KinematicTree, Workspace)>,
+    pub(crate) builder: TreeBuilder,
+    pub(crate) built: Option<(KinematicTree, Workspace)>,
 }
 
 /// Borrows the tree behind a handle.
 ///
 /// # Safety
 /// `tree` must be NULL or a handle from mech_tree_create that was not destroyed.
-unsafe fn tree_mut<'a>(tree: *mut mech_tree_t) -> Result<&'a mut mech_tree_t, FfiError> {
+pub(crate) unsafe fn tree_mut<'a>(tree: *mut mech_tree_t) -> Result<&'a mut mech_tree_t, FfiError> {
     if !tree.is_aligned() {
         return Err(FfiError::new(MECH_STATUS_MISALIGNED_POINTER, "tree is misaligned"));
     }
@@ -628,7 +628,7 @@ unsafe fn tree_mut<'a>(tree: *mut mech_tree_t) -> Result<&'a mut mech_tree_t, Ff
     unsafe { tree.as_mut() }.ok_or_else(|| FfiError::new(MECH_STATUS_NULL_POINTER, "tree is NULL"))
 }
 
-fn built(t: &mut mech_tree_t) -> Result<(&KinematicTree, &mut Workspace), FfiError> {
+pub(crate) fn built(t: &mut mech_tree_t) -> Result<(&KinematicTree, &mut Workspace), FfiError> {
     match &mut t.built {
         Some((tree, ws)) => Ok((tree, ws)),
         None => Err(FfiError::new(

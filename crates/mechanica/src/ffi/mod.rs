@@ -20,6 +20,8 @@ mod impulse;
 mod kinematics;
 #[cfg(feature = "mass")]
 mod mass;
+#[cfg(feature = "mechanism")]
+mod mechanism;
 #[cfg(feature = "modal")]
 mod modal;
 
@@ -34,5 +36,7 @@ pub use impulse::*;
 pub use kinematics::*;
 #[cfg(feature = "mass")]
 pub use mass::*;
+#[cfg(feature = "mechanism")]
+pub use mechanism::*;
 #[cfg(feature = "modal")]
 pub use modal::*;

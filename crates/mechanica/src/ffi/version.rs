@@ -20,6 +20,8 @@ pub const MECH_FEATURE_BIT_MASS: u32 = 1 << 1;
 pub const MECH_FEATURE_BIT_IMPULSE: u32 = 1 << 2;
 /// Bit of mech_features() set when the modal-analysis functions are compiled in.
 pub const MECH_FEATURE_BIT_MODAL: u32 = 1 << 3;
+/// Bit of mech_features() set when the mechanism functions (potentials, equilibrium, modes) are compiled in.
+pub const MECH_FEATURE_BIT_MECHANISM: u32 = 1 << 4;
 
 /// The library version as a static NUL-terminated string "MAJOR.MINOR.PATCH".
 #[unsafe(no_mangle)]
@@ -48,6 +50,9 @@ pub extern "C" fn mech_features() -> u32 {
     }
     if cfg!(feature = "modal") {
         bits |= MECH_FEATURE_BIT_MODAL;
+    }
+    if cfg!(feature = "mechanism") {
+        bits |= MECH_FEATURE_BIT_MECHANISM;
     }
     bits
 }
