@@ -31,6 +31,8 @@
 #define MECH_FEATURE_IMPULSE 1
 /** Declared by default: the modal-analysis functions. */
 #define MECH_FEATURE_MODAL 1
+/** Declared by default: the mechanism functions (potentials, equilibrium, stability, modes). */
+#define MECH_FEATURE_MECHANISM 1
 #endif
 
 /**
@@ -73,6 +75,11 @@
  * Bit of mech_features() set when the modal-analysis functions are compiled in.
  */
 #define MECH_FEATURE_BIT_MODAL (1 << 3)
+
+/**
+ * Bit of mech_features() set when the mechanism functions (potentials, equilibrium, modes) are compiled in.
+ */
+#define MECH_FEATURE_BIT_MECHANISM (1 << 4)
 
 #if defined(MECH_FEATURE_MODAL)
 /**
@@ -682,6 +689,30 @@ typedef struct mech_mesh_report_t {
 } mech_mesh_report_t;
 #endif
 
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The kinetic energy of a tree on a moving base split by powers of q̇ (syllabus 9.7–9.10).
+ */
+typedef struct mech_energy_split_t {
+    /**
+     * T₀ = ½∫ρ|∂x/∂t|² dV: the energy of the base motion alone (J).
+     */
+    double t0;
+    /**
+     * T₁ = b·q̇ with b_k = ∫ρ ∂x/∂t·∂x/∂q_k dV (J).
+     */
+    double t1;
+    /**
+     * T₂ = ½ q̇ᵀ A q̇ (J).
+     */
+    double t2;
+    /**
+     * T = T₀ + T₁ + T₂ (J).
+     */
+    double total;
+} mech_energy_split_t;
+#endif
+
 #if defined(MECH_FEATURE_MODAL)
 /**
  * Which modes a solve returns (int32_t; see MECH_MODAL_SELECTION_*).
@@ -830,6 +861,41 @@ typedef struct mech_modal_accuracy_t {
      */
     size_t massless;
 } mech_modal_accuracy_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * How well the modal coordinates of mech_modal_free_response reproduce the initial state, and
+ * the response's own error bound.
+ */
+typedef struct mech_modal_response_fit_t {
+    /**
+     * ‖δ(0) − Σ q_k(0) x_k‖₂ (m).
+     */
+    double displacement_residual;
+    /**
+     * ‖δ̇(0) − Σ q̇_k(0) x_k‖₂ (m/s).
+     */
+    double velocity_residual;
+    /**
+     * displacement_residual / ‖δ(0)‖₂ (0 when δ(0) = 0).
+     */
+    double relative_displacement_residual;
+    /**
+     * velocity_residual / ‖δ̇(0)‖₂ (0 when δ̇(0) = 0).
+     */
+    double relative_velocity_residual;
+    /**
+     * The largest first-order bound on ‖δ(t) − δ_exact(t)‖₂ over the requested times, from the
+     * error bounds of the frequencies (phase drift) and rounding; excludes the residuals above.
+     */
+    double max_error_bound;
+    /**
+     * Number of massless coordinates (infinite modes); they follow the massive ones statically,
+     * so with massless > 0 the residuals include the inconsistency of δ(0), δ̇(0).
+     */
+    size_t massless;
+} mech_modal_response_fit_t;
 #endif
 
 /**
@@ -2206,6 +2272,98 @@ mech_status_t mech_mass_mesh(const double *vertices,
                              struct mech_mesh_report_t *report_out);
 #endif
 
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The mass matrix A(q) = [α_kl] (syllabus 8.28) of a finalized tree at the coordinates of the
+ * last mech_tree_set_state, by the composite-rigid-body recursion, into `a_out` (n×n doubles,
+ * column-major, n = dof). `bodies` holds one mass-properties value per body (`body_count` =
+ * the tree's body count), each in its own body frame; masses may be 0 (massless links).
+ *
+ * Errors: NULL_POINTER; BAD_DIMENSION (n ≠ dof, n = 0, body_count ≠ body count); NON_FINITE
+ * or INVALID_ARGUMENT (a body's numbers or negative mass; the message names the body);
+ * INVALID_ARGUMENT (tree not finalized or no state set).
+ *
+ * # Safety
+ * `tree` must be a live handle; `bodies` must point to `body_count` readable entries; `a_out`
+ * to n·n writable doubles.
+ */
+mech_status_t mech_tree_mass_matrix(struct mech_tree_t *tree,
+                                    const struct mech_mass_properties_t *bodies,
+                                    size_t body_count,
+                                    double *a_out,
+                                    size_t n);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The kinetic energy T = ½ q̇ᵀ A q̇ (syllabus 8.27) and the generalized momenta ∂T/∂q̇ = A q̇
+ * (`momenta_out`, n = dof doubles) of a tree on a fixed base, at the state (q, q̇) of the last
+ * mech_tree_set_state. `bodies` as in mech_tree_mass_matrix. For a moving base use
+ * mech_tree_energy_split.
+ *
+ * Errors: as mech_tree_mass_matrix (n = dof is required; n = 0 is accepted for a tree without
+ * coordinates).
+ *
+ * # Safety
+ * `tree` must be a live handle; `bodies` must point to `body_count` readable entries;
+ * `energy_out` writable; `momenta_out` must point to n writable doubles.
+ */
+mech_status_t mech_tree_kinetic_energy(struct mech_tree_t *tree,
+                                       const struct mech_mass_properties_t *bodies,
+                                       size_t body_count,
+                                       double *energy_out,
+                                       double *momenta_out,
+                                       size_t n);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The centre of mass of the whole tree and its Jacobian ∂x₀/∂q (3×n doubles, column-major,
+ * n = dof; world components) at the coordinates of the last mech_tree_set_state.
+ * `system_out` receives the mass properties of the whole system in world components (total
+ * mass, centre, central inertia). `bodies` as in mech_tree_mass_matrix.
+ *
+ * Errors: as mech_tree_mass_matrix, and INVALID_ARGUMENT when the total mass is 0.
+ *
+ * # Safety
+ * `tree` must be a live handle; `bodies` must point to `body_count` readable entries;
+ * `system_out` writable; `jacobian_out` must point to 3·n writable doubles.
+ */
+mech_status_t mech_tree_center_of_mass(struct mech_tree_t *tree,
+                                       const struct mech_mass_properties_t *bodies,
+                                       size_t body_count,
+                                       struct mech_mass_properties_t *system_out,
+                                       double *jacobian_out,
+                                       size_t n);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The split T = T₀ + T₁ + T₂ (syllabus 9.7–9.10) of a tree whose base moves with angular
+ * velocity `base_omega` and base-origin velocity `base_velocity` (world components; the base
+ * pose is the tree's, so the drag velocity of a point x is ∂x/∂t = v₀ + ω₀ × (x − p₀)), at the
+ * state (q, q̇) of the last mech_tree_set_state. Writes the split, b(q, t) = ∂T₁/∂q̇ into
+ * `b_out` and the generalized momenta ∂T/∂q̇ = A q̇ + b into `momenta_out` (n = dof doubles
+ * each). `bodies` as in mech_tree_mass_matrix.
+ *
+ * Errors: as mech_tree_kinetic_energy, and NULL_POINTER / NON_FINITE for the base vectors.
+ *
+ * # Safety
+ * `tree` must be a live handle; `bodies` must point to `body_count` readable entries;
+ * `base_omega`, `base_velocity` readable; `split_out` writable; `b_out` and `momenta_out` must
+ * point to n writable doubles each.
+ */
+mech_status_t mech_tree_energy_split(struct mech_tree_t *tree,
+                                     const struct mech_mass_properties_t *bodies,
+                                     size_t body_count,
+                                     const struct mech_vec3_t *base_omega,
+                                     const struct mech_vec3_t *base_velocity,
+                                     struct mech_energy_split_t *split_out,
+                                     double *b_out,
+                                     double *momenta_out,
+                                     size_t n);
+#endif
+
 #if defined(MECH_FEATURE_MODAL)
 /**
  * Checks that the n×n column-major matrices `a` (mass) and `b` (stiffness) form a valid
@@ -2324,6 +2482,35 @@ mech_status_t mech_modal_count_below(size_t n,
                                      const double *b,
                                      double shift,
                                      size_t *below);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * The free response of A δ̈ + B δ = 0 (8.91) from δ(0) = `delta0` and δ̇(0) = `delta_dot0`
+ * (n each) at `time_count` times `times` (s, any sign): δ(t_j) = Σ_k q_k(t_j) x_k with
+ * q = q₀ cos ωt + (q̇₀/ω) sin ωt for oscillatory modes, q₀ + q̇₀t for zero (rigid-body) modes
+ * and q₀ cosh γt + (q̇₀/γ) sinh γt for unstable ones; massless coordinates follow statically.
+ * `result` must come from mech_modal_solve with MECH_MODAL_SELECTION_ALL and vectors = 1
+ * (else MECH_STATUS_INVALID_ARGUMENT). Writes δ(t_j) as column j of the n × time_count
+ * column-major `delta_out` (capacity ≥ n·time_count), δ̇(t_j) likewise into `velocity_out`
+ * (may be NULL), and the fit summary into `fit_out` (may be NULL). An unstable mode that
+ * overflows a double at some t_j gives MECH_STATUS_INVALID_ARGUMENT; nothing is written then.
+ *
+ * # Safety
+ * `result` must be a live handle; `delta0`, `delta_dot0` must point to n readable doubles,
+ * `times` to `time_count`; `delta_out` to `delta_capacity` writable doubles; `velocity_out`
+ * NULL or `velocity_capacity` writable doubles; `fit_out` NULL or writable.
+ */
+mech_status_t mech_modal_free_response(const struct mech_modal_result_t *result,
+                                       const double *delta0,
+                                       const double *delta_dot0,
+                                       const double *times,
+                                       size_t time_count,
+                                       double *delta_out,
+                                       size_t delta_capacity,
+                                       double *velocity_out,
+                                       size_t velocity_capacity,
+                                       struct mech_modal_response_fit_t *fit_out);
 #endif
 
 #ifdef __cplusplus

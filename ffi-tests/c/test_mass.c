@@ -406,6 +406,183 @@ static void meshes(void) {
     CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, NULL, &rs), MECH_STATUS_NULL_POINTER);
 }
 
+/* A double pendulum in the xy plane: revolute z joints; link 1 a uniform thin rod of mass m1 and
+ * length l1 along its x axis, link 2 a point mass m2 at distance l2 from its joint. Closed forms:
+ * A11 = m1 l1²/3 + m2 (l1² + l2² + 2 l1 l2 cos q2), A12 = m2 (l2² + l1 l2 cos q2), A22 = m2 l2²;
+ * the energies from the particle and rigid-body velocities directly. */
+static void tree_mechanism(void) {
+    const double l1 = 0.8, l2 = 0.5, m1 = 1.5, m2 = 0.6;
+    const double i1 = m1 * l1 * l1 / 12.0;
+    mech_tree_t *tree = NULL;
+    CHECK_STATUS(mech_tree_create(&tree), MECH_STATUS_OK);
+    mech_mat3_t id;
+    memset(&id, 0, sizeof id);
+    id.m[0] = id.m[4] = id.m[8] = 1.0;
+    mech_vec3_t origin = {0.0, 0.0, 0.0}, link = {l1, 0.0, 0.0}, z = {0.0, 0.0, 1.0};
+    size_t b0, b1;
+    CHECK_STATUS(mech_tree_add_body(tree, -1, MECH_JOINT_REVOLUTE, &z, &id, &origin, &b0), MECH_STATUS_OK);
+    CHECK_STATUS(mech_tree_add_body(tree, (int64_t)b0, MECH_JOINT_REVOLUTE, &z, &id, &link, &b1), MECH_STATUS_OK);
+
+    mech_mass_properties_t bodies[2];
+    memset(bodies, 0, sizeof bodies);
+    bodies[0].mass = m1;
+    bodies[0].center_of_mass.x = l1 / 2.0;
+    bodies[0].inertia_about_com.m[4] = i1;
+    bodies[0].inertia_about_com.m[8] = i1;
+    mech_vec3_t tip = {l2, 0.0, 0.0};
+    CHECK_STATUS(mech_mass_point(m2, &tip, &bodies[1]), MECH_STATUS_OK);
+
+    double a[4];
+    FILL_SENTINEL(a, sizeof a);
+    /* Not finalized, then finalized without a state: nothing to compute from. */
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bodies, 2, a, 2), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_tree_finalize(tree), MECH_STATUS_OK);
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bodies, 2, a, 2), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(a, sizeof a));
+
+    const double q[2] = {0.3, -0.8}, qd[2] = {0.5, 1.1};
+    CHECK_STATUS(mech_tree_set_state(tree, q, qd, 2), MECH_STATUS_OK);
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bodies, 2, a, 2), MECH_STATUS_OK);
+    const double c2 = cos(q[1]);
+    const double a11 = m1 * l1 * l1 / 3.0 + m2 * (l1 * l1 + l2 * l2 + 2.0 * l1 * l2 * c2);
+    const double a12 = m2 * (l2 * l2 + l1 * l2 * c2), a22 = m2 * l2 * l2;
+    const double tol = 64 * EPS * a11;
+    CHECK_NEAR(a[0], a11, tol);
+    CHECK_NEAR(a[1], a12, tol);
+    CHECK_NEAR(a[2], a12, tol);
+    CHECK_NEAR(a[3], a22, tol);
+
+    /* Positions, point Jacobians and velocities of the rod centre c1 and the bob p2. */
+    const double s1 = sin(q[0]), k1 = cos(q[0]), s12 = sin(q[0] + q[1]), k12 = cos(q[0] + q[1]);
+    const double c1x = 0.5 * l1 * k1, c1y = 0.5 * l1 * s1;
+    const double p2x = l1 * k1 + l2 * k12, p2y = l1 * s1 + l2 * s12;
+    const double jc1[2] = {-0.5 * l1 * s1, 0.5 * l1 * k1};          /* ∂c1/∂q1 */
+    const double jp1[2] = {-l1 * s1 - l2 * s12, l1 * k1 + l2 * k12}; /* ∂p2/∂q1 */
+    const double jp2[2] = {-l2 * s12, l2 * k12};                     /* ∂p2/∂q2 */
+    const double vc1[2] = {jc1[0] * qd[0], jc1[1] * qd[0]};
+    const double vp2[2] = {jp1[0] * qd[0] + jp2[0] * qd[1], jp1[1] * qd[0] + jp2[1] * qd[1]};
+
+    /* Fixed base: T and p = A q̇. */
+    double t, p[2];
+    CHECK_STATUS(mech_tree_kinetic_energy(tree, bodies, 2, &t, p, 2), MECH_STATUS_OK);
+    const double t_ref = 0.5 * m1 * (vc1[0] * vc1[0] + vc1[1] * vc1[1]) + 0.5 * i1 * qd[0] * qd[0] +
+                         0.5 * m2 * (vp2[0] * vp2[0] + vp2[1] * vp2[1]);
+    CHECK_NEAR(t, t_ref, 64 * EPS * t_ref);
+    CHECK_NEAR(p[0], a11 * qd[0] + a12 * qd[1], 64 * EPS * a11);
+    CHECK_NEAR(p[1], a12 * qd[0] + a22 * qd[1], 64 * EPS * a11);
+
+    /* Centre of mass and its Jacobian. */
+    const double mt = m1 + m2;
+    mech_mass_properties_t system;
+    double jac[6];
+    CHECK_STATUS(mech_tree_center_of_mass(tree, bodies, 2, &system, jac, 2), MECH_STATUS_OK);
+    CHECK_NEAR(system.mass, mt, 4 * EPS * mt);
+    CHECK_NEAR(system.center_of_mass.x, (m1 * c1x + m2 * p2x) / mt, 16 * EPS);
+    CHECK_NEAR(system.center_of_mass.y, (m1 * c1y + m2 * p2y) / mt, 16 * EPS);
+    CHECK_NEAR(system.center_of_mass.z, 0.0, 16 * EPS);
+    CHECK_NEAR(jac[0], (m1 * jc1[0] + m2 * jp1[0]) / mt, 16 * EPS);
+    CHECK_NEAR(jac[1], (m1 * jc1[1] + m2 * jp1[1]) / mt, 16 * EPS);
+    CHECK_NEAR(jac[2], 0.0, 16 * EPS);
+    CHECK_NEAR(jac[3], m2 * jp2[0] / mt, 16 * EPS);
+    CHECK_NEAR(jac[4], m2 * jp2[1] / mt, 16 * EPS);
+    CHECK_NEAR(jac[5], 0.0, 16 * EPS);
+
+    /* The base turns about z at rate W and translates with (vx, vy): drag u(x) = v + W z × x. */
+    const double w = 0.7, vx = 0.2, vy = -0.1;
+    mech_vec3_t omega0 = {0.0, 0.0, w}, v0 = {vx, vy, 0.0};
+    const double uc1[2] = {vx - w * c1y, vy + w * c1x}, up2[2] = {vx - w * p2y, vy + w * p2x};
+    const double t0_ref = 0.5 * m1 * (uc1[0] * uc1[0] + uc1[1] * uc1[1]) + 0.5 * i1 * w * w +
+                          0.5 * m2 * (up2[0] * up2[0] + up2[1] * up2[1]);
+    const double b_ref[2] = {m1 * (jc1[0] * uc1[0] + jc1[1] * uc1[1]) + i1 * w + m2 * (jp1[0] * up2[0] + jp1[1] * up2[1]),
+                             m2 * (jp2[0] * up2[0] + jp2[1] * up2[1])};
+    const double wc1[2] = {vc1[0] + uc1[0], vc1[1] + uc1[1]}, wp2[2] = {vp2[0] + up2[0], vp2[1] + up2[1]};
+    const double total_ref = 0.5 * m1 * (wc1[0] * wc1[0] + wc1[1] * wc1[1]) + 0.5 * i1 * (qd[0] + w) * (qd[0] + w) +
+                             0.5 * m2 * (wp2[0] * wp2[0] + wp2[1] * wp2[1]);
+    mech_energy_split_t split;
+    double b[2], pm[2];
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &omega0, &v0, &split, b, pm, 2), MECH_STATUS_OK);
+    const double et = 64 * EPS * total_ref;
+    CHECK_NEAR(split.t2, t_ref, et);
+    CHECK_NEAR(split.t0, t0_ref, et);
+    CHECK_NEAR(split.t1, b_ref[0] * qd[0] + b_ref[1] * qd[1], et);
+    CHECK_NEAR(split.total, total_ref, et);
+    CHECK_NEAR(b[0], b_ref[0], 64 * EPS * a11);
+    CHECK_NEAR(b[1], b_ref[1], 64 * EPS * a11);
+    CHECK_NEAR(pm[0], a11 * qd[0] + a12 * qd[1] + b_ref[0], 64 * EPS * a11);
+    CHECK_NEAR(pm[1], a12 * qd[0] + a22 * qd[1] + b_ref[1], 64 * EPS * a11);
+    /* A base at rest: T0 = T1 = 0 and T = T2 (9.12). */
+    mech_vec3_t still = {0.0, 0.0, 0.0};
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &still, &still, &split, b, pm, 2), MECH_STATUS_OK);
+    CHECK(split.t0 == 0.0 && split.t1 == 0.0 && b[0] == 0.0 && b[1] == 0.0);
+    CHECK_NEAR(split.total, t_ref, 64 * EPS * t_ref);
+
+    /* Error paths: nothing is written. */
+    mech_mass_properties_t bad[2] = {bodies[0], bodies[1]};
+    FILL_SENTINEL(a, sizeof a);
+    CHECK_STATUS(mech_tree_mass_matrix(NULL, bodies, 2, a, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_mass_matrix(tree, NULL, 2, a, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bodies, 1, a, 2), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bodies, 3, a, 2), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bodies, 2, a, 1), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bodies, 2, a, 0), MECH_STATUS_BAD_DIMENSION);
+    bad[1].mass = NAN;
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bad, 2, a, 2), MECH_STATUS_NON_FINITE);
+    bad[1].mass = -1.0;
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bad, 2, a, 2), MECH_STATUS_INVALID_ARGUMENT);
+    char msg[256];
+    mech_last_error(msg, sizeof msg);
+    CHECK(strstr(msg, "body 1") != NULL);
+    bad[1] = bodies[1];
+    bad[0].inertia_about_com.m[3] = INFINITY;
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bad, 2, a, 2), MECH_STATUS_NON_FINITE);
+    bad[0] = bodies[0];
+    CHECK(mech_untouched(a, sizeof a));
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bodies, 2, NULL, 2), MECH_STATUS_NULL_POINTER);
+
+    double ts, ps[2];
+    FILL_SENTINEL(&ts, sizeof ts);
+    FILL_SENTINEL(ps, sizeof ps);
+    CHECK_STATUS(mech_tree_kinetic_energy(tree, bodies, 2, NULL, ps, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_kinetic_energy(tree, bodies, 2, &ts, NULL, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_kinetic_energy(tree, bodies, 2, &ts, ps, 1), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_tree_kinetic_energy(tree, bodies, 1, &ts, ps, 2), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_tree_kinetic_energy(NULL, bodies, 2, &ts, ps, 2), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&ts, sizeof ts) && mech_untouched(ps, sizeof ps));
+
+    mech_mass_properties_t ss;
+    double js[6];
+    FILL_SENTINEL(&ss, sizeof ss);
+    FILL_SENTINEL(js, sizeof js);
+    CHECK_STATUS(mech_tree_center_of_mass(tree, bodies, 2, NULL, js, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_center_of_mass(tree, bodies, 2, &ss, NULL, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_center_of_mass(tree, bodies, 2, &ss, js, 3), MECH_STATUS_BAD_DIMENSION);
+    mech_mass_properties_t massless[2];
+    memset(massless, 0, sizeof massless);
+    CHECK_STATUS(mech_tree_center_of_mass(tree, massless, 2, &ss, js, 2), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(&ss, sizeof ss) && mech_untouched(js, sizeof js));
+    /* Massless links are valid in the mass matrix: A = 0. */
+    CHECK_STATUS(mech_tree_mass_matrix(tree, massless, 2, a, 2), MECH_STATUS_OK);
+    CHECK(a[0] == 0.0 && a[1] == 0.0 && a[2] == 0.0 && a[3] == 0.0);
+
+    mech_energy_split_t es;
+    double bs[2], pms[2];
+    FILL_SENTINEL(&es, sizeof es);
+    FILL_SENTINEL(bs, sizeof bs);
+    FILL_SENTINEL(pms, sizeof pms);
+    mech_vec3_t nanv = {0.0, NAN, 0.0};
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, NULL, &v0, &es, bs, pms, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &omega0, NULL, &es, bs, pms, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &nanv, &v0, &es, bs, pms, 2), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &omega0, &nanv, &es, bs, pms, 2), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &omega0, &v0, NULL, bs, pms, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &omega0, &v0, &es, NULL, pms, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &omega0, &v0, &es, bs, NULL, 2), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &omega0, &v0, &es, bs, pms, 3), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_tree_energy_split(tree, bad, 1, &omega0, &v0, &es, bs, pms, 2), MECH_STATUS_BAD_DIMENSION);
+    CHECK(mech_untouched(&es, sizeof es) && mech_untouched(bs, sizeof bs) && mech_untouched(pms, sizeof pms));
+    mech_tree_destroy(tree);
+}
+
 int main(void) {
     point_and_steiner();
     primitives();
@@ -414,5 +591,6 @@ int main(void) {
     validity_and_repair();
     momenta_and_energy();
     meshes();
+    tree_mechanism();
     return CHECK_DONE();
 }

@@ -219,8 +219,89 @@ static void error_paths(void) {
     mech_modal_result_destroy(NULL);
 }
 
+static void free_response(void) {
+    /* ground–m–m–ground, unit springs: ω² = 1 (x = (1, 1)/√2) and 3 (x = (1, −1)/√2). From
+     * δ(0) = (1, 0), δ̇(0) = 0: δ(t) = ½(cos t + cos √3t, cos t − cos √3t). */
+    double a[4] = {1, 0, 0, 1}, b[4] = {2, -1, -1, 2};
+    mech_modal_options_t o = default_options();
+    mech_modal_result_t *r = NULL;
+    CHECK_STATUS(mech_modal_solve(2, a, b, &o, &r), MECH_STATUS_OK);
+    const double d0[2] = {1.0, 0.0}, v0[2] = {0.0, 0.0};
+    const double times[3] = {0.0, 0.7, -2.5};
+    double d[6], v[6];
+    mech_modal_response_fit_t fit;
+    CHECK_STATUS(mech_modal_free_response(r, d0, v0, times, 3, d, 6, v, 6, &fit), MECH_STATUS_OK);
+    const double s3 = sqrt(3.0);
+    for (int j = 0; j < 3; ++j) {
+        double t = times[j];
+        CHECK_NEAR(d[2 * j], 0.5 * (cos(t) + cos(s3 * t)), 1e-14);
+        CHECK_NEAR(d[2 * j + 1], 0.5 * (cos(t) - cos(s3 * t)), 1e-14);
+        CHECK_NEAR(v[2 * j], -0.5 * (sin(t) + s3 * sin(s3 * t)), 1e-14);
+        CHECK_NEAR(v[2 * j + 1], -0.5 * (sin(t) - s3 * sin(s3 * t)), 1e-14);
+    }
+    CHECK(fit.relative_displacement_residual <= 1e-15 && fit.velocity_residual == 0.0);
+    CHECK(fit.max_error_bound >= 0.0 && fit.max_error_bound < 1e-13);
+    CHECK(fit.massless == 0);
+    /* Velocity and fit are optional. */
+    CHECK_STATUS(mech_modal_free_response(r, d0, v0, times, 3, d, 6, NULL, 0, NULL), MECH_STATUS_OK);
+
+    /* Errors: nothing written. */
+    double sentinel[6];
+    FILL_SENTINEL(sentinel, sizeof sentinel);
+    mech_modal_response_fit_t fit_sentinel;
+    FILL_SENTINEL(&fit_sentinel, sizeof fit_sentinel);
+    CHECK_STATUS(mech_modal_free_response(NULL, d0, v0, times, 3, sentinel, 6, NULL, 0, NULL),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_free_response(r, NULL, v0, times, 3, sentinel, 6, NULL, 0, &fit_sentinel),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_free_response(r, d0, v0, NULL, 3, sentinel, 6, NULL, 0, NULL), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_free_response(r, d0, v0, times, 3, NULL, 6, NULL, 0, NULL), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_modal_free_response(r, d0, v0, times, 3, sentinel, 5, NULL, 0, &fit_sentinel),
+                 MECH_STATUS_BUFFER_TOO_SMALL);
+    CHECK_STATUS(mech_modal_free_response(r, d0, v0, times, 3, sentinel, 6, sentinel, 4, &fit_sentinel),
+                 MECH_STATUS_BUFFER_TOO_SMALL);
+    const double bad_times[2] = {0.0, NAN};
+    CHECK_STATUS(mech_modal_free_response(r, d0, v0, bad_times, 2, sentinel, 6, NULL, 0, &fit_sentinel),
+                 MECH_STATUS_NON_FINITE);
+    const double bad_d0[2] = {INFINITY, 0.0};
+    CHECK_STATUS(mech_modal_free_response(r, bad_d0, v0, times, 3, sentinel, 6, NULL, 0, &fit_sentinel),
+                 MECH_STATUS_NON_FINITE);
+    CHECK(mech_untouched(sentinel, sizeof sentinel));
+    CHECK(mech_untouched(&fit_sentinel, sizeof fit_sentinel));
+    mech_modal_result_destroy(r);
+
+    /* A values-only result cannot give a response. */
+    o.vectors = 0;
+    CHECK_STATUS(mech_modal_solve(2, a, b, &o, &r), MECH_STATUS_OK);
+    CHECK_STATUS(mech_modal_free_response(r, d0, v0, times, 3, sentinel, 6, NULL, 0, NULL),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(sentinel, sizeof sentinel));
+    mech_modal_result_destroy(r);
+
+    /* Free pair (rigid-body mode): from δ̇(0) = (1, 0) the centre drifts at ½ m/s and
+     * δ₁(t) = t/2 + sin(√2 t)/(2√2). An inverted pair overflows at t = 1e4. */
+    double bf[4] = {1, -1, -1, 1};
+    o.vectors = 1;
+    CHECK_STATUS(mech_modal_solve(2, a, bf, &o, &r), MECH_STATUS_OK);
+    const double zero[2] = {0.0, 0.0}, push[2] = {1.0, 0.0}, t4[1] = {4.0};
+    CHECK_STATUS(mech_modal_free_response(r, zero, push, t4, 1, d, 2, NULL, 0, NULL), MECH_STATUS_OK);
+    const double s2 = sqrt(2.0);
+    CHECK_NEAR(d[0], 2.0 + sin(s2 * 4.0) / (2.0 * s2), 1e-13);
+    CHECK_NEAR(d[1], 2.0 - sin(s2 * 4.0) / (2.0 * s2), 1e-13);
+    mech_modal_result_destroy(r);
+    double bu[4] = {-1, 0, 0, -1};
+    CHECK_STATUS(mech_modal_solve(2, a, bu, &o, &r), MECH_STATUS_OK);
+    const double late[1] = {1e4};
+    FILL_SENTINEL(sentinel, sizeof sentinel);
+    CHECK_STATUS(mech_modal_free_response(r, push, zero, late, 1, sentinel, 2, NULL, 0, NULL),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(sentinel, sizeof sentinel));
+    mech_modal_result_destroy(r);
+}
+
 int main(void) {
     all_pairs();
+    free_response();
     subsets_and_values_only();
     massless_coordinate();
     error_paths();

@@ -107,6 +107,57 @@ pub enum ImpulseError {
         /// Actual number.
         got: usize,
     },
+    /// The mass matrix A(q) of a mechanism is singular or only semidefinite at this
+    /// configuration: coordinate `coordinate` adds (almost) no inertia beyond the earlier
+    /// coordinates (a rod spinning about its own axis, a point mass on a spherical joint, a
+    /// massless leaf link), so Lagrange's impulse equations (7.117) have no unique solution.
+    #[error(
+        "mass matrix is singular at coordinate {coordinate}: Cholesky pivot {pivot} vs diagonal {diagonal} \
+         (a rod, point mass or massless link leaves this coordinate without inertia)"
+    )]
+    SingularMassMatrix {
+        /// The coordinate (column of A) whose pivot vanished.
+        coordinate: usize,
+        /// The Cholesky pivot found for it.
+        pivot: f64,
+        /// The diagonal entry A_kk it is compared with.
+        diagonal: f64,
+    },
+    /// A body index does not name a body of the tree.
+    #[error("{what}: body index {body} is out of range (the tree has {bodies} bodies)")]
+    BodyOutOfRange {
+        /// Which input held the index.
+        what: &'static str,
+        /// The offending index.
+        body: usize,
+        /// Number of bodies of the tree.
+        bodies: usize,
+    },
+    /// A contact that cannot move along its normal (W_nn = 0) is approaching: no finite
+    /// impulse can stop it (e.g. a contact on the fixed base, or two points of one rigid body).
+    #[error("contact {contact} is immovable along its normal (W_nn = {w_nn}) while approaching at {u_n} m/s")]
+    ContactImmovable {
+        /// Index of the contact.
+        contact: usize,
+        /// Its normal entry of the Delassus matrix.
+        w_nn: f64,
+        /// Its normal velocity before the impact (negative: approaching).
+        u_n: f64,
+    },
+    /// The input of one contact (or point impulse) of a list was invalid.
+    #[error("contact {contact}: {source}")]
+    InContact {
+        /// Index of the contact (or impulse) in the list.
+        contact: usize,
+        /// What was wrong with it.
+        source: Box<ImpulseError>,
+    },
+    /// The kinematic tree rejected a computation (workspace not updated, wrong lengths...).
+    #[error(transparent)]
+    Kinematics(#[from] mechanica_kinematics::KinematicsError),
+    /// The mass crate rejected a computation (wrong number of body mass properties...).
+    #[error(transparent)]
+    Mass(#[from] mechanica_mass::MassError),
 }
 
 /// Fails with [`ImpulseError::NonFinite`] if `value` is NaN or ±∞.

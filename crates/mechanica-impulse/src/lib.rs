@@ -7,14 +7,23 @@
 //! - [`contact_space`]: one frictional impact given the contact mobility W, by the
 //!   impulse-parameterised process with Newton, Poisson or Stronge restitution (7.94–7.99);
 //! - [`contact`]: two bodies meeting at a point (7.72–7.99);
-//! - [`fixation`]: bringing a body point to rest (7.100–7.108).
+//! - [`fixation`]: bringing a body point to rest (7.100–7.108);
+//! - [`mechanism`]: Lagrange's impulse equations A(q) Δq̇ = Q_S of a kinematic tree (7.115–7.117);
+//! - [`mechanism_contact`]: contacts of a mechanism, the Delassus matrix W = J A⁻¹ Jᵀ and the
+//!   single frictional contact by the impulse process;
+//! - [`multi_contact`]: simultaneous frictional impacts at several contacts;
+//! - [`showcase`]: Kane's double pendulum striking a rough floor under each restitution law.
 
 pub mod body;
 pub mod contact;
 pub mod contact_space;
 pub mod error;
 pub mod fixation;
+pub mod mechanism;
+pub mod mechanism_contact;
+pub mod multi_contact;
 pub mod point;
+pub mod showcase;
 
 pub use body::{BodyResponse, RigidBody};
 pub use contact::{TwoBodyImpact, resolve_contact};
@@ -23,3 +32,8 @@ pub use contact_space::{
 };
 pub use error::ImpulseError;
 pub use fixation::{Fixation, fix_point};
+pub use mechanism::{BodyPoint, GeneralizedImpulseResponse, MechanismInertia, PointImpulse, apply_point_impulses};
+pub use mechanism_contact::{
+    ContactOutcome, ContactSpace, ImpactModel, MechanismContact, MechanismImpact, resolve_single_contact,
+};
+pub use multi_contact::{MultiContactOptions, resolve_contacts};

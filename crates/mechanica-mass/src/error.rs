@@ -115,6 +115,14 @@ pub enum MassError {
         /// The length given.
         got: usize,
     },
+    /// The mass properties of one body of a tree are unusable.
+    #[error("body {body}: {error}")]
+    Body {
+        /// Index of the body in the tree.
+        body: usize,
+        /// What is wrong with its mass properties.
+        error: Box<MassError>,
+    },
     /// The kinematic tree or its workspace rejected a request.
     #[error(transparent)]
     Kinematics(#[from] mechanica_kinematics::KinematicsError),

@@ -9,12 +9,89 @@
 //! α_kl = m_c u_k·u_l + w_k·J_c w_l with u = w × (x_c − o) + v, for l a coordinate of j or of
 //! one of its ancestors. Cost: O(n) for the composites plus O(depth) per column.
 //!
-//! Only a fixed (scleronomic) base is covered: with a prescribed base motion, T has the extra
-//! terms T₀ + T₁ (9.7–9.10), which this module does not compute yet.
+//! With a prescribed (rheonomic) base motion, [`TreeMass::energy_split`] gives the split
+//! T = T₀ + T₁ + T₂ (9.7–9.10): the drag field ∂x/∂t = v₀ + ω₀ × (x − p₀) of the base is a rigid
+//! velocity field, so T₀ and b_k = ∫ρ ∂x/∂q_k·∂x/∂t dV collapse onto composite mass properties
+//! exactly like α_kl.
 
 use crate::{MassError, MassProperties};
-use mechanica_kinematics::tree::{KinematicTree, Workspace};
+use mechanica_kinematics::tree::{BaseState, KinematicTree, Workspace};
 use nalgebra::{Matrix3, Vector3};
+
+/// The kinetic energy of a tree on a moving base split by powers of q̇ (9.7–9.10):
+/// T₀ = ½∫ρ |∂x/∂t|² dV, T₁ = b·q̇ with b_k = ∫ρ ∂x/∂t·∂x/∂q_k dV, T₂ = ½ q̇ᵀ A q̇.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnergySplit {
+    /// T₀ (9.8): the energy of the drag motion alone (q̇ = 0), J.
+    pub t0: f64,
+    /// T₁ (9.9): the part linear in q̇, J.
+    pub t1: f64,
+    /// T₂ (9.10): the quadratic part ½ q̇ᵀ A q̇, J.
+    pub t2: f64,
+}
+
+impl EnergySplit {
+    /// T = T₀ + T₁ + T₂ (9.7).
+    pub fn total(&self) -> f64 {
+        self.t0 + self.t1 + self.t2
+    }
+}
+
+/// A rigid velocity field u(x) = v + ω × (x − o): the drag velocity ∂x/∂t of the points of a
+/// tree whose base moves (v, ω: velocity of the base origin o and angular velocity, world).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DragField {
+    /// The base origin o = p_W0 (world), m.
+    pub origin: Vector3<f64>,
+    /// The base angular velocity ω₀ (world), rad/s.
+    pub omega: Vector3<f64>,
+    /// The velocity v₀ of the base origin (world), m/s.
+    pub velocity: Vector3<f64>,
+}
+
+impl DragField {
+    /// u(x) = v + ω × (x − o) at the world point `x`.
+    pub fn velocity_at(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        self.velocity + self.omega.cross(&(x - self.origin))
+    }
+}
+
+impl From<&BaseState> for DragField {
+    /// The drag field of the base state (its pose's origin, angular velocity and velocity).
+    fn from(base: &BaseState) -> Self {
+        Self {
+            origin: base.position,
+            omega: base.omega,
+            velocity: base.velocity,
+        }
+    }
+}
+
+/// The output buffers of [`TreeMass::energy_split`].
+#[derive(Debug)]
+pub struct SplitBuffers<'a> {
+    /// A(q), dof × dof, column-major.
+    pub mass_matrix: &'a mut [f64],
+    /// b(q, t) = ∂T₁/∂q̇, dof entries.
+    pub b: &'a mut [f64],
+    /// The generalized momenta ∂T/∂q̇ = A q̇ + b, dof entries.
+    pub momenta: &'a mut [f64],
+}
+
+/// The inner product ∫ρ (a + α × (x − c))·(b + β × (x − c)) dV of two rigid velocity fields over
+/// a body with mass m, centre c and central tensor J, given by their velocities a, b at the
+/// centre: m a·b + α·J β (the cross terms vanish since ∫ρ (x − c) dV = 0, and
+/// ∫ρ (α × y)·(β × y) dV = α·J β by (3.17)).
+#[inline]
+fn field_product(
+    body: &MassProperties,
+    a: &Vector3<f64>,
+    alpha: &Vector3<f64>,
+    b: &Vector3<f64>,
+    beta: &Vector3<f64>,
+) -> f64 {
+    body.mass * a.dot(b) + alpha.dot(&(body.inertia_c * beta))
+}
 
 /// The mass properties of every body of a tree (in its own body frame) and the buffers of the
 /// recursion, sized once.
@@ -44,7 +121,7 @@ fn union(a: &MassProperties, b: &MassProperties) -> MassProperties {
 impl TreeMass {
     /// One mass-properties value per body of `tree`, each in the body's own frame B (centre
     /// p_BC and central tensor in B). Masses must be finite and ≥ 0 (massless links are
-    /// allowed); tensors must be finite.
+    /// allowed); tensors must be finite. A bad body fails with [`MassError::Body`] naming it.
     pub fn new(tree: &KinematicTree, bodies: Vec<MassProperties>) -> Result<Self, MassError> {
         if bodies.len() != tree.body_count() {
             return Err(MassError::WrongLength {
@@ -53,13 +130,20 @@ impl TreeMass {
                 got: bodies.len(),
             });
         }
-        for b in &bodies {
-            crate::error::check_finite(b.mass, "body mass")?;
-            crate::error::check_all_finite(b.p_oc.iter(), "body centre of mass")?;
-            crate::error::check_all_finite(b.inertia_c.iter(), "body inertia")?;
-            if b.mass < 0.0 {
-                return Err(MassError::NonPositiveMass(b.mass));
-            }
+        for (body, b) in bodies.iter().enumerate() {
+            let check = || -> Result<(), MassError> {
+                crate::error::check_finite(b.mass, "body mass")?;
+                crate::error::check_all_finite(b.p_oc.iter(), "body centre of mass")?;
+                crate::error::check_all_finite(b.inertia_c.iter(), "body inertia")?;
+                if b.mass < 0.0 {
+                    return Err(MassError::NonPositiveMass(b.mass));
+                }
+                Ok(())
+            };
+            check().map_err(|error| MassError::Body {
+                body,
+                error: Box::new(error),
+            })?;
         }
         let composite = bodies.clone();
         Ok(Self { bodies, composite })
@@ -138,6 +222,7 @@ impl TreeMass {
 
     /// The generalized momenta ∂T/∂q̇ = A q̇ (7.55, 8.27) and the kinetic energy
     /// T = ½ q̇ᵀ A q̇ for a fixed base, computing A into `a_out` (dof × dof, column-major).
+    /// With a moving base these are T₂ and its momenta only; see [`TreeMass::energy_split`].
     pub fn momenta_and_energy(
         &mut self,
         tree: &KinematicTree,
@@ -168,6 +253,87 @@ impl TreeMass {
             t += 0.5 * q_dot[k] * s;
         }
         Ok(t)
+    }
+
+    /// The split T = T₀ + T₁ + T₂ (9.7–9.10) for a tree whose base moves with the drag field
+    /// `drag` (usually `DragField::from(ws.base())`), at the positions of the last
+    /// `update_positions` and the velocities `q_dot`. Writes A(q), b(q, t) and the generalized
+    /// momenta ∂T/∂q̇ = A q̇ + b into `out`.
+    ///
+    /// The drag field ∂x/∂t = v₀ + ω₀ × (x − p₀) is rigid, so with the composite (m_c, x_c, J_c)
+    /// of the subtree moved by q_k: b_k = m_c u_k·u(x_c) + w_k·J_c ω₀, and T₀ is the energy of the
+    /// whole system moving with the drag field: ½ m |u(x₀)|² + ½ ω₀·J₀ ω₀ (König, 3.41).
+    pub fn energy_split(
+        &mut self,
+        tree: &KinematicTree,
+        ws: &Workspace,
+        drag: &DragField,
+        q_dot: &[f64],
+        out: SplitBuffers<'_>,
+    ) -> Result<EnergySplit, MassError> {
+        let n = tree.dof();
+        let SplitBuffers {
+            mass_matrix: a_out,
+            b: b_out,
+            momenta: momenta_out,
+        } = out;
+        for (what, len) in [
+            ("q_dot", q_dot.len()),
+            ("b output", b_out.len()),
+            ("momenta output", momenta_out.len()),
+        ] {
+            if len != n {
+                return Err(MassError::WrongLength {
+                    what,
+                    expected: n,
+                    got: len,
+                });
+            }
+        }
+        crate::error::check_all_finite(q_dot.iter(), "q_dot")?;
+        crate::error::check_all_finite(
+            drag.origin.iter().chain(drag.omega.iter()).chain(drag.velocity.iter()),
+            "drag field",
+        )?;
+        self.mass_matrix(tree, ws, a_out)?;
+        let omega0 = drag.omega;
+        let mut t0 = 0.0;
+        for i in 0..tree.body_count() {
+            let c = self.composite[i];
+            if c.mass == 0.0 {
+                // A massless subtree carries no energy (as in mass_matrix).
+                b_out[tree.dof_range(i)].fill(0.0);
+                continue;
+            }
+            let u_c = drag.velocity_at(&c.p_oc);
+            if tree.parent(i).is_none() {
+                t0 += 0.5 * field_product(&c, &u_c, &omega0, &u_c, &omega0);
+            }
+            let o_i = ws.position(i)?;
+            for k in tree.dof_range(i) {
+                let (w_k, v_k) = ws.motion_column(k)?;
+                let u_k = w_k.cross(&(c.p_oc - o_i)) + v_k;
+                b_out[k] = field_product(&c, &u_k, &w_k, &u_c, &omega0);
+            }
+        }
+        let (mut t1, mut t2) = (0.0, 0.0);
+        for k in 0..n {
+            let mut s = 0.0;
+            for l in 0..n {
+                s += a_out[k + n * l] * q_dot[l];
+            }
+            t2 += 0.5 * q_dot[k] * s;
+            t1 += b_out[k] * q_dot[k];
+            momenta_out[k] = s + b_out[k];
+        }
+        let split = EnergySplit { t0, t1, t2 };
+        if !split.total().is_finite() {
+            return Err(MassError::NonFinite {
+                what: "kinetic energy (overflow)",
+                value: split.total(),
+            });
+        }
+        Ok(split)
     }
 
     /// The mass properties of the whole system in world components (centre x₀ and central

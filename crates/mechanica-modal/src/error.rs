@@ -86,6 +86,51 @@ pub enum ModalError {
     /// A shift for the inertia count was not finite.
     #[error("shift {0} is not finite")]
     BadShift(f64),
+    /// A vector argument has the wrong length.
+    #[error("{what} has length {len}, expected {expected}")]
+    BadLength {
+        /// Which vector.
+        what: &'static str,
+        /// Its length.
+        len: usize,
+        /// The length it should have.
+        expected: usize,
+    },
+    /// An entry of a vector (or a scalar argument, index 0) is NaN or infinite.
+    #[error("{what}[{index}] is not finite: {value}")]
+    NonFiniteValue {
+        /// Which vector or scalar.
+        what: &'static str,
+        /// Index of the entry.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// The free response needs every mode with its shape (`Selection::All`, vectors on), of a
+    /// solution of the same pencil.
+    #[error(
+        "the free response needs all {dim} modes with shapes; the solution has {modes} modes and {shapes} shape columns of length {shape_len}"
+    )]
+    IncompleteSolution {
+        /// Order n of the pencil.
+        dim: usize,
+        /// Number of modes in the solution.
+        modes: usize,
+        /// Number of mode-shape columns (0 when values only).
+        shapes: usize,
+        /// Length of each shape column (0 when values only).
+        shape_len: usize,
+    },
+    /// The free response at time t does not fit in a double: an unstable mode grew past f64::MAX.
+    #[error("the free response overflows at t = {t}: unstable mode {mode} grows as cosh({exponent:.3e})")]
+    ResponseOverflow {
+        /// The requested time (s).
+        t: f64,
+        /// Index of the overflowing mode.
+        mode: usize,
+        /// Its exponent γ|t|.
+        exponent: f64,
+    },
     /// faer's eigensolver did not converge.
     #[error("the symmetric eigensolver did not converge on the reduced {n}×{n} matrix")]
     NoConvergence {

@@ -21,6 +21,8 @@
 //!   Newton steps with double-double residuals (`refine`), and replaces its bound by a
 //!   gap-weighted residual bound. Tested on graded chains with ratios up to 1e12 against
 //!   60-digit mpmath references (tools/modal_reference.py).
+//! - **Free response** ([`FreeResponse`]): δ(t) = Σ q_k(t) x_k from δ(0), δ̇(0) (8.91), with
+//!   zero (q + q̇t), unstable (cosh/sinh), repeated and massless (static) modes.
 
 pub mod accuracy;
 mod condense;
@@ -31,6 +33,7 @@ pub mod inertia;
 pub mod problem;
 pub mod reduce;
 mod refine;
+pub mod response;
 pub mod solve;
 
 pub use accuracy::{AccuracyReport, BoundKind};
@@ -38,6 +41,7 @@ pub use error::ModalError;
 pub use faer;
 pub use inertia::{InertiaCount, count_below};
 pub use problem::PencilProblem;
+pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use solve::{
     InertiaCheck, Method, ModalSolution, Mode, ModeGroup, ModeKind, Refinement, Selection, SolveOptions, classify,
     solve,

@@ -6,17 +6,22 @@ use super::status::*;
 use super::validate::*;
 use mechanica_modal::faer::MatRef;
 use mechanica_modal::{
-    Method, ModalError, ModalSolution, ModeKind, PencilProblem, Refinement, Selection, SolveOptions, count_below, solve,
+    FreeResponse, Method, ModalError, ModalSolution, ModeKind, PencilProblem, Refinement, Selection, SolveOptions,
+    count_below, solve,
 };
 
 impl From<ModalError> for FfiError {
     fn from(error: ModalError) -> Self {
         let status = match error {
-            ModalError::BadShape { .. } => MECH_STATUS_BAD_DIMENSION,
-            ModalError::NonFinite { .. } | ModalError::BadShift(_) => MECH_STATUS_NON_FINITE,
-            ModalError::NotSymmetric { .. } | ModalError::BadInterval { .. } | ModalError::TooManyModes { .. } => {
-                MECH_STATUS_INVALID_ARGUMENT
+            ModalError::BadShape { .. } | ModalError::BadLength { .. } => MECH_STATUS_BAD_DIMENSION,
+            ModalError::NonFinite { .. } | ModalError::NonFiniteValue { .. } | ModalError::BadShift(_) => {
+                MECH_STATUS_NON_FINITE
             }
+            ModalError::NotSymmetric { .. }
+            | ModalError::BadInterval { .. }
+            | ModalError::TooManyModes { .. }
+            | ModalError::IncompleteSolution { .. }
+            | ModalError::ResponseOverflow { .. } => MECH_STATUS_INVALID_ARGUMENT,
             ModalError::IndefiniteMass { .. } => MECH_STATUS_NOT_POSITIVE_DEFINITE,
             ModalError::SingularPencil { .. } => MECH_STATUS_SINGULAR,
             ModalError::NoConvergence { .. } => MECH_STATUS_NOT_CONVERGED,
@@ -150,6 +155,7 @@ pub struct mech_modal_accuracy_t {
 /// The opaque result of mech_modal_solve. Free it with mech_modal_result_destroy.
 pub struct mech_modal_result_t {
     n: usize,
+    problem: PencilProblem,
     solution: ModalSolution,
 }
 
@@ -236,7 +242,7 @@ pub unsafe extern "C" fn mech_modal_solve(
                 refinement,
             },
         )?;
-        let handle = Box::into_raw(Box::new(mech_modal_result_t { n, solution }));
+        let handle = Box::into_raw(Box::new(mech_modal_result_t { n, problem, solution }));
         // SAFETY: `out` was checked writable by the caller's contract.
         unsafe { out.write(handle) };
         Ok(())
@@ -462,6 +468,122 @@ pub unsafe extern "C" fn mech_modal_count_below(
         let count = count_below(&problem, shift)?;
         // SAFETY: checked writable.
         unsafe { out.write(count.below) };
+        Ok(())
+    })
+}
+
+/// How well the modal coordinates of mech_modal_free_response reproduce the initial state, and
+/// the response's own error bound.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_modal_response_fit_t {
+    /// ‖δ(0) − Σ q_k(0) x_k‖₂ (m).
+    pub displacement_residual: f64,
+    /// ‖δ̇(0) − Σ q̇_k(0) x_k‖₂ (m/s).
+    pub velocity_residual: f64,
+    /// displacement_residual / ‖δ(0)‖₂ (0 when δ(0) = 0).
+    pub relative_displacement_residual: f64,
+    /// velocity_residual / ‖δ̇(0)‖₂ (0 when δ̇(0) = 0).
+    pub relative_velocity_residual: f64,
+    /// The largest first-order bound on ‖δ(t) − δ_exact(t)‖₂ over the requested times, from the
+    /// error bounds of the frequencies (phase drift) and rounding; excludes the residuals above.
+    pub max_error_bound: f64,
+    /// Number of massless coordinates (infinite modes); they follow the massive ones statically,
+    /// so with massless > 0 the residuals include the inconsistency of δ(0), δ̇(0).
+    pub massless: usize,
+}
+
+/// The free response of A δ̈ + B δ = 0 (8.91) from δ(0) = `delta0` and δ̇(0) = `delta_dot0`
+/// (n each) at `time_count` times `times` (s, any sign): δ(t_j) = Σ_k q_k(t_j) x_k with
+/// q = q₀ cos ωt + (q̇₀/ω) sin ωt for oscillatory modes, q₀ + q̇₀t for zero (rigid-body) modes
+/// and q₀ cosh γt + (q̇₀/γ) sinh γt for unstable ones; massless coordinates follow statically.
+/// `result` must come from mech_modal_solve with MECH_MODAL_SELECTION_ALL and vectors = 1
+/// (else MECH_STATUS_INVALID_ARGUMENT). Writes δ(t_j) as column j of the n × time_count
+/// column-major `delta_out` (capacity ≥ n·time_count), δ̇(t_j) likewise into `velocity_out`
+/// (may be NULL), and the fit summary into `fit_out` (may be NULL). An unstable mode that
+/// overflows a double at some t_j gives MECH_STATUS_INVALID_ARGUMENT; nothing is written then.
+///
+/// # Safety
+/// `result` must be a live handle; `delta0`, `delta_dot0` must point to n readable doubles,
+/// `times` to `time_count`; `delta_out` to `delta_capacity` writable doubles; `velocity_out`
+/// NULL or `velocity_capacity` writable doubles; `fit_out` NULL or writable.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn mech_modal_free_response(
+    result: *const mech_modal_result_t,
+    delta0: *const f64,
+    delta_dot0: *const f64,
+    times: *const f64,
+    time_count: usize,
+    delta_out: *mut f64,
+    delta_capacity: usize,
+    velocity_out: *mut f64,
+    velocity_capacity: usize,
+    fit_out: *mut mech_modal_response_fit_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let r = unsafe { borrow(result) }?;
+        let n = r.n;
+        // SAFETY: caller's contract.
+        let (d0, v0, ts) = unsafe {
+            (
+                read_slice(delta0, n, "delta0")?,
+                read_slice(delta_dot0, n, "delta_dot0")?,
+                read_slice(times, time_count, "times")?,
+            )
+        };
+        finite(d0, "delta0")?;
+        finite(v0, "delta_dot0")?;
+        finite(ts, "times")?;
+        let len = n.checked_mul(time_count).ok_or_else(|| {
+            FfiError::new(
+                MECH_STATUS_BAD_DIMENSION,
+                format!("n·time_count = {n}·{time_count} overflows"),
+            )
+        })?;
+        check_capacity(delta_capacity, len, "delta_out")?;
+        let d_out = OutSlice::new(delta_out, len, "delta_out")?;
+        let v_out = if velocity_out.is_null() {
+            None
+        } else {
+            check_capacity(velocity_capacity, len, "velocity_out")?;
+            Some(OutSlice::new(velocity_out, len, "velocity_out")?)
+        };
+        let f_out = if fit_out.is_null() {
+            None
+        } else {
+            Some(Out::new(fit_out, "fit_out")?)
+        };
+        let response = FreeResponse::new(&r.problem, &r.solution, d0, v0)?;
+        let mut deltas = vec![0.0; len];
+        let mut velocities = vec![0.0; if v_out.is_some() { len } else { 0 }];
+        let mut max_error_bound = 0.0_f64;
+        for (j, &t) in ts.iter().enumerate() {
+            response.at(t, &mut deltas[j * n..(j + 1) * n])?;
+            if v_out.is_some() {
+                response.velocity_at(t, &mut velocities[j * n..(j + 1) * n])?;
+            }
+            max_error_bound = max_error_bound.max(response.error_bound(t)?);
+        }
+        let fit = response.fit();
+        // SAFETY: checked for len writable elements / writable (caller's contract).
+        unsafe {
+            d_out.write(&deltas);
+            if let Some(v) = v_out {
+                v.write(&velocities);
+            }
+            if let Some(f) = f_out {
+                f.write(mech_modal_response_fit_t {
+                    displacement_residual: fit.displacement_residual,
+                    velocity_residual: fit.velocity_residual,
+                    relative_displacement_residual: fit.relative_displacement_residual,
+                    relative_velocity_residual: fit.relative_velocity_residual,
+                    max_error_bound,
+                    massless: fit.massless,
+                });
+            }
+        }
         Ok(())
     })
 }

@@ -1,0 +1,299 @@
+//! Lagrange's impulse equations for a mechanism in generalized coordinates (7.115–7.117).
+//!
+//! A kinematic tree with coordinates q and mass matrix A(q) is struck by point impulses S_k
+//! at body points x_k. Integrating Lagrange's equations over the vanishing impact time
+//! (positions fixed, finite forces contribute nothing) gives
+//!
+//! ```text
+//!   A(q) Δq̇ = Q_S,     Q_S = Σ_k J_kᵀ S_k,     J_k = ∂x_k/∂q     (7.115, 7.117)
+//! ```
+//!
+//! with the point Jacobians J_k of the kinematics crate. [`MechanismInertia`] factors A once
+//! per configuration (Cholesky), so every impulse, contact Jacobian and Delassus matrix of
+//! that configuration reuses the factor. The energy change is
+//! ΔT = Q_S·(q̇⁻ + ½ Δq̇) (the generalized form of 7.107).
+//!
+//! A(q) is only positive *semi*definite when a coordinate moves no inertia: a rod (zero axial
+//! inertia) or a point mass on a spherical or free joint, or a massless leaf link. Lagrange's
+//! equations then do not determine that coordinate's velocity jump; the factorisation reports
+//! [`ImpulseError::SingularMassMatrix`] naming the coordinate. Model such bodies with a joint
+//! that has no coordinate for the missing inertia (e.g. a revolute or universal joint for a rod
+//! instead of a spherical one), or give them a small physical axial inertia.
+
+use crate::ImpulseError;
+use crate::error::check_all_finite;
+use mechanica_kinematics::tree::{KinematicTree, Workspace};
+use mechanica_mass::mechanism::TreeMass;
+use nalgebra::Vector3;
+
+/// Relative Cholesky pivot threshold: coordinate k is singular when its pivot is
+/// ≤ `MASS_MATRIX_PIVOT_RELATIVE`·A_kk, i.e. when all but a fraction 1e-12 of its inertia is
+/// already carried by the earlier coordinates (≈ 5000 ulps of round-off; a physical rod would
+/// need a slenderness of 10⁶ to come this close).
+pub const MASS_MATRIX_PIVOT_RELATIVE: f64 = 1e-12;
+
+/// A point fixed in a body of the tree: `body` index and the point's coordinates `p_bq` in the
+/// body frame B.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyPoint {
+    /// Body index in the tree.
+    pub body: usize,
+    /// The point in the body frame B (m).
+    pub p_bq: Vector3<f64>,
+}
+
+/// A point impulse S (world frame, N·s) applied at a body point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointImpulse {
+    /// Where the impulse acts.
+    pub point: BodyPoint,
+    /// The impulse S, world components (N·s).
+    pub s_w: Vector3<f64>,
+}
+
+/// The mass matrix A(q) of a tree at one configuration and its Cholesky factor A = L Lᵀ.
+///
+/// The factor is computed by a plain column Cholesky rather than faer's: it needs a relative
+/// pivot test per coordinate (to name the coordinate without inertia), and mechanisms have a
+/// few dozen coordinates, where a blocked factorisation brings nothing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MechanismInertia {
+    n: usize,
+    /// A, column-major n×n.
+    a: Vec<f64>,
+    /// L, column-major n×n, lower triangle (upper part zero).
+    l: Vec<f64>,
+}
+
+impl MechanismInertia {
+    /// A(q) of `tree` at the configuration of the last `update_positions` in `ws`, by the
+    /// composite-rigid-body recursion of `mass` (8.28), factored.
+    pub fn new(tree: &KinematicTree, ws: &Workspace, mass: &mut TreeMass) -> Result<Self, ImpulseError> {
+        let n = tree.dof();
+        let mut a = vec![0.0; n * n];
+        mass.mass_matrix(tree, ws, &mut a)?;
+        Self::from_mass_matrix(n, a)
+    }
+
+    /// Factors a given symmetric mass matrix `a` (n×n, column-major; only the lower triangle
+    /// is read for the factor, the whole matrix is kept for residuals).
+    pub fn from_mass_matrix(n: usize, a: Vec<f64>) -> Result<Self, ImpulseError> {
+        if a.len() != n * n {
+            return Err(ImpulseError::DimensionMismatch {
+                what: "mass matrix (n² entries)",
+                expected: n * n,
+                got: a.len(),
+            });
+        }
+        check_all_finite("mass matrix", a.iter())?;
+        let mut l = a.clone();
+        for j in 0..n {
+            let diagonal = a[j + n * j];
+            let mut d = diagonal;
+            for k in 0..j {
+                d -= l[j + n * k] * l[j + n * k];
+            }
+            if !(d > MASS_MATRIX_PIVOT_RELATIVE * diagonal && d > 0.0) {
+                return Err(ImpulseError::SingularMassMatrix {
+                    coordinate: j,
+                    pivot: d,
+                    diagonal,
+                });
+            }
+            let djj = d.sqrt();
+            l[j + n * j] = djj;
+            for i in j + 1..n {
+                let mut s = l[i + n * j];
+                for k in 0..j {
+                    s -= l[i + n * k] * l[j + n * k];
+                }
+                l[i + n * j] = s / djj;
+            }
+            for i in 0..j {
+                l[i + n * j] = 0.0;
+            }
+        }
+        Ok(Self { n, a, l })
+    }
+
+    /// Number of coordinates n.
+    pub fn dof(&self) -> usize {
+        self.n
+    }
+
+    /// The mass matrix A (column-major n×n).
+    pub fn mass_matrix(&self) -> &[f64] {
+        &self.a
+    }
+
+    /// The Cholesky factor L (column-major n×n, lower triangular), A = L Lᵀ.
+    pub fn factor(&self) -> &[f64] {
+        &self.l
+    }
+
+    /// Solves L y = b in place (forward substitution).
+    pub(crate) fn forward_in_place(&self, b: &mut [f64]) {
+        let n = self.n;
+        for j in 0..n {
+            let yj = b[j] / self.l[j + n * j];
+            b[j] = yj;
+            for i in j + 1..n {
+                b[i] -= self.l[i + n * j] * yj;
+            }
+        }
+    }
+
+    /// Solves Lᵀ x = y in place (back substitution).
+    pub(crate) fn backward_in_place(&self, b: &mut [f64]) {
+        let n = self.n;
+        for j in (0..n).rev() {
+            let col = &self.l[n * j..n * j + n];
+            let mut s = b[j];
+            for i in j + 1..n {
+                s -= col[i] * b[i];
+            }
+            b[j] = s / col[j];
+        }
+    }
+
+    /// Solves A x = b in place (b has n entries).
+    pub fn solve_in_place(&self, b: &mut [f64]) -> Result<(), ImpulseError> {
+        self.check_len("right-hand side", b.len())?;
+        self.forward_in_place(b);
+        self.backward_in_place(b);
+        Ok(())
+    }
+
+    /// A x (n entries) into `out`.
+    pub(crate) fn multiply(&self, x: &[f64], out: &mut [f64]) {
+        let n = self.n;
+        out.fill(0.0);
+        for j in 0..n {
+            let xj = x[j];
+            for i in 0..n {
+                out[i] += self.a[i + n * j] * xj;
+            }
+        }
+    }
+
+    /// The kinetic energy T = ½ q̇ᵀ A q̇ (8.27) of a fixed-base tree.
+    pub fn kinetic_energy(&self, q_dot: &[f64]) -> Result<f64, ImpulseError> {
+        self.check_len("q_dot", q_dot.len())?;
+        let mut aq = vec![0.0; self.n];
+        self.multiply(q_dot, &mut aq);
+        Ok(0.5 * dot(q_dot, &aq))
+    }
+
+    /// The normwise backward error of a solution x of A x = b:
+    /// ‖A x − b‖∞ / (‖A‖∞ ‖x‖∞ + ‖b‖∞) (0 for b = 0).
+    pub(crate) fn backward_error(&self, x: &[f64], b: &[f64]) -> f64 {
+        let n = self.n;
+        let mut ax = vec![0.0; n];
+        self.multiply(x, &mut ax);
+        let residual = ax.iter().zip(b).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        let norm_a = (0..n)
+            .map(|i| (0..n).map(|j| self.a[i + n * j].abs()).sum::<f64>())
+            .fold(0.0, f64::max);
+        let scale = norm_a * inf_norm(x) + inf_norm(b);
+        if scale > 0.0 { residual / scale } else { 0.0 }
+    }
+
+    pub(crate) fn check_len(&self, what: &'static str, got: usize) -> Result<(), ImpulseError> {
+        if got != self.n {
+            return Err(ImpulseError::DimensionMismatch {
+                what,
+                expected: self.n,
+                got,
+            });
+        }
+        Ok(())
+    }
+}
+
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+pub(crate) fn inf_norm(a: &[f64]) -> f64 {
+    a.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+/// The velocity jump of a mechanism struck by point impulses (7.117).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeneralizedImpulseResponse {
+    /// The generalized impulse Q_S = Σ J_kᵀ S_k (7.115), one entry per coordinate.
+    pub generalized_impulse: Vec<f64>,
+    /// Δq̇ = A⁻¹ Q_S.
+    pub delta_q_dot: Vec<f64>,
+    /// q̇⁺ = q̇⁻ + Δq̇.
+    pub q_dot_after: Vec<f64>,
+    /// T⁻ = ½ q̇⁻ᵀ A q̇⁻ (J).
+    pub energy_before: f64,
+    /// ΔT = Q_S·(q̇⁻ + ½ Δq̇) (J).
+    pub energy_change: f64,
+    /// Normwise backward error of the solve A Δq̇ = Q_S (see [`MechanismInertia`]).
+    pub backward_error: f64,
+}
+
+/// Checks a body point of `tree` and returns its Jacobian column-major 3×n into `out`.
+pub(crate) fn point_jacobian_into(
+    tree: &KinematicTree,
+    ws: &Workspace,
+    what: &'static str,
+    point: &BodyPoint,
+    out: &mut [f64],
+) -> Result<(), ImpulseError> {
+    if point.body >= tree.body_count() {
+        return Err(ImpulseError::BodyOutOfRange {
+            what,
+            body: point.body,
+            bodies: tree.body_count(),
+        });
+    }
+    check_all_finite(what, point.p_bq.iter())?;
+    tree.point_jacobian(ws, point.body, &point.p_bq, out)?;
+    Ok(())
+}
+
+/// Applies the point impulses `impulses` to the tree at the configuration of `ws` (positions
+/// updated) moving with `q_dot`, through Lagrange's impulse equations (7.115–7.117), with the
+/// factored mass matrix `inertia` of the same configuration.
+pub fn apply_point_impulses(
+    tree: &KinematicTree,
+    ws: &Workspace,
+    inertia: &MechanismInertia,
+    q_dot: &[f64],
+    impulses: &[PointImpulse],
+) -> Result<GeneralizedImpulseResponse, ImpulseError> {
+    let n = tree.dof();
+    inertia.check_len("mass matrix dimension (tree dof)", n)?;
+    inertia.check_len("q_dot", q_dot.len())?;
+    check_all_finite("q_dot", q_dot.iter())?;
+    let mut q = vec![0.0; n];
+    let mut jac = vec![0.0; 3 * n];
+    for (index, impulse) in impulses.iter().enumerate() {
+        let in_contact = |source| ImpulseError::InContact {
+            contact: index,
+            source: Box::new(source),
+        };
+        check_all_finite("impulse", impulse.s_w.iter()).map_err(in_contact)?;
+        point_jacobian_into(tree, ws, "impulse point", &impulse.point, &mut jac).map_err(in_contact)?;
+        for k in 0..n {
+            q[k] += jac[3 * k] * impulse.s_w.x + jac[3 * k + 1] * impulse.s_w.y + jac[3 * k + 2] * impulse.s_w.z;
+        }
+    }
+    let mut dq = q.clone();
+    inertia.solve_in_place(&mut dq)?;
+    let backward_error = inertia.backward_error(&dq, &q);
+    let energy_before = inertia.kinetic_energy(q_dot)?;
+    let energy_change = q.iter().zip(q_dot).zip(&dq).map(|((s, v), d)| s * (v + 0.5 * d)).sum();
+    let q_dot_after = q_dot.iter().zip(&dq).map(|(v, d)| v + d).collect();
+    Ok(GeneralizedImpulseResponse {
+        generalized_impulse: q,
+        delta_q_dot: dq,
+        q_dot_after,
+        energy_before,
+        energy_change,
+        backward_error,
+    })
+}

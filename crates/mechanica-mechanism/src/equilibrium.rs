@@ -1,0 +1,213 @@
+//! Equilibria: grad U*(q) = 0 (8.79) by Newton's method with a backtracking line search on
+//! ‖grad U*‖, inside the joint limits.
+//!
+//! Newton's direction d = −B⁻¹ g is a descent direction of ½‖g‖² whenever B is nonsingular, so
+//! the search finds any equilibrium (stable or not: an inverted pendulum's upright position is
+//! found as readily as the hanging one). B is inverted through its eigen-decomposition with
+//! the eigenvalues kept away from zero by δ = √u·‖B‖, so a singular B (a neutral direction)
+//! gives a bounded step instead of a blow-up. Steps are clipped to the joint limits (projected
+//! search). Spherical and free joints are re-centred ([`Mechanism::rebase`]) before every
+//! Hessian, so the returned q is in the mechanism's final chart.
+//!
+//! **Convergence criterion.** ‖g‖ ≤ τ with τ = 64·n·u·(‖B(q₀)‖_F·max(1, ‖q₀‖) + ‖g(q₀)‖) by
+//! default: the size of the rounding error of g near q₀. The report gives ‖g‖ and the last
+//! Newton step, an estimate of the distance to the exact equilibrium.
+
+use crate::{Mechanism, MechanismError};
+use faer::{Mat, Side};
+
+/// Options of [`find_equilibrium`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EquilibriumOptions {
+    /// Maximum Newton iterations.
+    pub max_iterations: usize,
+    /// Gradient-norm tolerance τ; None derives it from rounding (see the module docs).
+    pub tolerance: Option<f64>,
+}
+
+impl Default for EquilibriumOptions {
+    fn default() -> Self {
+        Self {
+            max_iterations: 100,
+            tolerance: None,
+        }
+    }
+}
+
+/// A converged equilibrium.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equilibrium {
+    /// The coordinates (in the mechanism's chart after re-centring).
+    pub q: Vec<f64>,
+    /// U* at q.
+    pub potential: f64,
+    /// ‖grad U*(q)‖.
+    pub gradient_norm: f64,
+    /// The tolerance τ used.
+    pub tolerance: f64,
+    /// Newton iterations.
+    pub iterations: usize,
+    /// ‖d‖ of the last Newton step: an estimate of the distance to the exact equilibrium.
+    pub last_step: f64,
+    /// Coordinates resting on a joint limit (there the gradient component is a reaction, not zero).
+    pub at_limit: Vec<usize>,
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// The gradient with the components pushing against an active limit removed (those are
+/// carried by the limit).
+fn free_gradient(g: &[f64], q: &[f64], limits: &[(f64, f64)]) -> (Vec<f64>, Vec<usize>) {
+    let mut free = g.to_vec();
+    let mut at_limit = Vec::new();
+    for k in 0..g.len() {
+        let (lo, hi) = limits[k];
+        if (q[k] <= lo && g[k] > 0.0) || (q[k] >= hi && g[k] < 0.0) {
+            free[k] = 0.0;
+            at_limit.push(k);
+        }
+    }
+    (free, at_limit)
+}
+
+fn clamp(q: &mut [f64], limits: &[(f64, f64)]) {
+    for (x, (lo, hi)) in q.iter_mut().zip(limits) {
+        *x = x.clamp(*lo, *hi);
+    }
+}
+
+/// The regularised Newton step d = −B̃⁻¹ g (see the module docs).
+fn newton_step(b: &Mat<f64>, g: &[f64]) -> Result<Vec<f64>, MechanismError> {
+    let n = g.len();
+    let eig = b
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|_| MechanismError::Numerical("eigen-decomposition of the Hessian did not converge"))?;
+    let (s, u) = (eig.S(), eig.U());
+    let scale = (0..n).map(|i| s[i].abs()).fold(0.0, f64::max);
+    let floor = (f64::EPSILON.sqrt() * scale).max(f64::MIN_POSITIVE);
+    let mut d = vec![0.0; n];
+    for i in 0..n {
+        let coefficient: f64 = (0..n).map(|r| u[(r, i)] * g[r]).sum();
+        let lambda = if s[i].abs() < floor { floor.copysign(s[i]) } else { s[i] };
+        let c = -coefficient / lambda;
+        for (r, x) in d.iter_mut().enumerate() {
+            *x += c * u[(r, i)];
+        }
+    }
+    Ok(d)
+}
+
+/// Finds an equilibrium of `mechanism` from `q0` (see the module docs). On failure the error
+/// carries the best point found and its ‖grad U*‖.
+pub fn find_equilibrium(
+    mechanism: &mut Mechanism,
+    q0: &[f64],
+    options: &EquilibriumOptions,
+) -> Result<Equilibrium, MechanismError> {
+    let limits = mechanism.limits().to_vec();
+    let mut q = q0.to_vec();
+    if q.len() != mechanism.dof() {
+        return Err(MechanismError::WrongLength {
+            what: "q0",
+            expected: mechanism.dof(),
+            got: q.len(),
+        });
+    }
+    crate::error::check_all_finite(&q, "q0")?;
+    clamp(&mut q, &limits);
+    let rebase = mechanism.has_rotation_vectors();
+    if rebase {
+        mechanism.rebase(&mut q)?;
+    }
+    let start = mechanism.potential(&q, true)?;
+    let start_hessian_norm = start.hessian.as_ref().map_or(0.0, |h| h.norm_l2());
+    let n = q.len().max(1) as f64;
+    let tolerance = match options.tolerance {
+        Some(t) => crate::error::check_finite(t, "equilibrium tolerance")?,
+        None => {
+            64.0 * n * f64::EPSILON * (start_hessian_norm * norm(&q).max(1.0) + norm(&start.gradient))
+                + f64::MIN_POSITIVE
+        }
+    };
+    let mut current = start;
+    let mut last_step = f64::INFINITY;
+    for iteration in 0..=options.max_iterations {
+        let (free, at_limit) = free_gradient(&current.gradient, &q, &limits);
+        let gradient_norm = norm(&free);
+        if gradient_norm <= tolerance {
+            return Ok(Equilibrium {
+                q,
+                potential: current.value,
+                gradient_norm,
+                tolerance,
+                iterations: iteration,
+                last_step: if last_step.is_finite() { last_step } else { 0.0 },
+                at_limit,
+            });
+        }
+        if iteration == options.max_iterations {
+            break;
+        }
+        let hessian = current.hessian.as_ref().ok_or(MechanismError::Numerical("Hessian missing"))?;
+        let direction = newton_step(hessian, &free)?;
+        let mut alpha = 1.0;
+        let mut accepted = None;
+        for _ in 0..40 {
+            let mut trial: Vec<f64> = q.iter().zip(&direction).map(|(x, d)| x + alpha * d).collect();
+            clamp(&mut trial, &limits);
+            let evaluation = mechanism.potential(&trial, false)?;
+            let (trial_free, _) = free_gradient(&evaluation.gradient, &trial, &limits);
+            if norm(&trial_free) < (1.0 - 1e-4 * alpha) * gradient_norm {
+                accepted = Some(trial);
+                break;
+            }
+            alpha *= 0.5;
+        }
+        let Some(mut next) = accepted else { break };
+        last_step = q.iter().zip(&next).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+        if rebase {
+            mechanism.rebase(&mut next)?;
+        }
+        q = next;
+        current = mechanism.potential(&q, true)?;
+    }
+    let (free, _) = free_gradient(&current.gradient, &q, &limits);
+    Err(MechanismError::NoEquilibrium {
+        iterations: options.max_iterations,
+        gradient_norm: norm(&free),
+        tolerance,
+        best_q: q,
+    })
+}
+
+/// Equilibria from several starting points, duplicates (within 1e-8·(1 + ‖q‖)) removed.
+/// Starts that do not converge are skipped; their count is returned alongside. Each start runs
+/// on its own copy of the mechanism, so with spherical or free joints every start and result
+/// is in the mechanism's current chart only before re-centring (compare body poses instead).
+pub fn find_equilibria(
+    mechanism: &mut Mechanism,
+    starts: &[Vec<f64>],
+    options: &EquilibriumOptions,
+) -> Result<(Vec<Equilibrium>, usize), MechanismError> {
+    let mut found: Vec<Equilibrium> = Vec::new();
+    let mut failed = 0;
+    for start in starts {
+        let mut copy = mechanism.clone();
+        match find_equilibrium(&mut copy, start, options) {
+            Ok(eq) => {
+                let duplicate = found.iter().any(|other| {
+                    let d: f64 = other.q.iter().zip(&eq.q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+                    d <= 1e-8 * (1.0 + norm(&eq.q))
+                });
+                if !duplicate {
+                    found.push(eq);
+                }
+            }
+            Err(MechanismError::NoEquilibrium { .. }) => failed += 1,
+            Err(other) => return Err(other),
+        }
+    }
+    Ok((found, failed))
+}

@@ -1,0 +1,279 @@
+//! Stability and small oscillations of a mechanism about an equilibrium q₀ (§8f–g):
+//! A(q₀) δ̈ + G(q₀) δ̇ + B(q₀) δ = 0 with A the mass matrix (8.28), B = ∂²U*/∂q∂q (8.79) and G
+//! the gyroscopic matrix of a rotating frame (zero otherwise).
+//!
+//! - **Stability** comes from the modes of the pencil (A, B) solved by the modal crate: the
+//!   number of unstable directions is the number of ω² < 0 beyond their error bounds, zero
+//!   modes are those within their bounds (no magic threshold), and the modal crate's Sturm
+//!   count certifies that none was missed.
+//! - **Modes** (G = 0): ω_k, A-orthonormal shapes x_k in q, their body displacements (the
+//!   centre-of-mass translation and rotation of every body per unit modal amplitude), and the
+//!   effective modal masses m_eff,k(d) = (x_kᵀ L_d)² with L_d = M J_cᵀ d the generalized
+//!   inertia of a unit base translation d; Σ_k m_eff,k(d) = M when all modes are kept and the
+//!   mechanism can translate freely along d.
+//! - **Gyroscopic coupling** (rotating frame): the quadratic problem det(s²A + sG + B) = 0 is
+//!   solved by its first companion linearisation [0 1; −A⁻¹B −A⁻¹G] (faer's real
+//!   non-symmetric eigensolver), reported as s = σ ± iω with the backward error of each
+//!   eigenvalue, ‖(s²A + sG + B)x‖ / ((|s|²‖A‖ + |s|‖G‖ + ‖B‖)‖x‖). Gyroscopic stabilisation
+//!   (B indefinite, all Re s = 0) is reported as such.
+
+use crate::{Mechanism, MechanismError};
+use faer::Mat;
+use faer::c64;
+use mechanica_modal::{ModalSolution, ModeKind, PencilProblem, SolveOptions, solve};
+use nalgebra::Vector3;
+
+/// The stability of an equilibrium from the inertia of B relative to A (8.79–8.80).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stability {
+    /// B positive definite: every mode oscillates.
+    Stable,
+    /// B has negative directions: the equilibrium is unstable.
+    Unstable {
+        /// Number of unstable directions (negative eigenvalues of B relative to A).
+        directions: usize,
+        /// Largest growth rate √(−ω²) (1/s).
+        max_growth_rate: f64,
+    },
+    /// No negative direction but zero modes within their error bounds: neutral (rigid-body or
+    /// higher-order) behaviour decides.
+    Marginal {
+        /// Number of zero modes.
+        zero_modes: usize,
+    },
+}
+
+/// One body's motion per unit modal amplitude (world/base components).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyDisplacement {
+    /// Displacement of the body's centre of mass.
+    pub translation: Vector3<f64>,
+    /// Small rotation vector of the body.
+    pub rotation: Vector3<f64>,
+}
+
+/// The quadratic eigenproblem of a rotating frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GyroscopicModes {
+    /// Eigenvalues s = σ + iω, ordered by |ω| then σ (2n values; infinite ones omitted).
+    pub eigenvalues: Vec<(f64, f64)>,
+    /// Backward error of each eigenvalue (see the module docs).
+    pub backward_errors: Vec<f64>,
+    /// Largest real part: > its error bound means unstable.
+    pub max_real_part: f64,
+    /// Bound on |Re s| that is indistinguishable from zero (from the backward errors).
+    pub real_part_bound: f64,
+    /// True when every Re s is within `real_part_bound` of zero.
+    pub stable: bool,
+}
+
+/// The modes of a mechanism at q₀.
+#[derive(Debug, Clone)]
+pub struct MechanismModes {
+    /// The configuration (after re-centring of spherical and free joints).
+    pub q: Vec<f64>,
+    /// A(q₀).
+    pub mass_matrix: Mat<f64>,
+    /// B(q₀).
+    pub stiffness_matrix: Mat<f64>,
+    /// ‖grad U*(q₀)‖: how far q₀ is from an equilibrium (modes about a non-equilibrium point
+    /// are those of the linearisation, not of small oscillations).
+    pub gradient_norm: f64,
+    /// The modal solution of (A, B): modes, shapes, groups, accuracy report.
+    pub solution: ModalSolution,
+    /// Stability from the inertia of (A, B).
+    pub stability: Stability,
+    /// Per mode, per body: displacement per unit modal amplitude (empty without vectors).
+    pub body_displacements: Vec<Vec<BodyDisplacement>>,
+    /// Per mode: effective modal masses for unit base translations along x, y, z (kg).
+    pub effective_masses: Vec<[f64; 3]>,
+    /// Total mass (kg), the upper bound of the effective-mass sums.
+    pub total_mass: f64,
+    /// The gyroscopic problem, in a rotating frame with G ≠ 0.
+    pub gyroscopic: Option<GyroscopicModes>,
+}
+
+fn stability_of(solution: &ModalSolution) -> Stability {
+    let mut unstable = 0;
+    let mut zero = 0;
+    let mut growth: f64 = 0.0;
+    for mode in &solution.modes {
+        match mode.kind {
+            ModeKind::Unstable { growth_rate } => {
+                unstable += 1;
+                growth = growth.max(growth_rate);
+            }
+            ModeKind::Zero => zero += 1,
+            _ => {}
+        }
+    }
+    if unstable > 0 {
+        Stability::Unstable {
+            directions: unstable,
+            max_growth_rate: growth,
+        }
+    } else if zero > 0 {
+        Stability::Marginal { zero_modes: zero }
+    } else {
+        Stability::Stable
+    }
+}
+
+/// The stability and modes of `mechanism` about q₀ (normally an equilibrium from
+/// [`crate::find_equilibrium`]). `options` select the modes as in the modal crate; stability
+/// needs the unstable and zero modes, which are the lowest, so `Selection::Lowest(k)` suffices.
+pub fn mechanism_modes(
+    mechanism: &mut Mechanism,
+    q0: &[f64],
+    options: &SolveOptions,
+) -> Result<MechanismModes, MechanismError> {
+    let mut q = q0.to_vec();
+    if mechanism.has_rotation_vectors() {
+        mechanism.rebase(&mut q)?;
+    }
+    let evaluation = mechanism.potential(&q, true)?;
+    let b = evaluation.hessian.ok_or(MechanismError::Numerical("Hessian missing"))?;
+    let a = mechanism.mass_matrix(&q)?;
+    let problem = PencilProblem::new(a.as_ref(), b.as_ref())?;
+    let solution = solve(&problem, options)?;
+    let stability = stability_of(&solution);
+    let gradient_norm = evaluation.gradient.iter().map(|g| g * g).sum::<f64>().sqrt();
+    let (body_displacements, effective_masses, total_mass) = shapes_in_space(mechanism, &q, &a, &solution)?;
+    let g = mechanism.gyroscopic_matrix(&q)?;
+    let gyroscopic = if g.norm_l2() > 0.0 {
+        Some(gyroscopic_modes(&a, &g, &b)?)
+    } else {
+        None
+    };
+    Ok(MechanismModes {
+        q,
+        mass_matrix: a,
+        stiffness_matrix: b,
+        gradient_norm,
+        solution,
+        stability,
+        body_displacements,
+        effective_masses,
+        total_mass,
+        gyroscopic,
+    })
+}
+
+type Shapes = (Vec<Vec<BodyDisplacement>>, Vec<[f64; 3]>, f64);
+
+fn shapes_in_space(
+    mechanism: &Mechanism,
+    q: &[f64],
+    a: &Mat<f64>,
+    solution: &ModalSolution,
+) -> Result<Shapes, MechanismError> {
+    let tree = mechanism.tree();
+    let n = tree.dof();
+    let mut ws = tree.workspace();
+    tree.update_positions(&mut ws, q)?;
+    let bodies = mechanism.bodies();
+    let total_mass: f64 = bodies.iter().map(|b| b.mass).sum();
+    // Per body: Jacobians of the centre of mass and of the rotation.
+    let mut point = Vec::with_capacity(bodies.len());
+    let mut angular = Vec::with_capacity(bodies.len());
+    let mut com_jacobian = vec![0.0; 3 * n];
+    for (i, body) in bodies.iter().enumerate() {
+        let mut jp = vec![0.0; 3 * n];
+        let mut jw = vec![0.0; 3 * n];
+        tree.point_jacobian(&ws, i, &body.p_oc, &mut jp)?;
+        tree.angular_jacobian(&ws, i, &mut jw)?;
+        for (c, p) in com_jacobian.iter_mut().zip(&jp) {
+            *c += body.mass * p;
+        }
+        point.push(jp);
+        angular.push(jw);
+    }
+    let Some(x) = &solution.vectors else {
+        return Ok((Vec::new(), Vec::new(), total_mass));
+    };
+    let _ = a;
+    let mut displacements = Vec::with_capacity(x.ncols());
+    let mut effective = Vec::with_capacity(x.ncols());
+    for m in 0..x.ncols() {
+        let finite = !matches!(solution.modes[m].kind, ModeKind::Infinite);
+        let combine = |jac: &[f64]| {
+            let mut v = Vector3::zeros();
+            for k in 0..n {
+                for r in 0..3 {
+                    v[r] += jac[3 * k + r] * x[(k, m)];
+                }
+            }
+            v
+        };
+        displacements.push(
+            (0..bodies.len())
+                .map(|i| BodyDisplacement {
+                    translation: combine(&point[i]),
+                    rotation: combine(&angular[i]),
+                })
+                .collect(),
+        );
+        // Γ_d = x_kᵀ L_d with L_d = Σ m_i J_iᵀ d = (M J_c)ᵀ d; x_k is A-normalised.
+        let participation = combine(&com_jacobian);
+        effective.push(if finite {
+            [participation.x.powi(2), participation.y.powi(2), participation.z.powi(2)]
+        } else {
+            [0.0; 3]
+        });
+    }
+    Ok((displacements, effective, total_mass))
+}
+
+/// Solves det(s²A + sG + B) = 0 by the companion linearisation (see the module docs).
+fn gyroscopic_modes(a: &Mat<f64>, g: &Mat<f64>, b: &Mat<f64>) -> Result<GyroscopicModes, MechanismError> {
+    let n = a.nrows();
+    let llt = a
+        .llt(faer::Side::Lower)
+        .map_err(|_| MechanismError::Numerical("gyroscopic modes need a positive definite mass matrix"))?;
+    use faer::linalg::solvers::Solve;
+    let a_inv_b = llt.solve(b);
+    let a_inv_g = llt.solve(g);
+    let companion = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+        (true, true) => 0.0,
+        (true, false) => f64::from(u8::from(i + n == j)),
+        (false, true) => -a_inv_b[(i - n, j)],
+        (false, false) => -a_inv_g[(i - n, j - n)],
+    });
+    let eig = companion
+        .eigen()
+        .map_err(|_| MechanismError::Numerical("the companion eigenproblem did not converge"))?;
+    let (s, u) = (eig.S(), eig.U());
+    let (na, ng, nb) = (a.norm_l2(), g.norm_l2(), b.norm_l2());
+    let mut pairs = Vec::with_capacity(2 * n);
+    for m in 0..2 * n {
+        let lambda: c64 = s[m];
+        // x = top half of the eigenvector.
+        let x: Vec<c64> = (0..n).map(|r| u[(r, m)]).collect();
+        let x_norm = x.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
+        let mut residual: f64 = 0.0;
+        for r in 0..n {
+            let mut acc = c64::new(0.0, 0.0);
+            for c in 0..n {
+                acc += (lambda * lambda * a[(r, c)] + lambda * g[(r, c)] + c64::new(b[(r, c)], 0.0)) * x[c];
+            }
+            residual += acc.norm_sqr();
+        }
+        let modulus = lambda.norm();
+        let scale = (modulus * modulus * na + modulus * ng + nb) * x_norm;
+        let eta = if scale > 0.0 { residual.sqrt() / scale } else { 0.0 };
+        pairs.push(((lambda.re, lambda.im), eta));
+    }
+    pairs.sort_by(|p, q| (p.0.1.abs(), p.0.0).partial_cmp(&(q.0.1.abs(), q.0.0)).unwrap_or(std::cmp::Ordering::Equal));
+    let max_real_part = pairs.iter().map(|p| p.0.0).fold(f64::NEG_INFINITY, f64::max);
+    let max_modulus = pairs.iter().map(|p| p.0.0.hypot(p.0.1)).fold(0.0, f64::max);
+    let max_eta = pairs.iter().map(|p| p.1).fold(0.0, f64::max);
+    // A backward error η perturbs s by about η·cond; take the companion scale as the yardstick.
+    let real_part_bound = (max_eta.max(f64::EPSILON) * 2.0 * n as f64 * max_modulus.max(1.0)).sqrt() * max_modulus.max(1.0);
+    Ok(GyroscopicModes {
+        eigenvalues: pairs.iter().map(|p| p.0).collect(),
+        backward_errors: pairs.iter().map(|p| p.1).collect(),
+        max_real_part,
+        real_part_bound,
+        stable: max_real_part <= real_part_bound,
+    })
+}
