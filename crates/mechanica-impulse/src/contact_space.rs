@@ -335,7 +335,7 @@ impl Process {
             }
             self.final_mode = Some(ContactMode::Stick);
             let t = -pseudo_inverse2(&self.w_tt()) * self.w_tn();
-            self.linear(t, f64::INFINITY)?;
+            self.linear_stick(t)?;
             return Ok(());
         }
         let u = self.velocity(self.p, &self.q);
@@ -378,7 +378,7 @@ impl Process {
             } else {
                 ContactMode::Stick
             });
-            self.linear(t_stick, f64::INFINITY)?;
+            self.linear_stick(t_stick)?;
         } else {
             let s_hat = ray_direction(&self.w_tt(), &self.w_tn(), self.f);
             self.final_mode = Some(if self.halted {
@@ -409,6 +409,26 @@ impl Process {
     fn compress_here(&mut self) -> bool {
         self.compression = Some((self.p, self.work));
         self.event(self.p, &self.q, self.work) >= 0.0
+    }
+
+    /// A sticking segment with the impulse ratio `t` that keeps u_T = 0, to the end of the
+    /// impact. When W has a null vector with a normal component (a contact point that can only
+    /// move in a plane or on a line: a body on a spherical joint, a planar mechanism), the
+    /// normal velocity cannot change along this ray (W_nn − W_nT W_TT⁺ W_Tn = 0) and u lies in
+    /// range(W), so u_n is zero as soon as u_T is: the point is stopped for good and the impact
+    /// ends here; the residual |u_n| (from the slip-halting cut-off) is added to the error as
+    /// the impulse |u_n|/W_nn.
+    fn linear_stick(&mut self, t: Vector2<f64>) -> Result<SegmentEnd, ImpulseError> {
+        let b = (self.w * Vector3::new(t.x, t.y, 1.0)).z;
+        if b.abs() <= 1e-9 * self.w.amax() {
+            let a = self.velocity(self.p, &self.q).z;
+            self.error += a.abs() / self.w[(2, 2)];
+            if self.compression.is_none() {
+                self.compression = Some((self.p, self.work));
+            }
+            return Ok(SegmentEnd::Terminated);
+        }
+        self.linear(t, f64::INFINITY)
     }
 
     /// A segment with constant impulse ratio dP/dp = (t, 1), at most `limit` long in p. Every

@@ -201,7 +201,7 @@ fn simultaneous(
             sweeper.push(n, p_new - p1[n]);
             p1[n] = p_new;
             if b.friction > 0.0 {
-                let radius = b.friction * p1[n];
+                let radius = disk_radius(b.friction, p1[n]);
                 tangential_update(b, i, radius, &mut p1, &mut sweeper);
             }
         }
@@ -237,7 +237,7 @@ fn simultaneous(
             iterations2 += 1;
             for (i, b) in blocks.iter().enumerate() {
                 if b.active && b.friction > 0.0 && p2[3 * i + 2] > 0.0 {
-                    let radius = b.friction * p2[3 * i + 2];
+                    let radius = disk_radius(b.friction, p2[3 * i + 2]);
                     tangential_update(b, i, radius, &mut p2, &mut sweeper);
                 }
             }
@@ -307,6 +307,11 @@ enum Phase {
     Restitution,
 }
 
+/// The friction disk radius f p_n (0 when p_n = 0, also for f = +∞).
+fn disk_radius(friction: f64, normal_impulse: f64) -> f64 {
+    if normal_impulse > 0.0 { friction * normal_impulse } else { 0.0 }
+}
+
 /// Exact block update of the tangential impulse of contact `i` within the disk `radius`
 /// (friction f p_n, +∞ for f = ∞): minimises ½ PᵀWP + P·u⁻ over that block.
 fn tangential_update(b: &Block, i: usize, radius: f64, p: &mut [f64], sweeper: &mut Sweeper<'_>) {
@@ -336,7 +341,7 @@ fn residual(blocks: &[Block], p1: &[f64], p: &[f64], sweeper: &Sweeper<'_>, phas
         };
         let r_t = if b.friction > 0.0 && b.l_t > 0.0 {
             let pt = Vector2::new(p[3 * i], p[3 * i + 1]);
-            let radius = b.friction * p[n];
+            let radius = disk_radius(b.friction, p[n]);
             let y = pt - sweeper.v_t(i) / b.l_t;
             let norm = y.norm();
             let projected = if norm > radius { y * (radius / norm) } else { y };

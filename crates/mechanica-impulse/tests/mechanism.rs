@@ -341,7 +341,6 @@ fn two_active_frictionless_contacts_match_the_kkt_solution() {
     let tree = builder.build().expect("tree");
     let rod = solid(1.0, Vector3::new(1.0, 1e-3, 1.0) / 12.0, Vector3::new(0.0, -0.5, 0.0), Vector3::zeros());
     let mech = Mechanism::new(tree, vec![rod, rod], &[0.3, -0.5]);
-    let q_dot = [-1.0, 0.4];
     let e = 0.6;
     // Contact 0: elbow against a wall with normal +x; contact 1: tip on the floor (+y).
     let contacts = [
@@ -356,16 +355,24 @@ fn two_active_frictionless_contacts_match_the_kkt_solution() {
         },
         ground_contact(b1, Vector3::new(0.0, -1.0, 0.0), ContactLaw::smooth(e).expect("law")),
     ];
-    let space = ContactSpace::new(&mech.tree, &mech.ws, &mech.inertia, &q_dot, &contacts).expect("space");
-    let w = space.delassus();
-    let u = space.u_before();
-    let (un0, un1) = (u[2], u[5]);
-    assert!(un0 < 0.0 && un1 < 0.0, "both contacts approach: {un0} {un1}");
-    let (w00, w01, w11) = (w[2 + 6 * 2], w[2 + 6 * 5], w[5 + 6 * 5]);
-    let det = w00 * w11 - w01 * w01;
-    let (r0, r1) = (-(1.0 + e) * un0, -(1.0 + e) * un1);
-    let p = [(w11 * r0 - w01 * r1) / det, (w00 * r1 - w01 * r0) / det];
-    assert!(p[0] > 0.0 && p[1] > 0.0, "the KKT solution has both contacts active: {p:?}");
+    // The first of a few velocity states at which the KKT solution has both contacts active.
+    let mut found = None;
+    let grid = (0..81).map(|k| [0.5 * (k % 9) as f64 - 2.0, 0.5 * (k / 9) as f64 - 2.0]);
+    for q_dot in grid {
+        let space = ContactSpace::new(&mech.tree, &mech.ws, &mech.inertia, &q_dot, &contacts).expect("space");
+        let w = space.delassus();
+        let u = space.u_before();
+        let (un0, un1) = (u[2], u[5]);
+        let (w00, w01, w11) = (w[2 + 6 * 2], w[2 + 6 * 5], w[5 + 6 * 5]);
+        let det = w00 * w11 - w01 * w01;
+        let (r0, r1) = (-(1.0 + e) * un0, -(1.0 + e) * un1);
+        let p = [(w11 * r0 - w01 * r1) / det, (w00 * r1 - w01 * r0) / det];
+        if p[0] > 0.0 && p[1] > 0.0 && un0 < 0.0 && un1 < 0.0 {
+            found = Some((q_dot, p, un0, un1, w00, w01, w11));
+            break;
+        }
+    }
+    let (q_dot, p, un0, un1, w00, w01, w11) = found.expect("a state with both contacts active");
     let options = MultiContactOptions::default();
     let r = resolve_contacts(&mech.tree, &mech.ws, &mech.inertia, &q_dot, &contacts, &options).expect("impact");
     for k in 0..2 {
@@ -466,12 +473,17 @@ fn duplicated_contact_gives_the_same_total_impulse() {
     let m = chain(&[Joint::Spherical, Joint::Spherical]);
     let q_dot = [0.5, -0.3, 0.8, -1.0, 0.2, 0.6];
     let tip = Vector3::new(0.05, -0.5, 0.02);
+    // Orient the floor normal against the tip's velocity so that the contact approaches.
+    let probe = ground_contact(1, tip, law(0.0, 0.0, RestitutionLaw::Poisson));
+    let space = ContactSpace::new(&m.tree, &m.ws, &m.inertia, &q_dot, &[probe]).expect("space");
+    let sign = if space.u_before()[2] < 0.0 { 1.0 } else { -1.0 };
     for (e, f) in [(0.0, 0.0), (0.7, 0.0), (0.0, f64::INFINITY)] {
-        let c = ground_contact(1, tip, law(e, f, RestitutionLaw::Poisson));
+        let mut c = ground_contact(1, tip, law(e, f, RestitutionLaw::Poisson));
+        c.normal_w *= sign;
         let options = MultiContactOptions::default();
         let one = resolve_single_contact(&m.tree, &m.ws, &m.inertia, &q_dot, &c, &options.process).expect("one");
         let two = resolve_contacts(&m.tree, &m.ws, &m.inertia, &q_dot, &[c, c], &options).expect("two");
-        assert!(one.contacts[0].normal_impulse > 0.0, "the contact must be active");
+        assert!(one.contacts[0].normal_impulse > 0.0, "the contact must be active: e {e} f {f} {one:?}");
         assert_eq!(two.delassus_rank, one.delassus_rank);
         let p_one = one.contacts[0].impulse_w;
         let p_two = two.contacts[0].impulse_w + two.contacts[1].impulse_w;
@@ -717,4 +729,17 @@ proptest! {
             }
         }
     }
+}
+
+#[test]
+fn debug_case() {
+    let m = chain(&[Joint::Spherical, Joint::Spherical]);
+    let q_dot = [0.5, -0.3, 0.8, -1.0, 0.2, 0.6];
+    let tip = Vector3::new(0.05, -0.5, 0.02);
+    let mut probe = ground_contact(1, tip, law(0.0, 0.0, RestitutionLaw::Poisson));
+    probe.normal_w = -Vector3::y();
+    let space = ContactSpace::new(&m.tree, &m.ws, &m.inertia, &q_dot, &[probe]).expect("space");
+    println!("W {:?}\n u {:?}", space.delassus(), space.u_before());
+    let r = resolve_single_contact(&m.tree, &m.ws, &m.inertia, &q_dot, &probe, &ImpactOptions::default());
+    println!("{r:?}");
 }

@@ -16,6 +16,17 @@
 use crate::{Mechanism, MechanismError};
 use faer::{Mat, Side};
 
+/// Which equilibria a search heads for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Seek {
+    /// Any equilibrium (stable or not): Newton on grad U* = 0, line search on ‖grad U*‖.
+    Stationary,
+    /// A local minimum of U* (a stable equilibrium when B is definite): Newton with the
+    /// Hessian's eigenvalues replaced by their absolute values (a descent direction), line
+    /// search on U* with the Armijo condition.
+    Minimum,
+}
+
 /// Options of [`find_equilibrium`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EquilibriumOptions {
@@ -23,6 +34,11 @@ pub struct EquilibriumOptions {
     pub max_iterations: usize,
     /// Gradient-norm tolerance τ; None derives it from rounding (see the module docs).
     pub tolerance: Option<f64>,
+    /// Stationary point or minimum.
+    pub seek: Seek,
+    /// Largest step ‖Δq‖ (trust radius, in the units of q), which keeps a singular or
+    /// indefinite Hessian from throwing the search far away.
+    pub max_step: f64,
 }
 
 impl Default for EquilibriumOptions {
@@ -30,6 +46,8 @@ impl Default for EquilibriumOptions {
         Self {
             max_iterations: 100,
             tolerance: None,
+            seek: Seek::Stationary,
+            max_step: 1.0,
         }
     }
 }
@@ -78,8 +96,9 @@ fn clamp(q: &mut [f64], limits: &[(f64, f64)]) {
     }
 }
 
-/// The regularised Newton step d = −B̃⁻¹ g (see the module docs).
-fn newton_step(b: &Mat<f64>, g: &[f64]) -> Result<Vec<f64>, MechanismError> {
+/// The regularised Newton step d = −B̃⁻¹ g (see the module docs), with |B| instead of B when
+/// seeking a minimum, shortened to at most `max_step`.
+fn newton_step(b: &Mat<f64>, g: &[f64], seek: Seek, max_step: f64) -> Result<Vec<f64>, MechanismError> {
     let n = g.len();
     let eig = b
         .self_adjoint_eigen(Side::Lower)
@@ -90,10 +109,20 @@ fn newton_step(b: &Mat<f64>, g: &[f64]) -> Result<Vec<f64>, MechanismError> {
     let mut d = vec![0.0; n];
     for i in 0..n {
         let coefficient: f64 = (0..n).map(|r| u[(r, i)] * g[r]).sum();
-        let lambda = if s[i].abs() < floor { floor.copysign(s[i]) } else { s[i] };
+        let lambda = match seek {
+            Seek::Stationary if s[i].abs() >= floor => s[i],
+            Seek::Stationary => floor.copysign(s[i]),
+            Seek::Minimum => s[i].abs().max(floor),
+        };
         let c = -coefficient / lambda;
         for (r, x) in d.iter_mut().enumerate() {
             *x += c * u[(r, i)];
+        }
+    }
+    let length = norm(&d);
+    if length > max_step {
+        for x in &mut d {
+            *x *= max_step / length;
         }
     }
     Ok(d)
@@ -116,6 +145,13 @@ pub fn find_equilibrium(
         });
     }
     crate::error::check_all_finite(&q, "q0")?;
+    if !(options.max_step > 0.0) {
+        return Err(MechanismError::OutOfRange {
+            what: "maximum equilibrium step",
+            requirement: "> 0",
+            value: options.max_step,
+        });
+    }
     clamp(&mut q, &limits);
     let rebase = mechanism.has_rotation_vectors();
     if rebase {
@@ -151,7 +187,8 @@ pub fn find_equilibrium(
             break;
         }
         let hessian = current.hessian.as_ref().ok_or(MechanismError::Numerical("Hessian missing"))?;
-        let direction = newton_step(hessian, &free)?;
+        let direction = newton_step(hessian, &free, options.seek, options.max_step)?;
+        let slope: f64 = free.iter().zip(&direction).map(|(g, d)| g * d).sum();
         let mut alpha = 1.0;
         let mut accepted = None;
         for _ in 0..40 {
@@ -159,7 +196,14 @@ pub fn find_equilibrium(
             clamp(&mut trial, &limits);
             let evaluation = mechanism.potential(&trial, false)?;
             let (trial_free, _) = free_gradient(&evaluation.gradient, &trial, &limits);
-            if norm(&trial_free) < (1.0 - 1e-4 * alpha) * gradient_norm {
+            let sufficient = match options.seek {
+                Seek::Stationary => norm(&trial_free) < (1.0 - 1e-4 * alpha) * gradient_norm,
+                Seek::Minimum => {
+                    evaluation.value <= current.value + 1e-4 * alpha * slope
+                        || norm(&trial_free) < 1e-3 * gradient_norm
+                }
+            };
+            if sufficient {
                 accepted = Some(trial);
                 break;
             }

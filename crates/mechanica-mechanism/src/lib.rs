@@ -19,7 +19,7 @@ pub mod modes;
 pub mod potentials;
 
 pub use configuration::Configuration;
-pub use equilibrium::{Equilibrium, EquilibriumOptions, find_equilibria, find_equilibrium};
+pub use equilibrium::{Equilibrium, EquilibriumOptions, Seek, find_equilibria, find_equilibrium};
 pub use error::MechanismError;
 pub use mechanism::{Mechanism, RotatingFrame};
 pub use modes::{BodyDisplacement, GyroscopicModes, MechanismModes, Stability, mechanism_modes};

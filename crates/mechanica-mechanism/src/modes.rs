@@ -122,6 +122,7 @@ fn stability_of(solution: &ModalSolution) -> Stability {
 /// The stability and modes of `mechanism` about q₀ (normally an equilibrium from
 /// [`crate::find_equilibrium`]). `options` select the modes as in the modal crate; stability
 /// needs the unstable and zero modes, which are the lowest, so `Selection::Lowest(k)` suffices.
+/// Mode shapes are always computed (`options.vectors` is ignored).
 pub fn mechanism_modes(
     mechanism: &mut Mechanism,
     q0: &[f64],
@@ -135,7 +136,14 @@ pub fn mechanism_modes(
     let b = evaluation.hessian.ok_or(MechanismError::Numerical("Hessian missing"))?;
     let a = mechanism.mass_matrix(&q)?;
     let problem = PencilProblem::new(a.as_ref(), b.as_ref())?;
-    let solution = solve(&problem, options)?;
+    // Shapes are always computed: they carry the propagation of B's rounding (below) and the
+    // body displacements; for mechanisms (n in the hundreds at most) they cost little.
+    let options = SolveOptions {
+        vectors: true,
+        ..*options
+    };
+    let mut solution = solve(&problem, &options)?;
+    propagate_assembly_error(&mut solution, &b);
     let stability = stability_of(&solution);
     let gradient_norm = evaluation.gradient.iter().map(|g| g * g).sum::<f64>().sqrt();
     let (body_displacements, effective_masses, total_mass) = shapes_in_space(mechanism, &q, &a, &solution)?;
@@ -157,6 +165,29 @@ pub fn mechanism_modes(
         total_mass,
         gyroscopic,
     })
+}
+
+/// Relative size of the rounding error of an assembled B: ‖δB‖ ≤ 64·n·u·‖B‖_F (generous:
+/// each entry is a sum of O(n) products of rounded kinematic quantities).
+fn assembly_error(b: &Mat<f64>) -> f64 {
+    64.0 * b.nrows() as f64 * f64::EPSILON * b.norm_l2()
+}
+
+/// The modal solver certifies each ω² for the B it was given; B itself carries the rounding
+/// of its assembly. To first order a perturbation δB moves ω²_k by x_kᵀ δB x_k, so
+/// ‖δB‖·‖x_k‖² (x_k A-normalised) is added to every bound and the modes are reclassified with
+/// it: a ω² of 1e-29 from a B of size 40 is a zero mode, not an instability.
+fn propagate_assembly_error(solution: &mut ModalSolution, b: &Mat<f64>) {
+    let delta = assembly_error(b);
+    let Some(x) = &solution.vectors else { return };
+    for (k, mode) in solution.modes.iter_mut().enumerate() {
+        if matches!(mode.kind, ModeKind::Infinite) {
+            continue;
+        }
+        let norm_sq: f64 = (0..x.nrows()).map(|r| x[(r, k)] * x[(r, k)]).sum();
+        mode.error_bound += delta * norm_sq;
+        mode.kind = mechanica_modal::classify(mode.omega_sq, mode.error_bound);
+    }
 }
 
 type Shapes = (Vec<Vec<BodyDisplacement>>, Vec<[f64; 3]>, f64);

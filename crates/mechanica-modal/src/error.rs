@@ -131,6 +131,67 @@ pub enum ModalError {
         /// Its exponent γ|t|.
         exponent: f64,
     },
+    /// A sparse entry's index lies outside the n×n matrix.
+    #[error("{what} has an entry at ({row}, {col}) outside its {dim}×{dim} shape")]
+    IndexOutOfRange {
+        /// Which matrix.
+        what: &'static str,
+        /// Row of the entry.
+        row: usize,
+        /// Column of the entry.
+        col: usize,
+        /// The order n.
+        dim: usize,
+    },
+    /// No shift σ made B − σA positive definite (sparse solver): A is not positive semidefinite,
+    /// or the pencil has modes far below the shifts tried; pass a shift below the lowest ω².
+    #[error("B − σA is not positive definite for any shift tried down to σ = {lowest_shift:.3e} (last failed pivot {pivot})")]
+    NoDefiniteShift {
+        /// The lowest shift tried (rad²/s²).
+        lowest_shift: f64,
+        /// The Cholesky pivot that failed at that shift.
+        pivot: usize,
+    },
+    /// The mass matrix gave a Lanczos vector a non-positive A-norm: A is not positive semidefinite.
+    #[error("mass matrix A is not positive semidefinite: a Lanczos vector has xᵀAx = {value:.3e}")]
+    MassNotSemidefinite {
+        /// The value of xᵀAx found.
+        value: f64,
+    },
+    /// The sparse Lanczos iteration did not converge all wanted pairs.
+    #[error("Lanczos converged {converged} of {wanted} wanted pairs in {restarts} restarts")]
+    LanczosNoConvergence {
+        /// Pairs converged.
+        converged: usize,
+        /// Pairs wanted.
+        wanted: usize,
+        /// Restarts made.
+        restarts: usize,
+    },
+    /// A sparse factorization failed for a reason other than a pivot (memory, index overflow).
+    #[error("sparse factorization of {what} failed: {detail}")]
+    Factorization {
+        /// Which matrix.
+        what: &'static str,
+        /// faer's description.
+        detail: String,
+    },
+    /// A Matrix Market file could not be read.
+    #[error("cannot read Matrix Market file {path}: {detail}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The operating system's message.
+        detail: String,
+    },
+    /// A Matrix Market file is malformed.
+    #[error("Matrix Market line {line}: {detail}")]
+    MatrixMarket {
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        detail: String,
+    },
     /// faer's eigensolver did not converge.
     #[error("the symmetric eigensolver did not converge on the reduced {n}×{n} matrix")]
     NoConvergence {

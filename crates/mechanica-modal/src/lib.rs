@@ -35,12 +35,16 @@ pub mod reduce;
 mod refine;
 pub mod response;
 pub mod solve;
+pub mod sparse_inertia;
+pub mod sparse_pencil;
 
 pub use accuracy::{AccuracyReport, BoundKind};
 pub use error::ModalError;
 pub use faer;
 pub use inertia::{InertiaCount, count_below};
 pub use problem::PencilProblem;
+pub use sparse_inertia::{SparseInertia, count_below_sparse};
+pub use sparse_pencil::SparsePencil;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use solve::{
     InertiaCheck, Method, ModalSolution, Mode, ModeGroup, ModeKind, Refinement, Selection, SolveOptions, classify,

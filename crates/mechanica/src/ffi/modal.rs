@@ -13,7 +13,16 @@ use mechanica_modal::{
 impl From<ModalError> for FfiError {
     fn from(error: ModalError) -> Self {
         let status = match error {
-            ModalError::BadShape { .. } | ModalError::BadLength { .. } => MECH_STATUS_BAD_DIMENSION,
+            ModalError::BadShape { .. } | ModalError::BadLength { .. } | ModalError::IndexOutOfRange { .. } => {
+                MECH_STATUS_BAD_DIMENSION
+            }
+            ModalError::NoDefiniteShift { .. } | ModalError::MassNotSemidefinite { .. } => {
+                MECH_STATUS_NOT_POSITIVE_DEFINITE
+            }
+            ModalError::LanczosNoConvergence { .. } => MECH_STATUS_NOT_CONVERGED,
+            ModalError::Factorization { .. } => MECH_STATUS_BAD_DIMENSION,
+            ModalError::Io { .. } => MECH_STATUS_IO_ERROR,
+            ModalError::MatrixMarket { .. } => MECH_STATUS_PARSE_ERROR,
             ModalError::NonFinite { .. } | ModalError::NonFiniteValue { .. } | ModalError::BadShift(_) => {
                 MECH_STATUS_NON_FINITE
             }
