@@ -420,6 +420,187 @@ typedef struct mech_impact_result_t {
 } mech_impact_result_t;
 #endif
 
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * A point impulse on a body of a mechanism.
+ */
+typedef struct mech_mechanism_impulse_t {
+    /**
+     * Index of the struck body in the tree.
+     */
+    size_t body;
+    /**
+     * The struck point in the body frame B (m).
+     */
+    struct mech_vec3_t point;
+    /**
+     * The impulse S, world frame (N·s).
+     */
+    struct mech_vec3_t impulse;
+} mech_mechanism_impulse_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The response of a mechanism to point impulses (7.115–7.117).
+ */
+typedef struct mech_mechanism_response_t {
+    /**
+     * Kinetic energy before, ½ q̇ᵀ A q̇ (J).
+     */
+    double energy_before;
+    /**
+     * ΔT = Q_S·(q̇ + ½ Δq̇) (J).
+     */
+    double energy_change;
+    /**
+     * Normwise backward error of the solve A Δq̇ = Q_S.
+     */
+    double backward_error;
+} mech_mechanism_response_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * A contact of a mechanism with the environment or between two of its bodies.
+ */
+typedef struct mech_mechanism_contact_t {
+    /**
+     * Index of the body that receives the impulse +P.
+     */
+    size_t body;
+    /**
+     * The contact point on `body`, body frame (m).
+     */
+    struct mech_vec3_t point;
+    /**
+     * Index of the other body (receives −P), or −1 for the static environment.
+     */
+    int64_t other_body;
+    /**
+     * The contact point on the other body, its body frame (m); ignored for the environment.
+     */
+    struct mech_vec3_t other_point;
+    /**
+     * Unit normal (world) from the environment / other body into `body` (|n| = 1 within 1e-9).
+     */
+    struct mech_vec3_t normal;
+    /**
+     * Coefficient of restitution e ∈ [0, 1].
+     */
+    double restitution;
+    /**
+     * Coulomb friction coefficient f ≥ 0 (+INFINITY: no slip).
+     */
+    double friction;
+    /**
+     * A MECH_RESTITUTION_* value (used when a single contact is resolved; several contacts use
+     * Poisson's rule, see mech_impulse_mechanism_contacts).
+     */
+    mech_restitution_law_t law;
+} mech_mechanism_contact_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Accuracy and budget of a mechanism impact; pass NULL for the defaults.
+ */
+typedef struct mech_multi_contact_options_t {
+    /**
+     * Relative complementarity tolerance of the simultaneous model (> 0; default 1e-10).
+     */
+    double tolerance;
+    /**
+     * Maximum Gauss–Seidel sweeps per phase (≥ 1; default 10000).
+     */
+    uint64_t max_iterations;
+    /**
+     * Relative tolerance of the single-contact process (> 0; default 1e-10).
+     */
+    double process_tolerance;
+} mech_multi_contact_options_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The outcome at one contact of a mechanism impact (world frame).
+ */
+typedef struct mech_mechanism_contact_result_t {
+    /**
+     * Total impulse P on `body` (the other body receives −P) (N·s).
+     */
+    struct mech_vec3_t impulse;
+    /**
+     * Normal impulse P·n ≥ 0 (N·s).
+     */
+    double normal_impulse;
+    /**
+     * Tangential (friction) impulse (N·s).
+     */
+    struct mech_vec3_t tangential_impulse;
+    /**
+     * Normal impulse at the end of compression (N·s).
+     */
+    double compression_impulse;
+    /**
+     * Relative velocity of the contact before the impact (m/s).
+     */
+    struct mech_vec3_t relative_velocity_before;
+    /**
+     * Relative velocity after the impact, u⁻ + Σ W P (m/s).
+     */
+    struct mech_vec3_t relative_velocity_after;
+    /**
+     * A MECH_CONTACT_* value.
+     */
+    mech_contact_mode_t mode;
+} mech_mechanism_contact_result_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The report of a mechanism impact.
+ */
+typedef struct mech_mechanism_impact_t {
+    /**
+     * Kinetic energy before, ½ q̇ᵀ A q̇ (J).
+     */
+    double energy_before;
+    /**
+     * ΔT = P·(u⁻ + ½ W P) (J); never positive for several contacts (energy guard).
+     */
+    double energy_change;
+    /**
+     * Largest complementarity residual over contacts (m/s); 0 for the single-contact process.
+     */
+    double complementarity_residual;
+    /**
+     * Impulse error of the single-contact process (N·s); 0 for several contacts.
+     */
+    double integration_error;
+    /**
+     * Factor applied to the restitution impulses by the energy guard (1: untouched).
+     */
+    double restitution_scale;
+    /**
+     * Gauss–Seidel sweeps (several contacts) or process steps (one contact).
+     */
+    uint64_t iterations;
+    /**
+     * Numerical rank of the 3m × 3m Delassus matrix W.
+     */
+    uint64_t delassus_rank;
+    /**
+     * 1 when the residual met the tolerance, 0 when the sweep budget ran out.
+     */
+    int32_t converged;
+    /**
+     * 1 when the simultaneous multi-contact model was used, 0 for the single-contact process.
+     */
+    int32_t simultaneous;
+} mech_mechanism_impact_t;
+#endif
+
 /**
  * A unit quaternion w + x i + y j + z k (scalar first), representing a rotation.
  */
@@ -1692,6 +1873,87 @@ mech_status_t mech_impulse_resolve_contact(const struct mech_impulse_body_t *bod
                                            const struct mech_impulse_body_t *body2,
                                            const struct mech_impulse_contact_t *contact,
                                            struct mech_impact_result_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Lagrange's impulse equations A(q) Δq̇ = Σ J_kᵀ S_k (7.115–7.117) for the tree at the state
+ * of mech_tree_set_state, with `bodies` = one mass-properties value per body (body frame;
+ * mass ≥ 0). Writes Δq̇ (`dof` doubles) and the energy report. MECH_STATUS_NOT_POSITIVE_DEFINITE
+ * when A is singular (a rod or point mass whose spin has a coordinate, a massless leaf);
+ * MECH_STATUS_INVALID_ARGUMENT for a body index out of range; MECH_STATUS_BAD_DIMENSION for a
+ * wrong `body_count` or `dof`.
+ *
+ * # Safety
+ * `tree` must be a live handle; `bodies` must point to `body_count` readable values,
+ * `impulses` to `impulse_count` readable values (NULL allowed when the count is 0),
+ * `delta_q_dot` to `dof` writable doubles, `out` writable.
+ */
+mech_status_t mech_impulse_mechanism_apply(struct mech_tree_t *tree,
+                                           const struct mech_mass_properties_t *bodies,
+                                           size_t body_count,
+                                           const struct mech_mechanism_impulse_t *impulses,
+                                           size_t impulse_count,
+                                           double *delta_q_dot,
+                                           size_t dof,
+                                           struct mech_mechanism_response_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Resolves an impact of the mechanism `tree` (at the state of mech_tree_set_state; `bodies`
+ * one mass-properties value per body) at `contact_count` contacts. One contact: the
+ * impulse-parameterised process with the contact's restitution law (as
+ * mech_impulse_resolve_contact, on W = J A⁻¹ Jᵀ). Several contacts: the simultaneous
+ * two-phase model (inelastic Signorini–Coulomb compression, then Poisson restitution with
+ * friction, energy-guarded so that ΔT ≤ 0) solved by projected block Gauss–Seidel from zero
+ * in contact order; see the Rust docs of mechanica_impulse::multi_contact. `options` may be
+ * NULL for the defaults. Writes one result per contact, Δq̇ (`dof` doubles) and the report.
+ * MECH_STATUS_SINGULAR when an approaching contact cannot move along its normal;
+ * MECH_STATUS_NOT_POSITIVE_DEFINITE for a singular mass matrix; MECH_STATUS_NOT_CONVERGED for
+ * a frictional jam of the single-contact process (an unconverged simultaneous solve is
+ * reported by `converged` = 0, not an error).
+ *
+ * # Safety
+ * `tree` must be a live handle; `bodies` must point to `body_count` readable values,
+ * `contacts` to `contact_count` readable values, `options` be NULL or readable, `results` point
+ * to `contact_count` writable values, `delta_q_dot` to `dof` writable doubles, `out` writable.
+ */
+mech_status_t mech_impulse_mechanism_contacts(struct mech_tree_t *tree,
+                                              const struct mech_mass_properties_t *bodies,
+                                              size_t body_count,
+                                              const struct mech_mechanism_contact_t *contacts,
+                                              size_t contact_count,
+                                              const struct mech_multi_contact_options_t *options,
+                                              struct mech_mechanism_contact_result_t *results,
+                                              double *delta_q_dot,
+                                              size_t dof,
+                                              struct mech_mechanism_impact_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The contact-space (Delassus) matrix W = J A⁻¹ Jᵀ of `contact_count` contacts of the
+ * mechanism at the state of mech_tree_set_state, into `delassus` (column-major, `rows` × `rows`
+ * with rows = 3·contact_count; rows 3i, 3i+1, 3i+2 are the tangents t₁, t₂ and the normal of
+ * contact i), its numerical rank into `rank_out`, and the contact frames (columns t₁, t₂, n;
+ * world) into `frames` (`contact_count` matrices). The restitution and friction of the contacts
+ * are validated but not used.
+ *
+ * # Safety
+ * `tree` must be a live handle; `bodies` must point to `body_count` readable values,
+ * `contacts` to `contact_count` readable values, `delassus` to rows² writable doubles,
+ * `frames` to `contact_count` writable matrices, `rank_out` writable.
+ */
+mech_status_t mech_impulse_mechanism_delassus(struct mech_tree_t *tree,
+                                              const struct mech_mass_properties_t *bodies,
+                                              size_t body_count,
+                                              const struct mech_mechanism_contact_t *contacts,
+                                              size_t contact_count,
+                                              double *delassus,
+                                              size_t rows,
+                                              struct mech_mat3_t *frames,
+                                              size_t *rank_out);
 #endif
 
 #if defined(MECH_FEATURE_KINEMATICS)

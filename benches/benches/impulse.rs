@@ -7,10 +7,21 @@
 //! - `impulse_swerve`: error against run time of the swerving-slip integration over the
 //!   tolerance, written to `target/reports/impulse_swerve.csv` and `.svg`. The error is
 //!   measured against a tolerance-1e-14 run; the reported error estimate is listed beside it.
+//! - `impulse_mechanism/*`: a humanoid-like tree of 14 bodies (free torso, head, four limbs of
+//!   three spherical joints each: 45 DOF) landing on hands and feet, 4 frictional contacts:
+//!   `mass_matrix_and_factor` (A(q) by CRBA and its Cholesky), `resolve_4_contacts` (J, W =
+//!   J A⁻¹ Jᵀ and the simultaneous frictional impact, given the factor), `end_to_end` (both),
+//!   and `single_contact` (one foot, the impulse process on W).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use mechanica::impulse::{ContactLaw, ImpactOptions, RestitutionLaw, RigidBody, TwoBodyImpact, resolve_contact};
-use mechanica::kinematics::nalgebra::{Matrix3, Rotation3, Vector3};
+use mechanica::impulse::{
+    BodyPoint, ContactLaw, ImpactOptions, MechanismContact, MechanismInertia, MultiContactOptions, RestitutionLaw,
+    RigidBody, TwoBodyImpact, resolve_contact, resolve_contacts, resolve_single_contact,
+};
+use mechanica::kinematics::nalgebra::{Isometry3, Matrix3, Rotation3, Vector3};
+use mechanica::kinematics::tree::{Joint, KinematicTree, TreeBuilder, Workspace};
+use mechanica::mass::MassProperties;
+use mechanica::mass::mechanism::TreeMass;
 use mechanica_benches::{Series, plot_error_vs_time, write_csv};
 use std::hint::black_box;
 use std::time::Instant;
@@ -143,5 +154,105 @@ fn swerve_series(_c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, single_contact, swerve_series);
+/// The humanoid-like tree: torso (free), head, two arms and two legs of three bodies each.
+/// Returns the tree, its workspace at a crouched landing pose, the body masses, q̇ and the
+/// four contacts (hands and feet on the floor, f = 0.6, e = 0.2).
+fn humanoid() -> (KinematicTree, Workspace, TreeMass, Vec<f64>, Vec<MechanismContact>) {
+    let mut builder = TreeBuilder::new();
+    let mut bodies = Vec::new();
+    let link = |mass: f64, length: f64| {
+        let r = 0.05_f64;
+        let (ia, it) = (0.5 * mass * r * r, mass * (3.0 * r * r + length * length) / 12.0);
+        MassProperties {
+            mass,
+            p_oc: Vector3::new(0.0, -0.5 * length, 0.0),
+            inertia_c: Matrix3::from_diagonal(&Vector3::new(it, ia, it)),
+        }
+    };
+    let torso = builder.add_body(None, Joint::Free, Isometry3::identity());
+    bodies.push(MassProperties {
+        mass: 30.0,
+        p_oc: Vector3::zeros(),
+        inertia_c: Matrix3::from_diagonal(&Vector3::new(1.2, 0.6, 1.0)),
+    });
+    builder.add_body(Some(torso), Joint::Spherical, Isometry3::translation(0.0, 0.3, 0.0));
+    bodies.push(MassProperties {
+        mass: 5.0,
+        p_oc: Vector3::new(0.0, 0.12, 0.0),
+        inertia_c: Matrix3::identity() * 0.03,
+    });
+    let mut ends = Vec::new();
+    for (x, y, lengths, masses) in [
+        (0.2, 0.25, [0.3, 0.28, 0.08], [2.5, 1.5, 0.5]),
+        (-0.2, 0.25, [0.3, 0.28, 0.08], [2.5, 1.5, 0.5]),
+        (0.1, -0.3, [0.45, 0.42, 0.1], [8.0, 4.0, 1.2]),
+        (-0.1, -0.3, [0.45, 0.42, 0.1], [8.0, 4.0, 1.2]),
+    ] {
+        let mut parent = torso;
+        let mut offset = Vector3::new(x, y, 0.0);
+        for k in 0..3 {
+            parent = builder.add_body(Some(parent), Joint::Spherical, Isometry3::translation(offset.x, offset.y, offset.z));
+            bodies.push(link(masses[k], lengths[k]));
+            offset = Vector3::new(0.0, -lengths[k], 0.0);
+        }
+        ends.push((parent, offset));
+    }
+    let tree = builder.build().expect("humanoid");
+    let n = tree.dof();
+    let q: Vec<f64> = (0..n).map(|k| if k < 6 { [0.0, 1.0, 0.0, 0.3, 0.0, 0.0][k] } else { 0.25 * ((k as f64) * 0.9).sin() }).collect();
+    let q_dot: Vec<f64> = (0..n).map(|k| if k == 1 { -2.0 } else { 0.3 * ((k as f64) * 1.3).cos() }).collect();
+    let mut ws = tree.workspace();
+    tree.update_positions(&mut ws, &q).expect("q");
+    let mass = TreeMass::new(&tree, bodies).expect("mass");
+    let law = ContactLaw::new(0.2, 0.6, RestitutionLaw::Stronge).expect("law");
+    let contacts = ends
+        .iter()
+        .map(|&(body, p_bq)| MechanismContact {
+            point: BodyPoint { body, p_bq },
+            other: None,
+            normal_w: Vector3::y(),
+            law,
+        })
+        .collect();
+    (tree, ws, mass, q_dot, contacts)
+}
+
+fn mechanism_contacts(c: &mut Criterion) {
+    let (tree, ws, mut mass, q_dot, contacts) = humanoid();
+    let inertia = MechanismInertia::new(&tree, &ws, &mut mass).expect("inertia");
+    let options = MultiContactOptions::default();
+    let sample = resolve_contacts(&tree, &ws, &inertia, &q_dot, &contacts, &options).expect("impact");
+    println!(
+        "impulse_mechanism: dof {}, contacts {}, sweeps {}, residual {:e} m/s, converged {}, rank {}, ΔT {:.4} J of T {:.4} J, modes {:?}",
+        tree.dof(),
+        contacts.len(),
+        sample.iterations,
+        sample.complementarity_residual,
+        sample.converged,
+        sample.delassus_rank,
+        sample.energy_change,
+        sample.energy_before,
+        sample.contacts.iter().map(|c| c.mode).collect::<Vec<_>>()
+    );
+    let mut group = c.benchmark_group("impulse_mechanism");
+    group.bench_function("mass_matrix_and_factor", |b| {
+        b.iter(|| MechanismInertia::new(black_box(&tree), black_box(&ws), &mut mass))
+    });
+    group.bench_function("resolve_4_contacts", |b| {
+        b.iter(|| resolve_contacts(black_box(&tree), black_box(&ws), &inertia, black_box(&q_dot), &contacts, &options))
+    });
+    group.bench_function("end_to_end", |b| {
+        b.iter(|| {
+            let inertia = MechanismInertia::new(black_box(&tree), black_box(&ws), &mut mass).expect("inertia");
+            resolve_contacts(&tree, &ws, &inertia, black_box(&q_dot), &contacts, &options)
+        })
+    });
+    let process = ImpactOptions::default();
+    group.bench_function("single_contact", |b| {
+        b.iter(|| resolve_single_contact(black_box(&tree), black_box(&ws), &inertia, black_box(&q_dot), &contacts[2], &process))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, single_contact, mechanism_contacts, swerve_series);
 criterion_main!(benches);

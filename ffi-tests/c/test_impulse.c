@@ -255,9 +255,198 @@ static void test_contacts(void) {
     CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &c, NULL), MECH_STATUS_NULL_POINTER);
 }
 
+/* A pendulum: one body on a revolute joint about z at the origin, bob of mass m at (0, −L, 0)
+ * with central inertia ic about z. I_z = ic + m L². At θ = 0, rate ω, the bob moves along +x. */
+static mech_tree_t *pendulum_tree(double omega) {
+    mech_tree_t *tree = NULL;
+    CHECK_STATUS(mech_tree_create(&tree), MECH_STATUS_OK);
+    mech_vec3_t z = v3(0.0, 0.0, 1.0), origin = v3(0.0, 0.0, 0.0);
+    mech_mat3_t id = diag3(1.0, 1.0, 1.0);
+    size_t b0 = 99;
+    CHECK_STATUS(mech_tree_add_body(tree, -1, MECH_JOINT_REVOLUTE, &z, &id, &origin, &b0), MECH_STATUS_OK);
+    CHECK(b0 == 0);
+    CHECK_STATUS(mech_tree_finalize(tree), MECH_STATUS_OK);
+    double q = 0.0;
+    CHECK_STATUS(mech_tree_set_state(tree, &q, &omega, 1), MECH_STATUS_OK);
+    return tree;
+}
+
+static void test_mechanisms(void) {
+    const double m = 2.0, l = 0.8, ic = 0.05, omega = 1.5, e = 0.5;
+    const double iz = ic + m * l * l;
+    mech_mass_properties_t bob;
+    memset(&bob, 0, sizeof bob);
+    bob.mass = m;
+    bob.center_of_mass = v3(0.0, -l, 0.0);
+    bob.inertia_about_com = diag3(ic, ic, ic);
+    mech_tree_t *tree = pendulum_tree(omega);
+
+    /* Lagrange's impulse equation: a horizontal impulse s at the bob gives Δθ̇ = L s / I_z. */
+    mech_mechanism_impulse_t hit;
+    memset(&hit, 0, sizeof hit);
+    hit.body = 0;
+    hit.point = v3(0.0, -l, 0.0);
+    hit.impulse = v3(0.3, 0.0, 0.0);
+    double dq = 0.0;
+    mech_mechanism_response_t resp;
+    CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, &hit, 1, &dq, 1, &resp), MECH_STATUS_OK);
+    CHECK_NEAR(dq, l * 0.3 / iz, 1e-14);
+    CHECK_NEAR(resp.energy_before, 0.5 * iz * omega * omega, 1e-14);
+    CHECK_NEAR(resp.energy_change, 0.5 * iz * ((omega + dq) * (omega + dq) - omega * omega), 1e-13);
+    CHECK(resp.backward_error <= 1e-15);
+
+    /* The bob hits a smooth wall (normal −x): θ̇⁺ = −e ω, P = (1 + e) ω I_z / L, ΔT = −½(1 − e²) I_z ω². */
+    mech_mechanism_contact_t wall;
+    memset(&wall, 0, sizeof wall);
+    wall.body = 0;
+    wall.point = v3(0.0, -l, 0.0);
+    wall.other_body = -1;
+    wall.normal = v3(-1.0, 0.0, 0.0);
+    wall.restitution = e;
+    wall.friction = 0.0;
+    wall.law = MECH_RESTITUTION_STRONGE;
+    mech_mechanism_contact_result_t res[2];
+    mech_mechanism_impact_t imp;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &wall, 1, NULL, res, &dq, 1, &imp), MECH_STATUS_OK);
+    CHECK_NEAR(dq, -(1.0 + e) * omega, 1e-13);
+    CHECK_NEAR(res[0].normal_impulse, (1.0 + e) * omega * iz / l, 1e-12);
+    CHECK_NEAR(res[0].impulse.x, -(1.0 + e) * omega * iz / l, 1e-12);
+    CHECK_NEAR(res[0].relative_velocity_before.x, omega * l, 1e-14);
+    CHECK_NEAR(res[0].relative_velocity_after.x, -e * omega * l, 1e-13);
+    CHECK(res[0].mode == MECH_CONTACT_FRICTIONLESS);
+    CHECK_NEAR(imp.energy_change, -0.5 * (1.0 - e * e) * iz * omega * omega, 1e-12);
+    CHECK(imp.simultaneous == 0 && imp.converged == 1 && imp.delassus_rank == 1);
+
+    /* The same contact twice, rough: the simultaneous model, rank 1 of 6, the same Δθ̇. */
+    mech_mechanism_contact_t two[2] = {wall, wall};
+    two[0].friction = 0.4;
+    two[1].friction = 0.4;
+    mech_multi_contact_options_t opts = {1e-12, 1000, 1e-10};
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, two, 2, &opts, res, &dq, 1, &imp), MECH_STATUS_OK);
+    CHECK(imp.simultaneous == 1 && imp.converged == 1 && imp.delassus_rank == 1);
+    CHECK_NEAR(dq, -(1.0 + e) * omega, 1e-10);
+    CHECK_NEAR(res[0].normal_impulse + res[1].normal_impulse, (1.0 + e) * omega * iz / l, 1e-10);
+    CHECK(imp.energy_change <= 0.0);
+    CHECK(imp.complementarity_residual <= 1e-12 * omega * l);
+
+    /* The Delassus matrix: W_nn = L² / I_z, the frame's third column is the normal. */
+    double w[36];
+    mech_mat3_t frames[2];
+    size_t rank = 0;
+    CHECK_STATUS(mech_impulse_mechanism_delassus(tree, &bob, 1, two, 2, w, 6, frames, &rank), MECH_STATUS_OK);
+    CHECK_NEAR(w[2 + 6 * 2], l * l / iz, 1e-14);
+    CHECK_NEAR(w[5 + 6 * 2], l * l / iz, 1e-14);
+    CHECK_NEAR(frames[1].m[6], -1.0, 0.0);
+    CHECK(rank == 1);
+
+    /* Error paths: nothing written. */
+    FILL_SENTINEL(res, sizeof res);
+    FILL_SENTINEL(&imp, sizeof imp);
+    FILL_SENTINEL(&dq, sizeof dq);
+    FILL_SENTINEL(&resp, sizeof resp);
+    FILL_SENTINEL(w, sizeof w);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(NULL, &bob, 1, &wall, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, NULL, 1, &wall, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, NULL, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &wall, 1, NULL, NULL, &dq, 1, &imp),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &wall, 1, NULL, res, NULL, 1, &imp),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 2, &wall, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &wall, 1, NULL, res, &dq, 2, &imp),
+                 MECH_STATUS_BAD_DIMENSION);
+    mech_mass_properties_t bad_bob = bob;
+    bad_bob.mass = NAN;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bad_bob, 1, &wall, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_NON_FINITE);
+    /* A point mass on the joint axis: A = 0, not positive definite. */
+    bad_bob = bob;
+    bad_bob.center_of_mass = v3(0.0, 0.0, 0.0);
+    bad_bob.inertia_about_com = diag3(0.0, 0.0, 0.0);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bad_bob, 1, &wall, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_NOT_POSITIVE_DEFINITE);
+    CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bad_bob, 1, &hit, 1, &dq, 1, &resp),
+                 MECH_STATUS_NOT_POSITIVE_DEFINITE);
+    mech_mechanism_contact_t bad = wall;
+    bad.body = 3;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &bad, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    bad = wall;
+    bad.normal = v3(-2.0, 0.0, 0.0);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &bad, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    bad = wall;
+    bad.normal.y = NAN;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &bad, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_NON_FINITE);
+    bad = wall;
+    bad.law = 9;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &bad, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_BAD_ENUM);
+    bad = wall;
+    bad.restitution = 1.5;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &bad, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    bad = wall;
+    bad.friction = -1.0;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &bad, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    bad = wall;
+    bad.other_body = -2;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &bad, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    mech_multi_contact_options_t bad_opts = {0.0, 10, 1e-10};
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, two, 2, &bad_opts, res, &dq, 1, &imp),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    bad_opts.tolerance = NAN;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, two, 2, &bad_opts, res, &dq, 1, &imp),
+                 MECH_STATUS_NON_FINITE);
+    CHECK(mech_untouched(res, sizeof res));
+    CHECK(mech_untouched(&imp, sizeof imp));
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &wall, 1, NULL, res, &dq, 1, NULL),
+                 MECH_STATUS_NULL_POINTER);
+
+    mech_mechanism_impulse_t bad_hit = hit;
+    bad_hit.impulse.x = INFINITY;
+    CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, &bad_hit, 1, &dq, 1, &resp), MECH_STATUS_NON_FINITE);
+    bad_hit = hit;
+    bad_hit.body = 1;
+    CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, &bad_hit, 1, &dq, 1, &resp),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, &hit, 1, &dq, 0, &resp), MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, NULL, 1, &dq, 1, &resp), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_mechanism_apply(NULL, &bob, 1, &hit, 1, &dq, 1, &resp), MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(&dq, sizeof dq));
+    CHECK(mech_untouched(&resp, sizeof resp));
+    CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, &hit, 1, &dq, 1, NULL), MECH_STATUS_NULL_POINTER);
+
+    CHECK_STATUS(mech_impulse_mechanism_delassus(tree, &bob, 1, two, 2, w, 5, frames, &rank),
+                 MECH_STATUS_BAD_DIMENSION);
+    CHECK_STATUS(mech_impulse_mechanism_delassus(tree, &bob, 1, two, 2, NULL, 6, frames, &rank),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_mechanism_delassus(tree, &bob, 1, two, 2, w, 6, NULL, &rank),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_impulse_mechanism_delassus(tree, &bob, 1, two, 2, w, 6, frames, NULL),
+                 MECH_STATUS_NULL_POINTER);
+    CHECK(mech_untouched(w, sizeof w));
+    mech_tree_destroy(tree);
+
+    /* A tree that is not finalized. */
+    mech_tree_t *open = NULL;
+    CHECK_STATUS(mech_tree_create(&open), MECH_STATUS_OK);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(open, &bob, 1, &wall, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    mech_tree_destroy(open);
+}
+
 int main(void) {
     test_points();
     test_bodies();
     test_contacts();
+    test_mechanisms();
     return CHECK_DONE();
 }

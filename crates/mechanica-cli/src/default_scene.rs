@@ -1,65 +1,41 @@
-//! The built-in default scene: a small tour that exercises each capability crate once.
-//! It grows as capabilities land.
+//! The built-in default scene: the example scenes a spring-loaded pendulum chain (mass
+//! properties, equilibrium, stability, modes, free response, an impact) and a bead on a
+//! rotating hoop (a relative equilibrium in a rotating frame), run through the same pipeline
+//! as any scene file and merged into one report.
 
-use crate::report::{Quantity, Report, timed_step};
-use mechanica::impulse::point::collide_collinear;
-use mechanica::kinematics::nalgebra::{Rotation3, Vector3};
-use mechanica::kinematics::rotation::{angular_velocity_from_rate, skew};
-use mechanica::mass::MassProperties;
+use crate::report::Report;
+use crate::scene::Scene;
+use std::path::Path;
 
-fn q(name: &str, values: Vec<f64>, unit: &str, accuracy: Option<String>) -> Quantity {
-    Quantity {
-        name: name.into(),
-        values,
-        unit: unit.into(),
-        accuracy,
-    }
-}
+/// The built-in scenes, (label, text).
+const SCENES: [(&str, &str); 2] = [
+    (
+        "built-in:spring_pendulum_chain.toml",
+        include_str!("../../../examples/scenes/spring_pendulum_chain.toml"),
+    ),
+    (
+        "built-in:rotating_hoop.toml",
+        include_str!("../../../examples/scenes/rotating_hoop.toml"),
+    ),
+];
 
-/// Runs the default scene and returns its report.
-pub fn run() -> Result<Report, String> {
+/// Runs the default scene and returns its report; with `plot_dir`, each part writes its plots
+/// into its own subdirectory.
+pub fn run(plot_dir: Option<&Path>) -> Result<Report, String> {
     let mut steps = Vec::new();
-
-    steps.push(timed_step("kinematics: spin about a tilted axis", || {
-        let w = Vector3::new(0.0, 0.6, 0.8) * 2.0;
-        let r = Rotation3::from_scaled_axis(Vector3::new(0.3, -0.2, 0.5));
-        let r_dot = skew(&w) * r.matrix();
-        let omega = angular_velocity_from_rate(&r, &r_dot).map_err(|e| e.to_string())?;
-        let error = (omega - w).norm() / w.norm();
-        Ok::<_, String>(vec![q(
-            "ω from Ω = Ṙ Rᵀ (2.7–2.12)",
-            omega.iter().copied().collect(),
-            "rad/s",
-            Some(format!("relative error vs. prescribed ω: {error:.1e}")),
-        )])
-    })?);
-
-    steps.push(timed_step("mass properties: point mass, Steiner", || {
-        let m = MassProperties::point(2.0, Vector3::new(0.0, 0.0, 1.5)).map_err(|e| e.to_string())?;
-        let j = m.inertia_about(&Vector3::zeros());
-        Ok::<_, String>(vec![q(
-            "J about origin, diagonal (3.27–3.29)",
-            vec![j[(0, 0)], j[(1, 1)], j[(2, 2)]],
-            "kg·m²",
-            None,
-        )])
-    })?);
-
-    steps.push(timed_step("impulse: billiard balls, λ = 0.9", || {
-        let out = collide_collinear(0.17, 2.0, 0.17, 0.0, 0.9).map_err(|e| e.to_string())?;
-        Ok::<_, String>(vec![
-            q(
-                "velocities after impact (5.21–5.22)",
-                vec![out.v1_after, out.v2_after],
-                "m/s",
-                None,
-            ),
-            q("energy change (5.23)", vec![out.energy_change], "J", None),
-        ])
-    })?);
-
+    for (label, text) in SCENES {
+        let path = Path::new(label);
+        let scene = Scene::parse(text, path).map_err(|e| e.to_string())?;
+        let name = label.trim_start_matches("built-in:").trim_end_matches(".toml");
+        let dir = plot_dir.map(|d| d.join(name));
+        let report = crate::scene_run::run(&scene, path, dir.as_deref())?;
+        for mut step in report.steps {
+            step.analysis = format!("[{}] {}", scene.title, step.analysis);
+            steps.push(step);
+        }
+    }
     Ok(Report {
-        title: "built-in default scene".into(),
+        title: "default scene: spring-loaded pendulum chain and a bead on a rotating hoop".into(),
         version: mechanica::version().into(),
         steps,
     })

@@ -3,6 +3,9 @@
 
 mod default_scene;
 mod mass_command;
+mod mechanism_run;
+mod plots;
+mod progress;
 mod report;
 mod scene;
 mod scene_run;
@@ -17,6 +20,9 @@ struct Cli {
     /// Print the machine-readable JSON report instead of the text report.
     #[arg(long, global = true)]
     json: bool,
+    /// Write SVG plots (spectrum, mode shapes, free response, impact energy) into this directory.
+    #[arg(long, global = true, value_name = "DIR")]
+    plot: Option<std::path::PathBuf>,
     #[command(subcommand)]
     command: Option<Command>,
 }
@@ -39,10 +45,10 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let report = match cli.command.unwrap_or(Command::Run { scene: None }) {
-        Command::Run { scene: None } => default_scene::run(),
+        Command::Run { scene: None } => default_scene::run(cli.plot.as_deref()),
         Command::Run { scene: Some(path) } => scene::Scene::load(&path)
             .map_err(|e| e.to_string())
-            .and_then(|scene| scene_run::run(&scene, &path)),
+            .and_then(|scene| scene_run::run(&scene, &path, cli.plot.as_deref())),
         Command::Mass(args) => mass_command::run(&args),
         Command::Version => report::version_report(),
     };

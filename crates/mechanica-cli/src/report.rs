@@ -26,6 +26,9 @@ pub struct Step {
     pub seconds: f64,
     /// What it produced.
     pub quantities: Vec<Quantity>,
+    /// Verdicts and remarks (e.g. "stable"), in words.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// A whole report.
@@ -54,6 +57,9 @@ impl Report {
                 }
                 let _ = writeln!(out);
             }
+            for note in &step.notes {
+                let _ = writeln!(out, "  → {note}");
+            }
         }
         out
     }
@@ -67,6 +73,7 @@ pub fn timed_step<E>(analysis: &str, body: impl FnOnce() -> Result<Vec<Quantity>
         analysis: analysis.to_string(),
         seconds: start.elapsed().as_secs_f64(),
         quantities,
+        notes: Vec::new(),
     })
 }
 
@@ -79,6 +86,7 @@ pub fn version_report() -> Result<Report, String> {
         steps: vec![Step {
             analysis: "library".into(),
             seconds: 0.0,
+            notes: Vec::new(),
             quantities: vec![
                 Quantity {
                     name: "C ABI version".into(),

@@ -22,9 +22,37 @@
 //! axis = [0.0, 1.0, 0.0]               # revolute / prismatic / planar normal, parent frame
 //! origin = [0.0, 0.0, 0.0]             # joint frame origin in the parent frame, m
 //! q0 = [0.1]                           # initial coordinates (length = joint's q size)
+//! qd0 = [0.0]                          # initial velocities; optional (default 0)
+//! limits = [-1.5, 1.5]                 # 1-coordinate joints: limits for equilibrium searches
+//!
+//! rotating_frame = { axis = [0.0, 0.0, 1.0], rate = 3.0 }   # optional (§8e), put before tables
+//!
+//! [[joint_spring]]                     # U = ½ k (q − rest)², on one coordinate of a joint
+//! joint = "shoulder"
+//! stiffness = 20.0                     # N·m/rad or N/m
+//! rest = 0.0                           # optional (default 0)
+//! coordinate = 0                       # optional: index within the joint (default 0)
+//!
+//! [[spring]]                           # U = ½ k (|x_a − x_b| − rest_length)²
+//! a = "lower"                          # body name or "ground"
+//! a_point = [0.0, 0.0, -1.0]           # body coordinates (world for the ground)
+//! b = "ground"
+//! b_point = [0.5, 0.0, -2.0]
+//! stiffness = 50.0                     # N/m
+//! rest_length = 0.0                    # optional (default 0)
+//!
+//! [[force]]                            # a constant world force at a body point: U = −F·x
+//! body = "lower"
+//! point = [0.0, 0.0, -1.0]
+//! force = [1.0, 0.0, 0.0]
 //!
 //! [analyses]                           # only what is listed is computed
 //! mass_properties = true
+//! equilibrium = { seek = "minimum" }   # or "stationary"; optional starts = [[...], ...]
+//! modes = { lowest = 4 }               # optional lowest = k; at the equilibrium if one is asked
+//! response = { duration = 5.0, samples = 200, dq0 = [0.1, 0.0] }   # free response (8.91)
+//! impact = { body = "lower", point = [0.0, 0.0, -1.0], normal = [0.0, 0.0, 1.0],
+//!            friction = 0.3, restitution = 0.5, law = "stronge" }  # at q0 with qd0
 //! ```
 //!
 //! `inertia` lists the six independent entries (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) about the centre
@@ -51,9 +79,80 @@ pub struct Scene {
     /// The joints connecting them.
     #[serde(default, rename = "joint")]
     pub joints: Vec<JointSpec>,
+    /// A steadily rotating base frame (§8e); everything is then relative to that frame.
+    pub rotating_frame: Option<RotatingFrameSpec>,
+    /// Springs on joint coordinates.
+    #[serde(default, rename = "joint_spring")]
+    pub joint_springs: Vec<JointSpringSpec>,
+    /// Springs between body points or a body point and the ground.
+    #[serde(default, rename = "spring")]
+    pub springs: Vec<SpringSpec>,
+    /// Constant forces at body points.
+    #[serde(default, rename = "force")]
+    pub forces: Vec<ForceSpec>,
     /// The analyses requested; nothing else is computed.
     #[serde(default)]
     pub analyses: Analyses,
+}
+
+/// The base frame turning at a constant rate about a fixed axis through its origin.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotatingFrameSpec {
+    /// Unit axis (world = base frame).
+    pub axis: Spanned<[f64; 3]>,
+    /// Rate, rad/s.
+    pub rate: f64,
+}
+
+/// A spring on one coordinate of a joint.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpringSpec {
+    /// The joint's name.
+    pub joint: Spanned<String>,
+    /// Stiffness, N·m/rad or N/m.
+    pub stiffness: f64,
+    /// Rest value of the coordinate.
+    #[serde(default)]
+    pub rest: f64,
+    /// Index of the coordinate within the joint.
+    #[serde(default)]
+    pub coordinate: usize,
+}
+
+/// A spring between two points.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringSpec {
+    /// First end: a body name or "ground".
+    pub a: Spanned<String>,
+    /// First end's point, body coordinates (world for the ground), m.
+    #[serde(default)]
+    pub a_point: [f64; 3],
+    /// Second end: a body name or "ground".
+    pub b: Spanned<String>,
+    /// Second end's point, m.
+    #[serde(default)]
+    pub b_point: [f64; 3],
+    /// Stiffness, N/m.
+    pub stiffness: f64,
+    /// Rest length, m.
+    #[serde(default)]
+    pub rest_length: f64,
+}
+
+/// A constant world force at a body point.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceSpec {
+    /// The body's name.
+    pub body: Spanned<String>,
+    /// Point of application, body coordinates, m.
+    #[serde(default)]
+    pub point: [f64; 3],
+    /// The force, world components, N.
+    pub force: [f64; 3],
 }
 
 /// One body and the source of its mass properties.
@@ -135,6 +234,10 @@ pub struct JointSpec {
     pub origin: [f64; 3],
     /// Initial generalized coordinates.
     pub q0: Option<Spanned<Vec<f64>>>,
+    /// Initial generalized velocities.
+    pub qd0: Option<Spanned<Vec<f64>>>,
+    /// Limits [lower, upper] of a one-coordinate joint, for equilibrium searches.
+    pub limits: Option<Spanned<[f64; 2]>>,
 }
 
 /// The joint types of a kinematic tree.
@@ -162,6 +265,74 @@ pub struct Analyses {
     /// Mass properties of every body and of the whole mechanism.
     #[serde(default)]
     pub mass_properties: bool,
+    /// An equilibrium search from q0 (and optional further starts), with its stability.
+    pub equilibrium: Option<EquilibriumSpec>,
+    /// Small-oscillation modes, at the equilibrium when one is searched, else at q0.
+    pub modes: Option<ModesSpec>,
+    /// The free response from a disturbed equilibrium (8.91); needs `modes`.
+    pub response: Option<ResponseSpec>,
+    /// One impact of a body point against the ground, at (q0, qd0).
+    pub impact: Option<ImpactSpec>,
+}
+
+/// Equilibrium search options.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EquilibriumSpec {
+    /// "minimum" (default: a stable equilibrium) or "stationary" (any).
+    pub seek: Option<Spanned<String>>,
+    /// Further starting points (each of length dof).
+    #[serde(default)]
+    pub starts: Vec<Vec<f64>>,
+    /// Iteration limit.
+    pub max_iterations: Option<usize>,
+}
+
+/// Mode options.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModesSpec {
+    /// Only the k lowest modes.
+    pub lowest: Option<usize>,
+}
+
+/// Free-response options.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ResponseSpec {
+    /// Time span, s.
+    pub duration: f64,
+    /// Number of samples.
+    #[serde(default = "default_samples")]
+    pub samples: usize,
+    /// Initial displacement from the equilibrium, per coordinate.
+    pub dq0: Option<Vec<f64>>,
+    /// Initial velocity, per coordinate.
+    pub v0: Option<Vec<f64>>,
+}
+
+fn default_samples() -> usize {
+    200
+}
+
+/// An impact of a body point against the ground.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImpactSpec {
+    /// The striking body's name.
+    pub body: Spanned<String>,
+    /// The contact point, body coordinates, m.
+    pub point: [f64; 3],
+    /// The ground's unit normal (pointing towards the body).
+    pub normal: [f64; 3],
+    /// Coulomb friction coefficient.
+    #[serde(default)]
+    pub friction: f64,
+    /// Restitution coefficient in [0, 1].
+    #[serde(default)]
+    pub restitution: f64,
+    /// "stronge" (default), "poisson" or "newton".
+    pub law: Option<Spanned<String>>,
 }
 
 /// A scene error, located in its file.
@@ -347,6 +518,74 @@ impl Scene {
                 }
                 at = parent_of[b];
             }
+        }
+        let body_or_ground = |name: &Spanned<String>, field: String| {
+            let n = name.get_ref().as_str();
+            if n == "ground" || index_of.contains_key(n) {
+                Ok(())
+            } else {
+                Err(error(Some(name.span()), field, format!("no body named \"{n}\"")))
+            }
+        };
+        let body_only = |name: &Spanned<String>, field: String| {
+            let n = name.get_ref().as_str();
+            if index_of.contains_key(n) {
+                Ok(())
+            } else {
+                Err(error(Some(name.span()), field, format!("no body named \"{n}\"")))
+            }
+        };
+        for (i, spring) in self.springs.iter().enumerate() {
+            body_or_ground(&spring.a, format!("spring[{i}].a"))?;
+            body_or_ground(&spring.b, format!("spring[{i}].b"))?;
+        }
+        for (i, force) in self.forces.iter().enumerate() {
+            body_only(&force.body, format!("force[{i}].body"))?;
+        }
+        if let Some(impact) = &self.analyses.impact {
+            body_only(&impact.body, "analyses.impact.body".into())?;
+        }
+        for (i, spring) in self.joint_springs.iter().enumerate() {
+            let name = spring.joint.get_ref();
+            if !self.joints.iter().any(|j| &j.name == name) {
+                return Err(error(
+                    Some(spring.joint.span()),
+                    format!("joint_spring[{i}].joint"),
+                    format!("no joint named \"{name}\""),
+                ));
+            }
+        }
+        if let Some(frame) = &self.rotating_frame {
+            let norm = frame.axis.get_ref().iter().map(|a| a * a).sum::<f64>().sqrt();
+            if !norm.is_finite() || (norm - 1.0).abs() > 1e-9 {
+                return Err(error(
+                    Some(frame.axis.span()),
+                    "rotating_frame.axis".into(),
+                    format!("axis must be a unit vector, |axis| = {norm}"),
+                ));
+            }
+        }
+        for (label, name) in [
+            ("analyses.equilibrium.seek", self.analyses.equilibrium.as_ref().and_then(|e| e.seek.as_ref())),
+            ("analyses.impact.law", self.analyses.impact.as_ref().and_then(|i| i.law.as_ref())),
+        ] {
+            let allowed: &[&str] = if label.ends_with("seek") {
+                &["minimum", "stationary"]
+            } else {
+                &["stronge", "poisson", "newton"]
+            };
+            if let Some(name) = name
+                && !allowed.contains(&name.get_ref().as_str())
+            {
+                return Err(error(
+                    Some(name.span()),
+                    label.into(),
+                    format!("\"{}\" is not one of {allowed:?}", name.get_ref()),
+                ));
+            }
+        }
+        if self.analyses.response.is_some() && self.analyses.modes.is_none() {
+            return Err(error(None, "analyses.response".into(), "the free response needs `modes`".into()));
         }
         Ok(())
     }

@@ -11,14 +11,20 @@ use std::path::Path;
 
 /// A scene turned into library objects: the tree, each body's mass properties in its own
 /// frame, and the initial coordinates.
-struct Model {
-    tree: KinematicTree,
-    bodies: Vec<MassProperties>,
-    q0: Vec<f64>,
+pub(crate) struct Model {
+    pub tree: KinematicTree,
+    pub bodies: Vec<MassProperties>,
+    pub q0: Vec<f64>,
+    pub qd0: Vec<f64>,
+    /// Per scene joint (by name): its body index.
+    pub joint_body: Vec<(String, usize)>,
+    /// Per coordinate: limits from the scene.
+    pub limits: Vec<Option<[f64; 2]>>,
 }
 
-/// Runs `scene` (loaded from `file`) and returns its report.
-pub fn run(scene: &Scene, file: &Path) -> Result<Report, String> {
+/// Runs `scene` (loaded from `file`) and returns its report; with `plot_dir`, also writes the
+/// SVG plots of what was computed there.
+pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report, String> {
     let mut steps: Vec<Step> = Vec::new();
     let mut model = None;
     steps.push(timed_step("build: bodies and kinematic tree", || {
@@ -35,6 +41,17 @@ pub fn run(scene: &Scene, file: &Path) -> Result<Report, String> {
         let gravity = scene.gravity.map(Vector3::from);
         steps.push(timed_step("mass properties at q0", || mass_report(&model, gravity))?);
     }
+    let mut plots = crate::plots::PlotData::default();
+    crate::mechanism_run::run(scene, &model, &mut steps, &mut plots)?;
+    if let Some(dir) = plot_dir {
+        let written = plots.write_all(dir)?;
+        steps.push(crate::report::Step {
+            analysis: "plots".into(),
+            seconds: 0.0,
+            quantities: Vec::new(),
+            notes: written.iter().map(|p| format!("wrote {}", p.display())).collect(),
+        });
+    }
     Ok(Report {
         title: scene.title.clone(),
         version: mechanica::version().into(),
@@ -42,7 +59,7 @@ pub fn run(scene: &Scene, file: &Path) -> Result<Report, String> {
     })
 }
 
-fn quantity(name: &str, values: Vec<f64>, unit: &str, accuracy: Option<String>) -> Quantity {
+pub(crate) fn quantity(name: &str, values: Vec<f64>, unit: &str, accuracy: Option<String>) -> Quantity {
     Quantity {
         name: name.into(),
         values,
@@ -112,7 +129,7 @@ fn joint_of(spec: &JointSpec) -> Joint {
     }
 }
 
-fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
+pub(crate) fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
     let bodies = scene
         .bodies
         .iter()
@@ -126,6 +143,9 @@ fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
     // The scene guarantees one joint per body; add bodies in scene order so indices agree.
     let mut builder = TreeBuilder::new();
     let mut q0 = Vec::new();
+    let mut qd0 = Vec::new();
+    let mut joint_body = Vec::new();
+    let mut limits = Vec::new();
     for (i, body) in scene.bodies.iter().enumerate() {
         let joint = scene
             .joints
@@ -153,10 +173,39 @@ fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
             Some(values) => q0.extend_from_slice(values.get_ref()),
             None => q0.extend(std::iter::repeat_n(0.0, lib_joint.dof())),
         }
+        match &joint.qd0 {
+            Some(values) if values.get_ref().len() != lib_joint.dof() => {
+                return Err(format!(
+                    "{}: joint \"{}\": qd0 has {} values, the joint has {}",
+                    file.display(),
+                    joint.name,
+                    values.get_ref().len(),
+                    lib_joint.dof()
+                ));
+            }
+            Some(values) => qd0.extend_from_slice(values.get_ref()),
+            None => qd0.extend(std::iter::repeat_n(0.0, lib_joint.dof())),
+        }
+        if joint.limits.is_some() && lib_joint.dof() != 1 {
+            return Err(format!(
+                "{}: joint \"{}\": limits apply to one-coordinate joints only",
+                file.display(),
+                joint.name
+            ));
+        }
+        limits.extend(std::iter::repeat_n(joint.limits.as_ref().map(|l| *l.get_ref()), lib_joint.dof()));
+        joint_body.push((joint.name.clone(), i));
     }
     // A tree with several bodies on the ground would have several roots; the tree needs one.
     let tree = builder.build().map_err(|e| format!("{}: {e}", file.display()))?;
-    Ok(Model { tree, bodies, q0 })
+    Ok(Model {
+        tree,
+        bodies,
+        q0,
+        qd0,
+        joint_body,
+        limits,
+    })
 }
 
 /// Total mass properties in the world frame at q0, and the gravitational potential
@@ -208,7 +257,7 @@ mod tests {
     use super::*;
 
     fn pendulum_at(q0: [f64; 2]) -> Model {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/double_pendulum.toml");
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/double_pendulum.toml");
         let text = std::fs::read_to_string(&path).expect("scene file");
         let text = text
             .replace(

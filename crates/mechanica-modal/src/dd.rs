@@ -88,6 +88,23 @@ pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     acc
 }
 
+/// M x in double-double for a sparse M (compressed columns).
+pub(crate) fn sparse_mat_vec(m: faer::sparse::SparseColMatRef<'_, usize, f64>, x: &[f64]) -> Vec<Dd> {
+    let (symbolic, val) = m.parts();
+    let rows = symbolic.row_idx();
+    let mut acc = vec![Dd::default(); m.nrows()];
+    for (j, &xj) in x.iter().enumerate() {
+        for k in symbolic.col_range(j) {
+            let i = rows[k];
+            let (p, e) = two_prod(val[k], xj);
+            let (s, e2) = two_sum(acc[i].hi, p);
+            acc[i].hi = s;
+            acc[i].lo += e + e2;
+        }
+    }
+    acc
+}
+
 /// Σ_i x[i]·y[i] with y in double-double.
 pub(crate) fn dot(x: &[f64], y: &[Dd]) -> Dd {
     let mut acc = Dd::default();

@@ -439,7 +439,7 @@ pub fn classify(omega_sq: f64, bound: f64) -> ModeKind {
 
 /// Groups consecutive modes whose ω² differ by at most the sum of their bounds, and stores
 /// each mode's group index.
-fn group_modes(modes: &mut [Mode]) -> Vec<ModeGroup> {
+pub(crate) fn group_modes(modes: &mut [Mode]) -> Vec<ModeGroup> {
     let mut groups: Vec<ModeGroup> = Vec::new();
     for i in 0..modes.len() {
         let joins = i > 0 && {

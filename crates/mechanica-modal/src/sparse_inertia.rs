@@ -23,7 +23,7 @@ use faer::{Par, Side};
 pub struct SparseInertia {
     /// The counts (as for the dense [`crate::count_below`]).
     pub count: InertiaCount,
-    /// Smallest |eigenvalue| over the 1×1 and 2×2 pivot blocks.
+    /// Smallest |eigenvalue| over the 1×1 and 2×2 pivot blocks (0 when not known: dense path).
     pub min_pivot: f64,
     /// Largest |eigenvalue| over the pivot blocks (growth shows as max_pivot ≫ ‖B − sA‖).
     pub max_pivot: f64,

@@ -4,22 +4,39 @@
 //! Bodies cross the boundary as plain data in *inverse* form ([`mech_impulse_body_t`]):
 //! inverse mass and inverse central inertia in world axes, so an infinite mass or a locked
 //! axis is a zero, plus an optional hinge. All vectors are in the world frame W.
+//!
+//! Mechanisms (part 5, 7.115–7.117) act through the kinematic tree handle at the state set by
+//! mech_tree_set_state, with one ::mech_mass_properties_t per body (body frame).
 
 use super::boundary::{FfiError, boundary};
+use super::kinematics::{built, mech_tree_t, tree_mut};
 use super::mass::mech_mass_properties_t;
 use super::status::*;
 use super::types::*;
 use super::validate::*;
 use mechanica_impulse::point::{collide_collinear, collide_points, impulse_on_point};
 use mechanica_impulse::{
-    ContactLaw, ContactMode, ImpactOptions, ImpulseError, RestitutionLaw, RigidBody, fix_point, resolve_contact,
+    BodyPoint, ContactLaw, ContactMode, ContactSpace, ImpactModel, ImpactOptions, ImpulseError, MechanismContact,
+    MechanismInertia, MultiContactOptions, PointImpulse, RestitutionLaw, RigidBody, apply_point_impulses, fix_point,
+    resolve_contact, resolve_contacts,
 };
+use mechanica_kinematics::tree::{KinematicTree, Workspace};
+use mechanica_mass::mechanism::TreeMass;
 use mechanica_kinematics::nalgebra::{Matrix3, Vector3};
 use mechanica_mass::MassProperties;
 
 impl From<ImpulseError> for FfiError {
     fn from(error: ImpulseError) -> Self {
         let status = match error {
+            ImpulseError::InContact { contact, source } => {
+                let inner = FfiError::from(*source);
+                return FfiError::new(inner.status, format!("contact {contact}: {}", inner.message));
+            }
+            ImpulseError::Kinematics(e) => return FfiError::from(e),
+            ImpulseError::Mass(e) => return FfiError::from(e),
+            ImpulseError::SingularMassMatrix { .. } => MECH_STATUS_NOT_POSITIVE_DEFINITE,
+            ImpulseError::BodyOutOfRange { .. } => MECH_STATUS_INVALID_ARGUMENT,
+            ImpulseError::ContactImmovable { .. } => MECH_STATUS_SINGULAR,
             ImpulseError::NonFinite { .. } => MECH_STATUS_NON_FINITE,
             ImpulseError::NonPositiveMass { .. }
             | ImpulseError::NegativeInverseMass { .. }
@@ -536,6 +553,403 @@ pub unsafe extern "C" fn mech_impulse_resolve_contact(
         };
         // SAFETY: caller's contract.
         unsafe { out.write(value) };
+        Ok(())
+    })
+}
+
+/// The body mass properties of a tree from C (one per body, each in its body frame), checked
+/// for finite numbers, and the factored mass matrix A(q) at the tree's current configuration.
+///
+/// # Safety
+/// `bodies` must point to `body_count` readable values (or be NULL with body_count = 0).
+unsafe fn tree_inertia(
+    tree: &KinematicTree,
+    ws: &Workspace,
+    bodies: *const mech_mass_properties_t,
+    body_count: usize,
+) -> Result<MechanismInertia, FfiError> {
+    // SAFETY: caller's contract.
+    let raw = unsafe { read_slice(bodies, body_count, "bodies") }?;
+    let mut props = Vec::with_capacity(raw.len());
+    for (i, b) in raw.iter().enumerate() {
+        finite(&b.mass, &format!("bodies[{i}].mass"))?;
+        finite(&b.center_of_mass, &format!("bodies[{i}].center_of_mass"))?;
+        finite(&b.inertia_about_com, &format!("bodies[{i}].inertia_about_com"))?;
+        props.push(MassProperties {
+            mass: b.mass,
+            p_oc: b.center_of_mass.into(),
+            inertia_c: Matrix3::from(b.inertia_about_com),
+        });
+    }
+    let mut mass = TreeMass::new(tree, props)?;
+    Ok(MechanismInertia::new(tree, ws, &mut mass)?)
+}
+
+/// Checks that a caller's dof argument matches the tree.
+fn check_dof(tree: &KinematicTree, dof: usize, what: &str) -> Result<(), FfiError> {
+    if dof != tree.dof() {
+        return Err(FfiError::new(
+            MECH_STATUS_BAD_DIMENSION,
+            format!("{what}: dof is {dof}, the tree has {} coordinates", tree.dof()),
+        ));
+    }
+    Ok(())
+}
+
+/// A point impulse on a body of a mechanism.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_mechanism_impulse_t {
+    /// Index of the struck body in the tree.
+    pub body: usize,
+    /// The struck point in the body frame B (m).
+    pub point: mech_vec3_t,
+    /// The impulse S, world frame (N·s).
+    pub impulse: mech_vec3_t,
+}
+
+/// The response of a mechanism to point impulses (7.115–7.117).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_mechanism_response_t {
+    /// Kinetic energy before, ½ q̇ᵀ A q̇ (J).
+    pub energy_before: f64,
+    /// ΔT = Q_S·(q̇ + ½ Δq̇) (J).
+    pub energy_change: f64,
+    /// Normwise backward error of the solve A Δq̇ = Q_S.
+    pub backward_error: f64,
+}
+
+/// Lagrange's impulse equations A(q) Δq̇ = Σ J_kᵀ S_k (7.115–7.117) for the tree at the state
+/// of mech_tree_set_state, with `bodies` = one mass-properties value per body (body frame;
+/// mass ≥ 0). Writes Δq̇ (`dof` doubles) and the energy report. MECH_STATUS_NOT_POSITIVE_DEFINITE
+/// when A is singular (a rod or point mass whose spin has a coordinate, a massless leaf);
+/// MECH_STATUS_INVALID_ARGUMENT for a body index out of range; MECH_STATUS_BAD_DIMENSION for a
+/// wrong `body_count` or `dof`.
+///
+/// # Safety
+/// `tree` must be a live handle; `bodies` must point to `body_count` readable values,
+/// `impulses` to `impulse_count` readable values (NULL allowed when the count is 0),
+/// `delta_q_dot` to `dof` writable doubles, `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_impulse_mechanism_apply(
+    tree: *mut mech_tree_t,
+    bodies: *const mech_mass_properties_t,
+    body_count: usize,
+    impulses: *const mech_mechanism_impulse_t,
+    impulse_count: usize,
+    delta_q_dot: *mut f64,
+    dof: usize,
+    out: *mut mech_mechanism_response_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let t = unsafe { tree_mut(tree) }?;
+        // SAFETY: caller's contract.
+        let raw = unsafe { read_slice(impulses, impulse_count, "impulses") }?;
+        let out = Out::new(out, "out")?;
+        let (kt, ws) = built(t)?;
+        check_dof(kt, dof, "delta_q_dot")?;
+        let dest = OutSlice::new(delta_q_dot, dof, "delta_q_dot")?;
+        let mut list = Vec::with_capacity(raw.len());
+        for (i, s) in raw.iter().enumerate() {
+            finite(&s.point, &format!("impulses[{i}].point"))?;
+            finite(&s.impulse, &format!("impulses[{i}].impulse"))?;
+            list.push(PointImpulse {
+                point: BodyPoint {
+                    body: s.body,
+                    p_bq: s.point.into(),
+                },
+                s_w: s.impulse.into(),
+            });
+        }
+        // SAFETY: caller's contract.
+        let inertia = unsafe { tree_inertia(kt, ws, bodies, body_count) }?;
+        let q_dot = ws.q_dot().to_vec();
+        let r = apply_point_impulses(kt, ws, &inertia, &q_dot, &list)?;
+        let value = mech_mechanism_response_t {
+            energy_before: r.energy_before,
+            energy_change: r.energy_change,
+            backward_error: r.backward_error,
+        };
+        // SAFETY: caller's contract.
+        unsafe {
+            dest.write(&r.delta_q_dot);
+            out.write(value);
+        }
+        Ok(())
+    })
+}
+
+/// A contact of a mechanism with the environment or between two of its bodies.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_mechanism_contact_t {
+    /// Index of the body that receives the impulse +P.
+    pub body: usize,
+    /// The contact point on `body`, body frame (m).
+    pub point: mech_vec3_t,
+    /// Index of the other body (receives −P), or −1 for the static environment.
+    pub other_body: i64,
+    /// The contact point on the other body, its body frame (m); ignored for the environment.
+    pub other_point: mech_vec3_t,
+    /// Unit normal (world) from the environment / other body into `body` (|n| = 1 within 1e-9).
+    pub normal: mech_vec3_t,
+    /// Coefficient of restitution e ∈ [0, 1].
+    pub restitution: f64,
+    /// Coulomb friction coefficient f ≥ 0 (+INFINITY: no slip).
+    pub friction: f64,
+    /// A MECH_RESTITUTION_* value (used when a single contact is resolved; several contacts use
+    /// Poisson's rule, see mech_impulse_mechanism_contacts).
+    pub law: mech_restitution_law_t,
+}
+
+/// Accuracy and budget of a mechanism impact; pass NULL for the defaults.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_multi_contact_options_t {
+    /// Relative complementarity tolerance of the simultaneous model (> 0; default 1e-10).
+    pub tolerance: f64,
+    /// Maximum Gauss–Seidel sweeps per phase (≥ 1; default 10000).
+    pub max_iterations: u64,
+    /// Relative tolerance of the single-contact process (> 0; default 1e-10).
+    pub process_tolerance: f64,
+}
+
+/// The outcome at one contact of a mechanism impact (world frame).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_mechanism_contact_result_t {
+    /// Total impulse P on `body` (the other body receives −P) (N·s).
+    pub impulse: mech_vec3_t,
+    /// Normal impulse P·n ≥ 0 (N·s).
+    pub normal_impulse: f64,
+    /// Tangential (friction) impulse (N·s).
+    pub tangential_impulse: mech_vec3_t,
+    /// Normal impulse at the end of compression (N·s).
+    pub compression_impulse: f64,
+    /// Relative velocity of the contact before the impact (m/s).
+    pub relative_velocity_before: mech_vec3_t,
+    /// Relative velocity after the impact, u⁻ + Σ W P (m/s).
+    pub relative_velocity_after: mech_vec3_t,
+    /// A MECH_CONTACT_* value.
+    pub mode: mech_contact_mode_t,
+}
+
+/// The report of a mechanism impact.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_mechanism_impact_t {
+    /// Kinetic energy before, ½ q̇ᵀ A q̇ (J).
+    pub energy_before: f64,
+    /// ΔT = P·(u⁻ + ½ W P) (J); never positive for several contacts (energy guard).
+    pub energy_change: f64,
+    /// Largest complementarity residual over contacts (m/s); 0 for the single-contact process.
+    pub complementarity_residual: f64,
+    /// Impulse error of the single-contact process (N·s); 0 for several contacts.
+    pub integration_error: f64,
+    /// Factor applied to the restitution impulses by the energy guard (1: untouched).
+    pub restitution_scale: f64,
+    /// Gauss–Seidel sweeps (several contacts) or process steps (one contact).
+    pub iterations: u64,
+    /// Numerical rank of the 3m × 3m Delassus matrix W.
+    pub delassus_rank: u64,
+    /// 1 when the residual met the tolerance, 0 when the sweep budget ran out.
+    pub converged: i32,
+    /// 1 when the simultaneous multi-contact model was used, 0 for the single-contact process.
+    pub simultaneous: i32,
+}
+
+/// Reads and validates C contacts.
+fn contacts_from_c(raw: &[mech_mechanism_contact_t]) -> Result<Vec<MechanismContact>, FfiError> {
+    let mut list = Vec::with_capacity(raw.len());
+    for (i, c) in raw.iter().enumerate() {
+        finite(&c.point, &format!("contacts[{i}].point"))?;
+        finite(&c.other_point, &format!("contacts[{i}].other_point"))?;
+        finite(&c.normal, &format!("contacts[{i}].normal"))?;
+        finite(&c.restitution, &format!("contacts[{i}].restitution"))?;
+        let law = enum_value::<RestitutionLaw>(c.law, &format!("contacts[{i}].law"))?;
+        let law = ContactLaw::new(c.restitution, c.friction, law).map_err(|e| {
+            FfiError::from(ImpulseError::InContact {
+                contact: i,
+                source: Box::new(e),
+            })
+        })?;
+        let other = match c.other_body {
+            -1 => None,
+            b if b >= 0 => Some(BodyPoint {
+                body: b as usize,
+                p_bq: c.other_point.into(),
+            }),
+            b => {
+                return Err(FfiError::new(
+                    MECH_STATUS_INVALID_ARGUMENT,
+                    format!("contacts[{i}].other_body must be a body index or -1, got {b}"),
+                ));
+            }
+        };
+        list.push(MechanismContact {
+            point: BodyPoint {
+                body: c.body,
+                p_bq: c.point.into(),
+            },
+            other,
+            normal_w: c.normal.into(),
+            law,
+        });
+    }
+    Ok(list)
+}
+
+/// Resolves an impact of the mechanism `tree` (at the state of mech_tree_set_state; `bodies`
+/// one mass-properties value per body) at `contact_count` contacts. One contact: the
+/// impulse-parameterised process with the contact's restitution law (as
+/// mech_impulse_resolve_contact, on W = J A⁻¹ Jᵀ). Several contacts: the simultaneous
+/// two-phase model (inelastic Signorini–Coulomb compression, then Poisson restitution with
+/// friction, energy-guarded so that ΔT ≤ 0) solved by projected block Gauss–Seidel from zero
+/// in contact order; see the Rust docs of mechanica_impulse::multi_contact. `options` may be
+/// NULL for the defaults. Writes one result per contact, Δq̇ (`dof` doubles) and the report.
+/// MECH_STATUS_SINGULAR when an approaching contact cannot move along its normal;
+/// MECH_STATUS_NOT_POSITIVE_DEFINITE for a singular mass matrix; MECH_STATUS_NOT_CONVERGED for
+/// a frictional jam of the single-contact process (an unconverged simultaneous solve is
+/// reported by `converged` = 0, not an error).
+///
+/// # Safety
+/// `tree` must be a live handle; `bodies` must point to `body_count` readable values,
+/// `contacts` to `contact_count` readable values, `options` be NULL or readable, `results` point
+/// to `contact_count` writable values, `delta_q_dot` to `dof` writable doubles, `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_impulse_mechanism_contacts(
+    tree: *mut mech_tree_t,
+    bodies: *const mech_mass_properties_t,
+    body_count: usize,
+    contacts: *const mech_mechanism_contact_t,
+    contact_count: usize,
+    options: *const mech_multi_contact_options_t,
+    results: *mut mech_mechanism_contact_result_t,
+    delta_q_dot: *mut f64,
+    dof: usize,
+    out: *mut mech_mechanism_impact_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let t = unsafe { tree_mut(tree) }?;
+        // SAFETY: caller's contract.
+        let raw = unsafe { read_slice(contacts, contact_count, "contacts") }?;
+        let mut opts = MultiContactOptions::default();
+        if !options.is_null() {
+            // SAFETY: caller's contract.
+            let o = unsafe { read(options, "options") }?;
+            finite(&o.tolerance, "options.tolerance")?;
+            finite(&o.process_tolerance, "options.process_tolerance")?;
+            if o.tolerance <= 0.0 || o.process_tolerance <= 0.0 || o.max_iterations == 0 {
+                return Err(FfiError::new(
+                    MECH_STATUS_INVALID_ARGUMENT,
+                    "options: tolerances must be positive and max_iterations at least 1",
+                ));
+            }
+            opts.tolerance = o.tolerance;
+            opts.max_iterations = usize::try_from(o.max_iterations).unwrap_or(usize::MAX);
+            opts.process.tolerance = o.process_tolerance;
+        }
+        let out = Out::new(out, "out")?;
+        let results = OutSlice::new(results, contact_count, "results")?;
+        let (kt, ws) = built(t)?;
+        check_dof(kt, dof, "delta_q_dot")?;
+        let dest = OutSlice::new(delta_q_dot, dof, "delta_q_dot")?;
+        let list = contacts_from_c(raw)?;
+        // SAFETY: caller's contract.
+        let inertia = unsafe { tree_inertia(kt, ws, bodies, body_count) }?;
+        let q_dot = ws.q_dot().to_vec();
+        let r = resolve_contacts(kt, ws, &inertia, &q_dot, &list, &opts)?;
+        let per_contact: Vec<mech_mechanism_contact_result_t> = r
+            .contacts
+            .iter()
+            .map(|c| mech_mechanism_contact_result_t {
+                impulse: c.impulse_w.into(),
+                normal_impulse: c.normal_impulse,
+                tangential_impulse: c.tangential_impulse_w.into(),
+                compression_impulse: c.compression_impulse,
+                relative_velocity_before: c.u_before_w.into(),
+                relative_velocity_after: c.u_after_w.into(),
+                mode: mode_to_c(c.mode),
+            })
+            .collect();
+        let value = mech_mechanism_impact_t {
+            energy_before: r.energy_before,
+            energy_change: r.energy_change,
+            complementarity_residual: r.complementarity_residual,
+            integration_error: r.integration_error,
+            restitution_scale: r.restitution_scale,
+            iterations: r.iterations as u64,
+            delassus_rank: r.delassus_rank as u64,
+            converged: i32::from(r.converged),
+            simultaneous: i32::from(r.model == ImpactModel::Simultaneous),
+        };
+        // SAFETY: caller's contract.
+        unsafe {
+            results.write(&per_contact);
+            dest.write(&r.delta_q_dot);
+            out.write(value);
+        }
+        Ok(())
+    })
+}
+
+/// The contact-space (Delassus) matrix W = J A⁻¹ Jᵀ of `contact_count` contacts of the
+/// mechanism at the state of mech_tree_set_state, into `delassus` (column-major, `rows` × `rows`
+/// with rows = 3·contact_count; rows 3i, 3i+1, 3i+2 are the tangents t₁, t₂ and the normal of
+/// contact i), its numerical rank into `rank_out`, and the contact frames (columns t₁, t₂, n;
+/// world) into `frames` (`contact_count` matrices). The restitution and friction of the contacts
+/// are validated but not used.
+///
+/// # Safety
+/// `tree` must be a live handle; `bodies` must point to `body_count` readable values,
+/// `contacts` to `contact_count` readable values, `delassus` to rows² writable doubles,
+/// `frames` to `contact_count` writable matrices, `rank_out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_impulse_mechanism_delassus(
+    tree: *mut mech_tree_t,
+    bodies: *const mech_mass_properties_t,
+    body_count: usize,
+    contacts: *const mech_mechanism_contact_t,
+    contact_count: usize,
+    delassus: *mut f64,
+    rows: usize,
+    frames: *mut mech_mat3_t,
+    rank_out: *mut usize,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let t = unsafe { tree_mut(tree) }?;
+        // SAFETY: caller's contract.
+        let raw = unsafe { read_slice(contacts, contact_count, "contacts") }?;
+        let expected = 3 * contact_count;
+        if rows != expected {
+            return Err(FfiError::new(
+                MECH_STATUS_BAD_DIMENSION,
+                format!("rows must be 3·contact_count = {expected}, got {rows}"),
+            ));
+        }
+        let size = square_len(rows, "delassus")?;
+        let dest = OutSlice::new(delassus, size, "delassus")?;
+        let frames_out = OutSlice::new(frames, contact_count, "frames")?;
+        let rank_out = Out::new(rank_out, "rank_out")?;
+        let (kt, ws) = built(t)?;
+        let list = contacts_from_c(raw)?;
+        // SAFETY: caller's contract.
+        let inertia = unsafe { tree_inertia(kt, ws, bodies, body_count) }?;
+        let q_dot = ws.q_dot().to_vec();
+        let space = ContactSpace::new(kt, ws, &inertia, &q_dot, &list)?;
+        let frame_values: Vec<mech_mat3_t> = (0..contact_count)
+            .map(|i| space.frame(i).copied().unwrap_or_else(Matrix3::identity).into())
+            .collect();
+        // SAFETY: caller's contract.
+        unsafe {
+            dest.write(space.delassus());
+            frames_out.write(&frame_values);
+            rank_out.write(space.rank());
+        }
         Ok(())
     })
 }

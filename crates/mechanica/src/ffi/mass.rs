@@ -29,7 +29,7 @@ impl From<MassError> for FfiError {
     fn from(error: MassError) -> Self {
         let status = match &error {
             MassError::NonFinite { .. } | MassError::NonFiniteVertex { .. } => MECH_STATUS_NON_FINITE,
-            MassError::TooManyVertices(_) | MassError::WrongLength { .. } => MECH_STATUS_BAD_DIMENSION,
+            MassError::TooManyVertices(_) | MassError::TooManyTriangles(_) | MassError::WrongLength { .. } => MECH_STATUS_BAD_DIMENSION,
             MassError::Kinematics(e) => return FfiError::from(e.clone()),
             MassError::Body { error: inner, .. } => FfiError::from((**inner).clone()).status,
             MassError::InvalidInertia(issues)

@@ -1,0 +1,340 @@
+//! The mechanism analyses of a scene (equilibrium, stability, modes, free response), run only
+//! when the scene asks for them.
+
+use crate::plots::{ModeShape, PlotData, ResponseSeries};
+use crate::report::{Step, timed_step};
+use crate::scene::Scene;
+use crate::scene_run::{Model, quantity};
+use mechanica::kinematics::nalgebra::{Unit, Vector3};
+use mechanica::mechanism::potentials::{ConstantForce, JointSpring, PointSpring};
+use mechanica::mechanism::{
+    Anchor, EquilibriumOptions, Mechanism, MechanismModes, RotatingFrame, Seek, Stability, find_equilibria,
+    find_equilibrium, mechanism_modes,
+};
+use mechanica::modal::response::FreeResponse;
+use mechanica::modal::{ModeKind, PencilProblem, Selection, SolveOptions};
+
+/// Builds the mechanism of a scene: tree, masses, gravity, rotating frame, springs, forces,
+/// limits.
+pub fn build_mechanism(scene: &Scene, model: &Model) -> Result<Mechanism, String> {
+    let text = |e: &dyn std::fmt::Display| e.to_string();
+    let mut mechanism = Mechanism::new(model.tree.clone(), model.bodies.clone()).map_err(|e| text(&e))?;
+    if let Some(g) = scene.gravity {
+        mechanism.set_gravity(Vector3::from(g)).map_err(|e| text(&e))?;
+    }
+    if let Some(frame) = &scene.rotating_frame {
+        mechanism
+            .set_rotating_frame(Some(RotatingFrame {
+                axis: Unit::new_normalize(Vector3::from(*frame.axis.get_ref())),
+                rate: frame.rate,
+            }))
+            .map_err(|e| format!("rotating_frame: {e}"))?;
+    }
+    let body_index = |name: &str| scene.bodies.iter().position(|b| b.name.get_ref() == name);
+    let anchor = |name: &str, point: [f64; 3]| Anchor {
+        body: if name == "ground" { None } else { body_index(name) },
+        point: Vector3::from(point),
+    };
+    for (i, spring) in scene.joint_springs.iter().enumerate() {
+        let body = model
+            .joint_body
+            .iter()
+            .find(|(n, _)| n == spring.joint.get_ref())
+            .map(|(_, b)| *b)
+            .ok_or_else(|| format!("joint_spring[{i}]: no joint \"{}\"", spring.joint.get_ref()))?;
+        let range = model.tree.dof_range(body);
+        if spring.coordinate >= range.len() {
+            return Err(format!(
+                "joint_spring[{i}].coordinate: the joint has {} coordinates, got index {}",
+                range.len(),
+                spring.coordinate
+            ));
+        }
+        mechanism
+            .add_potential(JointSpring {
+                coordinate: range.start + spring.coordinate,
+                stiffness: spring.stiffness,
+                rest: spring.rest,
+            })
+            .map_err(|e| format!("joint_spring[{i}]: {e}"))?;
+    }
+    for (i, spring) in scene.springs.iter().enumerate() {
+        mechanism
+            .add_potential(PointSpring {
+                a: anchor(spring.a.get_ref(), spring.a_point),
+                b: anchor(spring.b.get_ref(), spring.b_point),
+                stiffness: spring.stiffness,
+                rest_length: spring.rest_length,
+            })
+            .map_err(|e| format!("spring[{i}]: {e}"))?;
+    }
+    for (i, force) in scene.forces.iter().enumerate() {
+        let body = body_index(force.body.get_ref()).ok_or_else(|| format!("force[{i}]: unknown body"))?;
+        mechanism
+            .add_potential(ConstantForce {
+                body,
+                point: Vector3::from(force.point),
+                force: Vector3::from(force.force),
+            })
+            .map_err(|e| format!("force[{i}]: {e}"))?;
+    }
+    for (k, limit) in model.limits.iter().enumerate() {
+        if let Some([lower, upper]) = limit {
+            mechanism.set_limits(k, *lower, *upper).map_err(|e| text(&e))?;
+        }
+    }
+    Ok(mechanism)
+}
+
+fn stability_note(stability: &Stability) -> String {
+    match stability {
+        Stability::Stable => "stable: every mode oscillates (B positive definite relative to A)".into(),
+        Stability::Unstable {
+            directions,
+            max_growth_rate,
+        } => format!(
+            "unstable: {directions} unstable direction(s), fastest growth rate {max_growth_rate:.6e} 1/s"
+        ),
+        Stability::Marginal { zero_modes } => {
+            format!("marginal: {zero_modes} zero mode(s) within their error bounds, none unstable")
+        }
+    }
+}
+
+/// Runs the requested mechanism analyses, appending steps and plot data.
+pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut PlotData) -> Result<(), String> {
+    let analyses = &scene.analyses;
+    if analyses.equilibrium.is_none() && analyses.modes.is_none() {
+        return Ok(());
+    }
+    let mut built = None;
+    steps.push(timed_step("build: mechanism (potentials, frame)", || {
+        let mechanism = build_mechanism(scene, model)?;
+        let quantities = vec![quantity("potentials", vec![mechanism.potentials().len() as f64], "", None)];
+        built = Some(mechanism);
+        Ok::<_, String>(quantities)
+    })?);
+    let mut mechanism = built.ok_or("internal: mechanism not built")?;
+    let mut q = model.q0.clone();
+    if let Some(spec) = &analyses.equilibrium {
+        let options = EquilibriumOptions {
+            seek: match spec.seek.as_ref().map(|s| s.get_ref().as_str()) {
+                Some("stationary") => Seek::Stationary,
+                _ => Seek::Minimum,
+            },
+            max_iterations: spec.max_iterations.unwrap_or(100),
+            ..EquilibriumOptions::default()
+        };
+        let mut step = timed_step("equilibrium: Newton on grad U* (8.79)", || {
+            let eq = find_equilibrium(&mut mechanism, &q, &options).map_err(|e| e.to_string())?;
+            let quantities = vec![
+                quantity("q at equilibrium", eq.q.clone(), "rad | m", None),
+                quantity(
+                    "|grad U*| at equilibrium",
+                    vec![eq.gradient_norm],
+                    "J",
+                    Some(format!(
+                        "tolerance {:.1e}, {} Newton iterations, last step {:.1e}",
+                        eq.tolerance, eq.iterations, eq.last_step
+                    )),
+                ),
+                quantity("U* at equilibrium", vec![eq.potential], "J", None),
+            ];
+            q = eq.q;
+            Ok::<_, String>(quantities)
+        })?;
+        if !spec.starts.is_empty() {
+            let mut starts = spec.starts.clone();
+            starts.insert(0, q.clone());
+            let progress = crate::progress::bar(starts.len() as u64, "equilibria from several starts");
+            let mut found = Vec::new();
+            let mut failed = 0;
+            for start in &starts {
+                let (eqs, f) = find_equilibria(&mut mechanism, std::slice::from_ref(start), &options)
+                    .map_err(|e| e.to_string())?;
+                failed += f;
+                for eq in eqs {
+                    let fresh = found
+                        .iter()
+                        .all(|other: &Vec<f64>| other.iter().zip(&eq.q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) > 1e-8);
+                    if fresh {
+                        found.push(eq.q);
+                    }
+                }
+                progress.inc(1);
+            }
+            progress.finish_and_clear();
+            step.notes.push(format!(
+                "{} distinct equilibria from {} starts ({} did not converge)",
+                found.len(),
+                starts.len(),
+                failed
+            ));
+            for (i, eq) in found.iter().enumerate() {
+                step.quantities.push(quantity(&format!("equilibrium {i}"), eq.clone(), "rad | m", None));
+                let verdict = mechanism_modes(&mut mechanism.clone(), eq, &SolveOptions::default())
+                    .map(|m| stability_note(&m.stability))
+                    .unwrap_or_else(|e| format!("stability unknown: {e}"));
+                step.notes.push(format!("equilibrium {i}: {verdict}"));
+            }
+        }
+        steps.push(step);
+    }
+    let Some(spec) = &analyses.modes else { return Ok(()) };
+    let options = SolveOptions {
+        selection: spec.lowest.map_or(Selection::All, Selection::Lowest),
+        ..SolveOptions::default()
+    };
+    let mut modes: Option<MechanismModes> = None;
+    let mut step = timed_step("modes: det(λA + B) = 0 at the equilibrium (8.84–8.92)", || {
+        let m = mechanism_modes(&mut mechanism, &q, &options).map_err(|e| e.to_string())?;
+        let quantities = mode_quantities(&m);
+        modes = Some(m);
+        Ok::<_, String>(quantities)
+    })?;
+    let modes = modes.ok_or("internal: modes missing")?;
+    step.notes.push(stability_note(&modes.stability));
+    if let Some(gyro) = &modes.gyroscopic {
+        step.notes.push(format!(
+            "rotating frame: gyroscopic problem det(s²A + sG + B) = 0 solved; max Re s = {:.3e} (bound {:.1e}) → {}",
+            gyro.max_real_part,
+            gyro.real_part_bound,
+            if gyro.stable { "stable (possibly gyroscopically stabilised)" } else { "unstable" }
+        ));
+    }
+    if modes.gradient_norm > 1e-6 * modes.stiffness_matrix.norm_l2().max(1.0) {
+        step.notes.push(format!(
+            "warning: |grad U*| = {:.2e} at this configuration: it is not an equilibrium; the modes are those of the linearisation",
+            modes.gradient_norm
+        ));
+    }
+    steps.push(step);
+    plots.spectrum = modes
+        .solution
+        .modes
+        .iter()
+        .map(|m| (m.omega_sq, matches!(m.kind, ModeKind::Oscillatory { .. })))
+        .collect();
+    if let Some(x) = &modes.solution.vectors {
+        plots.shapes = (0..x.ncols().min(6))
+            .map(|k| ModeShape {
+                label: mode_label(&modes, k),
+                values: (0..x.nrows()).map(|r| x[(r, k)]).collect(),
+            })
+            .collect();
+    }
+    if let Some(response) = &analyses.response {
+        steps.push(response_step(&modes, response, plots)?);
+    }
+    Ok(())
+}
+
+fn mode_label(modes: &MechanismModes, k: usize) -> String {
+    match modes.solution.modes[k].kind {
+        ModeKind::Oscillatory { omega } => format!("mode {} — {:.4} Hz", k + 1, omega / std::f64::consts::TAU),
+        ModeKind::Zero => format!("mode {} — zero", k + 1),
+        ModeKind::Unstable { growth_rate } => format!("mode {} — unstable, γ = {growth_rate:.4} 1/s", k + 1),
+        ModeKind::Infinite => format!("mode {} — infinite", k + 1),
+    }
+}
+
+fn mode_quantities(m: &MechanismModes) -> Vec<crate::report::Quantity> {
+    let modes = &m.solution.modes;
+    let omega: Vec<f64> = modes
+        .iter()
+        .map(|mode| match mode.kind {
+            ModeKind::Oscillatory { omega } => omega,
+            ModeKind::Infinite => f64::INFINITY,
+            _ => 0.0,
+        })
+        .collect();
+    let bound = modes.iter().map(|mode| mode.error_bound).fold(0.0, f64::max);
+    let accuracy = &m.solution.accuracy;
+    let mut out = vec![
+        quantity(
+            "ω² (8.89: λ = −ω²)",
+            modes.iter().map(|mode| mode.omega_sq).collect(),
+            "rad²/s²",
+            Some(format!(
+                "max error bound {bound:.1e}; max backward error {:.1e}; A-orthogonality error {:.1e}; Sturm check {}",
+                accuracy.max_backward_error.unwrap_or(0.0),
+                accuracy.orthogonality_error.unwrap_or(0.0),
+                match &accuracy.inertia_check {
+                    Some(c) if c.consistent => "consistent",
+                    Some(_) => "INCONSISTENT",
+                    None => "not run",
+                }
+            )),
+        ),
+        quantity("ω", omega.clone(), "rad/s", None),
+        quantity("f = ω/2π", omega.iter().map(|w| w / std::f64::consts::TAU).collect(), "Hz", None),
+    ];
+    for (k, masses) in m.effective_masses.iter().enumerate().take(6) {
+        out.push(quantity(
+            &format!("mode {} effective mass (x, y, z)", k + 1),
+            masses.to_vec(),
+            "kg",
+            None,
+        ));
+    }
+    if let Some(x) = &m.solution.vectors {
+        for k in 0..x.ncols().min(6) {
+            out.push(quantity(
+                &format!("mode {} shape in q (A-normalised)", k + 1),
+                (0..x.nrows()).map(|r| x[(r, k)]).collect(),
+                "",
+                None,
+            ));
+        }
+    }
+    out
+}
+
+fn response_step(
+    modes: &MechanismModes,
+    spec: &crate::scene::ResponseSpec,
+    plots: &mut PlotData,
+) -> Result<Step, String> {
+    let n = modes.q.len();
+    timed_step("free response δ(t) by modal superposition (8.91)", || {
+        if !(spec.duration.is_finite() && spec.duration > 0.0) || spec.samples < 2 {
+            return Err("analyses.response: duration must be > 0 and samples ≥ 2".to_string());
+        }
+        let delta0 = spec.dq0.clone().unwrap_or_else(|| vec![0.0; n]);
+        let v0 = spec.v0.clone().unwrap_or_else(|| vec![0.0; n]);
+        let problem = PencilProblem::new(modes.mass_matrix.as_ref(), modes.stiffness_matrix.as_ref())
+            .map_err(|e| e.to_string())?;
+        let full = if modes.solution.modes.len() == n {
+            modes.solution.clone()
+        } else {
+            return Err("analyses.response needs every mode: remove `lowest` from analyses.modes".into());
+        };
+        let response = FreeResponse::new(&problem, &full, &delta0, &v0).map_err(|e| e.to_string())?;
+        let mut series = ResponseSeries {
+            times: Vec::with_capacity(spec.samples),
+            values: vec![Vec::with_capacity(spec.samples); n],
+        };
+        let mut out = vec![0.0; n];
+        for i in 0..spec.samples {
+            let t = spec.duration * i as f64 / (spec.samples - 1) as f64;
+            response.at(t, &mut out).map_err(|e| e.to_string())?;
+            series.times.push(t);
+            for (k, v) in out.iter().enumerate() {
+                series.values[k].push(*v);
+            }
+        }
+        let fit = response.fit();
+        let end_bound = response.error_bound(spec.duration).map_err(|e| e.to_string())?;
+        let quantities = vec![
+            quantity("δ(T) at the end of the span", out.clone(), "rad | m", Some(format!("error bound {end_bound:.1e}"))),
+            quantity(
+                "initial-state fit residual (δ, δ̇)",
+                vec![fit.displacement_residual, fit.velocity_residual],
+                "",
+                None,
+            ),
+        ];
+        plots.response = Some(series);
+        Ok(quantities)
+    })
+}

@@ -1,0 +1,158 @@
+//! `--plot DIR`: SVG plots of what a scene computed — the spectrum, bar charts of the mode
+//! shapes, the free response over time, and an impact's energy balance.
+
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// One mode shape for a bar chart.
+#[derive(Debug, Clone)]
+pub struct ModeShape {
+    /// Title, e.g. "mode 1 — 0.52 Hz".
+    pub label: String,
+    /// Entries per coordinate.
+    pub values: Vec<f64>,
+}
+
+/// Sampled free response: one series per coordinate.
+#[derive(Debug, Clone)]
+pub struct ResponseSeries {
+    /// Sample times, s.
+    pub times: Vec<f64>,
+    /// values[k][i] = δ_k(t_i).
+    pub values: Vec<Vec<f64>>,
+}
+
+/// Kinetic energy before and after an impact, per restitution law.
+#[derive(Debug, Clone)]
+pub struct EnergyBalance {
+    /// (law, T before, T after).
+    pub laws: Vec<(String, f64, f64)>,
+}
+
+/// Everything the scene computed that can be plotted.
+#[derive(Debug, Clone, Default)]
+pub struct PlotData {
+    /// (ω², oscillatory?) per mode.
+    pub spectrum: Vec<(f64, bool)>,
+    /// The first mode shapes.
+    pub shapes: Vec<ModeShape>,
+    /// The free response.
+    pub response: Option<ResponseSeries>,
+    /// The impact energy balance.
+    pub impact: Option<EnergyBalance>,
+}
+
+fn failed(e: impl std::fmt::Display) -> String {
+    format!("plot: {e}")
+}
+
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((0.0_f64, 0.0_f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let pad = 0.05 * (hi - lo).max(1e-12);
+    (lo - pad, hi + pad)
+}
+
+/// A bar chart of `values` into `area`.
+fn bars(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, title: &str, y_label: &str, values: &[(f64, RGBColor)]) -> Result<(), String> {
+    let (lo, hi) = range(values.iter().map(|v| v.0));
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 16))
+        .margin(8)
+        .x_label_area_size(28)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0f64..values.len() as f64, lo..hi)
+        .map_err(failed)?;
+    chart.configure_mesh().y_desc(y_label).x_desc("index").draw().map_err(failed)?;
+    chart
+        .draw_series(values.iter().enumerate().filter(|(_, v)| v.0.is_finite()).map(|(i, (v, color))| {
+            Rectangle::new([(i as f64 + 0.15, 0.0), (i as f64 + 0.85, *v)], color.filled())
+        }))
+        .map_err(failed)?;
+    Ok(())
+}
+
+impl PlotData {
+    /// Writes the SVGs of whatever was computed into `dir` (created if needed); returns the
+    /// files written.
+    pub fn write_all(&self, dir: &Path) -> Result<Vec<PathBuf>, String> {
+        std::fs::create_dir_all(dir).map_err(|e| format!("plot directory {}: {e}", dir.display()))?;
+        let mut written = Vec::new();
+        if !self.spectrum.is_empty() {
+            let path = dir.join("spectrum.svg");
+            let root = SVGBackend::new(&path, (800, 480)).into_drawing_area();
+            root.fill(&WHITE).map_err(failed)?;
+            let values: Vec<(f64, RGBColor)> = self
+                .spectrum
+                .iter()
+                .map(|&(w2, oscillatory)| {
+                    let f = w2.abs().sqrt() / std::f64::consts::TAU;
+                    if oscillatory { (f, BLUE) } else { (-f, RED) }
+                })
+                .collect();
+            bars(&root, "spectrum: f = ω/2π (red, negative: unstable or zero)", "Hz", &values)?;
+            root.present().map_err(failed)?;
+            written.push(path.clone());
+        }
+        if !self.shapes.is_empty() {
+            let path = dir.join("mode_shapes.svg");
+            let rows = self.shapes.len().div_ceil(2);
+            let root = SVGBackend::new(&path, (1000, 300 * rows as u32)).into_drawing_area();
+            root.fill(&WHITE).map_err(failed)?;
+            let areas = root.split_evenly((rows, 2));
+            for (shape, area) in self.shapes.iter().zip(&areas) {
+                let values: Vec<(f64, RGBColor)> = shape.values.iter().map(|&v| (v, BLUE)).collect();
+                bars(area, &shape.label, "q", &values)?;
+            }
+            root.present().map_err(failed)?;
+            written.push(path.clone());
+        }
+        if let Some(response) = &self.response {
+            let path = dir.join("response.svg");
+            let root = SVGBackend::new(&path, (900, 500)).into_drawing_area();
+            root.fill(&WHITE).map_err(failed)?;
+            let t_end = response.times.last().copied().unwrap_or(1.0);
+            let (lo, hi) = range(response.values.iter().flatten().copied());
+            let mut chart = ChartBuilder::on(&root)
+                .caption("free response δ(t) (8.91)", ("sans-serif", 18))
+                .margin(10)
+                .x_label_area_size(35)
+                .y_label_area_size(60)
+                .build_cartesian_2d(0f64..t_end, lo..hi)
+                .map_err(failed)?;
+            chart.configure_mesh().x_desc("t (s)").y_desc("δ").draw().map_err(failed)?;
+            for (k, series) in response.values.iter().enumerate() {
+                let color = Palette99::pick(k);
+                chart
+                    .draw_series(LineSeries::new(response.times.iter().copied().zip(series.iter().copied()), &color))
+                    .map_err(failed)?
+                    .label(format!("q{k}"))
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], Palette99::pick(k)));
+            }
+            chart.configure_series_labels().border_style(BLACK).draw().map_err(failed)?;
+            root.present().map_err(failed)?;
+            written.push(path.clone());
+        }
+        if let Some(impact) = &self.impact {
+            let path = dir.join("impact_energy.svg");
+            let root = SVGBackend::new(&path, (800, 480)).into_drawing_area();
+            root.fill(&WHITE).map_err(failed)?;
+            let mut values = Vec::new();
+            for (_, before, after) in &impact.laws {
+                values.push((*before, BLUE));
+                values.push((*after, if after > before { RED } else { GREEN }));
+            }
+            let names: Vec<&str> = impact.laws.iter().map(|l| l.0.as_str()).collect();
+            bars(
+                &root,
+                &format!("impact: kinetic energy before (blue) / after, laws {}", names.join(", ")),
+                "J",
+                &values,
+            )?;
+            root.present().map_err(failed)?;
+            written.push(path.clone());
+        }
+        Ok(written)
+    }
+}
