@@ -81,6 +81,21 @@
  */
 #define MECH_FEATURE_BIT_MECHANISM (1 << 4)
 
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * The ground, as a body index for mech_mechanism_add_point_spring.
+ */
+#define MECH_GROUND -1
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * A mechanism (opaque): a copy of a finalized tree with body mass properties and loads.
+ * Created by mech_mechanism_create, freed by mech_mechanism_destroy.
+ */
+typedef struct mech_mechanism_t mech_mechanism_t;
+#endif
+
 #if defined(MECH_FEATURE_MODAL)
 /**
  * The opaque result of mech_modal_solve. Free it with mech_modal_result_destroy.
@@ -894,6 +909,81 @@ typedef struct mech_energy_split_t {
 } mech_energy_split_t;
 #endif
 
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * What an equilibrium search heads for (int32_t; see MECH_SEEK_*).
+ */
+typedef int32_t mech_seek_t;
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * The report of an equilibrium search.
+ */
+typedef struct mech_equilibrium_report_t {
+    /**
+     * U* at the equilibrium (J).
+     */
+    double potential;
+    /**
+     * ‖grad U*‖ at the equilibrium.
+     */
+    double gradient_norm;
+    /**
+     * The tolerance used.
+     */
+    double tolerance;
+    /**
+     * Newton iterations.
+     */
+    size_t iterations;
+    /**
+     * Length of the last Newton step (an estimate of the distance to the exact equilibrium).
+     */
+    double last_step;
+    /**
+     * Number of coordinates resting on a joint limit.
+     */
+    size_t at_limit;
+} mech_equilibrium_report_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Classification of a mode (int32_t; see MECH_MODAL_KIND_*).
+ */
+typedef int32_t mech_modal_kind_t;
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * The stability verdict of mech_mechanism_modes.
+ */
+typedef struct mech_stability_t {
+    /**
+     * Number of unstable directions (0 for a stable or marginal equilibrium).
+     */
+    size_t unstable_directions;
+    /**
+     * Largest growth rate of the unstable directions (1/s; 0 when none).
+     */
+    double max_growth_rate;
+    /**
+     * Number of zero modes within their error bounds.
+     */
+    size_t zero_modes;
+    /**
+     * ‖grad U*‖ at q (should be ~0: modes are about an equilibrium).
+     */
+    double gradient_norm;
+    /**
+     * In a rotating frame with Coriolis coupling: 1 when every Re s of det(s²A + sG + B) = 0 is
+     * within its bound, 0 when some mode grows, −1 when there is no gyroscopic coupling.
+     */
+    int32_t gyroscopic_stable;
+} mech_stability_t;
+#endif
+
 #if defined(MECH_FEATURE_MODAL)
 /**
  * Which modes a solve returns (int32_t; see MECH_MODAL_SELECTION_*).
@@ -938,13 +1028,6 @@ typedef struct mech_modal_options_t {
      */
     mech_modal_refinement_t refinement;
 } mech_modal_options_t;
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Classification of a mode (int32_t; see MECH_MODAL_KIND_*).
- */
-typedef int32_t mech_modal_kind_t;
 #endif
 
 #if defined(MECH_FEATURE_MODAL)
@@ -1647,6 +1730,20 @@ typedef struct mech_modal_response_fit_t {
  * Fail with MECH_STATUS_INVALID_ARGUMENT.
  */
 #define MECH_DEGENERATE_REJECT 1
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Any equilibrium, stable or not (Newton on grad U* = 0, line search on ‖grad U*‖).
+ */
+#define MECH_SEEK_STATIONARY 0
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * A local minimum of U* (a stable equilibrium).
+ */
+#define MECH_SEEK_MINIMUM 1
 #endif
 
 #if defined(MECH_FEATURE_MODAL)
@@ -2624,6 +2721,187 @@ mech_status_t mech_tree_energy_split(struct mech_tree_t *tree,
                                      double *b_out,
                                      double *momenta_out,
                                      size_t n);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Creates a mechanism from a finalized tree (copied: later changes to the tree do not affect
+ * it) and one mass-properties value per body (in the body's frame, in body order).
+ *
+ * # Safety
+ * `tree` must be a live tree handle, `bodies` must point to `n_bodies` readable values and
+ * `mechanism_out` to a writable pointer.
+ */
+mech_status_t mech_mechanism_create(struct mech_tree_t *tree,
+                                    const struct mech_mass_properties_t *bodies,
+                                    size_t n_bodies,
+                                    struct mech_mechanism_t **mechanism_out);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Frees a mechanism. NULL is accepted and ignored.
+ *
+ * # Safety
+ * `mechanism` must be NULL or a live handle, not used afterwards.
+ */
+void mech_mechanism_destroy(struct mech_mechanism_t *mechanism);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Number of coordinates of the mechanism into `*dof_out`.
+ *
+ * # Safety
+ * `mechanism` must be a live handle and `dof_out` writable.
+ */
+mech_status_t mech_mechanism_dof(struct mech_mechanism_t *mechanism,
+                                 size_t *dof_out);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Sets uniform gravity g (m/s², base-frame components).
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_set_gravity(struct mech_mechanism_t *mechanism,
+                                         struct mech_vec3_t gravity);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Makes the base frame turn at `rate` rad/s about the unit `axis` through its origin (§8e);
+ * rate 0 removes the rotation. Gravity must be along the axis.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_set_rotating_frame(struct mech_mechanism_t *mechanism,
+                                                struct mech_vec3_t axis,
+                                                double rate);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Adds U = ½ k (q_i − rest)² on coordinate `coordinate` (not on spherical/free rotation vectors).
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_add_joint_spring(struct mech_mechanism_t *mechanism,
+                                              size_t coordinate,
+                                              double stiffness,
+                                              double rest);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Adds a spring U = ½ k (|x_a − x_b| − rest_length)² between the point `point_a` of body
+ * `body_a` and `point_b` of `body_b` (body coordinates; MECH_GROUND and world coordinates for
+ * the ground).
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_add_point_spring(struct mech_mechanism_t *mechanism,
+                                              int64_t body_a,
+                                              struct mech_vec3_t point_a,
+                                              int64_t body_b,
+                                              struct mech_vec3_t point_b,
+                                              double stiffness,
+                                              double rest_length);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Adds a constant world force `force` (N) at the point `point` of body `body` (U = −F·x).
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_add_force(struct mech_mechanism_t *mechanism,
+                                       size_t body,
+                                       struct mech_vec3_t point,
+                                       struct mech_vec3_t force);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Limits coordinate `coordinate` to [lower, upper] in equilibrium searches.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_set_limits(struct mech_mechanism_t *mechanism,
+                                        size_t coordinate,
+                                        double lower,
+                                        double upper);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * U*(q) into `*potential_out`, its gradient into `gradient_out` (n values) and, unless
+ * `hessian_out` is NULL, its Hessian B = ∂²(U*)/∂q∂q (n×n, column-major; spherical and free
+ * joints need φ = 0, else MECH_STATUS_INVALID_ARGUMENT). All exact (8.79).
+ *
+ * # Safety
+ * `mechanism` must be a live handle; `q` and `gradient_out` must hold n doubles,
+ * `hessian_out` n² (or be NULL).
+ */
+mech_status_t mech_mechanism_potential(struct mech_mechanism_t *mechanism,
+                                       const double *q,
+                                       size_t n,
+                                       double *potential_out,
+                                       double *gradient_out,
+                                       double *hessian_out);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Searches an equilibrium from `q0` (n values) and writes it to `q_out` (n values) with its
+ * report. `max_iterations` 0 means the default (100); `tolerance` ≤ 0 means the default
+ * derived from rounding. Spherical and free joints are re-centred during the search: the
+ * result is in the mechanism's new chart (bodies do not move). When the search fails
+ * (MECH_STATUS_NOT_CONVERGED), `q_out` still receives the best point found and
+ * `report_out` its gradient norm, so the caller can inspect it.
+ *
+ * # Safety
+ * `mechanism` must be a live handle; `q0` and `q_out` must hold n doubles; `report_out`
+ * must be writable.
+ */
+mech_status_t mech_mechanism_equilibrium(struct mech_mechanism_t *mechanism,
+                                         const double *q0,
+                                         size_t n,
+                                         mech_seek_t seek,
+                                         size_t max_iterations,
+                                         double tolerance,
+                                         double *q_out,
+                                         struct mech_equilibrium_report_t *report_out);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * The stability and the lowest `count` modes (count 0: all) of the mechanism about q (n
+ * values): ω² into `omega_sq_out`, their error bounds into `error_bounds_out`, their kinds
+ * (MECH_MODAL_KIND_*) into `kinds_out` (each `count` long, or n for all), the A-normalised
+ * shapes into `shapes_out` (n × count column-major, may be NULL) and the verdict into
+ * `stability_out`. The number of modes written goes to `*modes_out`.
+ *
+ * # Safety
+ * `mechanism` must be a live handle; the buffers must have the lengths above.
+ */
+mech_status_t mech_mechanism_modes(struct mech_mechanism_t *mechanism,
+                                   const double *q,
+                                   size_t n,
+                                   size_t count,
+                                   double *omega_sq_out,
+                                   double *error_bounds_out,
+                                   mech_modal_kind_t *kinds_out,
+                                   double *shapes_out,
+                                   size_t *modes_out,
+                                   struct mech_stability_t *stability_out);
 #endif
 
 #if defined(MECH_FEATURE_MODAL)

@@ -191,7 +191,11 @@ fn humanoid() -> (KinematicTree, Workspace, TreeMass, Vec<f64>, Vec<MechanismCon
         let mut parent = torso;
         let mut offset = Vector3::new(x, y, 0.0);
         for k in 0..3 {
-            parent = builder.add_body(Some(parent), Joint::Spherical, Isometry3::translation(offset.x, offset.y, offset.z));
+            parent = builder.add_body(
+                Some(parent),
+                Joint::Spherical,
+                Isometry3::translation(offset.x, offset.y, offset.z),
+            );
             bodies.push(link(masses[k], lengths[k]));
             offset = Vector3::new(0.0, -lengths[k], 0.0);
         }
@@ -199,8 +203,18 @@ fn humanoid() -> (KinematicTree, Workspace, TreeMass, Vec<f64>, Vec<MechanismCon
     }
     let tree = builder.build().expect("humanoid");
     let n = tree.dof();
-    let q: Vec<f64> = (0..n).map(|k| if k < 6 { [0.0, 1.0, 0.0, 0.3, 0.0, 0.0][k] } else { 0.25 * ((k as f64) * 0.9).sin() }).collect();
-    let q_dot: Vec<f64> = (0..n).map(|k| if k == 1 { -2.0 } else { 0.3 * ((k as f64) * 1.3).cos() }).collect();
+    let q: Vec<f64> = (0..n)
+        .map(|k| {
+            if k < 6 {
+                [0.0, 1.0, 0.0, 0.3, 0.0, 0.0][k]
+            } else {
+                0.25 * ((k as f64) * 0.9).sin()
+            }
+        })
+        .collect();
+    let q_dot: Vec<f64> = (0..n)
+        .map(|k| if k == 1 { -2.0 } else { 0.3 * ((k as f64) * 1.3).cos() })
+        .collect();
     let mut ws = tree.workspace();
     tree.update_positions(&mut ws, &q).expect("q");
     let mass = TreeMass::new(&tree, bodies).expect("mass");
@@ -239,7 +253,16 @@ fn mechanism_contacts(c: &mut Criterion) {
         b.iter(|| MechanismInertia::new(black_box(&tree), black_box(&ws), &mut mass))
     });
     group.bench_function("resolve_4_contacts", |b| {
-        b.iter(|| resolve_contacts(black_box(&tree), black_box(&ws), &inertia, black_box(&q_dot), &contacts, &options))
+        b.iter(|| {
+            resolve_contacts(
+                black_box(&tree),
+                black_box(&ws),
+                &inertia,
+                black_box(&q_dot),
+                &contacts,
+                &options,
+            )
+        })
     });
     group.bench_function("end_to_end", |b| {
         b.iter(|| {
@@ -249,7 +272,16 @@ fn mechanism_contacts(c: &mut Criterion) {
     });
     let process = ImpactOptions::default();
     group.bench_function("single_contact", |b| {
-        b.iter(|| resolve_single_contact(black_box(&tree), black_box(&ws), &inertia, black_box(&q_dot), &contacts[2], &process))
+        b.iter(|| {
+            resolve_single_contact(
+                black_box(&tree),
+                black_box(&ws),
+                &inertia,
+                black_box(&q_dot),
+                &contacts[2],
+                &process,
+            )
+        })
     });
     group.finish();
 }

@@ -93,10 +93,9 @@ fn scaled(mut mesh: TriangleMesh, scale: f64) -> Result<TriangleMesh, String> {
 /// The quantities of the mass-properties step.
 fn properties_quantities(result: &MeshMassProperties) -> Result<Vec<Quantity>, MassError> {
     let p = &result.properties;
-    let accuracy = Some(format!(
-        "relative rounding-error bound {:.1e}",
-        result.relative_error_bound
-    ));
+    let bound = result.relative_error_bound;
+    let accuracy = Some(format!("relative rounding-error bound {bound:.1e}"));
+    let moment_accuracy = Some(format!("rounding error ≲ {bound:.1e} relative to the body's scale"));
     let (measure_name, measure_unit, density_unit) = match result.model {
         MeshModel::Solid => ("volume", "m³", "kg/m³"),
         MeshModel::Shell => ("surface area", "m²", "kg/m²"),
@@ -111,20 +110,20 @@ fn properties_quantities(result: &MeshMassProperties) -> Result<Vec<Quantity>, M
             name: measure_name.into(),
             values: vec![result.measure],
             unit: measure_unit.into(),
-            accuracy: accuracy.clone(),
+            accuracy,
         },
         quantity("density", vec![p.mass / result.measure], density_unit),
         Quantity {
             name: "centre of mass (file frame)".into(),
             values: p.p_oc.iter().copied().collect(),
             unit: "m".into(),
-            accuracy: accuracy.clone(),
+            accuracy: moment_accuracy.clone(),
         },
         Quantity {
             name: "inertia about centre of mass (rows of 3×3)".into(),
             values: (0..3).flat_map(|r| (0..3).map(move |c| j[(r, c)])).collect(),
             unit: "kg·m²".into(),
-            accuracy,
+            accuracy: moment_accuracy,
         },
         quantity(
             "inertia about c.o.m. ixx ixy ixz iyy iyz izz",
@@ -193,7 +192,10 @@ pub fn run(args: &MassArgs) -> Result<Report, String> {
             count("triangles", d.triangles),
             count("degenerate triangles skipped", d.degenerate_triangles),
             count("boundary edges (used by one triangle)", d.topology.boundary_edges),
-            count("non-manifold edges (used by > 2 triangles)", d.topology.non_manifold_edges),
+            count(
+                "non-manifold edges (used by > 2 triangles)",
+                d.topology.non_manifold_edges,
+            ),
             count("misoriented edges", d.topology.misoriented_edges),
             count("inside out, orientation flipped (1 = yes)", usize::from(d.flipped)),
         ])

@@ -37,7 +37,10 @@ fn box_triangles(origin: [f64; 3], size: [f64; 3]) -> Vec<[[f64; 3]; 3]> {
         [1, 3, 7],
         [1, 7, 5],
     ];
-    faces.iter().map(|f| [corner(f[0]), corner(f[1]), corner(f[2])]).collect()
+    faces
+        .iter()
+        .map(|f| [corner(f[0]), corner(f[1]), corner(f[2])])
+        .collect()
 }
 
 /// An ASCII STL file of `triangles` (normals left zero; readers recompute them).
@@ -136,7 +139,8 @@ fn check_box_report(report: &serde_json::Value, mass: f64, origin: [f64; 3], siz
     for k in 0..6 {
         assert_close(six[k], expected_six[k], tol * scale, "URDF inertia");
     }
-    // Sorted principal moments and axes along the coordinate axes (distinct moments here).
+    // Sorted principal moments and axes along the coordinate axes (the boxes used have
+    // distinct sides, hence distinct moments).
     let mut sorted = diag;
     sorted.sort_by(f64::total_cmp);
     let moments = values(report, "principal moments I1 ≤ I2 ≤ I3");
@@ -146,7 +150,10 @@ fn check_box_report(report: &serde_json::Value, mass: f64, origin: [f64; 3], siz
     let axes = values(report, "principal axes (axis 1, axis 2, axis 3; right-handed)");
     assert_eq!(axes.len(), 9);
     for (k, &moment) in sorted.iter().enumerate() {
-        let axis = diag.iter().position(|&d| d == moment).expect("moment of a coordinate axis");
+        let axis = diag
+            .iter()
+            .position(|&d| d == moment)
+            .expect("moment of a coordinate axis");
         assert_close(axes[3 * k + axis].abs(), 1.0, 1e-12, "principal axis");
     }
 }
@@ -189,7 +196,10 @@ fn a_box_gives_the_closed_form_mass_centre_and_inertia() {
     let out = mechanica(&["mass", path, "--mass", "2"]);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("principal moments") && text.contains("centre of mass"), "{text}");
+    assert!(
+        text.contains("principal moments") && text.contains("centre of mass"),
+        "{text}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -213,17 +223,27 @@ fn millimetre_files_scale_to_metres_and_obj_matches_stl() {
         let x = origin[0] + if k & 1 != 0 { size[0] } else { 0.0 };
         let y = origin[1] + if k & 2 != 0 { size[1] } else { 0.0 };
         let z = origin[2] + if k & 4 != 0 { size[2] } else { 0.0 };
-        obj.push_str(&format!("v {x} {y} {z}
-"));
+        obj.push_str(&format!(
+            "v {x} {y} {z}
+"
+        ));
     }
     // 1-based corner indices; counter-clockwise seen from outside.
     for face in ["1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6"] {
-        obj.push_str(&format!("f {face}
-"));
+        obj.push_str(&format!(
+            "f {face}
+"
+        ));
     }
     let file = dir.join("box.OBJ");
     std::fs::write(&file, obj).expect("write OBJ");
-    check_box_report(&json_report(&[file.to_str().expect("utf-8"), "--mass", "2"]), 2.0, origin, size, TOL);
+    check_box_report(
+        &json_report(&[file.to_str().expect("utf-8"), "--mass", "2"]),
+        2.0,
+        origin,
+        size,
+        TOL,
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -231,7 +251,7 @@ fn millimetre_files_scale_to_metres_and_obj_matches_stl() {
 fn an_inside_out_box_is_flipped_and_reported() {
     let dir = temp_dir("flipped");
     let file = dir.join("inside_out.stl");
-    let (origin, size) = ([0.0, 0.0, 0.0], [2.0, 1.0, 1.0]);
+    let (origin, size) = ([0.0, 0.0, 0.0], [2.0, 1.0, 0.5]);
     let reversed: Vec<_> = box_triangles(origin, size).iter().map(|t| [t[0], t[2], t[1]]).collect();
     write_ascii_stl(&file, &reversed);
     let report = json_report(&[file.to_str().expect("utf-8"), "--mass", "1"]);
@@ -294,16 +314,23 @@ fn bad_inputs_fail_with_a_message_naming_the_problem() {
     assert!(err.contains("missing.stl") && err.contains("cannot read"), "{err}");
 
     let unknown = dir.join("mesh.ply");
-    std::fs::write(&unknown, "ply
-").expect("write");
+    std::fs::write(
+        &unknown, "ply
+",
+    )
+    .expect("write");
     let out = mechanica(&["mass", unknown.to_str().expect("utf-8")]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown mesh format"));
 
     let garbage = dir.join("garbage.obj");
-    std::fs::write(&garbage, "v 0 0 0
+    std::fs::write(
+        &garbage,
+        "v 0 0 0
 f 1 2 3
-").expect("write");
+",
+    )
+    .expect("write");
     let out = mechanica(&["mass", garbage.to_str().expect("utf-8")]);
     assert!(!out.status.success());
 

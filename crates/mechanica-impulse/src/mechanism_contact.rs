@@ -109,7 +109,8 @@ impl ContactSpace {
             for (row, axis) in [t1, t2, normal].iter().enumerate() {
                 let r = 3 * i + row;
                 for k in 0..n {
-                    jacobian[r + 3 * m * k] = axis.x * j_point[3 * k] + axis.y * j_point[3 * k + 1] + axis.z * j_point[3 * k + 2];
+                    jacobian[r + 3 * m * k] =
+                        axis.x * j_point[3 * k] + axis.y * j_point[3 * k + 1] + axis.z * j_point[3 * k + 2];
                 }
                 u_before[r] = axis.dot(&u_w);
             }
@@ -234,7 +235,7 @@ fn numerical_rank(k: usize, w: &[f64]) -> usize {
         let (best, pivot) = (step..k)
             .map(|i| (i, a[perm[i] + k * perm[i]]))
             .fold((step, f64::NEG_INFINITY), |acc, x| if x.1 > acc.1 { x } else { acc });
-        if !(pivot > tol) {
+        if pivot.is_nan() || pivot <= tol {
             return step;
         }
         perm.swap(step, best);
@@ -328,7 +329,11 @@ pub(crate) fn assemble_impact(
     for i in 0..m {
         let f = space.frames[i];
         let pc = Vector3::new(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
-        let du = Vector3::from_fn(|r, _| (0..rows).map(|c| space.delassus[3 * i + r + rows * c] * p[c]).sum::<f64>());
+        let du = Vector3::from_fn(|r, _| {
+            (0..rows)
+                .map(|c| space.delassus[3 * i + r + rows * c] * p[c])
+                .sum::<f64>()
+        });
         let u_before_w = space.u_before_w(i);
         let impulse_w = f * pc;
         contacts.push(ContactOutcome {
@@ -343,7 +348,11 @@ pub(crate) fn assemble_impact(
     }
     let energy_before = inertia.kinetic_energy(q_dot)?;
     let energy_change = space.energy_change(p);
-    if let Some(value) = delta_q_dot.iter().chain(std::iter::once(&energy_change)).find(|v| !v.is_finite()) {
+    if let Some(value) = delta_q_dot
+        .iter()
+        .chain(std::iter::once(&energy_change))
+        .find(|v| !v.is_finite())
+    {
         return Err(ImpulseError::NotConverged {
             reason: "the impulse overflowed (inputs too large for f64)",
             steps: 0,

@@ -181,11 +181,7 @@ fn simultaneous(
     }
     let speed = u.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
     let target = options.tolerance * speed;
-    let mut sweeper = Sweeper {
-        rows,
-        w,
-        v: u.to_vec(),
-    };
+    let mut sweeper = Sweeper { rows, w, v: u.to_vec() };
     // Phase 1: compression, the inelastic Signorini–Coulomb problem.
     let mut p1 = vec![0.0; rows];
     let mut iterations = 0;
@@ -213,7 +209,11 @@ fn simultaneous(
     if e1 > 0.0 {
         let a: f64 = p1.iter().zip(u).map(|(p, u)| p * u).sum();
         let c = 2.0 * (e1 - a);
-        let s = if a < 0.0 && c > 0.0 { (-2.0 * a / c).min(1.0) } else { 0.0 };
+        let s = if a < 0.0 && c > 0.0 {
+            (-2.0 * a / c).min(1.0)
+        } else {
+            0.0
+        };
         p1.iter_mut().for_each(|p| *p *= s);
         sweeper.v = u.to_vec();
         for r in 0..rows {
@@ -226,7 +226,11 @@ fn simultaneous(
     let mut p2 = vec![0.0; rows];
     let mut residual2 = 0.0;
     let mut iterations2 = 0;
-    if blocks.iter().enumerate().any(|(i, b)| b.restitution > 0.0 && p1[3 * i + 2] > 0.0) {
+    if blocks
+        .iter()
+        .enumerate()
+        .any(|(i, b)| b.restitution > 0.0 && p1[3 * i + 2] > 0.0)
+    {
         for (i, b) in blocks.iter().enumerate() {
             let n = 3 * i + 2;
             p2[n] = b.restitution * p1[n];
@@ -309,7 +313,11 @@ enum Phase {
 
 /// The friction disk radius f p_n (0 when p_n = 0, also for f = +∞).
 fn disk_radius(friction: f64, normal_impulse: f64) -> f64 {
-    if normal_impulse > 0.0 { friction * normal_impulse } else { 0.0 }
+    if normal_impulse > 0.0 {
+        friction * normal_impulse
+    } else {
+        0.0
+    }
 }
 
 /// Exact block update of the tangential impulse of contact `i` within the disk `radius`
@@ -375,7 +383,9 @@ fn disk_minimizer(w: &Matrix2<f64>, c: &Vector2<f64>, r: f64) -> Vector2<f64> {
             unbounded = true;
         }
     }
-    if !unbounded && interior.norm() <= r {
+    // With f = ∞ the disk is the plane: the min-norm unconstrained minimiser (a slip along a
+    // direction the mechanism cannot change is left as it is).
+    if (!unbounded && interior.norm() <= r) || r.is_infinite() {
         return eig.eigenvectors * interior;
     }
     let norm_at = |mu: f64| (cp.x / (lam.x + mu)).hypot(cp.y / (lam.y + mu));
@@ -426,7 +436,10 @@ mod tests {
         assert!((x.norm() - r).abs() <= 1e-15);
         let g = w * x + c;
         let cross = g.x * x.y - g.y * x.x;
-        assert!(cross.abs() <= 1e-14 * g.norm() * r, "gradient not parallel to x: {cross}");
+        assert!(
+            cross.abs() <= 1e-14 * g.norm() * r,
+            "gradient not parallel to x: {cross}"
+        );
         assert!(g.dot(&x) <= 0.0);
     }
 

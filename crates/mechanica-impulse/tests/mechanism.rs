@@ -99,7 +99,12 @@ fn free_body_mechanism_equals_rigid_body_contact() {
     builder.add_body(None, Joint::Free, Isometry3::identity());
     let tree = builder.build().expect("tree");
     // A slender cylinder along its body y axis: axial inertia 1e-3 of the transverse one.
-    let props = solid(2.0, Vector3::new(0.5, 5e-4, 0.5), Vector3::new(0.0, 0.4, 0.0), Vector3::zeros());
+    let props = solid(
+        2.0,
+        Vector3::new(0.5, 5e-4, 0.5),
+        Vector3::new(0.0, 0.4, 0.0),
+        Vector3::zeros(),
+    );
     let q = [0.1, 0.8, -0.2, 0.3, -0.2, 0.6];
     let q_dot = [0.4, -1.5, 0.3, 0.7, -0.4, 1.1];
     let mech = Mechanism::new(tree, vec![props], &q);
@@ -128,12 +133,21 @@ fn free_body_mechanism_equals_rigid_body_contact() {
         // the larger of the two reported integration errors.
         let scale = reference.contact.impulse_w.norm();
         let tol = 1e-10 * scale + 10.0 * (reference.contact.integration_error + impact.integration_error);
-        assert!((c.impulse_w - reference.contact.impulse_w).norm() <= tol, "impulse e {e} f {f}");
+        assert!(
+            (c.impulse_w - reference.contact.impulse_w).norm() <= tol,
+            "impulse e {e} f {f}"
+        );
         let (v_after, w_after) = mech.body_velocity(0, &impact.q_dot_after);
         let v_scale = v.norm() + w.norm();
         let tol_v = 1e-9 * v_scale + 1e3 * tol;
-        assert!((v_after - reference.body2.v_wc_after).norm() <= tol_v, "v after e {e} f {f}");
-        assert!((w_after - reference.body2.w_w_after).norm() <= tol_v, "w after e {e} f {f}");
+        assert!(
+            (v_after - reference.body2.v_wc_after).norm() <= tol_v,
+            "v after e {e} f {f}"
+        );
+        assert!(
+            (w_after - reference.body2.w_w_after).norm() <= tol_v,
+            "w after e {e} f {f}"
+        );
         assert!(
             (impact.energy_change - reference.contact.energy_change).abs() <= 1e-9 * impact.energy_before + 1e3 * tol,
             "energy e {e} f {f}"
@@ -148,13 +162,14 @@ fn free_body_mechanism_equals_rigid_body_contact() {
 fn pendulum_struck_at_a_point() {
     let axis = Vector3::new(0.2, 0.3, 0.9).normalize();
     let mut builder = TreeBuilder::new();
-    builder.add_body(
-        None,
-        Joint::Revolute { axis },
-        Isometry3::translation(0.3, -0.2, 0.5),
-    );
+    builder.add_body(None, Joint::Revolute { axis }, Isometry3::translation(0.3, -0.2, 0.5));
     let tree = builder.build().expect("tree");
-    let props = solid(1.7, Vector3::new(0.1, 0.25, 0.3), Vector3::new(0.4, -0.6, 0.1), Vector3::new(0.3, 0.1, -0.4));
+    let props = solid(
+        1.7,
+        Vector3::new(0.1, 0.25, 0.3),
+        Vector3::new(0.4, -0.6, 0.1),
+        Vector3::new(0.3, 0.1, -0.4),
+    );
     let q = [0.7];
     let q_dot = [-1.3];
     let mech = Mechanism::new(tree, vec![props], &q);
@@ -184,7 +199,9 @@ fn pendulum_struck_at_a_point() {
         .hinged_on_axis(&Vector3::new(0.3, -0.2, 0.5), &a_w)
         .expect("hinge");
     let x = mech.ws.point_position(0, &point).expect("x");
-    let body = rigid.apply_impulse_at(&s, &x, &Vector3::zeros()).expect("body response");
+    let body = rigid
+        .apply_impulse_at(&s, &x, &Vector3::zeros())
+        .expect("body response");
     let (v_after, w_after) = mech.body_velocity(0, &response.q_dot_after);
     assert!(rel_err(&w_after, &body.w_w_after) <= 1e-12);
     assert!(rel_err(&v_after, &body.v_wc_after) <= 1e-12);
@@ -249,7 +266,12 @@ fn lagrange_impulse_agrees_with_body_level() {
     let mut builder = TreeBuilder::new();
     builder.add_body(None, Joint::Free, Isometry3::translation(0.1, 0.0, -0.3));
     let tree = builder.build().expect("tree");
-    let props = solid(3.2, Vector3::new(0.2, 0.35, 0.4), Vector3::new(0.1, 0.2, -0.1), Vector3::new(0.5, -0.3, 0.2));
+    let props = solid(
+        3.2,
+        Vector3::new(0.2, 0.35, 0.4),
+        Vector3::new(0.1, 0.2, -0.1),
+        Vector3::new(0.5, -0.3, 0.2),
+    );
     let q = [0.5, -0.2, 0.9, -0.4, 0.8, 0.3];
     let q_dot = [0.3, 0.1, -0.7, 1.2, -0.4, 0.6];
     let mech = Mechanism::new(tree, vec![props], &q);
@@ -321,12 +343,19 @@ fn box_falling_flat_on_four_redundant_contacts() {
         // PGS converges linearly; the velocity error is bounded by the residual (m/s) times a
         // modest factor (W's coupling, ≤ number of contacts).
         let tol = 8.0 * options.tolerance * v + 1e-14;
-        assert!((v_after - Vector3::new(0.0, e * v, 0.0)).norm() <= tol, "e {e} f {f}: {v_after}");
+        assert!(
+            (v_after - Vector3::new(0.0, e * v, 0.0)).norm() <= tol,
+            "e {e} f {f}: {v_after}"
+        );
         assert!(w_after.norm() * hx <= tol, "e {e} f {f}: {w_after}");
         let total: f64 = r.contacts.iter().map(|c| c.normal_impulse).sum();
         assert!((total - mass * (1.0 + e) * v).abs() <= mass * tol);
         let dt = -0.5 * mass * (1.0 - e * e) * v * v;
-        assert!((r.energy_change - dt).abs() <= 2.0 * mass * v * tol, "e {e}: {} vs {dt}", r.energy_change);
+        assert!(
+            (r.energy_change - dt).abs() <= 2.0 * mass * v * tol,
+            "e {e}: {} vs {dt}",
+            r.energy_change
+        );
     }
 }
 
@@ -339,7 +368,12 @@ fn two_active_frictionless_contacts_match_the_kkt_solution() {
     let b0 = builder.add_body(None, z, Isometry3::identity());
     let b1 = builder.add_body(Some(b0), z, Isometry3::translation(0.0, -1.0, 0.0));
     let tree = builder.build().expect("tree");
-    let rod = solid(1.0, Vector3::new(1.0, 1e-3, 1.0) / 12.0, Vector3::new(0.0, -0.5, 0.0), Vector3::zeros());
+    let rod = solid(
+        1.0,
+        Vector3::new(1.0, 1e-3, 1.0) / 12.0,
+        Vector3::new(0.0, -0.5, 0.0),
+        Vector3::zeros(),
+    );
     let mech = Mechanism::new(tree, vec![rod, rod], &[0.3, -0.5]);
     let e = 0.6;
     // Contact 0: elbow against a wall with normal +x; contact 1: tip on the floor (+y).
@@ -389,13 +423,24 @@ fn two_active_frictionless_contacts_match_the_kkt_solution() {
 /// multiple frictional contacts.
 #[test]
 fn energy_identity() {
-    let m = chain(&[Joint::Spherical, Joint::Revolute { axis: Vector3::x() }, Joint::Spherical]);
+    let m = chain(&[
+        Joint::Spherical,
+        Joint::Revolute { axis: Vector3::x() },
+        Joint::Spherical,
+    ]);
     let q_dot = [0.3, -0.8, 0.5, 1.2, -0.4, 0.9, 0.2];
     let c0 = ground_contact(2, Vector3::new(0.1, -0.5, 0.0), law(0.5, 0.4, RestitutionLaw::Stronge));
     let c1 = ground_contact(1, Vector3::new(0.0, -0.5, 0.1), law(0.3, 0.8, RestitutionLaw::Poisson));
     for contacts in [vec![c0], vec![c0, c1]] {
-        let r = resolve_contacts(&m.tree, &m.ws, &m.inertia, &q_dot, &contacts, &MultiContactOptions::default())
-            .expect("impact");
+        let r = resolve_contacts(
+            &m.tree,
+            &m.ws,
+            &m.inertia,
+            &q_dot,
+            &contacts,
+            &MultiContactOptions::default(),
+        )
+        .expect("impact");
         let dt = m.energy(&r.q_dot_after) - m.energy(&q_dot);
         let t = m.energy(&q_dot);
         assert!((r.energy_change - dt).abs() <= 1e-12 * t, "{} vs {dt}", r.energy_change);
@@ -450,7 +495,10 @@ fn grazing_and_separating_contacts_get_no_impulse() {
         .expect("single");
         assert_eq!(single.contacts[0].mode, ContactMode::NoImpact);
         assert!(single.delta_q_dot.iter().all(|d| *d == 0.0));
-        let contacts = [ground_contact(0, bottom, rough), ground_contact(0, Vector3::new(0.2, -0.2, 0.0), rough)];
+        let contacts = [
+            ground_contact(0, bottom, rough),
+            ground_contact(0, Vector3::new(0.2, -0.2, 0.0), rough),
+        ];
         let multi = resolve_contacts(
             &mech.tree,
             &mech.ws,
@@ -483,12 +531,18 @@ fn duplicated_contact_gives_the_same_total_impulse() {
         let options = MultiContactOptions::default();
         let one = resolve_single_contact(&m.tree, &m.ws, &m.inertia, &q_dot, &c, &options.process).expect("one");
         let two = resolve_contacts(&m.tree, &m.ws, &m.inertia, &q_dot, &[c, c], &options).expect("two");
-        assert!(one.contacts[0].normal_impulse > 0.0, "the contact must be active: e {e} f {f} {one:?}");
+        assert!(
+            one.contacts[0].normal_impulse > 0.0,
+            "the contact must be active: e {e} f {f} {one:?}"
+        );
         assert_eq!(two.delassus_rank, one.delassus_rank);
         let p_one = one.contacts[0].impulse_w;
         let p_two = two.contacts[0].impulse_w + two.contacts[1].impulse_w;
         let tol = 8.0 * (two.complementarity_residual + options.tolerance) * q_dot.len() as f64;
-        assert!((p_two - p_one).norm() <= tol * p_one.norm(), "e {e} f {f}: {p_two} vs {p_one}");
+        assert!(
+            (p_two - p_one).norm() <= tol * p_one.norm(),
+            "e {e} f {f}: {p_two} vs {p_one}"
+        );
         for (a, b) in one.delta_q_dot.iter().zip(&two.delta_q_dot) {
             assert!(a.is_finite() && (a - b).abs() <= tol * (1.0 + a.abs()), "e {e} f {f}");
         }
@@ -538,7 +592,11 @@ fn bad_input_is_rejected() {
     ));
     assert!(matches!(
         run(&[0.1, 0.2], good),
-        Err(ImpulseError::DimensionMismatch { expected: 4, got: 2, .. })
+        Err(ImpulseError::DimensionMismatch {
+            expected: 4,
+            got: 2,
+            ..
+        })
     ));
     let mut c = good;
     c.normal_w = Vector3::new(0.0, 2.0, 0.0);
@@ -547,7 +605,10 @@ fn bad_input_is_rejected() {
     assert!(matches!(e, ImpulseError::NotUnit { .. }));
     c = good;
     c.normal_w = Vector3::new(f64::NAN, 1.0, 0.0);
-    assert!(matches!(unwrap_contact(run(&q_dot, c).expect_err("nan")).1, ImpulseError::NonFinite { .. }));
+    assert!(matches!(
+        unwrap_contact(run(&q_dot, c).expect_err("nan")).1,
+        ImpulseError::NonFinite { .. }
+    ));
     c = good;
     c.law.restitution = 1.5;
     assert!(matches!(
@@ -568,7 +629,10 @@ fn bad_input_is_rejected() {
     ));
     c = good;
     c.point.p_bq.x = f64::INFINITY;
-    assert!(matches!(unwrap_contact(run(&q_dot, c).expect_err("p")).1, ImpulseError::NonFinite { .. }));
+    assert!(matches!(
+        unwrap_contact(run(&q_dot, c).expect_err("p")).1,
+        ImpulseError::NonFinite { .. }
+    ));
     let bad_options = MultiContactOptions {
         tolerance: 0.0,
         ..options
@@ -602,7 +666,10 @@ fn bad_input_is_rejected() {
     };
     let mut mass = TreeMass::new(&tree, vec![point_mass]).expect("mass");
     let err = MechanismInertia::new(&tree, &ws, &mut mass).expect_err("semidefinite");
-    assert!(matches!(err, ImpulseError::SingularMassMatrix { coordinate: 1, .. }), "{err:?}");
+    assert!(
+        matches!(err, ImpulseError::SingularMassMatrix { coordinate: 1, .. }),
+        "{err:?}"
+    );
     // Contact on a body whose point cannot move along the normal while approaching.
     let mut builder = TreeBuilder::new();
     builder.add_body(None, Joint::Revolute { axis: Vector3::z() }, Isometry3::identity());
@@ -612,8 +679,15 @@ fn bad_input_is_rejected() {
     // The point on the axis never moves: approach is impossible, so u_n = 0 → no impulse,
     // while a moving point on the rim tangent to the normal... the immovable contact case:
     let on_axis = ground_contact(0, Vector3::zeros(), law(0.5, 0.0, RestitutionLaw::Stronge));
-    let r = resolve_single_contact(&hinge.tree, &hinge.ws, &hinge.inertia, &[2.0], &on_axis, &ImpactOptions::default())
-        .expect("no approach, no impulse");
+    let r = resolve_single_contact(
+        &hinge.tree,
+        &hinge.ws,
+        &hinge.inertia,
+        &[2.0],
+        &on_axis,
+        &ImpactOptions::default(),
+    )
+    .expect("no approach, no impulse");
     assert_eq!(r.contacts[0].mode, ContactMode::NoImpact);
 }
 
@@ -632,8 +706,8 @@ fn extreme_mass_ratios() {
         ground_contact(1, Vector3::new(0.0, -0.5, 0.0), law(0.2, 0.9, RestitutionLaw::Stronge)),
     ];
     for cs in [&contacts[..1], &contacts[..]] {
-        let r = resolve_contacts(&m.tree, &m.ws, &m.inertia, &q_dot, cs, &MultiContactOptions::default())
-            .expect("impact");
+        let r =
+            resolve_contacts(&m.tree, &m.ws, &m.inertia, &q_dot, cs, &MultiContactOptions::default()).expect("impact");
         let t = r.energy_before;
         assert!(r.energy_change <= 1e-12 * t, "{}", r.energy_change);
         assert!(r.delta_q_dot.iter().all(|d| d.is_finite()));
@@ -642,18 +716,31 @@ fn extreme_mass_ratios() {
 
 fn impact_is_energy_safe(r: &MechanismImpact, m: &Mechanism, q_dot: &[f64]) -> Result<(), TestCaseError> {
     let t = r.energy_before;
-    let scale = t + r.contacts.iter().map(|c| c.normal_impulse * c.u_before_w.norm()).sum::<f64>();
-    prop_assert!(r.energy_change <= 1e-10 * scale, "energy gained: {} (T = {t})", r.energy_change);
+    let scale = t + r
+        .contacts
+        .iter()
+        .map(|c| c.normal_impulse * c.u_before_w.norm())
+        .sum::<f64>();
+    prop_assert!(
+        r.energy_change <= 1e-10 * scale,
+        "energy gained: {} (T = {t})",
+        r.energy_change
+    );
     let dt = m.energy(&r.q_dot_after) - m.energy(q_dot);
-    prop_assert!((dt - r.energy_change).abs() <= 1e-9 * scale, "identity: {dt} vs {}", r.energy_change);
+    prop_assert!(
+        (dt - r.energy_change).abs() <= 1e-9 * scale,
+        "identity: {dt} vs {}",
+        r.energy_change
+    );
     Ok(())
 }
 
 fn joint_strategy() -> impl Strategy<Value = Joint> {
     prop_oneof![
         Just(Joint::Spherical),
-        (-1.0..1.0f64, -1.0..1.0f64, 0.2..1.0f64)
-            .prop_map(|(x, y, z)| Joint::Revolute { axis: Vector3::new(x, y, z).normalize() }),
+        (-1.0..1.0f64, -1.0..1.0f64, 0.2..1.0f64).prop_map(|(x, y, z)| Joint::Revolute {
+            axis: Vector3::new(x, y, z).normalize()
+        }),
         Just(Joint::Revolute { axis: Vector3::z() }),
     ]
 }
@@ -731,3 +818,52 @@ proptest! {
     }
 }
 
+/// The box of the previous test falling flat while sliding fast along x, with f·h_y < h_x so
+/// that all four contacts stay active: friction cannot tip it, so ω⁺ = 0, v_y⁺ = e v_y,
+/// Σ p_n = m (1 + e) v_y, and the slip never halts: v_x⁺ = v_x − f (1 + e) v_y. Every contact
+/// impulse lies in its friction cone.
+#[test]
+fn box_sliding_flat_on_four_rough_contacts() {
+    let mut builder = TreeBuilder::new();
+    builder.add_body(None, Joint::Free, Isometry3::identity());
+    let tree = builder.build().expect("tree");
+    let (mass, hx, hy, hz) = (2.5, 0.4, 0.2, 0.3);
+    let diag = Vector3::new(hy * hy + hz * hz, hx * hx + hz * hz, hx * hx + hy * hy) * (mass / 3.0);
+    let props = solid(mass, diag, Vector3::zeros(), Vector3::zeros());
+    let mech = Mechanism::new(tree, vec![props], &[0.0, hy, 0.0, 0.0, 0.0, 0.0]);
+    let (vx, vy, e, f) = (2.0, 1.5, 0.5, 0.3);
+    let q_dot = [vx, -vy, 0.0, 0.0, 0.0, 0.0];
+    let contacts: Vec<_> = [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)]
+        .iter()
+        .map(|&(sx, sz)| ground_contact(0, Vector3::new(sx * hx, -hy, sz * hz), law(e, f, RestitutionLaw::Stronge)))
+        .collect();
+    let options = MultiContactOptions::default();
+    let r = resolve_contacts(&mech.tree, &mech.ws, &mech.inertia, &q_dot, &contacts, &options).expect("impact");
+    assert!(r.converged, "residual {}", r.complementarity_residual);
+    assert_eq!(r.restitution_scale, 1.0);
+    let tol = 8.0 * options.tolerance * vx.hypot(vy) + 1e-14;
+    let (v_after, w_after) = mech.body_velocity(0, &r.q_dot_after);
+    let expected = Vector3::new(vx - f * (1.0 + e) * vy, e * vy, 0.0);
+    assert!((v_after - expected).norm() <= tol, "{v_after} vs {expected}");
+    assert!(w_after.norm() * hx <= tol, "{w_after}");
+    for c in &r.contacts {
+        assert!(c.normal_impulse > 0.0);
+        assert!(c.tangential_impulse_w.norm() <= f * c.normal_impulse * (1.0 + 1e-12));
+        assert_eq!(c.mode, ContactMode::Slip);
+    }
+    assert!(r.energy_change < 0.0);
+    let dt = 0.5 * mass * (v_after.norm_squared() - vx * vx - vy * vy);
+    assert!((r.energy_change - dt).abs() <= 4.0 * mass * vx * tol);
+}
+
+/// No contacts: a zero impact, and the report is still complete.
+#[test]
+fn no_contacts_is_a_zero_impact() {
+    let m = chain(&[Joint::Spherical]);
+    let q_dot = [0.1, 0.2, 0.3];
+    let r = resolve_contacts(&m.tree, &m.ws, &m.inertia, &q_dot, &[], &MultiContactOptions::default()).expect("empty");
+    assert!(r.contacts.is_empty());
+    assert_eq!(r.delta_q_dot, vec![0.0; 3]);
+    assert_eq!(r.energy_change, 0.0);
+    assert_eq!(r.delassus_rank, 0);
+}

@@ -125,7 +125,8 @@ pub struct MeshMassProperties {
     pub measure: f64,
     /// What the checks found.
     pub diagnostics: MeshDiagnostics,
-    /// Bound on the relative rounding error of `measure`, (BLOCK + n/BLOCK + 16)·ε·Σ|terms|/|measure|;
+    /// Bound on the relative rounding error of `measure`,
+    /// (min(n, BLOCK) + ⌈n/BLOCK⌉ + 16)·ε·Σ|terms|/|measure|;
     /// the first and second moments have errors of the same order relative to their scale.
     pub relative_error_bound: f64,
 }
@@ -544,9 +545,11 @@ pub fn mesh_mass_properties(
         }
         sums.abs_measure /= 6.0;
     }
-    let n = triangles.len() as f64;
-    let relative_error_bound =
-        |measure: f64| (BLOCK as f64 + n / BLOCK as f64 + 16.0) * f64::EPSILON * sums.abs_measure / measure.abs();
+    // Recursive summation within a block (at most min(n, BLOCK) terms), then over the blocks,
+    // plus a few roundings per term.
+    let n = triangles.len();
+    let terms = (n.min(BLOCK) + n.div_ceil(BLOCK) + 16) as f64;
+    let relative_error_bound = |measure: f64| terms * f64::EPSILON * sums.abs_measure / measure.abs();
     let mut flipped = false;
     if model == MeshModel::Solid {
         let volume = sums.v[0];

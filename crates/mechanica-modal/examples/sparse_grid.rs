@@ -18,7 +18,7 @@ fn main() {
     };
     let assembled = clock.elapsed();
     let clock = Instant::now();
-    let sol = match solve_sparse(&p, &SparseOptions { count: k, ..SparseOptions::default() }) {
+    let sol = match solve_sparse(&p, &SparseOptions { count: k, block_size: std::env::var("BLOCK").ok().and_then(|b| b.parse().ok()).unwrap_or(4), tolerance: std::env::var("TOL").ok().and_then(|b| b.parse().ok()).unwrap_or(1e-12), ..SparseOptions::default() }) {
         Ok(s) => s,
         Err(e) => return eprintln!("{e}"),
     };

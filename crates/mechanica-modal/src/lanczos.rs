@@ -30,10 +30,11 @@ use crate::solve::{Mode, ModeGroup, classify, group_modes};
 use crate::sparse_inertia::{SparseInertia, inertia_with, symbolic_supernodal};
 use crate::sparse_pencil::{Csc, SparsePencil, abs_quadratic, frobenius, mul};
 use crate::{ModalError, PencilProblem, Refinement, Selection, SolveOptions, solve};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::LltError;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::{ColRef, Mat, MatMut, MatRef, Side};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+};
+use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 use std::time::{Duration, Instant};
 
 /// Options of [`solve_sparse`].
@@ -49,6 +50,9 @@ pub struct SparseOptions {
     pub max_restarts: usize,
     /// Seed of the pseudo-random start vectors.
     pub seed: u64,
+    /// Block size b of the block Lanczos iteration (≥ 1): b vectors share each pass over the
+    /// Cholesky factor, and an eigenvalue of multiplicity ≤ b is seen in one run.
+    pub block_size: usize,
 }
 
 impl Default for SparseOptions {
@@ -59,6 +63,7 @@ impl Default for SparseOptions {
             tolerance: 1e-12,
             max_restarts: 300,
             seed: 1,
+            block_size: 2,
         }
     }
 }
@@ -74,6 +79,8 @@ pub struct SparseTimings {
     pub refine: Duration,
     /// Inertia (Sturm) checks.
     pub inertia: Duration,
+    /// Of lanczos + refine: the triangular solves with the factor of B − σA.
+    pub solves: Duration,
 }
 
 /// How the sparse result was obtained and how accurate it is.
@@ -83,6 +90,9 @@ pub struct SparseReport {
     pub shift: f64,
     /// Cholesky factorizations tried to find a positive definite B − σA.
     pub shift_attempts: usize,
+    /// Stored entries of the Cholesky factor L of B − σA (0 on the dense path): the memory of
+    /// the solve is O(this + n·basis size).
+    pub factor_nnz: usize,
     /// ‖A‖_F and ‖B‖_F.
     pub norm_a: f64,
     /// ‖B‖_F.
@@ -125,24 +135,58 @@ pub struct SparseModalSolution {
 /// At or below this order the sparse solver converts to dense and calls [`crate::solve`].
 pub const DENSE_LIMIT: usize = 400;
 
-/// Shift-invert operator x ↦ K⁻¹(Ax).
+/// Shift-invert operator x ↦ K⁻¹(Ax) with the Cholesky factor of K = B − σA.
 struct Operator<'a> {
-    llt: Llt<usize, f64>,
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
     a: faer::sparse::SparseColMatRef<'a, usize, f64>,
     applications: usize,
+    solve_time: Duration,
 }
 
 impl Operator<'_> {
-    fn apply(&mut self, x: &[f64], out: &mut [f64]) {
-        mul(self.a, x, out);
-        self.solve(out);
-        self.applications += 1;
+    /// x ← K⁻¹x for an n × b column-major block (one pass over the factor for all columns).
+    /// Sequential: on a shared machine faer's threaded triangular solves contend badly.
+    fn solve_block(&mut self, x: &mut [f64], b: usize) {
+        let clock = Instant::now();
+        let n = self.a.nrows();
+        let req = self.symbolic.solve_in_place_scratch::<f64>(b, Par::Seq);
+        let mut mem = MemBuffer::new(req);
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(x, n, b),
+            Par::Seq,
+            MemStack::new(&mut mem),
+        );
+        self.applications += b;
+        self.solve_time += clock.elapsed();
     }
+}
 
-    fn solve(&self, x: &mut [f64]) {
-        let n = x.len();
-        self.llt.solve_in_place(MatMut::from_column_major_slice_mut(x, n, 1));
-    }
+/// Factors K = B − σA (lower triangle read) with a symbolic analysis of its pattern; on a
+/// non-positive pivot returns its index.
+fn factor_llt(symbolic: &SymbolicCholesky<usize>, k: &Csc) -> Result<Result<Vec<f64>, usize>, ModalError> {
+    let m = k.to_faer();
+    let par = faer::get_global_parallelism();
+    let req = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+    let mut mem = MemBuffer::try_new(req).map_err(|_| ModalError::Factorization {
+        what: "B − σA",
+        detail: "out of memory for the factorization workspace".into(),
+    })?;
+    let mut values = vec![0.0; symbolic.len_val()];
+    let result = symbolic.factorize_numeric_llt(
+        &mut values,
+        m.as_ref(),
+        Side::Lower,
+        Default::default(),
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    );
+    Ok(match result {
+        Ok(_) => Ok(values),
+        Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) => Err(index),
+    })
 }
 
 /// Pseudo-random numbers in [−1, 1).
@@ -157,14 +201,28 @@ impl Lcg {
     }
 }
 
+/// lhs · rhs, sequential (faer's threaded kernels contend on a shared machine at these sizes).
+fn product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
+    let mut out = Mat::<f64>::zeros(lhs.nrows(), rhs.ncols());
+    faer::linalg::matmul::matmul(out.as_mut(), faer::Accum::Replace, lhs, rhs, 1.0, Par::Seq);
+    out
+}
+
 fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
 
-/// A-orthogonalises `w` against the columns of `basis` (n × cols, column-major) and of
-/// `locked`, twice (classical Gram–Schmidt with reorthogonalisation); returns the coefficients
-/// against `basis` and ‖w‖_A² afterwards.
-fn orthogonalise(
+/// Y = M X for n × b column-major blocks.
+fn mul_block(m: faer::sparse::SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64], n: usize) {
+    for (xc, yc) in x.chunks_exact(n).zip(y.chunks_exact_mut(n)) {
+        mul(m, xc, yc);
+    }
+}
+
+/// A-orthogonalises the n × b block `w` against the first `cols` columns of `basis` and all of
+/// `locked`, twice (block classical Gram–Schmidt with reorthogonalisation); returns the
+/// accumulated cols × b coefficients.
+fn orthogonalise_block(
     a: faer::sparse::SparseColMatRef<'_, usize, f64>,
     basis: &[f64],
     cols: usize,
@@ -172,42 +230,113 @@ fn orthogonalise(
     locked_cols: usize,
     w: &mut [f64],
     scratch: &mut [f64],
-) -> (Vec<f64>, f64) {
-    let n = w.len();
-    let mut total = vec![0.0; cols];
+) -> Mat<f64> {
+    let n = a.nrows();
+    let b = w.len() / n;
+    let mut total = Mat::<f64>::zeros(cols, b);
     for _ in 0..2 {
-        mul(a, w, scratch);
-        let z = ColRef::from_slice(scratch);
-        if cols > 0 {
-            let v = MatRef::from_column_major_slice(&basis[..n * cols], n, cols);
-            let h = v.transpose() * z;
-            let update = v * &h;
-            for i in 0..n {
-                w[i] -= update[i];
+        mul_block(a, w, scratch, n);
+        let z = MatRef::from_column_major_slice(scratch, n, b);
+        for (part, count, accumulate) in [(basis, cols, true), (locked, locked_cols, false)] {
+            if count == 0 {
+                continue;
             }
-            for (t, i) in total.iter_mut().zip(0..cols) {
-                *t += h[i];
+            let v = MatRef::from_column_major_slice(&part[..n * count], n, count);
+            let h = product(v.transpose(), z);
+            let update = product(v, h.as_ref());
+            for c in 0..b {
+                let wc = &mut w[n * c..n * (c + 1)];
+                for (i, x) in wc.iter_mut().enumerate() {
+                    *x -= update[(i, c)];
+                }
             }
-        }
-        if locked_cols > 0 {
-            let x = MatRef::from_column_major_slice(&locked[..n * locked_cols], n, locked_cols);
-            let h = x.transpose() * z;
-            let update = x * &h;
-            for i in 0..n {
-                w[i] -= update[i];
+            if accumulate {
+                total += &h;
             }
         }
     }
-    mul(a, w, scratch);
-    (total, dot(w, scratch))
+    total
 }
 
-/// One thick-restart Lanczos run for the `nev` largest θ of T restricted to the A-orthogonal
-/// complement of `locked`. Returns (θ descending, n × nev Ritz vectors column-major, restarts).
+/// A-orthonormalises the columns of the block `w` among themselves (modified Gram–Schmidt, each
+/// column against the earlier ones, twice); returns the b × b upper triangular R with
+/// W_old = W_new R. A column that vanishes (invariant subspace) is replaced by a random vector
+/// orthogonal to everything, with a zero column in R. Errors if A gives a negative norm.
+#[allow(clippy::too_many_arguments)]
+fn normalise_block(
+    a: faer::sparse::SparseColMatRef<'_, usize, f64>,
+    basis: &[f64],
+    cols: usize,
+    locked: &[f64],
+    locked_cols: usize,
+    w: &mut [f64],
+    scale: f64,
+    rng: &mut Lcg,
+) -> Result<Mat<f64>, ModalError> {
+    let n = a.nrows();
+    let b = w.len() / n;
+    let mut r = Mat::<f64>::zeros(b, b);
+    let mut aw = vec![0.0; n];
+    let mut scratch = vec![0.0; n];
+    for c in 0..b {
+        let (done, rest) = w.split_at_mut(n * c);
+        let wc = &mut rest[..n];
+        for _ in 0..2 {
+            mul(a, wc, &mut aw);
+            for d in 0..c {
+                let wd = &done[n * d..n * (d + 1)];
+                let h = dot(wd, &aw);
+                r[(d, c)] += h;
+                for (x, y) in wc.iter_mut().zip(wd) {
+                    *x -= h * y;
+                }
+            }
+        }
+        mul(a, wc, &mut aw);
+        let norm_sq = dot(wc, &aw);
+        if norm_sq < -1e4 * (f64::EPSILON * scale).powi(2) {
+            return Err(ModalError::MassNotSemidefinite { value: norm_sq });
+        }
+        let norm = norm_sq.max(0.0).sqrt();
+        if norm > 1e3 * f64::EPSILON * scale.max(f64::MIN_POSITIVE) {
+            r[(c, c)] = norm;
+            wc.iter_mut().for_each(|x| *x /= norm);
+            continue;
+        }
+        // Deflated direction: a fresh random vector, A-orthogonal to everything so far.
+        let mut replaced = false;
+        for _ in 0..8 {
+            wc.iter_mut().for_each(|x| *x = rng.next());
+            let mut all = basis[..n * cols].to_vec();
+            all.extend_from_slice(done);
+            let _ = orthogonalise_block(a, &all, cols + c, locked, locked_cols, wc, &mut scratch);
+            mul(a, wc, &mut aw);
+            let fresh = dot(wc, &aw);
+            if fresh > 0.0 {
+                let s = fresh.sqrt();
+                wc.iter_mut().for_each(|x| *x /= s);
+                replaced = true;
+                break;
+            }
+        }
+        if !replaced {
+            return Err(ModalError::LanczosNoConvergence {
+                converged: 0,
+                wanted: b,
+                restarts: 0,
+            });
+        }
+    }
+    Ok(r)
+}
+
+/// One block thick-restart Lanczos run for the `nev` largest θ of T restricted to the
+/// A-orthogonal complement of `locked`. Returns (θ descending, n × nev Ritz vectors, restarts).
 #[allow(clippy::too_many_arguments)]
 fn lanczos_run(
     op: &mut Operator<'_>,
     nev: usize,
+    block: usize,
     locked: &[f64],
     locked_cols: usize,
     tolerance: f64,
@@ -217,77 +346,57 @@ fn lanczos_run(
     let a = op.a;
     let n = a.nrows();
     let room = n.saturating_sub(locked_cols);
-    let m = (2 * nev + 8).max(20).min(room);
-    let nev = nev.min(m.saturating_sub(1)).max(1);
-    let mut basis = vec![0.0; n * (m + 1)];
-    let mut h = Mat::<f64>::zeros(m + 1, m);
-    let mut scratch = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    // Start vector: random, A-orthogonal to the locked vectors, A-normalised.
-    let mut start = |w: &mut [f64], basis: &[f64], cols: usize, scratch: &mut [f64]| -> Result<(), ModalError> {
-        for attempt in 0..8 {
-            for x in w.iter_mut() {
-                *x = rng.next();
-            }
-            let (_, norm_sq) = orthogonalise(a, basis, cols, locked, locked_cols, w, scratch);
-            if norm_sq < 0.0 {
-                return Err(ModalError::MassNotSemidefinite { value: norm_sq });
-            }
-            if norm_sq > 0.0 {
-                let s = norm_sq.sqrt().recip();
-                w.iter_mut().for_each(|x| *x *= s);
-                return Ok(());
-            }
-            let _ = attempt;
-        }
-        Err(ModalError::LanczosNoConvergence {
-            converged: 0,
-            wanted: nev,
-            restarts: 0,
-        })
-    };
-    start(&mut w, &basis, 0, &mut scratch)?;
-    basis[..n].copy_from_slice(&w);
-    let mut kept = 0usize;
+    let b = block.clamp(1, (room / 4).max(1));
+    // m basis columns (a multiple of b) plus one residual block.
+    let wanted_m = (2 * nev + 2 * b).max(24);
+    let m = (wanted_m.div_ceil(b) * b).min((room.saturating_sub(b) / b) * b);
+    if m < 2 * b || nev >= m {
+        return Err(ModalError::TooManyModes {
+            requested: nev + locked_cols,
+            available: n,
+        });
+    }
+    let mut basis = vec![0.0; n * (m + b)];
+    let mut h = Mat::<f64>::zeros(m + b, m);
+    let mut scratch = vec![0.0; n * b];
+    let mut w = vec![0.0; n * b];
+    // Start block: random, A-orthonormal, A-orthogonal to the locked vectors.
+    w.iter_mut().for_each(|x| *x = rng.next());
+    let _ = orthogonalise_block(a, &[], 0, locked, locked_cols, &mut w, &mut scratch);
+    normalise_block(a, &[], 0, locked, locked_cols, &mut w, 1.0, rng)?;
+    basis[..n * b].copy_from_slice(&w);
+    let mut cols = 0usize;
     let mut restarts = 0usize;
     loop {
-        for j in kept..m {
-            let (done, rest) = basis.split_at_mut(n * (j + 1));
-            let vj = &done[n * j..n * (j + 1)];
-            op.apply(vj, &mut w);
-            let (coefficients, norm_sq) = orthogonalise(a, done, j + 1, locked, locked_cols, &mut w, &mut scratch);
-            for (i, c) in coefficients.iter().enumerate() {
-                h[(i, j)] = *c;
-            }
-            // The coupling θ-scale: |h_jj| ~ θ; an A-norm below u·θ·‖v‖ means an invariant subspace.
-            let scale = coefficients.iter().fold(0.0_f64, |s, c| s.max(c.abs()));
-            if norm_sq < -(f64::EPSILON * scale).powi(2) * 1e4 {
-                return Err(ModalError::MassNotSemidefinite { value: norm_sq });
-            }
-            let beta = norm_sq.max(0.0).sqrt();
-            let next = &mut rest[..n];
-            if beta > 1e3 * f64::EPSILON * scale {
-                let s = beta.recip();
-                for (x, y) in next.iter_mut().zip(&w) {
-                    *x = y * s;
+        while cols < m {
+            let current = &basis[n * cols..n * (cols + b)];
+            mul_block(a, current, &mut w, n);
+            op.solve_block(&mut w, b);
+            let coefficients = orthogonalise_block(a, &basis, cols + b, locked, locked_cols, &mut w, &mut scratch);
+            let scale = (0..cols + b)
+                .flat_map(|i| (0..b).map(move |c| (i, c)))
+                .fold(0.0_f64, |s, (i, c)| s.max(coefficients[(i, c)].abs()));
+            let r = normalise_block(a, &basis, cols + b, locked, locked_cols, &mut w, scale, rng)?;
+            for c in 0..b {
+                for i in 0..cols + b {
+                    h[(i, cols + c)] = coefficients[(i, c)];
                 }
-                h[(j + 1, j)] = beta;
-            } else {
-                // Invariant subspace found: continue with a fresh direction, coupling 0.
-                start(&mut w, done, j + 1, &mut scratch)?;
-                next.copy_from_slice(&w);
-                h[(j + 1, j)] = 0.0;
+                for i in 0..b {
+                    h[(cols + b + i, cols + c)] = r[(i, c)];
+                }
             }
+            basis[n * (cols + b)..n * (cols + 2 * b)].copy_from_slice(&w);
+            cols += b;
         }
-        // Ritz pairs of the symmetrised projected matrix.
+        // Ritz pairs of the symmetrised projected matrix; coupling rows m..m+b.
         let hm = Mat::from_fn(m, m, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
         let eig = hm
             .self_adjoint_eigen(Side::Lower)
             .map_err(|_| ModalError::NoConvergence { n: m })?;
         let theta: Vec<f64> = (0..m).map(|i| eig.S()[i]).collect();
         let y = eig.U();
-        // Wanted: the nev largest θ (last columns). Residual |c·y| with c the coupling row m.
-        let residual = |col: usize| -> f64 { (0..m).map(|i| h[(m, i)] * y[(i, col)]).sum::<f64>().abs() };
+        let coupling = product(h.as_ref().submatrix(m, 0, b, m), y);
+        let residual = |col: usize| -> f64 { (0..b).map(|i| coupling[(i, col)].powi(2)).sum::<f64>().sqrt() };
         let wanted: Vec<usize> = (0..nev).map(|r| m - 1 - r).collect();
         let converged = wanted
             .iter()
@@ -296,7 +405,7 @@ fn lanczos_run(
         let v = MatRef::from_column_major_slice(&basis[..n * m], n, m);
         if converged == nev {
             let ys = Mat::from_fn(m, nev, |i, r| y[(i, wanted[r])]);
-            let x = v * &ys;
+            let x = product(v, ys.as_ref());
             let mut out = vec![0.0; n * nev];
             for r in 0..nev {
                 for i in 0..n {
@@ -313,25 +422,28 @@ fn lanczos_run(
             });
         }
         restarts += 1;
-        // Thick restart: keep the p largest Ritz vectors and the residual direction.
-        let p = (nev + (m - nev) / 2).min(m - 1).max(nev);
+        // Thick restart: keep the p largest Ritz vectors and the residual block.
+        // p ≡ m (mod b), so that the expansions fill the basis exactly.
+        let p_wanted = (nev + (m - nev) / 2).min(m - b).max(nev);
+        let p = m - (m - p_wanted).div_ceil(b) * b;
         let keep: Vec<usize> = (0..p).map(|r| m - 1 - r).collect();
         let ys = Mat::from_fn(m, p, |i, r| y[(i, keep[r])]);
-        let x = v * &ys;
-        let coupling: Vec<f64> = keep.iter().map(|&c| (0..m).map(|i| h[(m, i)] * y[(i, c)]).sum()).collect();
-        let residual_vector: Vec<f64> = basis[n * m..n * (m + 1)].to_vec();
+        let x = product(v, ys.as_ref());
+        let residual_block: Vec<f64> = basis[n * m..n * (m + b)].to_vec();
         for r in 0..p {
             for i in 0..n {
                 basis[i + n * r] = x[(i, r)];
             }
         }
-        basis[n * p..n * (p + 1)].copy_from_slice(&residual_vector);
+        basis[n * p..n * (p + b)].copy_from_slice(&residual_block);
         h.fill(0.0);
         for r in 0..p {
             h[(r, r)] = theta[keep[r]];
-            h[(p, r)] = coupling[r];
+            for i in 0..b {
+                h[(p + i, r)] = coupling[(i, keep[r])];
+            }
         }
-        kept = p;
+        cols = p;
     }
 }
 
@@ -361,24 +473,24 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
     // Factor K = B − σA at a shift below the spectrum.
     let clock = Instant::now();
     let pattern = Csc::combine(1.0, &cb, 1.0, &ca);
-    let symbolic = SymbolicLlt::try_new(pattern.to_faer().symbolic(), Side::Lower).map_err(|e| {
-        ModalError::Factorization {
-            what: "B − σA (symbolic)",
-            detail: format!("{e:?}"),
-        }
+    let symbolic = factorize_symbolic_cholesky(
+        pattern.to_faer().symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Amd,
+        CholeskySymbolicParams::default(),
+    )
+    .map_err(|e| ModalError::Factorization {
+        what: "B − σA (symbolic)",
+        detail: format!("{e:?}"),
     })?;
     let ratio = if norm_a > 0.0 { norm_b / norm_a } else { 1.0 };
     let mut sigma = options.shift.unwrap_or(-f64::EPSILON.sqrt() * ratio.max(f64::MIN_POSITIVE));
     let mut attempts = 0;
-    let (llt, sigma) = loop {
+    let values = loop {
         attempts += 1;
-        let kmat = Csc::combine(1.0, &cb, -sigma, &ca).to_faer();
-        match Llt::try_new_with_symbolic(symbolic.clone(), kmat.as_ref(), Side::Lower) {
-            Ok(llt) => break (llt, sigma),
-            Err(LltError::Numeric(e)) => {
-                let pivot = match e {
-                    faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => index,
-                };
+        match factor_llt(&symbolic, &Csc::combine(1.0, &cb, -sigma, &ca))? {
+            Ok(values) => break values,
+            Err(pivot) => {
                 if options.shift.is_some() || attempts >= 6 {
                     return Err(ModalError::NoDefiniteShift {
                         lowest_shift: sigma,
@@ -387,19 +499,15 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
                 }
                 sigma *= 1e3;
             }
-            Err(LltError::Generic(e)) => {
-                return Err(ModalError::Factorization {
-                    what: "B − σA",
-                    detail: format!("{e:?}"),
-                });
-            }
         }
     };
     timings.factor = clock.elapsed();
     let mut op = Operator {
-        llt,
+        symbolic,
+        values,
         a,
         applications: 0,
+        solve_time: Duration::ZERO,
     };
     let mut rng = Lcg(options.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x5851_f42d_4c95_7f2d);
     // First run: k plus a buffer, so that a gap above the k-th mode is seen.
@@ -408,6 +516,7 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
     let (_, mut found, mut restarts) = lanczos_run(
         &mut op,
         (k + buffer).min(n - 1),
+        options.block_size,
         &[],
         0,
         options.tolerance,
@@ -456,9 +565,11 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
             timings.refine += clock.elapsed();
             let mut solution = solution;
             solution.report.shift_attempts = attempts;
+            solution.report.factor_nnz = op.symbolic.len_val();
             solution.report.restarts = restarts;
             solution.report.lanczos_runs = runs;
             solution.report.timings = timings;
+            solution.report.timings.solves = op.solve_time;
             return Ok(solution);
         }
         // Missed modes (repeated eigenvalues): rerun deflated against everything found.
@@ -466,6 +577,7 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
         let (_, more, r) = lanczos_run(
             &mut op,
             (missing + 1).min(n - cols - 1).max(1),
+            options.block_size,
             &refined.vectors,
             cols,
             options.tolerance,
@@ -506,8 +618,8 @@ fn rayleigh_ritz(pencil: &SparsePencil, x: &[f64], cols: usize) -> Result<Refine
         mul(b, &x[n * c..n * (c + 1)], &mut bx[n * c..n * (c + 1)]);
     }
     let xm = MatRef::from_column_major_slice(x, n, cols);
-    let pa = xm.transpose() * MatRef::from_column_major_slice(&ax, n, cols);
-    let pb = xm.transpose() * MatRef::from_column_major_slice(&bx, n, cols);
+    let pa = product(xm.transpose(), MatRef::from_column_major_slice(&ax, n, cols));
+    let pb = product(xm.transpose(), MatRef::from_column_major_slice(&bx, n, cols));
     let sym = |m: &Mat<f64>| Mat::from_fn(cols, cols, |i, j| 0.5 * (m[(i, j)] + m[(j, i)]));
     let projected = PencilProblem::new(sym(&pa).as_ref(), sym(&pb).as_ref())?;
     let sol = solve(
@@ -520,7 +632,7 @@ fn rayleigh_ritz(pencil: &SparsePencil, x: &[f64], cols: usize) -> Result<Refine
     )?;
     let y = sol.vectors.ok_or(ModalError::NoConvergence { n: cols })?;
     let finite = sol.modes.iter().take_while(|m| m.omega_sq.is_finite()).count();
-    let z = xm * y.subcols(0, finite);
+    let z = product(xm, y.subcols(0, finite));
     let mut vectors = vec![0.0; n * finite];
     for c in 0..finite {
         for i in 0..n {
@@ -556,6 +668,9 @@ fn finish(
     let mut eta = vec![0.0; cols];
     let mut rounding = vec![0.0; cols];
     let mut omega_sq = refined.omega_sq.clone();
+    // Residuals s = Ax − θKx of every pair, solved with K in one block.
+    let mut residuals = vec![0.0; n * cols];
+    let mut xkx = vec![0.0; cols];
     for c in 0..cols {
         let x = &refined.vectors[n * c..n * (c + 1)];
         // Rayleigh quotient and residuals in double-double: the bounds below then need no
@@ -568,15 +683,12 @@ fn finish(
         omega_sq[c] = w;
         let t = 1.0 / (w - sigma);
         theta[c] = t;
-        // s = Ax − θ(Bx − σAx); ‖s‖²_{K⁻¹} = sᵀK⁻¹s; ‖x‖²_K = xᵀBx − σxᵀAx.
+        // s = Ax − θ(Bx − σAx); ‖x‖²_K = xᵀBx − σxᵀAx.
         let (td, sd) = (Dd::of(t), Dd::of(sigma));
-        let s: Vec<f64> = (0..n)
-            .map(|i| ax_dd[i].minus(td.times(bx_dd[i].minus(sd.times(ax_dd[i])))).to_f64())
-            .collect();
-        let mut ks = s.clone();
-        op.solve(&mut ks);
-        let xkx = xbx.minus(sd.times(xax)).to_f64();
-        delta[c] = (dot(&s, &ks).max(0.0) / xkx.max(f64::MIN_POSITIVE)).sqrt();
+        for i in 0..n {
+            residuals[i + n * c] = ax_dd[i].minus(td.times(bx_dd[i].minus(sd.times(ax_dd[i])))).to_f64();
+        }
+        xkx[c] = xbx.minus(sd.times(xax)).to_f64();
         let wd = Dd::of(w);
         let r: Vec<f64> = (0..n).map(|i| bx_dd[i].minus(wd.times(ax_dd[i])).to_f64()).collect();
         let xn = dot(x, x).sqrt();
@@ -585,6 +697,13 @@ fn finish(
         // Rounding of the double-double quotient and its final rounding to double.
         rounding[c] = 2.0 * f64::EPSILON * w.abs()
             + max_row * f64::EPSILON * f64::EPSILON * (abs_quadratic(b, x) + w.abs() * abs_quadratic(a, x)) / xax;
+    }
+    let mut solved = residuals.clone();
+    op.solve_block(&mut solved, cols);
+    for c in 0..cols {
+        let sc = &residuals[n * c..n * (c + 1)];
+        let kc = &solved[n * c..n * (c + 1)];
+        delta[c] = (dot(sc, kc).max(0.0) / xkx[c].max(f64::MIN_POSITIVE)).sqrt();
     }
     // Clusters of θ whose δ-intervals overlap; Kato–Temple with the gap to other clusters and to
     // θ(τ) (no eigenvalue with ω² < τ is unaccounted for when the inertia check passed).
@@ -635,6 +754,7 @@ fn finish(
         report: SparseReport {
             shift: sigma,
             shift_attempts: 0,
+            factor_nnz: 0,
             norm_a,
             norm_b,
             restarts: 0,
@@ -674,7 +794,7 @@ fn orthogonality(a: faer::sparse::SparseColMatRef<'_, usize, f64>, x: &Mat<f64>)
             ax[(i, j)] = out[i];
         }
     }
-    let g = x.transpose() * &ax;
+    let g = product(x.transpose(), ax.as_ref());
     let mut worst = 0.0_f64;
     for j in 0..c {
         for i in 0..c {
@@ -714,6 +834,7 @@ fn dense_fallback(pencil: &SparsePencil, k: usize, norm_a: f64, norm_b: f64) -> 
         report: SparseReport {
             shift: f64::NEG_INFINITY,
             shift_attempts: 0,
+            factor_nnz: 0,
             norm_a,
             norm_b,
             restarts: 0,

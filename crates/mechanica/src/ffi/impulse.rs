@@ -20,10 +20,10 @@ use mechanica_impulse::{
     MechanismInertia, MultiContactOptions, PointImpulse, RestitutionLaw, RigidBody, apply_point_impulses, fix_point,
     resolve_contact, resolve_contacts,
 };
-use mechanica_kinematics::tree::{KinematicTree, Workspace};
-use mechanica_mass::mechanism::TreeMass;
 use mechanica_kinematics::nalgebra::{Matrix3, Vector3};
+use mechanica_kinematics::tree::{KinematicTree, Workspace};
 use mechanica_mass::MassProperties;
+use mechanica_mass::mechanism::TreeMass;
 
 impl From<ImpulseError> for FfiError {
     fn from(error: ImpulseError) -> Self {

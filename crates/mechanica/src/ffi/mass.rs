@@ -7,9 +7,9 @@ use super::types::*;
 use super::validate::*;
 use mechanica_kinematics::nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 use mechanica_kinematics::rotation::{self, QuaternionNorm};
+use mechanica_mass::mechanism::{DragField, EnergySplit, SplitBuffers, TreeMass};
 use mechanica_mass::mesh::{DegeneratePolicy, InsideOutPolicy, MeshModel, MeshOptions, OpenMeshPolicy};
 use mechanica_mass::validity::{self, InertiaClass, InertiaIssue, ValidityTolerance};
-use mechanica_mass::mechanism::{DragField, EnergySplit, SplitBuffers, TreeMass};
 use mechanica_mass::{Amount, MassError, MassProperties, primitives};
 
 /// Mass properties: mass (kg), centre of mass (m, in the body's reference frame) and the
@@ -29,7 +29,9 @@ impl From<MassError> for FfiError {
     fn from(error: MassError) -> Self {
         let status = match &error {
             MassError::NonFinite { .. } | MassError::NonFiniteVertex { .. } => MECH_STATUS_NON_FINITE,
-            MassError::TooManyVertices(_) | MassError::TooManyTriangles(_) | MassError::WrongLength { .. } => MECH_STATUS_BAD_DIMENSION,
+            MassError::TooManyVertices(_) | MassError::TooManyTriangles(_) | MassError::WrongLength { .. } => {
+                MECH_STATUS_BAD_DIMENSION
+            }
             MassError::Kinematics(e) => return FfiError::from(e.clone()),
             MassError::Body { error: inner, .. } => FfiError::from((**inner).clone()).status,
             MassError::InvalidInertia(issues)
@@ -931,8 +933,14 @@ unsafe fn tree_mass<'a>(
     tree: *mut mech_tree_t,
     bodies: *const mech_mass_properties_t,
     body_count: usize,
-) -> Result<(TreeMass, &'a mechanica_kinematics::tree::KinematicTree, &'a mechanica_kinematics::tree::Workspace), FfiError>
-{
+) -> Result<
+    (
+        TreeMass,
+        &'a mechanica_kinematics::tree::KinematicTree,
+        &'a mechanica_kinematics::tree::Workspace,
+    ),
+    FfiError,
+> {
     // SAFETY: caller's contract.
     let t = unsafe { tree_mut(tree) }?;
     // SAFETY: caller's contract.
