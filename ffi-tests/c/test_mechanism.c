@@ -137,7 +137,8 @@ int main(void) {
     CHECK_STATUS(mech_mechanism_create(tree, &wheel, 1, &unfinished), MECH_STATUS_INVALID_ARGUMENT); /* not finalized */
     CHECK(unfinished == NULL);
     CHECK_STATUS(mech_tree_finalize(tree), MECH_STATUS_OK);
-    CHECK_STATUS(mech_mechanism_create(tree, &wheel, 2, &unfinished), MECH_STATUS_BAD_DIMENSION);
+    const mech_mass_properties_t two_wheels[2] = {wheel, wheel};
+    CHECK_STATUS(mech_mechanism_create(tree, two_wheels, 2, &unfinished), MECH_STATUS_BAD_DIMENSION);
     mech_mechanism_t *w = NULL;
     CHECK_STATUS(mech_mechanism_create(tree, &wheel, 1, &w), MECH_STATUS_OK);
     const mech_vec3_t rim = {0.1, 0.0, 0.0}, tangential = {0.0, 3.0, 0.0};
