@@ -43,7 +43,7 @@ fn meshes(c: &mut Criterion) {
         let n = mesh.triangles.len() as u64;
         group.throughput(Throughput::Elements(n));
         group.bench_with_input(BenchmarkId::new("mechanica", n), &mesh, |b, mesh| {
-            b.iter(|| mesh_topology(mesh.vertices.len(), black_box(&mesh.triangles)))
+            b.iter(|| mesh_topology(mesh.vertices.len(), black_box(&mesh.triangles)).map(|t| t.boundary_edges))
         });
     }
     group.finish();

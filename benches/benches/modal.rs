@@ -112,9 +112,11 @@ fn sparse(c: &mut Criterion) {
         count: 10,
         ..SparseOptions::default()
     };
-    group.bench_with_input(BenchmarkId::new("mechanica_lowest10_grid", side * side), &pencil, |bch, p| {
-        bch.iter(|| solve_sparse(black_box(p), &options).map(|s| s.modes[0].omega_sq))
-    });
+    group.bench_with_input(
+        BenchmarkId::new("mechanica_lowest10_grid", side * side),
+        &pencil,
+        |bch, p| bch.iter(|| solve_sparse(black_box(p), &options).map(|s| s.modes[0].omega_sq)),
+    );
     group.finish();
 }
 

@@ -6,6 +6,7 @@ mod mass_command;
 mod mechanism_run;
 mod plots;
 mod progress;
+mod urdf;
 mod report;
 mod scene;
 mod scene_run;
@@ -20,6 +21,10 @@ struct Cli {
     /// Print the machine-readable JSON report instead of the text report.
     #[arg(long, global = true)]
     json: bool,
+    /// URDF input: replace invalid link inertias by the nearest physical tensors (and say so)
+    /// instead of refusing the file.
+    #[arg(long, global = true)]
+    repair_inertia: bool,
     /// Write SVG plots (spectrum, mode shapes, free response, impact energy) into this directory.
     #[arg(long, global = true, value_name = "DIR")]
     plot: Option<std::path::PathBuf>,
@@ -29,7 +34,7 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Run a scene file (TOML; see the format in the README), or the built-in default scene
+    /// Run a scene file (TOML; see the format in the README) or a URDF robot, or the built-in default scene
     /// when no file is given (also what a bare `mechanica` does).
     Run {
         /// The scene file.
@@ -46,6 +51,15 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let report = match cli.command.unwrap_or(Command::Run { scene: None }) {
         Command::Run { scene: None } => default_scene::run(cli.plot.as_deref()),
+        Command::Run { scene: Some(path) } if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) => {
+            urdf::load(&path, cli.repair_inertia).and_then(|(scene, notes)| {
+                let mut report = scene_run::run(&scene, &path, cli.plot.as_deref())?;
+                if let Some(first) = report.steps.first_mut() {
+                    first.notes.extend(notes);
+                }
+                Ok(report)
+            })
+        }
         Command::Run { scene: Some(path) } => scene::Scene::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| scene_run::run(&scene, &path, cli.plot.as_deref())),

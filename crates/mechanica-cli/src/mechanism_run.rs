@@ -9,7 +9,7 @@ use mechanica::kinematics::nalgebra::{Unit, Vector3};
 use mechanica::mechanism::potentials::{ConstantForce, JointSpring, PointSpring};
 use mechanica::mechanism::{
     Anchor, EquilibriumOptions, Mechanism, MechanismModes, RotatingFrame, Seek, Stability, find_equilibria,
-    find_equilibrium, mechanism_modes,
+    find_equilibrium, mechanism_modes, mechanism_modes_with_locks,
 };
 use mechanica::modal::response::FreeResponse;
 use mechanica::modal::{ModeKind, PencilProblem, Selection, SolveOptions};
@@ -116,6 +116,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     })?);
     let mut mechanism = built.ok_or("internal: mechanism not built")?;
     let mut q = model.q0.clone();
+    let mut locked: Vec<usize> = Vec::new();
     if let Some(spec) = &analyses.equilibrium {
         let options = EquilibriumOptions {
             seek: match spec.seek.as_ref().map(|s| s.get_ref().as_str()) {
@@ -141,6 +142,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
                 quantity("U* at equilibrium", vec![eq.potential], "J", None),
             ];
             q = eq.q;
+            locked = eq.at_limit;
             Ok::<_, String>(quantities)
         })?;
         if !spec.starts.is_empty() {
@@ -187,7 +189,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     };
     let mut modes: Option<MechanismModes> = None;
     let mut step = timed_step("modes: det(λA + B) = 0 at the equilibrium (8.84–8.92)", || {
-        let m = mechanism_modes(&mut mechanism, &q, &options).map_err(|e| e.to_string())?;
+        let m = mechanism_modes_with_locks(&mut mechanism, &q, &locked, &options).map_err(|e| e.to_string())?;
         let quantities = mode_quantities(&m);
         modes = Some(m);
         Ok::<_, String>(quantities)
@@ -206,6 +208,11 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
         step.notes.push(format!(
             "warning: |grad U*| = {:.2e} at this configuration: it is not an equilibrium; the modes are those of the linearisation",
             modes.gradient_norm
+        ));
+    }
+    if !locked.is_empty() {
+        step.notes.push(format!(
+            "coordinates {locked:?} rest on joint limits at the equilibrium and are held fixed for the modes"
         ));
     }
     steps.push(step);

@@ -21,6 +21,7 @@
 //! child = "upper"
 //! axis = [0.0, 1.0, 0.0]               # revolute / prismatic / planar normal, parent frame
 //! origin = [0.0, 0.0, 0.0]             # joint frame origin in the parent frame, m
+//! rpy = [0.0, 0.0, 0.0]                # joint frame orientation (URDF roll-pitch-yaw), rad
 //! q0 = [0.1]                           # initial coordinates (length = joint's q size)
 //! qd0 = [0.0]                          # initial velocities; optional (default 0)
 //! limits = [-1.5, 1.5]                 # 1-coordinate joints: limits for equilibrium searches
@@ -232,6 +233,10 @@ pub struct JointSpec {
     /// Joint-frame origin in the parent frame, m.
     #[serde(default)]
     pub origin: [f64; 3],
+    /// Joint-frame orientation in the parent frame: roll, pitch, yaw about the parent's x, y,
+    /// z axes (R = R_z(yaw) R_y(pitch) R_x(roll), as in URDF), rad.
+    #[serde(default)]
+    pub rpy: [f64; 3],
     /// Initial generalized coordinates.
     pub q0: Option<Spanned<Vec<f64>>>,
     /// Initial generalized velocities.
@@ -393,6 +398,11 @@ impl Scene {
         })?;
         scene.validate(text, file)?;
         Ok(scene)
+    }
+
+    /// Validates a scene built in memory (e.g. from a URDF); errors name the file and field.
+    pub fn check(&self, file: &Path) -> Result<(), String> {
+        self.validate("", file).map_err(|e| e.to_string())
     }
 
     /// Checks what the schema cannot: unique names, resolvable references, one parent per body,

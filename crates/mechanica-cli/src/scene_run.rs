@@ -2,7 +2,7 @@
 
 use crate::report::{Quantity, Report, Step, timed_step};
 use crate::scene::{BodySpec, JointKind, JointSpec, Scene};
-use mechanica::kinematics::nalgebra::{Isometry3, Matrix3, Vector3};
+use mechanica::kinematics::nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use mechanica::kinematics::tree::{Joint, KinematicTree, TreeBuilder};
 use mechanica::mass::MassProperties;
 use mechanica::mass::mesh::MeshOptions;
@@ -75,6 +75,14 @@ fn body_mass(body: &BodySpec, index: usize, file: &Path) -> Result<MassPropertie
     if let Some(m) = &body.mass_properties {
         let [ixx, iyy, izz, ixy, ixz, iyz] = m.inertia;
         let inertia = Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
+        if m.mass == 0.0 && inertia == Matrix3::zeros() {
+            // A massless link (a frame), common in URDF files.
+            return Ok(MassProperties {
+                mass: 0.0,
+                p_oc: Vector3::from(m.com),
+                inertia_c: inertia,
+            });
+        }
         return MassProperties::new(m.mass, Vector3::from(m.com), inertia).map_err(|e| located(&e));
     }
     if let Some(p) = &body.primitive {
@@ -157,7 +165,10 @@ pub(crate) fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
         let index = builder.add_body(
             parent,
             lib_joint,
-            Isometry3::translation(joint.origin[0], joint.origin[1], joint.origin[2]),
+            Isometry3::from_parts(
+                Vector3::from(joint.origin).into(),
+                UnitQuaternion::from_euler_angles(joint.rpy[0], joint.rpy[1], joint.rpy[2]),
+            ),
         );
         debug_assert_eq!(index, i);
         match &joint.q0 {

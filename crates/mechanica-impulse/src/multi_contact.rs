@@ -11,9 +11,10 @@
 //!    0 ≤ p_n ⊥ v_n ≥ 0 at every contact, and |P_t| ≤ f p_n with P_t = −f p_n v_t/|v_t| when
 //!    v_t ≠ 0. Every solution of these conditions dissipates energy:
 //!    ΔT = P·v − ½ PᵀWP = −Σ f p_n |v_t| − ½ PᵀWP ≤ 0.
-//!    Without friction this is the linear complementarity problem of Pinocchio's
-//!    `impulseDynamics` with restitution 0, and also the minimum of the convex quadratic
-//!    ½ PᵀWP + P·u⁻ over P ≥ 0.
+//!    Without friction this is the linear complementarity problem 0 ≤ P ⊥ W P + u⁻ ≥ 0, i.e.
+//!    the minimum of the convex quadratic ½ PᵀWP + P·u⁻ over P ≥ 0; when every normal impulse
+//!    comes out positive it is the bilateral KKT system of Pinocchio's `impulseDynamics`
+//!    (the tests compare with it, with f = ∞ and restitution 0).
 //! 2. **Restitution** (Poisson per contact): each contact receives the normal impulse
 //!    e_i p_c,i on top, while friction, again complementary with the tangential velocity and
 //!    bounded by f_i e_i p_c,i, acts during this phase. For frictionless contacts with one
@@ -34,7 +35,12 @@
 //! impulse minimises ½ PᵀWP + P·u⁻ over p_n ≥ 0, then the tangential impulse minimises it
 //! over the disk |P_t| ≤ f p_n (a 2-D trust-region problem solved through the eigenvalues of
 //! W_tt,i); its optimality condition is exactly Coulomb's law at that contact. Sweeps stop
-//! when the complementarity residual (below) is ≤ `tolerance`·max|u⁻|.
+//! when the complementarity residual (below) is ≤ `tolerance`·max|u⁻|. Frictionless, the
+//! sweep is coordinate descent on a convex quadratic and converges; with friction the
+//! Coulomb problem is not convex and convergence is not guaranteed: when the sweep budget
+//! runs out the result is returned with `converged = false` and its residual, and an
+//! unconverged compression phase that would gain energy is scaled back like the restitution.
+//! With f = +∞ a contact's tangential impulse is unbounded (it sticks whenever p_n > 0).
 //!
 //! When W is rank deficient (redundant contacts: duplicated points, four coplanar contacts
 //! of a body, planar mechanisms) the velocities u⁺ and Δq̇ of the frictionless problem are
@@ -115,6 +121,9 @@ struct Block {
     restitution: f64,
     w_nn: f64,
     w_tt: Matrix2<f64>,
+    /// Eigenvalues (clamped ≥ 0) and eigenvectors of W_tt, computed once.
+    eig_values: Vector2<f64>,
+    eig_vectors: Matrix2<f64>,
     /// Largest eigenvalue of W_tt.
     l_t: f64,
 }
@@ -169,14 +178,17 @@ fn simultaneous(
             w[3 * i + 1 + rows * 3 * i],
             w[3 * i + 1 + rows * (3 * i + 1)],
         );
-        let l_t = w_tt.symmetric_eigenvalues().max().max(0.0);
+        let eig = w_tt.symmetric_eigen();
+        let eig_values = eig.eigenvalues.map(|l| l.max(0.0));
         blocks.push(Block {
             active: movable,
             friction: contact.law.friction,
             restitution: contact.law.restitution,
             w_nn,
             w_tt,
-            l_t,
+            eig_values,
+            eig_vectors: eig.eigenvectors,
+            l_t: eig_values.max(),
         });
     }
     let speed = u.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
@@ -328,7 +340,7 @@ fn tangential_update(b: &Block, i: usize, radius: f64, p: &mut [f64], sweeper: &
     }
     let pt = Vector2::new(p[3 * i], p[3 * i + 1]);
     let c = sweeper.v_t(i) - b.w_tt * pt;
-    let x = disk_minimizer(&b.w_tt, &c, radius);
+    let x = disk_minimizer(&b.eig_values, &b.eig_vectors, &c, radius);
     sweeper.push(3 * i, x.x - pt.x);
     sweeper.push(3 * i + 1, x.y - pt.y);
     p[3 * i] = x.x;
@@ -362,16 +374,15 @@ fn residual(blocks: &[Block], p1: &[f64], p: &[f64], sweeper: &Sweeper<'_>, phas
     worst
 }
 
-/// Minimises ½ xᵀ W x + cᵀ x over the disk |x| ≤ r (W symmetric PSD 2×2, r may be +∞).
+/// Minimises ½ xᵀ W x + cᵀ x over the disk |x| ≤ r (W = V diag(λ) Vᵀ symmetric PSD 2×2 given
+/// by its clamped eigenvalues `lam` and eigenvectors `v`; r may be +∞).
 /// Inside: x = −W⁺c; on the boundary x = −(W + μI)⁻¹ c with μ > 0 from the secular equation
 /// |x(μ)| = r (monotone; safeguarded Newton on 1/|x| − 1/r, as in Moré–Sorensen).
-fn disk_minimizer(w: &Matrix2<f64>, c: &Vector2<f64>, r: f64) -> Vector2<f64> {
+fn disk_minimizer(lam: &Vector2<f64>, v: &Matrix2<f64>, c: &Vector2<f64>, r: f64) -> Vector2<f64> {
     if r <= 0.0 {
         return Vector2::zeros();
     }
-    let eig = w.symmetric_eigen();
-    let lam = eig.eigenvalues.map(|l| l.max(0.0));
-    let cp = eig.eigenvectors.transpose() * c;
+    let cp = v.transpose() * c;
     let lam_max = lam.max();
     let zero = 1e-12 * lam_max;
     let mut interior = Vector2::zeros();
@@ -386,7 +397,7 @@ fn disk_minimizer(w: &Matrix2<f64>, c: &Vector2<f64>, r: f64) -> Vector2<f64> {
     // With f = ∞ the disk is the plane: the min-norm unconstrained minimiser (a slip along a
     // direction the mechanism cannot change is left as it is).
     if (!unbounded && interior.norm() <= r) || r.is_infinite() {
-        return eig.eigenvectors * interior;
+        return v * interior;
     }
     let norm_at = |mu: f64| (cp.x / (lam.x + mu)).hypot(cp.y / (lam.y + mu));
     let (mut lo, mut hi) = (0.0_f64, cp.norm() / r);
@@ -415,24 +426,29 @@ fn disk_minimizer(w: &Matrix2<f64>, c: &Vector2<f64>, r: f64) -> Vector2<f64> {
     let norm = x.norm();
     // Put the result exactly on the disk (the secular root is accurate to a few ulps).
     let x = if norm > 0.0 { x * (r / norm) } else { x };
-    eig.eigenvectors * x
+    v * x
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn minimise(w: &Matrix2<f64>, c: &Vector2<f64>, r: f64) -> Vector2<f64> {
+        let eig = w.symmetric_eigen();
+        disk_minimizer(&eig.eigenvalues.map(|l| l.max(0.0)), &eig.eigenvectors, c, r)
+    }
+
     #[test]
     fn disk_minimizer_interior_and_boundary() {
         let w = Matrix2::new(2.0, 0.5, 0.5, 1.0);
         let c = Vector2::new(-1.0, 0.3);
         // Interior: the unconstrained minimiser −W⁻¹c.
-        let x = disk_minimizer(&w, &c, 10.0);
+        let x = minimise(&w, &c, 10.0);
         let exact = -w.try_inverse().expect("invertible") * c;
         assert!((x - exact).norm() <= 1e-14);
         // Boundary: KKT W x + c = −μ x with μ ≥ 0 and |x| = r.
         let r = 0.1;
-        let x = disk_minimizer(&w, &c, r);
+        let x = minimise(&w, &c, r);
         assert!((x.norm() - r).abs() <= 1e-15);
         let g = w * x + c;
         let cross = g.x * x.y - g.y * x.x;
@@ -448,10 +464,10 @@ mod tests {
         // W = diag(1, 0) with a linear term along the null direction: the minimum is on the
         // boundary and the whole disk is used.
         let w = Matrix2::new(1.0, 0.0, 0.0, 0.0);
-        let x = disk_minimizer(&w, &Vector2::new(0.0, 1.0), 0.5);
+        let x = minimise(&w, &Vector2::new(0.0, 1.0), 0.5);
         assert!((x - Vector2::new(0.0, -0.5)).norm() <= 1e-12, "{x}");
         // No linear term along the null direction: the interior min-norm solution.
-        let x = disk_minimizer(&w, &Vector2::new(-0.2, 0.0), 0.5);
+        let x = minimise(&w, &Vector2::new(-0.2, 0.0), 0.5);
         assert!((x - Vector2::new(0.2, 0.0)).norm() <= 1e-15, "{x}");
     }
 }

@@ -1,4 +1,4 @@
-//! The mass matrix A(q) = [α_kl] of a kinematic tree (8.27–8.28) by a composite-rigid-body
+//! The mass matrix A(q) = \[α_kl\] of a kinematic tree (8.27–8.28) by a composite-rigid-body
 //! recursion, the kinetic energy T = ½ q̇ᵀ A q̇, the generalized momenta ∂T/∂q̇ = A q̇, and the
 //! centre of mass of the whole system with its Jacobian.
 //!
@@ -99,6 +99,9 @@ fn field_product(
 pub struct TreeMass {
     bodies: Vec<MassProperties>,
     composite: Vec<MassProperties>,
+    /// Per coordinate l: the motion column (w_l, v̄_l) with v̄_l = v_l + (o_j − r) × w_l, the
+    /// velocity per unit q̇_l of the body point at the reference r (see `mass_matrix`).
+    columns: Vec<(Vector3<f64>, Vector3<f64>)>,
 }
 
 /// The union of two bodies in one frame; zero-mass parts (massless links) are allowed.
@@ -146,7 +149,12 @@ impl TreeMass {
             })?;
         }
         let composite = bodies.clone();
-        Ok(Self { bodies, composite })
+        let columns = vec![(Vector3::zeros(), Vector3::zeros()); tree.dof()];
+        Ok(Self {
+            bodies,
+            composite,
+            columns,
+        })
     }
 
     /// Fills the composites (subtree mass properties in world components) from the poses of
@@ -182,34 +190,40 @@ impl TreeMass {
             });
         }
         self.update_composites(tree, ws)?;
+        if self.columns.len() != n {
+            self.columns.resize(n, (Vector3::zeros(), Vector3::zeros()));
+        }
+        // Moments are taken about the root's origin r, so that the per-pair work is two dot
+        // products: with c' = x_c − r and v̄_l = v_l + (o_j − r) × w_l, the velocity of the
+        // composite's points is u_l(x) = w_l × (x − r) + v̄_l, and
+        // α_kl = m_c u_k·u_l(x_c) + w_l·J_c w_k = w_l·(J_c w_k + c' × f_k) + v̄_l·f_k with
+        // f_k = m_c u_k(x_c). Taking r on the tree keeps the rounding relative to its size.
+        let root = tree.topological_order().first().copied().unwrap_or(0);
+        let r = ws.position(root)?;
+        for i in 0..tree.body_count() {
+            let d = ws.position(i)? - r;
+            for l in tree.dof_range(i) {
+                let (w, v) = ws.motion_column(l)?;
+                self.columns[l] = (w, v + d.cross(&w));
+            }
+        }
         for i in 0..tree.body_count() {
             let c = self.composite[i];
-            if c.mass == 0.0 {
-                for k in tree.dof_range(i) {
-                    let mut b = Some(i);
-                    while let Some(j) = b {
-                        for l in tree.dof_range(j) {
-                            out[k + n * l] = 0.0;
-                            out[l + n * k] = 0.0;
-                        }
-                        b = tree.parent(j);
-                    }
-                }
-                continue;
-            }
-            let o_i = ws.position(i)?;
+            let c_r = c.p_oc - r;
             for k in tree.dof_range(i) {
-                let (w_k, v_k) = ws.motion_column(k)?;
-                let u_k = w_k.cross(&(c.p_oc - o_i)) + v_k;
-                let p = c.mass * u_k;
-                let l_c = c.inertia_c * w_k;
+                let (w_k, v_k) = self.columns[k];
+                let f = c.mass * (w_k.cross(&c_r) + v_k);
+                let moment = c.inertia_c * w_k + c_r.cross(&f);
                 let mut b = Some(i);
                 while let Some(j) = b {
-                    let o_j = ws.position(j)?;
                     for l in tree.dof_range(j) {
-                        let (w_l, v_l) = ws.motion_column(l)?;
-                        let u_l = w_l.cross(&(c.p_oc - o_j)) + v_l;
-                        let a = p.dot(&u_l) + w_l.dot(&l_c);
+                        let (w_l, v_l) = &self.columns[l];
+                        // A massless composite gives exact zeros (f = 0 and J_c = 0).
+                        let a = if c.mass == 0.0 {
+                            0.0
+                        } else {
+                            w_l.dot(&moment) + v_l.dot(&f)
+                        };
                         out[k + n * l] = a;
                         out[l + n * k] = a;
                     }

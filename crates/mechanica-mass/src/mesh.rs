@@ -238,9 +238,12 @@ pub fn mesh_topology(vertex_count: usize, triangles: &[[u32; 3]]) -> Result<Mesh
                 scope.spawn(move || topology_of_range(triangles, lo, hi))
             })
             .collect();
-        // A worker cannot panic (indices are checked, buffers sized from the same counts), so
-        // a failed join only propagates a panic that is already a bug.
-        handles.into_iter().map(|h| h.join().unwrap_or_default()).collect()
+        // A worker cannot panic (indices are checked, buffers sized from the same counts); if
+        // one did, that bug is re-raised here rather than hidden.
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
     });
     let mut total = MeshTopology::default();
     for p in parts {
@@ -302,6 +305,15 @@ fn topology_of_range(triangles: &[[u32; 3]], lo: usize, hi: usize) -> MeshTopolo
     for v in 0..len {
         let list = &mut bucket[end[v] as usize..end[v + 1] as usize];
         list.sort_unstable();
+        // The common case, a closed and consistently oriented neighbourhood: the sorted list
+        // is pairs (2x, 2x + 1), each edge once in each direction (distinct x by sorting).
+        let mut paired = list.len().is_multiple_of(2);
+        for p in list.chunks_exact(2) {
+            paired &= (p[0] & 1 == 0) & (p[1] == p[0] | 1);
+        }
+        if paired {
+            continue;
+        }
         let mut i = 0;
         while i < list.len() {
             let other = list[i] >> 1;
@@ -608,4 +620,108 @@ pub fn mesh_mass_properties(
         },
         relative_error_bound: relative_error_bound(measure),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tessellation::torus_mesh;
+    use proptest::prelude::*;
+    use std::collections::HashMap;
+
+    /// The edge classification by brute force: a map from undirected edge to the number of
+    /// traversals in each direction.
+    fn reference_topology(triangles: &[[u32; 3]]) -> MeshTopology {
+        let mut uses: HashMap<(u32, u32), (usize, usize)> = HashMap::new();
+        for t in triangles
+            .iter()
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
+        {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let entry = uses.entry((a.min(b), a.max(b))).or_default();
+                if a < b {
+                    entry.0 += 1;
+                } else {
+                    entry.1 += 1;
+                }
+            }
+        }
+        let mut topo = MeshTopology::default();
+        for (forward, backward) in uses.into_values() {
+            match (forward + backward, forward) {
+                (1, _) => topo.boundary_edges += 1,
+                (2, 1) => {}
+                (2, _) => topo.misoriented_edges += 1,
+                _ => topo.non_manifold_edges += 1,
+            }
+        }
+        topo
+    }
+
+    fn add(a: MeshTopology, b: MeshTopology) -> MeshTopology {
+        MeshTopology {
+            boundary_edges: a.boundary_edges + b.boundary_edges,
+            non_manifold_edges: a.non_manifold_edges + b.non_manifold_edges,
+            misoriented_edges: a.misoriented_edges + b.misoriented_edges,
+        }
+    }
+
+    proptest! {
+        /// Random triangle soups over few vertices (so that edges repeat, flip and pile up)
+        /// are classified as the brute-force reference does, also when the vertex range is
+        /// split between workers at any point.
+        #[test]
+        fn bucketed_topology_equals_brute_force(
+            triangles in proptest::collection::vec(proptest::array::uniform3(0u32..12), 1..60),
+            split in 0usize..13,
+        ) {
+            let expected = reference_topology(&triangles);
+            prop_assert_eq!(mesh_topology(12, &triangles).expect("in range"), expected);
+            let parts = add(topology_of_range(&triangles, 0, split.min(12)), topology_of_range(&triangles, split.min(12), 12));
+            prop_assert_eq!(parts, expected);
+        }
+    }
+
+    #[test]
+    fn topology_of_a_large_closed_mesh_is_clean_on_any_number_of_workers() {
+        let mesh = torus_mesh(2.0, 0.5, 300, 250);
+        assert!(mesh.triangles.len() >= PARALLEL_MIN_TRIANGLES);
+        let v = mesh.vertices.len();
+        assert_eq!(mesh_topology(v, &mesh.triangles).expect("ok"), MeshTopology::default());
+        let third = v / 3;
+        let parts = add(
+            add(
+                topology_of_range(&mesh.triangles, 0, third),
+                topology_of_range(&mesh.triangles, third, 2 * third),
+            ),
+            topology_of_range(&mesh.triangles, 2 * third, v),
+        );
+        assert_eq!(parts, MeshTopology::default());
+        // Dropping one triangle opens three edges.
+        assert_eq!(mesh_topology(v, &mesh.triangles[1..]).expect("ok").boundary_edges, 3);
+        assert!(matches!(
+            mesh_topology(3, &[[0, 1, 3]]),
+            Err(MassError::IndexOutOfRange {
+                triangle: 0,
+                corner: 2,
+                index: 3,
+                vertex_count: 3
+            })
+        ));
+    }
+
+    #[test]
+    fn integrals_are_bitwise_identical_on_one_two_and_three_threads() {
+        let mesh = torus_mesh(2.0, 0.5, 200, 100);
+        let (r, _) = reference_point(&mesh.vertices).expect("finite");
+        for block in [solid_block as BlockFn, shell_block] {
+            let one = integrate_on(1, &mesh.vertices, &mesh.triangles, &r, block);
+            for threads in [2, 3, 7] {
+                let many = integrate_on(threads, &mesh.vertices, &mesh.triangles, &r, block);
+                assert_eq!(one.v, many.v);
+                assert_eq!(one.abs_measure, many.abs_measure);
+            }
+        }
+    }
 }

@@ -295,6 +295,38 @@ fn bead_on_a_rotating_translating_rod_matches_the_closed_form() {
     assert!(close(p[0], m * r_dot + m * v * theta.cos()));
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// A(q) does not depend on where the base sits; far from the world origin (1e6) only the
+    /// rounding of the body positions (1e6·ε absolute per placement, accumulated over a depth
+    /// of at most 6 and a few products) enters, so the matrices agree to 64·1e6·ε relative to
+    /// the tree's unit size. A recursion taking moments about the
+    /// world origin would lose about 1e12·ε instead.
+    #[test]
+    fn mass_matrix_keeps_its_accuracy_far_from_the_origin(
+        specs in proptest::collection::vec(spec(), 1..7),
+        seed in proptest::collection::vec(-1.0f64..1.0, 40),
+    ) {
+        let (tree, clouds) = build(&specs);
+        let n = tree.dof();
+        let q: Vec<f64> = (0..n).map(|k| seed[k % seed.len()]).collect();
+        let bodies: Vec<MassProperties> = clouds.iter().map(body_properties).collect();
+        let mut mass = TreeMass::new(&tree, bodies).expect("valid bodies");
+        let mut at = |position: Vector3<f64>| {
+            let mut ws = tree.workspace();
+            ws.set_base(BaseState { position, ..BaseState::default() }).expect("base");
+            tree.update_positions(&mut ws, &q).expect("positions");
+            let mut a = vec![0.0; n * n];
+            mass.mass_matrix(&tree, &ws, &mut a).expect("mass matrix");
+            DMatrix::from_column_slice(n, n, &a)
+        };
+        let near = at(Vector3::zeros());
+        let far = at(Vector3::new(1e6, -1e6, 1e6));
+        let tol = 64.0 * 1e6 * f64::EPSILON * near.amax().max(1.0);
+        prop_assert!((&far - &near).amax() <= tol, "{} > {tol}", (&far - &near).amax());
+    }
+}
+
 #[test]
 fn wrong_lengths_are_named() {
     let mut builder = TreeBuilder::new();
@@ -308,6 +340,21 @@ fn wrong_lengths_are_named() {
             got: 2,
             ..
         })
+    ));
+    // A bad body is named by its index.
+    let mut nan = body;
+    nan.inertia_c[(0, 1)] = f64::NAN;
+    let err = TreeMass::new(&tree, vec![nan]).expect_err("NaN inertia");
+    assert!(matches!(&err, mechanica_mass::MassError::Body { body: 0, .. }), "{err}");
+    assert!(
+        err.to_string().starts_with("body 0: body inertia is not finite"),
+        "{err}"
+    );
+    let mut negative = body;
+    negative.mass = -1.0;
+    assert!(matches!(
+        TreeMass::new(&tree, vec![negative]),
+        Err(mechanica_mass::MassError::Body { body: 0, .. })
     ));
     let mut mass = TreeMass::new(&tree, vec![body]).expect("ok");
     let mut ws = tree.workspace();

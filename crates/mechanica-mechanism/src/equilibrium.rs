@@ -5,8 +5,9 @@
 //! the search finds any equilibrium (stable or not: an inverted pendulum's upright position is
 //! found as readily as the hanging one). B is inverted through its eigen-decomposition with
 //! the eigenvalues kept away from zero by δ = √u·‖B‖, so a singular B (a neutral direction)
-//! gives a bounded step instead of a blow-up. Steps are clipped to the joint limits (projected
-//! search). Spherical and free joints are re-centred ([`Mechanism::rebase`]) before every
+//! gives a bounded step instead of a blow-up. Coordinates resting on a limit that pushes them
+//! outwards are frozen and the Newton step is taken in the others (projected Newton); trial
+//! points are clipped to the limits. Spherical and free joints are re-centred ([`Mechanism::rebase`]) before every
 //! Hessian, so the returned q is in the mechanism's final chart.
 //!
 //! **Convergence criterion.** ‖g‖ ≤ τ with τ = 64·n·u·(‖B(q₀)‖_F·max(1, ‖q₀‖) + ‖g(q₀)‖) by
@@ -187,7 +188,16 @@ pub fn find_equilibrium(
             break;
         }
         let hessian = current.hessian.as_ref().ok_or(MechanismError::Numerical("Hessian missing"))?;
-        let direction = newton_step(hessian, &free, options.seek, options.max_step)?;
+        // Projected Newton: coordinates held by a limit are frozen, the rest take the Newton
+        // step of the reduced problem.
+        let moving: Vec<usize> = (0..q.len()).filter(|k| !at_limit.contains(k)).collect();
+        let reduced = Mat::from_fn(moving.len(), moving.len(), |i, j| hessian[(moving[i], moving[j])]);
+        let reduced_gradient: Vec<f64> = moving.iter().map(|&k| free[k]).collect();
+        let reduced_step = newton_step(&reduced, &reduced_gradient, options.seek, options.max_step)?;
+        let mut direction = vec![0.0; q.len()];
+        for (&k, d) in moving.iter().zip(&reduced_step) {
+            direction[k] = *d;
+        }
         let slope: f64 = free.iter().zip(&direction).map(|(g, d)| g * d).sum();
         let mut alpha = 1.0;
         let mut accepted = None;

@@ -128,13 +128,37 @@ pub fn mechanism_modes(
     q0: &[f64],
     options: &SolveOptions,
 ) -> Result<MechanismModes, MechanismError> {
+    mechanism_modes_with_locks(mechanism, q0, &[], options)
+}
+
+/// As [`mechanism_modes`], with the coordinates in `locked` held fixed (e.g. those resting on a
+/// joint limit at the equilibrium, [`crate::Equilibrium::at_limit`]): A and B are restricted to
+/// the free coordinates, the gradient norm counts only those, and the shapes carry zeros in the
+/// locked rows. Matrices in the result are the restricted ones.
+pub fn mechanism_modes_with_locks(
+    mechanism: &mut Mechanism,
+    q0: &[f64],
+    locked: &[usize],
+    options: &SolveOptions,
+) -> Result<MechanismModes, MechanismError> {
     let mut q = q0.to_vec();
     if mechanism.has_rotation_vectors() {
         mechanism.rebase(&mut q)?;
     }
+    let n_all = mechanism.dof();
+    if let Some(&k) = locked.iter().find(|&&k| k >= n_all) {
+        return Err(MechanismError::NoSuchCoordinate {
+            what: "locked coordinate",
+            index: k,
+            dof: n_all,
+        });
+    }
+    let free: Vec<usize> = (0..n_all).filter(|k| !locked.contains(k)).collect();
     let evaluation = mechanism.potential(&q, true)?;
-    let b = evaluation.hessian.ok_or(MechanismError::Numerical("Hessian missing"))?;
-    let a = mechanism.mass_matrix(&q)?;
+    let b_all = evaluation.hessian.ok_or(MechanismError::Numerical("Hessian missing"))?;
+    let a_all = mechanism.mass_matrix(&q)?;
+    let restrict = |m: &Mat<f64>| Mat::from_fn(free.len(), free.len(), |i, j| m[(free[i], free[j])]);
+    let (a, b) = (restrict(&a_all), restrict(&b_all));
     let problem = PencilProblem::new(a.as_ref(), b.as_ref())?;
     // Shapes are always computed: they carry the propagation of B's rounding (below) and the
     // body displacements; for mechanisms (n in the hundreds at most) they cost little.
@@ -145,9 +169,14 @@ pub fn mechanism_modes(
     let mut solution = solve(&problem, &options)?;
     propagate_assembly_error(&mut solution, &b);
     let stability = stability_of(&solution);
-    let gradient_norm = evaluation.gradient.iter().map(|g| g * g).sum::<f64>().sqrt();
-    let (body_displacements, effective_masses, total_mass) = shapes_in_space(mechanism, &q, &a, &solution)?;
-    let g = mechanism.gyroscopic_matrix(&q)?;
+    let gradient_norm = free.iter().map(|&k| evaluation.gradient[k].powi(2)).sum::<f64>().sqrt();
+    if let Some(x) = solution.vectors.take() {
+        solution.vectors = Some(Mat::from_fn(n_all, x.ncols(), |r, c| {
+            free.iter().position(|&k| k == r).map_or(0.0, |i| x[(i, c)])
+        }));
+    }
+    let (body_displacements, effective_masses, total_mass) = shapes_in_space(mechanism, &q, &solution)?;
+    let g = restrict(&mechanism.gyroscopic_matrix(&q)?);
     let gyroscopic = if g.norm_l2() > 0.0 {
         Some(gyroscopic_modes(&a, &g, &b)?)
     } else {
@@ -198,7 +227,6 @@ type Shapes = (Vec<Vec<BodyDisplacement>>, Vec<[f64; 3]>, f64);
 fn shapes_in_space(
     mechanism: &Mechanism,
     q: &[f64],
-    a: &Mat<f64>,
     solution: &ModalSolution,
 ) -> Result<Shapes, MechanismError> {
     let tree = mechanism.tree();
@@ -225,7 +253,6 @@ fn shapes_in_space(
     let Some(x) = &solution.vectors else {
         return Ok((Vec::new(), Vec::new(), total_mass));
     };
-    let _ = a;
     let mut displacements = Vec::with_capacity(x.ncols());
     let mut effective = Vec::with_capacity(x.ncols());
     for m in 0..x.ncols() {

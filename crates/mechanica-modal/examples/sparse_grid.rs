@@ -18,7 +18,15 @@ fn main() {
     };
     let assembled = clock.elapsed();
     let clock = Instant::now();
-    let sol = match solve_sparse(&p, &SparseOptions { count: k, block_size: std::env::var("BLOCK").ok().and_then(|b| b.parse().ok()).unwrap_or(4), tolerance: std::env::var("TOL").ok().and_then(|b| b.parse().ok()).unwrap_or(1e-12), ..SparseOptions::default() }) {
+    let sol = match solve_sparse(
+        &p,
+        &SparseOptions {
+            count: k,
+            block_size: std::env::var("BLOCK").ok().and_then(|b| b.parse().ok()).unwrap_or(4),
+            tolerance: std::env::var("TOL").ok().and_then(|b| b.parse().ok()).unwrap_or(1e-12),
+            ..SparseOptions::default()
+        },
+    ) {
         Ok(s) => s,
         Err(e) => return eprintln!("{e}"),
     };
@@ -30,6 +38,9 @@ fn main() {
         .zip(&exact)
         .map(|(m, w)| (m.omega_sq - w).abs() / w)
         .fold(0.0, f64::max);
-    println!("n = {}, k = {k}: validate {assembled:?}, solve {solved:?}, max relative error {worst:.2e}", side * side);
+    println!(
+        "n = {}, k = {k}: validate {assembled:?}, solve {solved:?}, max relative error {worst:.2e}",
+        side * side
+    );
     println!("{:#?}", sol.report);
 }

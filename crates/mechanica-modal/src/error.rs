@@ -145,7 +145,9 @@ pub enum ModalError {
     },
     /// No shift σ made B − σA positive definite (sparse solver): A is not positive semidefinite,
     /// or the pencil has modes far below the shifts tried; pass a shift below the lowest ω².
-    #[error("B − σA is not positive definite for any shift tried down to σ = {lowest_shift:.3e} (last failed pivot {pivot})")]
+    #[error(
+        "B − σA is not positive definite for any shift tried down to σ = {lowest_shift:.3e} (last failed pivot {pivot})"
+    )]
     NoDefiniteShift {
         /// The lowest shift tried (rad²/s²).
         lowest_shift: f64,

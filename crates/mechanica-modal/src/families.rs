@@ -151,11 +151,14 @@ pub fn graded_exponents(n: usize, decades: i32) -> Vec<i32> {
         .collect()
 }
 
+/// Sparse entries (row, col, value) of a matrix, both triangles.
+pub type Triplets = Vec<Triplet<usize, usize, f64>>;
+
 /// The 5-point Dirichlet Laplacian of an nx × ny grid of unit spacing (node (i, j) is unknown
-/// i + nx·j), as triplets of B, with the identity mass matrix A: ω²_{pq} = 4 sin²(pπ/(2(nx+1)))
-/// + 4 sin²(qπ/(2(ny+1))), p = 1..nx, q = 1..ny (double on a square grid for p ≠ q).
-/// Returns (A, B) triplets, both triangles.
-pub fn grid_laplacian(nx: usize, ny: usize) -> (Vec<Triplet<usize, usize, f64>>, Vec<Triplet<usize, usize, f64>>) {
+/// i + nx·j) as B, with the identity mass matrix A. Its spectrum is
+/// ω²_pq = 4 sin²(pπ/(2(nx+1))) + 4 sin²(qπ/(2(ny+1))), p = 1..nx, q = 1..ny (double on a
+/// square grid for p ≠ q). Returns (A, B) triplets, both triangles.
+pub fn grid_laplacian(nx: usize, ny: usize) -> (Triplets, Triplets) {
     let n = nx * ny;
     let a = (0..n).map(|i| Triplet::new(i, i, 1.0)).collect();
     let mut b = Vec::with_capacity(5 * n);

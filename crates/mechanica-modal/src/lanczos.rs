@@ -484,7 +484,9 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
         detail: format!("{e:?}"),
     })?;
     let ratio = if norm_a > 0.0 { norm_b / norm_a } else { 1.0 };
-    let mut sigma = options.shift.unwrap_or(-f64::EPSILON.sqrt() * ratio.max(f64::MIN_POSITIVE));
+    let mut sigma = options
+        .shift
+        .unwrap_or(-f64::EPSILON.sqrt() * ratio.max(f64::MIN_POSITIVE));
     let mut attempts = 0;
     let values = loop {
         attempts += 1;
@@ -776,7 +778,10 @@ fn finish(
 
 /// Largest number of stored entries in a column (= row, symmetric).
 fn row_lengths(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> usize {
-    (0..m.ncols()).map(|j| m.symbolic().col_range(j).len()).max().unwrap_or(0)
+    (0..m.ncols())
+        .map(|j| m.symbolic().col_range(j).len())
+        .max()
+        .unwrap_or(0)
 }
 
 /// max |(XᵀAX − I)_ij|.
@@ -806,7 +811,12 @@ fn orthogonality(a: faer::sparse::SparseColMatRef<'_, usize, f64>, x: &Mat<f64>)
 }
 
 /// Small problems: the dense solver, with its report mapped onto the sparse one.
-fn dense_fallback(pencil: &SparsePencil, k: usize, norm_a: f64, norm_b: f64) -> Result<SparseModalSolution, ModalError> {
+fn dense_fallback(
+    pencil: &SparsePencil,
+    k: usize,
+    norm_a: f64,
+    norm_b: f64,
+) -> Result<SparseModalSolution, ModalError> {
     let n = pencil.dim();
     let dense = |m: faer::sparse::SparseColMatRef<'_, usize, f64>| {
         let mut d = Mat::<f64>::zeros(n, n);

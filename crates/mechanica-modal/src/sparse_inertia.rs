@@ -3,7 +3,8 @@
 //!
 //! B − sA is factored by faer's supernodal LBLᵀ with Bunch–Kaufman pivoting inside each
 //! supernode ("intranodal"; the fill-reducing AMD ordering is kept), and the signs of the 1×1 and
-//! 2×2 blocks of the block-diagonal factor are counted. By Sylvester's law of inertia the number
+//! 2×2 blocks of the block-diagonal factor are counted. For patterns faer keeps simplicial
+//! (e.g. diagonal matrices) the factorization is an unpivoted LDLᵀ. By Sylvester's law of inertia the number
 //! of negative eigenvalues equals the number of modes with ω² < s when A is positive definite
 //! (or semidefinite with B positive definite on the null space of A). Pivoting confined to
 //! supernodes is not backward stable in the worst case: the smallest and largest |pivot| are
@@ -78,12 +79,6 @@ pub(crate) fn inertia_with(
             max_pivot: 0.0,
         });
     }
-    let SymbolicCholeskyRaw::Supernodal(supernodal) = symbolic.raw() else {
-        return Err(ModalError::Factorization {
-            what: "B − sA",
-            detail: "symbolic analysis is not supernodal".into(),
-        });
-    };
     let m = k.to_faer();
     let par = Par::Seq;
     let params = Default::default();
@@ -108,46 +103,60 @@ pub(crate) fn inertia_with(
         params,
     );
     let _ = lblt;
-    let (mut below, mut zero, mut above) = (0, 0, 0);
-    let (mut min_pivot, mut max_pivot) = (f64::INFINITY, 0.0_f64);
-    let col_ptr_val = supernodal.col_ptr_for_val();
-    let begin = supernodal.supernode_begin();
-    let end = supernodal.supernode_end();
-    let row_ptr = supernodal.col_ptr_for_row_idx();
-    for s in 0..supernodal.n_supernodes() {
-        let (start, stop) = (begin[s], end[s]);
-        let size = stop - start;
-        let pattern_len = row_ptr[s + 1] - row_ptr[s];
-        let rows = size + pattern_len;
-        let block = &values[col_ptr_val[s]..col_ptr_val[s + 1]];
-        let diag = |i: usize| block[i + i * rows];
-        let mut i = 0;
-        while i < size {
-            let e = subdiag[start + i];
-            let eigenvalues = if e != 0.0 && i + 1 < size {
-                let (d1, d2) = (diag(i), diag(i + 1));
-                let mean = 0.5 * (d1 + d2);
-                let radius = (0.25 * (d1 - d2) * (d1 - d2) + e * e).sqrt();
-                i += 2;
-                vec![mean - radius, mean + radius]
-            } else {
-                i += 1;
-                vec![diag(i - 1)]
-            };
-            for v in eigenvalues {
-                if !v.is_finite() || v == 0.0 {
-                    zero += 1;
-                    min_pivot = 0.0;
-                    continue;
-                }
-                min_pivot = min_pivot.min(v.abs());
-                max_pivot = max_pivot.max(v.abs());
-                if v < 0.0 {
-                    below += 1;
-                } else {
-                    above += 1;
+    // The eigenvalues of the pivot blocks, in any order.
+    let mut pivots: Vec<f64> = Vec::with_capacity(n);
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Supernodal(supernodal) => {
+            let col_ptr_val = supernodal.col_ptr_for_val();
+            let begin = supernodal.supernode_begin();
+            let end = supernodal.supernode_end();
+            let row_ptr = supernodal.col_ptr_for_row_idx();
+            for s in 0..supernodal.n_supernodes() {
+                let (start, stop) = (begin[s], end[s]);
+                let size = stop - start;
+                let rows = size + (row_ptr[s + 1] - row_ptr[s]);
+                let block = &values[col_ptr_val[s]..col_ptr_val[s + 1]];
+                let diag = |i: usize| block[i + i * rows];
+                let mut i = 0;
+                while i < size {
+                    let e = subdiag[start + i];
+                    if e != 0.0 && i + 1 < size {
+                        let (d1, d2) = (diag(i), diag(i + 1));
+                        let mean = 0.5 * (d1 + d2);
+                        let radius = (0.25 * (d1 - d2) * (d1 - d2) + e * e).sqrt();
+                        pivots.extend([mean - radius, mean + radius]);
+                        i += 2;
+                    } else {
+                        pivots.push(diag(i));
+                        i += 1;
+                    }
                 }
             }
+        }
+        SymbolicCholeskyRaw::Simplicial(simplicial) => {
+            // faer falls back to an unpivoted LDLᵀ here; D sits on the diagonal of L.
+            let factor = simplicial.factor();
+            let rows = factor.row_idx();
+            for j in 0..n {
+                let d = factor.col_range(j).find(|&p| rows[p] == j).map_or(0.0, |p| values[p]);
+                pivots.push(d);
+            }
+        }
+    }
+    let (mut below, mut zero, mut above) = (0, 0, 0);
+    let (mut min_pivot, mut max_pivot) = (f64::INFINITY, 0.0_f64);
+    for v in pivots {
+        if !v.is_finite() || v == 0.0 {
+            zero += 1;
+            min_pivot = 0.0;
+            continue;
+        }
+        min_pivot = min_pivot.min(v.abs());
+        max_pivot = max_pivot.max(v.abs());
+        if v < 0.0 {
+            below += 1;
+        } else {
+            above += 1;
         }
     }
     Ok(SparseInertia {

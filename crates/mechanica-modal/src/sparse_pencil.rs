@@ -76,7 +76,9 @@ impl Csc {
         let n = self.n;
         Csc::from_entries(
             n,
-            (0..n).flat_map(move |j| (self.col_ptr[j]..self.col_ptr[j + 1]).map(move |k| (j, self.row_idx[k], self.val[k]))),
+            (0..n).flat_map(move |j| {
+                (self.col_ptr[j]..self.col_ptr[j + 1]).map(move |k| (j, self.row_idx[k], self.val[k]))
+            }),
         )
     }
 
@@ -120,8 +122,9 @@ impl Csc {
     pub fn to_faer(&self) -> SparseColMat<usize, f64> {
         // SAFETY: col_ptr is non-decreasing from 0 to nnz, every column's rows are strictly
         // increasing and < n (built by from_entries/combine from validated indices).
-        let symbolic =
-            unsafe { SymbolicSparseColMat::new_unchecked(self.n, self.n, self.col_ptr.clone(), None, self.row_idx.clone()) };
+        let symbolic = unsafe {
+            SymbolicSparseColMat::new_unchecked(self.n, self.n, self.col_ptr.clone(), None, self.row_idx.clone())
+        };
         SparseColMat::new(symbolic, self.val.clone())
     }
 
@@ -327,7 +330,12 @@ mod tests {
         ));
         assert!(matches!(
             SparsePencil::from_triplets(2, &a, &[t(1, 1, f64::NAN)]),
-            Err(ModalError::NonFinite { what: "B", row: 1, col: 1, .. })
+            Err(ModalError::NonFinite {
+                what: "B",
+                row: 1,
+                col: 1,
+                ..
+            })
         ));
     }
 }

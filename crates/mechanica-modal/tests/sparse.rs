@@ -24,7 +24,12 @@ fn check_grid(nx: usize, ny: usize, k: usize, mass: f64) {
     assert_eq!(sol.modes.len(), k);
     for (m, w) in sol.modes.iter().zip(&exact) {
         let err = (m.omega_sq - w).abs();
-        assert!(err <= m.error_bound, "ω² {} vs {w}: error {err:e} > bound {:e}", m.omega_sq, m.error_bound);
+        assert!(
+            err <= m.error_bound,
+            "ω² {} vs {w}: error {err:e} > bound {:e}",
+            m.omega_sq,
+            m.error_bound
+        );
         assert!(err <= 1e-12 * w, "relative error {:e}", err / w);
         assert!(m.error_bound <= 1e-12 * w, "bound {:e} not tight", m.error_bound);
         assert!(m.backward_error.expect("vectors") <= 10.0 * U * (nx * ny) as f64);
@@ -32,7 +37,6 @@ fn check_grid(nx: usize, ny: usize, k: usize, mass: f64) {
     let r = &sol.report;
     assert!(r.consistent, "{r:?}");
     assert!(r.orthogonality_error <= 1e3 * U, "{r:?}");
-    eprintln!("{nx}x{ny} k={k}: {r:?}");
 }
 
 #[test]
@@ -43,4 +47,146 @@ fn square_grid_with_double_eigenvalues() {
 #[test]
 fn rectangular_grid_with_mass() {
     check_grid(120, 90, 8, 2.5);
+}
+
+/// A diagonal pencil with an exactly triple eigenvalue and a single-vector Krylov space (block
+/// size 1): all three copies come back as an A-orthonormal group, and the inertia count agrees.
+#[test]
+fn inertia_guard_recovers_a_triple_eigenvalue() {
+    let n = 600;
+    let diag = |i: usize| if i < 3 { 1.0 } else { 1.5 + i as f64 };
+    let a: Vec<_> = (0..n).map(|i| Triplet::new(i, i, 1.0)).collect();
+    let b: Vec<_> = (0..n).map(|i| Triplet::new(i, i, diag(i))).collect();
+    let p = SparsePencil::from_triplets(n, &a, &b).expect("valid");
+    let sol = solve_sparse(
+        &p,
+        &SparseOptions {
+            count: 5,
+            block_size: 1,
+            ..SparseOptions::default()
+        },
+    )
+    .expect("solve");
+    let got: Vec<f64> = sol.modes.iter().map(|m| m.omega_sq).collect();
+    let exact = [1.0, 1.0, 1.0, 4.5, 5.5];
+    for (g, e) in got.iter().zip(&exact) {
+        assert!((g - e).abs() <= 1e-13 * e, "{got:?}");
+    }
+    assert!(sol.report.consistent);
+    assert_eq!(sol.groups[0].multiplicity, 3);
+    assert!(sol.report.orthogonality_error <= 1e3 * U);
+}
+
+/// The count of the sparse LBLᵀ inertia equals the closed-form count on a grid, at shifts
+/// between eigenvalues.
+#[test]
+fn sparse_inertia_counts_grid_modes() {
+    let (nx, ny) = (60, 50);
+    let (a, b) = families::grid_laplacian(nx, ny);
+    let p = SparsePencil::from_triplets(nx * ny, &a, &b).expect("valid");
+    let exact = families::grid_omega_sq(nx, ny, 40);
+    for j in [0usize, 5, 17, 38] {
+        let shift = 0.5 * (exact[j] + exact[j + 1]);
+        if exact[j + 1] - exact[j] < 1e-9 {
+            continue;
+        }
+        let c = count_below_sparse(&p, shift).expect("count");
+        assert_eq!(c.count.below, j + 1, "shift {shift}");
+    }
+}
+
+#[test]
+fn unstable_modes_lower_the_shift() {
+    // B = Laplacian − I/16 on a 30×30 grid (exact in binary): the lowest modes have ω² < 0.
+    let (nx, ny) = (30, 30);
+    let (a, b) = families::grid_laplacian(nx, ny);
+    let b: Vec<_> = b
+        .iter()
+        .map(|t| Triplet::new(t.row, t.col, if t.row == t.col { t.val - 0.0625 } else { t.val }))
+        .collect();
+    let p = SparsePencil::from_triplets(nx * ny, &a, &b).expect("valid");
+    let sol = solve_sparse(&p, &lowest(4)).expect("solve");
+    let exact: Vec<f64> = families::grid_omega_sq(nx, ny, 4).iter().map(|w| w - 0.0625).collect();
+    assert!(exact[0] < 0.0);
+    for (m, w) in sol.modes.iter().zip(&exact) {
+        // The closed form itself is rounded: a few u of the unshifted ω².
+        let reference_rounding = 4.0 * U * (w + 0.0625);
+        assert!(
+            (m.omega_sq - w).abs() <= m.error_bound + reference_rounding,
+            "{} vs {w}",
+            m.omega_sq
+        );
+    }
+    assert!(sol.report.shift_attempts > 1);
+    assert!(sol.report.consistent);
+}
+
+#[test]
+fn bad_sparse_input_is_located() {
+    let t = |r, c, v| Triplet::new(r, c, v);
+    let a = [t(0, 0, 1.0), t(1, 1, 1.0)];
+    assert!(matches!(
+        SparsePencil::from_triplets(2, &a, &[t(0, 5, 1.0)]),
+        Err(ModalError::IndexOutOfRange { what: "B", col: 5, .. })
+    ));
+    assert!(matches!(
+        SparsePencil::from_triplets(2, &a, &[t(1, 0, 1.0)]),
+        Err(ModalError::NotSymmetric { what: "B", .. })
+    ));
+    let p = SparsePencil::from_triplets(2, &a, &a).expect("valid");
+    assert!(matches!(
+        solve_sparse(&p, &lowest(3)),
+        Err(ModalError::TooManyModes {
+            requested: 3,
+            available: 2
+        })
+    ));
+    assert!(matches!(
+        solve_sparse(&p, &lowest(0)),
+        Err(ModalError::TooManyModes { .. })
+    ));
+    assert!(matches!(
+        solve_sparse(
+            &p,
+            &SparseOptions {
+                shift: Some(f64::NAN),
+                ..lowest(1)
+            }
+        ),
+        Err(ModalError::BadShift(_))
+    ));
+    assert!(count_below_sparse(&p, f64::INFINITY).is_err());
+    // A shift above a mode cannot be factored: a typed error naming the pivot.
+    let (ga, gb) = families::grid_laplacian(25, 25);
+    let g = SparsePencil::from_triplets(625, &ga, &gb).expect("valid");
+    assert!(matches!(
+        solve_sparse(
+            &g,
+            &SparseOptions {
+                shift: Some(0.5),
+                ..lowest(2)
+            }
+        ),
+        Err(ModalError::NoDefiniteShift { .. })
+    ));
+    // An indefinite mass matrix is refused.
+    let neg: Vec<_> = (0..625).map(|i| t(i, i, if i == 7 { -1.0 } else { 1.0 })).collect();
+    let bad = SparsePencil::from_triplets(625, &neg, &gb).expect("valid shapes");
+    assert!(solve_sparse(&bad, &lowest(2)).is_err());
+}
+
+#[test]
+fn matrix_market_files_feed_the_solver() {
+    let (nx, ny) = (22, 21);
+    let (a, b) = families::grid_laplacian(nx, ny);
+    let n = nx * ny;
+    let ma = mechanica_modal::parse_matrix_market(&mechanica_modal::matrix_market::symmetric_to_string(n, &a))
+        .expect("A parses");
+    let mb = mechanica_modal::parse_matrix_market(&mechanica_modal::matrix_market::symmetric_to_string(n, &b))
+        .expect("B parses");
+    let p = SparsePencil::from_triplets(n, &ma.entries, &mb.entries).expect("valid");
+    let sol = solve_sparse(&p, &lowest(3)).expect("solve");
+    for (m, w) in sol.modes.iter().zip(families::grid_omega_sq(nx, ny, 3)) {
+        assert!((m.omega_sq - w).abs() <= m.error_bound);
+    }
 }
