@@ -1,7 +1,9 @@
 //! The built-in default scene: the example scenes a spring-loaded pendulum chain (mass
 //! properties, equilibrium, stability, modes, free response, an impact) and a bead on a
 //! rotating hoop (a relative equilibrium in a rotating frame), run through the same pipeline
-//! as any scene file and merged into one report.
+//! as any scene file and merged into one report, followed by Kane's double pendulum striking a
+//! rough floor under each restitution law (Newton's gains energy; the default, Stronge's, never
+//! does).
 
 use crate::report::Report;
 use crate::scene::Scene;
@@ -34,6 +36,29 @@ pub fn run(plot_dir: Option<&Path>) -> Result<Report, String> {
             steps.push(step);
         }
     }
+    steps.push(crate::report::timed_step(
+        "impulse: Kane's double pendulum on a rough floor, e = f = 0.5, every law",
+        || {
+            let outcomes = mechanica::impulse::showcase::kane_double_pendulum_demo().map_err(|e| e.to_string())?;
+            Ok::<_, String>(
+                outcomes
+                    .iter()
+                    .map(|o| {
+                        crate::scene_run::quantity(
+                            &format!("{}: T before, ΔT", o.law),
+                            vec![o.energy_before, o.energy_change],
+                            "J",
+                            Some(if o.energy_change > 0.0 {
+                                "energy GAINED (Kane's paradox)".into()
+                            } else {
+                                "energy lost".into()
+                            }),
+                        )
+                    })
+                    .collect(),
+            )
+        },
+    )?);
     Ok(Report {
         title: "default scene: spring-loaded pendulum chain and a bead on a rotating hoop".into(),
         version: mechanica::version().into(),

@@ -1,7 +1,11 @@
 //! The mechanism analyses of a scene (equilibrium, stability, modes, free response), run only
 //! when the scene asks for them.
 
-use crate::plots::{ModeShape, PlotData, ResponseSeries};
+use crate::plots::{EnergyBalance, ModeShape, PlotData, ResponseSeries};
+use mechanica::impulse::{
+    BodyPoint, ContactLaw, ImpactOptions, MechanismContact, MechanismInertia, RestitutionLaw, resolve_single_contact,
+};
+use mechanica::mass::mechanism::TreeMass;
 use crate::report::{Step, timed_step};
 use crate::scene::Scene;
 use crate::scene_run::{Model, quantity};
@@ -104,6 +108,9 @@ fn stability_note(stability: &Stability) -> String {
 /// Runs the requested mechanism analyses, appending steps and plot data.
 pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut PlotData) -> Result<(), String> {
     let analyses = &scene.analyses;
+    if let Some(impact) = &analyses.impact {
+        steps.push(impact_step(scene, model, impact, plots)?);
+    }
     if analyses.equilibrium.is_none() && analyses.modes.is_none() {
         return Ok(());
     }
@@ -343,5 +350,90 @@ fn response_step(
         ];
         plots.response = Some(series);
         Ok(quantities)
+    })
+}
+
+fn law_named(name: &str) -> RestitutionLaw {
+    match name {
+        "newton" => RestitutionLaw::Newton,
+        "poisson" => RestitutionLaw::Poisson,
+        _ => RestitutionLaw::Stronge,
+    }
+}
+
+/// One impact of a body point against the ground at (q0, qd0), by Lagrange's impulse equations
+/// (7.115–7.117) and the impulse-parameterised contact process.
+fn impact_step(
+    scene: &Scene,
+    model: &Model,
+    spec: &crate::scene::ImpactSpec,
+    plots: &mut PlotData,
+) -> Result<Step, String> {
+    let text = |e: &dyn std::fmt::Display| format!("analyses.impact: {e}");
+    let chosen = spec.law.as_ref().map_or("stronge", |l| l.get_ref().as_str());
+    timed_step(&format!("impact: body point on the ground, {chosen} law (7.115–7.117)"), || {
+        let body = scene
+            .bodies
+            .iter()
+            .position(|b| b.name.get_ref() == spec.body.get_ref())
+            .ok_or_else(|| text(&"unknown body"))?;
+        let tree = &model.tree;
+        let mut ws = tree.workspace();
+        tree.update_positions(&mut ws, &model.q0).map_err(|e| text(&e))?;
+        tree.update_velocities(&mut ws, &model.qd0).map_err(|e| text(&e))?;
+        let mut masses = TreeMass::new(tree, model.bodies.clone()).map_err(|e| text(&e))?;
+        let inertia = MechanismInertia::new(tree, &ws, &mut masses).map_err(|e| text(&e))?;
+        let mut laws = vec![chosen];
+        if spec.compare_laws {
+            laws.extend(["newton", "poisson", "stronge"].into_iter().filter(|l| *l != chosen));
+        }
+        let mut quantities = Vec::new();
+        let mut balance = EnergyBalance { laws: Vec::new() };
+        for name in laws {
+            let law = ContactLaw::new(spec.restitution, spec.friction, law_named(name)).map_err(|e| text(&e))?;
+            let contact = MechanismContact {
+                point: BodyPoint {
+                    body,
+                    p_bq: Vector3::from(spec.point),
+                },
+                other: None,
+                normal_w: Vector3::from(spec.normal),
+                law,
+            };
+            let impact = resolve_single_contact(tree, &ws, &inertia, &model.qd0, &contact, &ImpactOptions::default())
+                .map_err(|e| text(&e))?;
+            let outcome = impact.contacts.first().ok_or_else(|| text(&"no contact outcome"))?;
+            let after = impact.energy_before + impact.energy_change;
+            balance.laws.push((name.to_string(), impact.energy_before, after));
+            let accuracy = Some(format!(
+                "integration error {:.1e} N·s, mode {:?}",
+                impact.integration_error, outcome.mode
+            ));
+            quantities.push(quantity(
+                &format!("{name}: impulse on the body (world)"),
+                outcome.impulse_w.iter().copied().collect(),
+                "N·s",
+                accuracy,
+            ));
+            quantities.push(quantity(&format!("{name}: q̇ after"), impact.q_dot_after.clone(), "rad/s | m/s", None));
+            quantities.push(quantity(
+                &format!("{name}: T before, ΔT (7.107)"),
+                vec![impact.energy_before, impact.energy_change],
+                "J",
+                None,
+            ));
+        }
+        plots.impact = Some(balance);
+        Ok(quantities)
+    })
+    .map(|mut step| {
+        if let Some(impact) = &plots.impact {
+            for (law, before, after) in &impact.laws {
+                if after > before {
+                    step.notes.push(format!("{law}: the impact GAINS energy ({:.4e} J): Kane's paradox", after - before));
+                }
+            }
+        }
+        step
     })
 }

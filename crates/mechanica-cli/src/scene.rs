@@ -53,7 +53,8 @@
 //! modes = { lowest = 4 }               # optional lowest = k; at the equilibrium if one is asked
 //! response = { duration = 5.0, samples = 200, dq0 = [0.1, 0.0] }   # free response (8.91)
 //! impact = { body = "lower", point = [0.0, 0.0, -1.0], normal = [0.0, 0.0, 1.0],
-//!            friction = 0.3, restitution = 0.5, law = "stronge" }  # at q0 with qd0
+//!            friction = 0.3, restitution = 0.5, law = "stronge",
+//!            compare_laws = true }           # at q0 with qd0; compare_laws adds the other two laws
 //! ```
 //!
 //! `inertia` lists the six independent entries (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) about the centre
@@ -338,6 +339,9 @@ pub struct ImpactSpec {
     pub restitution: f64,
     /// "stronge" (default), "poisson" or "newton".
     pub law: Option<Spanned<String>>,
+    /// Also resolve the impact under the two other laws, for comparison (and the energy plot).
+    #[serde(default)]
+    pub compare_laws: bool,
 }
 
 /// A scene error, located in its file.

@@ -5,9 +5,10 @@ use super::boundary::{FfiError, boundary};
 use super::status::*;
 use super::validate::*;
 use mechanica_modal::faer::MatRef;
+use mechanica_modal::faer::sparse::Triplet;
 use mechanica_modal::{
     FreeResponse, Method, ModalError, ModalSolution, ModeKind, PencilProblem, Refinement, Selection, SolveOptions,
-    count_below, solve,
+    SparseOptions, SparsePencil, count_below, solve, solve_sparse,
 };
 
 impl From<ModalError> for FfiError {
@@ -591,6 +592,167 @@ pub unsafe extern "C" fn mech_modal_free_response(
                     max_error_bound,
                     massless: fit.massless,
                 });
+            }
+        }
+        Ok(())
+    })
+}
+
+/// Accuracy and cost summary of mech_modal_sparse_lowest.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_modal_sparse_report_t {
+    /// The shift σ of the factored B − σA (every mode lies above it); −HUGE_VAL on the dense path.
+    pub shift: f64,
+    /// Largest backward error η of the returned pairs.
+    pub max_backward_error: f64,
+    /// max |(XᵀAX − I)_ij| of the returned mode shapes.
+    pub orthogonality_error: f64,
+    /// The shift τ of the inertia (Sturm) check.
+    pub inertia_shift: f64,
+    /// Modes with ω² < τ by the inertia of B − τA.
+    pub inertia_below: usize,
+    /// Modes with ω² < τ among the computed ones.
+    pub computed_below: usize,
+    /// 1 when the two counts agree (no mode below τ missed).
+    pub inertia_consistent: i32,
+    /// Applications of (B − σA)⁻¹A.
+    pub operator_applications: usize,
+    /// Stored entries of the Cholesky factor of B − σA.
+    pub factor_nnz: usize,
+}
+
+/// Reads one n×n CSC matrix (both triangles) into triplets, checking the column pointers.
+///
+/// # Safety
+/// `col_ptr` must point to n + 1 readable size_t; `row_idx` and `values` to col_ptr[n] elements.
+unsafe fn read_csc(
+    n: usize,
+    col_ptr: *const usize,
+    row_idx: *const usize,
+    values: *const f64,
+    what: &str,
+) -> Result<Vec<Triplet<usize, usize, f64>>, FfiError> {
+    let len = n.checked_add(1).ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n + 1 overflows"))?;
+    // SAFETY: caller's contract.
+    let ptr = unsafe { read_slice(col_ptr, len, what) }?;
+    if ptr[0] != 0 || ptr.windows(2).any(|w| w[1] < w[0]) {
+        return Err(FfiError::new(
+            MECH_STATUS_INVALID_ARGUMENT,
+            format!("{what}: column pointers must start at 0 and not decrease"),
+        ));
+    }
+    let nnz = ptr[n];
+    // SAFETY: caller's contract.
+    let (rows, vals) = unsafe { (read_slice(row_idx, nnz, what)?, read_slice(values, nnz, what)?) };
+    let mut out = Vec::with_capacity(nnz);
+    for j in 0..n {
+        for p in ptr[j]..ptr[j + 1] {
+            out.push(Triplet::new(rows[p], j, vals[p]));
+        }
+    }
+    Ok(out)
+}
+
+/// The `count` lowest modes of det(λA + B) = 0 for sparse n×n A (mass, positive semidefinite)
+/// and B (stiffness) in compressed sparse columns (0-based, both triangles stored; duplicates are
+/// summed): shift-invert block Lanczos on a sparse Cholesky factorization, certified by a sparse
+/// inertia count. Writes ω²_k ascending into `omega_sq_out` (count), their error bounds into
+/// `error_bound_out` (count, may be NULL), the A-orthonormal shapes as an n × count column-major
+/// matrix into `vectors_out` (may be NULL) and the summary into `report_out` (may be NULL).
+/// Errors: BAD_DIMENSION for an index ≥ n, NON_FINITE, INVALID_ARGUMENT for asymmetry, bad
+/// column pointers or count ∉ [1, n]; NOT_POSITIVE_DEFINITE when no shift below the spectrum
+/// was found (A indefinite); NOT_CONVERGED.
+///
+/// # Safety
+/// Each `*_col_ptr` must point to n + 1 readable size_t, each `*_row_idx` / `*_values` to
+/// `*_col_ptr[n]` elements; outputs NULL (where allowed) or writable for the sizes above.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn mech_modal_sparse_lowest(
+    n: usize,
+    a_col_ptr: *const usize,
+    a_row_idx: *const usize,
+    a_values: *const f64,
+    b_col_ptr: *const usize,
+    b_row_idx: *const usize,
+    b_values: *const f64,
+    count: usize,
+    omega_sq_out: *mut f64,
+    error_bound_out: *mut f64,
+    vectors_out: *mut f64,
+    report_out: *mut mech_modal_sparse_report_t,
+) -> mech_status_t {
+    boundary(|| {
+        if n == 0 {
+            return Err(FfiError::new(MECH_STATUS_BAD_DIMENSION, "n: dimension is 0"));
+        }
+        let w_out = OutSlice::new(omega_sq_out, count, "omega_sq_out")?;
+        let e_out = if error_bound_out.is_null() {
+            None
+        } else {
+            Some(OutSlice::new(error_bound_out, count, "error_bound_out")?)
+        };
+        let len = n
+            .checked_mul(count)
+            .ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n·count overflows"))?;
+        let x_out = if vectors_out.is_null() {
+            None
+        } else {
+            Some(OutSlice::new(vectors_out, len, "vectors_out")?)
+        };
+        let r_out = if report_out.is_null() {
+            None
+        } else {
+            Some(Out::new(report_out, "report_out")?)
+        };
+        // SAFETY: caller's contract.
+        let (a, b) = unsafe {
+            (
+                read_csc(n, a_col_ptr, a_row_idx, a_values, "a")?,
+                read_csc(n, b_col_ptr, b_row_idx, b_values, "b")?,
+            )
+        };
+        let pencil = SparsePencil::from_triplets(n, &a, &b)?;
+        let sol = solve_sparse(
+            &pencil,
+            &SparseOptions {
+                count,
+                ..SparseOptions::default()
+            },
+        )?;
+        let omega: Vec<f64> = sol.modes.iter().map(|m| m.omega_sq).collect();
+        let bounds: Vec<f64> = sol.modes.iter().map(|m| m.error_bound).collect();
+        let mut shapes = Vec::with_capacity(len);
+        for j in 0..sol.vectors.ncols() {
+            shapes.extend((0..n).map(|i| sol.vectors[(i, j)]));
+        }
+        if omega.len() != count || shapes.len() != len {
+            return Err(FfiError::new(MECH_STATUS_NOT_CONVERGED, "fewer modes than requested were found"));
+        }
+        let r = &sol.report;
+        let report = mech_modal_sparse_report_t {
+            shift: r.shift,
+            max_backward_error: r.max_backward_error,
+            orthogonality_error: r.orthogonality_error,
+            inertia_shift: r.inertia.map_or(0.0, |c| c.count.shift),
+            inertia_below: r.inertia.map_or(0, |c| c.count.below),
+            computed_below: r.computed_below,
+            inertia_consistent: i32::from(r.consistent),
+            operator_applications: r.operator_applications,
+            factor_nnz: r.factor_nnz,
+        };
+        // SAFETY: checked writable for the sizes above (caller's contract).
+        unsafe {
+            w_out.write(&omega);
+            if let Some(e) = e_out {
+                e.write(&bounds);
+            }
+            if let Some(x) = x_out {
+                x.write(&shapes);
+            }
+            if let Some(o) = r_out {
+                o.write(report);
             }
         }
         Ok(())
