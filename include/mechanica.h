@@ -1162,6 +1162,50 @@ typedef struct mech_modal_response_fit_t {
 } mech_modal_response_fit_t;
 #endif
 
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Accuracy and cost summary of mech_modal_sparse_lowest.
+ */
+typedef struct mech_modal_sparse_report_t {
+    /**
+     * The shift σ of the factored B − σA (every mode lies above it); −HUGE_VAL on the dense path.
+     */
+    double shift;
+    /**
+     * Largest backward error η of the returned pairs.
+     */
+    double max_backward_error;
+    /**
+     * max |(XᵀAX − I)_ij| of the returned mode shapes.
+     */
+    double orthogonality_error;
+    /**
+     * The shift τ of the inertia (Sturm) check.
+     */
+    double inertia_shift;
+    /**
+     * Modes with ω² < τ by the inertia of B − τA.
+     */
+    size_t inertia_below;
+    /**
+     * Modes with ω² < τ among the computed ones.
+     */
+    size_t computed_below;
+    /**
+     * 1 when the two counts agree (no mode below τ missed).
+     */
+    int32_t inertia_consistent;
+    /**
+     * Applications of (B − σA)⁻¹A.
+     */
+    size_t operator_applications;
+    /**
+     * Stored entries of the Cholesky factor of B − σA.
+     */
+    size_t factor_nnz;
+} mech_modal_sparse_report_t;
+#endif
+
 /**
  * Success.
  */
@@ -3051,6 +3095,36 @@ mech_status_t mech_modal_free_response(const struct mech_modal_result_t *result,
                                        double *velocity_out,
                                        size_t velocity_capacity,
                                        struct mech_modal_response_fit_t *fit_out);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * The `count` lowest modes of det(λA + B) = 0 for sparse n×n A (mass, positive semidefinite)
+ * and B (stiffness) in compressed sparse columns (0-based, both triangles stored; duplicates are
+ * summed): shift-invert block Lanczos on a sparse Cholesky factorization, certified by a sparse
+ * inertia count. Writes ω²_k ascending into `omega_sq_out` (count), their error bounds into
+ * `error_bound_out` (count, may be NULL), the A-orthonormal shapes as an n × count column-major
+ * matrix into `vectors_out` (may be NULL) and the summary into `report_out` (may be NULL).
+ * Errors: BAD_DIMENSION for an index ≥ n, NON_FINITE, INVALID_ARGUMENT for asymmetry, bad
+ * column pointers or count ∉ [1, n]; NOT_POSITIVE_DEFINITE when no shift below the spectrum
+ * was found (A indefinite); NOT_CONVERGED.
+ *
+ * # Safety
+ * Each `*_col_ptr` must point to n + 1 readable size_t, each `*_row_idx` / `*_values` to
+ * `*_col_ptr[n]` elements; outputs NULL (where allowed) or writable for the sizes above.
+ */
+mech_status_t mech_modal_sparse_lowest(size_t n,
+                                       const size_t *a_col_ptr,
+                                       const size_t *a_row_idx,
+                                       const double *a_values,
+                                       const size_t *b_col_ptr,
+                                       const size_t *b_row_idx,
+                                       const double *b_values,
+                                       size_t count,
+                                       double *omega_sq_out,
+                                       double *error_bound_out,
+                                       double *vectors_out,
+                                       struct mech_modal_sparse_report_t *report_out);
 #endif
 
 #ifdef __cplusplus

@@ -214,3 +214,48 @@ fn a_search_that_cannot_converge_reports_its_best_point() {
         other => panic!("expected NoEquilibrium, got {other:?}"),
     }
 }
+
+/// A point mass m on two sliders (x, y) held by an isotropic zero-length spring k, seen from a
+/// frame turning at Ω about z: m ẍ − 2mΩẏ + (k − mΩ²)x = 0 and its mirror. The frequencies are
+/// ω₀ ∓ Ω (ω₀ = √(k/m)); beyond Ω = ω₀ the potential U* is a maximum (B negative definite) yet
+/// the gyroscopic coupling keeps every mode oscillating.
+#[test]
+fn gyroscopic_coupling_shifts_frequencies_and_stabilises_a_potential_maximum() {
+    let (m, k) = (2.0_f64, 18.0_f64);
+    let omega0 = (k / m).sqrt();
+    for &rate in &[0.5, 1.7, 5.0] {
+        let mut builder = TreeBuilder::new();
+        let carriage = builder.add_body(None, Joint::Prismatic { axis: Vector3::x() }, Isometry3::identity());
+        builder.add_body(Some(carriage), Joint::Prismatic { axis: Vector3::y() }, Isometry3::identity());
+        let tree = builder.build().expect("tree");
+        let massless = MassProperties { mass: 0.0, p_oc: Vector3::zeros(), inertia_c: nalgebra::Matrix3::zeros() };
+        let bodies = vec![massless, MassProperties::point(m, Vector3::zeros()).expect("mass")];
+        let mut mechanism = Mechanism::new(tree, bodies).expect("mechanism");
+        mechanism
+            .set_rotating_frame(Some(RotatingFrame { axis: Unit::new_normalize(Vector3::z()), rate }))
+            .expect("rotation");
+        mechanism
+            .add_potential(PointSpring {
+                a: Anchor { body: Some(1), point: Vector3::zeros() },
+                b: Anchor { body: None, point: Vector3::zeros() },
+                stiffness: k,
+                rest_length: 0.0,
+            })
+            .expect("spring");
+        let modes = mechanism_modes(&mut mechanism, &[0.0, 0.0], &SolveOptions::default()).expect("modes");
+        let gyro = modes.gyroscopic.expect("rotating frame with coupling");
+        let mut frequencies: Vec<f64> = gyro.eigenvalues.iter().map(|s| s.1.abs()).collect();
+        frequencies.sort_by(f64::total_cmp);
+        let mut expected = vec![(omega0 - rate).abs(), (omega0 - rate).abs(), omega0 + rate, omega0 + rate];
+        expected.sort_by(f64::total_cmp);
+        for (got, want) in frequencies.iter().zip(&expected) {
+            assert!((got - want).abs() <= 1e-10 * want.max(1.0), "Ω = {rate}: {frequencies:?} vs {expected:?}");
+        }
+        assert!(gyro.stable, "Ω = {rate}: max Re s = {}", gyro.max_real_part);
+        if rate > omega0 {
+            assert!(matches!(modes.stability, Stability::Unstable { directions: 2, .. }), "{:?}", modes.stability);
+        } else {
+            assert_eq!(modes.stability, Stability::Stable);
+        }
+    }
+}
