@@ -190,3 +190,21 @@ fn matrix_market_files_feed_the_solver() {
         assert!((m.omega_sq - w).abs() <= m.error_bound);
     }
 }
+
+#[test]
+fn faer_sparse_matrices_are_accepted() {
+    use mechanica_modal::faer::sparse::SparseColMat;
+    let (nx, ny) = (21, 20);
+    let (a, b) = families::grid_laplacian(nx, ny);
+    let n = nx * ny;
+    let to_faer = |t: &[Triplet<usize, usize, f64>]| {
+        SparseColMat::<usize, f64>::try_new_from_triplets(n, n, t).expect("valid triplets")
+    };
+    let (fa, fb) = (to_faer(&a), to_faer(&b));
+    let p = SparsePencil::new(fa.as_ref(), fb.as_ref()).expect("valid");
+    assert_eq!(p.nnz(), (n, b.len()));
+    let sol = solve_sparse(&p, &lowest(2)).expect("solve");
+    for (m, w) in sol.modes.iter().zip(families::grid_omega_sq(nx, ny, 2)) {
+        assert!((m.omega_sq - w).abs() <= m.error_bound);
+    }
+}

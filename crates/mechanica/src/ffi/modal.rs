@@ -633,7 +633,9 @@ unsafe fn read_csc(
     values: *const f64,
     what: &str,
 ) -> Result<Vec<Triplet<usize, usize, f64>>, FfiError> {
-    let len = n.checked_add(1).ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n + 1 overflows"))?;
+    let len = n
+        .checked_add(1)
+        .ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n + 1 overflows"))?;
     // SAFETY: caller's contract.
     let ptr = unsafe { read_slice(col_ptr, len, what) }?;
     if ptr[0] != 0 || ptr.windows(2).any(|w| w[1] < w[0]) {
@@ -728,7 +730,10 @@ pub unsafe extern "C" fn mech_modal_sparse_lowest(
             shapes.extend((0..n).map(|i| sol.vectors[(i, j)]));
         }
         if omega.len() != count || shapes.len() != len {
-            return Err(FfiError::new(MECH_STATUS_NOT_CONVERGED, "fewer modes than requested were found"));
+            return Err(FfiError::new(
+                MECH_STATUS_NOT_CONVERGED,
+                "fewer modes than requested were found",
+            ));
         }
         let r = &sol.report;
         let report = mech_modal_sparse_report_t {
