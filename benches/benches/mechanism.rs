@@ -66,7 +66,9 @@ fn bench(c: &mut Criterion) {
     assert_eq!(n, 44);
     let q: Vec<f64> = (0..n).map(|k| 0.1 * ((k as f64) * 0.37).sin()).collect();
     let mut group = c.benchmark_group("mechanism_44dof");
-    group.bench_function("assemble_a", |b| b.iter(|| black_box(mechanism.mass_matrix(black_box(&q)).expect("A"))));
+    group.bench_function("assemble_a", |b| {
+        b.iter(|| black_box(mechanism.mass_matrix(black_box(&q)).expect("A")))
+    });
     group.bench_function("assemble_b", |b| {
         b.iter(|| black_box(mechanism.potential(black_box(&q), true).expect("B")))
     });

@@ -6,10 +6,10 @@ mod mass_command;
 mod mechanism_run;
 mod plots;
 mod progress;
-mod urdf;
 mod report;
 mod scene;
 mod scene_run;
+mod urdf;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -2,14 +2,14 @@
 //! when the scene asks for them.
 
 use crate::plots::{EnergyBalance, ModeShape, PlotData, ResponseSeries};
-use mechanica::impulse::{
-    BodyPoint, ContactLaw, ImpactOptions, MechanismContact, MechanismInertia, RestitutionLaw, resolve_single_contact,
-};
-use mechanica::mass::mechanism::TreeMass;
 use crate::report::{Step, timed_step};
 use crate::scene::Scene;
 use crate::scene_run::{Model, quantity};
+use mechanica::impulse::{
+    BodyPoint, ContactLaw, ImpactOptions, MechanismContact, MechanismInertia, RestitutionLaw, resolve_single_contact,
+};
 use mechanica::kinematics::nalgebra::{Unit, Vector3};
+use mechanica::mass::mechanism::TreeMass;
 use mechanica::mechanism::potentials::{ConstantForce, JointSpring, PointSpring};
 use mechanica::mechanism::{
     Anchor, EquilibriumOptions, Mechanism, MechanismModes, RotatingFrame, Seek, Stability, find_equilibria,
@@ -96,9 +96,7 @@ fn stability_note(stability: &Stability) -> String {
         Stability::Unstable {
             directions,
             max_growth_rate,
-        } => format!(
-            "unstable: {directions} unstable direction(s), fastest growth rate {max_growth_rate:.6e} 1/s"
-        ),
+        } => format!("unstable: {directions} unstable direction(s), fastest growth rate {max_growth_rate:.6e} 1/s"),
         Stability::Marginal { zero_modes } => {
             format!("marginal: {zero_modes} zero mode(s) within their error bounds, none unstable")
         }
@@ -117,7 +115,12 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     let mut built = None;
     steps.push(timed_step("build: mechanism (potentials, frame)", || {
         let mechanism = build_mechanism(scene, model)?;
-        let quantities = vec![quantity("potentials", vec![mechanism.potentials().len() as f64], "", None)];
+        let quantities = vec![quantity(
+            "potentials",
+            vec![mechanism.potentials().len() as f64],
+            "",
+            None,
+        )];
         built = Some(mechanism);
         Ok::<_, String>(quantities)
     })?);
@@ -163,9 +166,9 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
                     .map_err(|e| e.to_string())?;
                 failed += f;
                 for eq in eqs {
-                    let fresh = found
-                        .iter()
-                        .all(|other: &Vec<f64>| other.iter().zip(&eq.q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) > 1e-8);
+                    let fresh = found.iter().all(|other: &Vec<f64>| {
+                        other.iter().zip(&eq.q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) > 1e-8
+                    });
                     if fresh {
                         found.push(eq.q);
                     }
@@ -180,7 +183,8 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
                 failed
             ));
             for (i, eq) in found.iter().enumerate() {
-                step.quantities.push(quantity(&format!("equilibrium {i}"), eq.clone(), "rad | m", None));
+                step.quantities
+                    .push(quantity(&format!("equilibrium {i}"), eq.clone(), "rad | m", None));
                 let verdict = mechanism_modes(&mut mechanism.clone(), eq, &SolveOptions::default())
                     .map(|m| stability_note(&m.stability))
                     .unwrap_or_else(|e| format!("stability unknown: {e}"));
@@ -208,7 +212,11 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
             "rotating frame: gyroscopic problem det(s²A + sG + B) = 0 solved; max Re s = {:.3e} (bound {:.1e}) → {}",
             gyro.max_real_part,
             gyro.real_part_bound,
-            if gyro.stable { "stable (possibly gyroscopically stabilised)" } else { "unstable" }
+            if gyro.stable {
+                "stable (possibly gyroscopically stabilised)"
+            } else {
+                "unstable"
+            }
         ));
     }
     if modes.gradient_norm > 1e-6 * modes.stiffness_matrix.norm_l2().max(1.0) {
@@ -281,7 +289,12 @@ fn mode_quantities(m: &MechanismModes) -> Vec<crate::report::Quantity> {
             )),
         ),
         quantity("ω", omega.clone(), "rad/s", None),
-        quantity("f = ω/2π", omega.iter().map(|w| w / std::f64::consts::TAU).collect(), "Hz", None),
+        quantity(
+            "f = ω/2π",
+            omega.iter().map(|w| w / std::f64::consts::TAU).collect(),
+            "Hz",
+            None,
+        ),
     ];
     for (k, masses) in m.effective_masses.iter().enumerate().take(6) {
         out.push(quantity(
@@ -340,7 +353,12 @@ fn response_step(
         let fit = response.fit();
         let end_bound = response.error_bound(spec.duration).map_err(|e| e.to_string())?;
         let quantities = vec![
-            quantity("δ(T) at the end of the span", out.clone(), "rad | m", Some(format!("error bound {end_bound:.1e}"))),
+            quantity(
+                "δ(T) at the end of the span",
+                out.clone(),
+                "rad | m",
+                Some(format!("error bound {end_bound:.1e}")),
+            ),
             quantity(
                 "initial-state fit residual (δ, δ̇)",
                 vec![fit.displacement_residual, fit.velocity_residual],
@@ -371,66 +389,78 @@ fn impact_step(
 ) -> Result<Step, String> {
     let text = |e: &dyn std::fmt::Display| format!("analyses.impact: {e}");
     let chosen = spec.law.as_ref().map_or("stronge", |l| l.get_ref().as_str());
-    timed_step(&format!("impact: body point on the ground, {chosen} law (7.115–7.117)"), || {
-        let body = scene
-            .bodies
-            .iter()
-            .position(|b| b.name.get_ref() == spec.body.get_ref())
-            .ok_or_else(|| text(&"unknown body"))?;
-        let tree = &model.tree;
-        let mut ws = tree.workspace();
-        tree.update_positions(&mut ws, &model.q0).map_err(|e| text(&e))?;
-        tree.update_velocities(&mut ws, &model.qd0).map_err(|e| text(&e))?;
-        let mut masses = TreeMass::new(tree, model.bodies.clone()).map_err(|e| text(&e))?;
-        let inertia = MechanismInertia::new(tree, &ws, &mut masses).map_err(|e| text(&e))?;
-        let mut laws = vec![chosen];
-        if spec.compare_laws {
-            laws.extend(["newton", "poisson", "stronge"].into_iter().filter(|l| *l != chosen));
-        }
-        let mut quantities = Vec::new();
-        let mut balance = EnergyBalance { laws: Vec::new() };
-        for name in laws {
-            let law = ContactLaw::new(spec.restitution, spec.friction, law_named(name)).map_err(|e| text(&e))?;
-            let contact = MechanismContact {
-                point: BodyPoint {
-                    body,
-                    p_bq: Vector3::from(spec.point),
-                },
-                other: None,
-                normal_w: Vector3::from(spec.normal),
-                law,
-            };
-            let impact = resolve_single_contact(tree, &ws, &inertia, &model.qd0, &contact, &ImpactOptions::default())
-                .map_err(|e| text(&e))?;
-            let outcome = impact.contacts.first().ok_or_else(|| text(&"no contact outcome"))?;
-            let after = impact.energy_before + impact.energy_change;
-            balance.laws.push((name.to_string(), impact.energy_before, after));
-            let accuracy = Some(format!(
-                "integration error {:.1e} N·s, mode {:?}",
-                impact.integration_error, outcome.mode
-            ));
-            quantities.push(quantity(
-                &format!("{name}: impulse on the body (world)"),
-                outcome.impulse_w.iter().copied().collect(),
-                "N·s",
-                accuracy,
-            ));
-            quantities.push(quantity(&format!("{name}: q̇ after"), impact.q_dot_after.clone(), "rad/s | m/s", None));
-            quantities.push(quantity(
-                &format!("{name}: T before, ΔT (7.107)"),
-                vec![impact.energy_before, impact.energy_change],
-                "J",
-                None,
-            ));
-        }
-        plots.impact = Some(balance);
-        Ok(quantities)
-    })
+    timed_step(
+        &format!("impact: body point on the ground, {chosen} law (7.115–7.117)"),
+        || {
+            let body = scene
+                .bodies
+                .iter()
+                .position(|b| b.name.get_ref() == spec.body.get_ref())
+                .ok_or_else(|| text(&"unknown body"))?;
+            let tree = &model.tree;
+            let mut ws = tree.workspace();
+            tree.update_positions(&mut ws, &model.q0).map_err(|e| text(&e))?;
+            tree.update_velocities(&mut ws, &model.qd0).map_err(|e| text(&e))?;
+            let mut masses = TreeMass::new(tree, model.bodies.clone()).map_err(|e| text(&e))?;
+            let inertia = MechanismInertia::new(tree, &ws, &mut masses).map_err(|e| text(&e))?;
+            let mut laws = vec![chosen];
+            if spec.compare_laws {
+                laws.extend(["newton", "poisson", "stronge"].into_iter().filter(|l| *l != chosen));
+            }
+            let mut quantities = Vec::new();
+            let mut balance = EnergyBalance { laws: Vec::new() };
+            for name in laws {
+                let law = ContactLaw::new(spec.restitution, spec.friction, law_named(name)).map_err(|e| text(&e))?;
+                let contact = MechanismContact {
+                    point: BodyPoint {
+                        body,
+                        p_bq: Vector3::from(spec.point),
+                    },
+                    other: None,
+                    normal_w: Vector3::from(spec.normal),
+                    law,
+                };
+                let impact =
+                    resolve_single_contact(tree, &ws, &inertia, &model.qd0, &contact, &ImpactOptions::default())
+                        .map_err(|e| text(&e))?;
+                let outcome = impact.contacts.first().ok_or_else(|| text(&"no contact outcome"))?;
+                let after = impact.energy_before + impact.energy_change;
+                balance.laws.push((name.to_string(), impact.energy_before, after));
+                let accuracy = Some(format!(
+                    "integration error {:.1e} N·s, mode {:?}",
+                    impact.integration_error, outcome.mode
+                ));
+                quantities.push(quantity(
+                    &format!("{name}: impulse on the body (world)"),
+                    outcome.impulse_w.iter().copied().collect(),
+                    "N·s",
+                    accuracy,
+                ));
+                quantities.push(quantity(
+                    &format!("{name}: q̇ after"),
+                    impact.q_dot_after.clone(),
+                    "rad/s | m/s",
+                    None,
+                ));
+                quantities.push(quantity(
+                    &format!("{name}: T before, ΔT (7.107)"),
+                    vec![impact.energy_before, impact.energy_change],
+                    "J",
+                    None,
+                ));
+            }
+            plots.impact = Some(balance);
+            Ok(quantities)
+        },
+    )
     .map(|mut step| {
         if let Some(impact) = &plots.impact {
             for (law, before, after) in &impact.laws {
                 if after > before {
-                    step.notes.push(format!("{law}: the impact GAINS energy ({:.4e} J): Kane's paradox", after - before));
+                    step.notes.push(format!(
+                        "{law}: the impact GAINS energy ({:.4e} J): Kane's paradox",
+                        after - before
+                    ));
                 }
             }
         }

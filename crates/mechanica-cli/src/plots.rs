@@ -55,7 +55,12 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 /// A bar chart of `values` into `area`.
-fn bars(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, title: &str, y_label: &str, values: &[(f64, RGBColor)]) -> Result<(), String> {
+fn bars(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    title: &str,
+    y_label: &str,
+    values: &[(f64, RGBColor)],
+) -> Result<(), String> {
     let (lo, hi) = range(values.iter().map(|v| v.0));
     let mut chart = ChartBuilder::on(area)
         .caption(title, ("sans-serif", 16))
@@ -64,11 +69,20 @@ fn bars(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, title: &str,
         .y_label_area_size(60)
         .build_cartesian_2d(0f64..values.len() as f64, lo..hi)
         .map_err(failed)?;
-    chart.configure_mesh().y_desc(y_label).x_desc("index").draw().map_err(failed)?;
     chart
-        .draw_series(values.iter().enumerate().filter(|(_, v)| v.0.is_finite()).map(|(i, (v, color))| {
-            Rectangle::new([(i as f64 + 0.15, 0.0), (i as f64 + 0.85, *v)], color.filled())
-        }))
+        .configure_mesh()
+        .y_desc(y_label)
+        .x_desc("index")
+        .draw()
+        .map_err(failed)?;
+    chart
+        .draw_series(
+            values
+                .iter()
+                .enumerate()
+                .filter(|(_, v)| v.0.is_finite())
+                .map(|(i, (v, color))| Rectangle::new([(i as f64 + 0.15, 0.0), (i as f64 + 0.85, *v)], color.filled())),
+        )
         .map_err(failed)?;
     Ok(())
 }
@@ -91,7 +105,12 @@ impl PlotData {
                     if oscillatory { (f, BLUE) } else { (-f, RED) }
                 })
                 .collect();
-            bars(&root, "spectrum: f = ω/2π (red, negative: unstable or zero)", "Hz", &values)?;
+            bars(
+                &root,
+                "spectrum: f = ω/2π (red, negative: unstable or zero)",
+                "Hz",
+                &values,
+            )?;
             root.present().map_err(failed)?;
             written.push(path.clone());
         }
@@ -121,16 +140,28 @@ impl PlotData {
                 .y_label_area_size(60)
                 .build_cartesian_2d(0f64..t_end, lo..hi)
                 .map_err(failed)?;
-            chart.configure_mesh().x_desc("t (s)").y_desc("δ").draw().map_err(failed)?;
+            chart
+                .configure_mesh()
+                .x_desc("t (s)")
+                .y_desc("δ")
+                .draw()
+                .map_err(failed)?;
             for (k, series) in response.values.iter().enumerate() {
                 let color = Palette99::pick(k);
                 chart
-                    .draw_series(LineSeries::new(response.times.iter().copied().zip(series.iter().copied()), &color))
+                    .draw_series(LineSeries::new(
+                        response.times.iter().copied().zip(series.iter().copied()),
+                        &color,
+                    ))
                     .map_err(failed)?
                     .label(format!("q{k}"))
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], Palette99::pick(k)));
             }
-            chart.configure_series_labels().border_style(BLACK).draw().map_err(failed)?;
+            chart
+                .configure_series_labels()
+                .border_style(BLACK)
+                .draw()
+                .map_err(failed)?;
             root.present().map_err(failed)?;
             written.push(path.clone());
         }
@@ -146,7 +177,10 @@ impl PlotData {
             let names: Vec<&str> = impact.laws.iter().map(|l| l.0.as_str()).collect();
             bars(
                 &root,
-                &format!("impact: kinetic energy before (blue) / after, laws {}", names.join(", ")),
+                &format!(
+                    "impact: kinetic energy before (blue) / after, laws {}",
+                    names.join(", ")
+                ),
                 "J",
                 &values,
             )?;

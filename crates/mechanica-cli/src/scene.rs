@@ -580,8 +580,14 @@ impl Scene {
             }
         }
         for (label, name) in [
-            ("analyses.equilibrium.seek", self.analyses.equilibrium.as_ref().and_then(|e| e.seek.as_ref())),
-            ("analyses.impact.law", self.analyses.impact.as_ref().and_then(|i| i.law.as_ref())),
+            (
+                "analyses.equilibrium.seek",
+                self.analyses.equilibrium.as_ref().and_then(|e| e.seek.as_ref()),
+            ),
+            (
+                "analyses.impact.law",
+                self.analyses.impact.as_ref().and_then(|i| i.law.as_ref()),
+            ),
         ] {
             let allowed: &[&str] = if label.ends_with("seek") {
                 &["minimum", "stationary"]
@@ -599,7 +605,11 @@ impl Scene {
             }
         }
         if self.analyses.response.is_some() && self.analyses.modes.is_none() {
-            return Err(error(None, "analyses.response".into(), "the free response needs `modes`".into()));
+            return Err(error(
+                None,
+                "analyses.response".into(),
+                "the free response needs `modes`".into(),
+            ));
         }
         Ok(())
     }

@@ -204,7 +204,10 @@ pub(crate) fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
                 joint.name
             ));
         }
-        limits.extend(std::iter::repeat_n(joint.limits.as_ref().map(|l| *l.get_ref()), lib_joint.dof()));
+        limits.extend(std::iter::repeat_n(
+            joint.limits.as_ref().map(|l| *l.get_ref()),
+            lib_joint.dof(),
+        ));
         joint_body.push((joint.name.clone(), i));
     }
     // A tree with several bodies on the ground would have several roots; the tree needs one.

@@ -49,7 +49,9 @@ pub fn load(path: &Path, repair_inertia: bool) -> Result<(Scene, Vec<String>), S
     let mut bodies = Vec::new();
     for link in &robot.links {
         if link.name == "ground" {
-            return Err(located("a link named \"ground\" clashes with the scene's name for the world".into()));
+            return Err(located(
+                "a link named \"ground\" clashes with the scene's name for the world".into(),
+            ));
         }
         let inertial = &link.inertial;
         let r = rotation(inertial.origin.rpy.0);
@@ -70,7 +72,10 @@ pub fn load(path: &Path, repair_inertia: bool) -> Result<(Scene, Vec<String>), S
             props = mesh_props;
         }
         if props.mass < 0.0 || !props.mass.is_finite() {
-            problems.push(format!("link \"{}\": mass {} is not a physical mass", link.name, props.mass));
+            problems.push(format!(
+                "link \"{}\": mass {} is not a physical mass",
+                link.name, props.mass
+            ));
         } else if props.mass > 0.0 {
             match check(&props, &ValidityTolerance::default()) {
                 Ok(_) => {}
@@ -219,7 +224,9 @@ fn mesh_mass(urdf: &Path, link: &urdf_rs::Link) -> Option<(MassProperties, Strin
                     v[k] *= s[k];
                 }
             }
-            let props = mesh.mass_properties(Amount::Density(MESH_DENSITY), &MeshOptions::default()).ok()?;
+            let props = mesh
+                .mass_properties(Amount::Density(MESH_DENSITY), &MeshOptions::default())
+                .ok()?;
             let pose = mechanica::kinematics::nalgebra::Isometry3::from_parts(
                 Vector3::from(origin.xyz.0).into(),
                 rotation(origin.rpy.0).into(),

@@ -5,7 +5,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn mechanica(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_mechanica")).args(args).output().expect("run mechanica");
+    let out = Command::new(env!("CARGO_BIN_EXE_mechanica"))
+        .args(args)
+        .output()
+        .expect("run mechanica");
     (
         out.status.success(),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -28,7 +31,12 @@ fn values(json: &serde_json::Value, name: &str) -> Vec<f64> {
     for step in json["steps"].as_array().expect("steps") {
         for q in step["quantities"].as_array().expect("quantities") {
             if q["name"].as_str().is_some_and(|n| n.starts_with(name)) {
-                return q["values"].as_array().expect("values").iter().map(|v| v.as_f64().unwrap_or(f64::NAN)).collect();
+                return q["values"]
+                    .as_array()
+                    .expect("values")
+                    .iter()
+                    .map(|v| v.as_f64().unwrap_or(f64::NAN))
+                    .collect();
             }
         }
     }
@@ -54,7 +62,12 @@ fn rotating_hoop_scene_finds_the_relative_equilibrium_and_its_frequency() {
 fn chain_scene_reports_stable_modes_response_and_plots() {
     let path = examples().join("spring_pendulum_chain.toml");
     let plots = scratch("plots");
-    let (ok, out, err) = mechanica(&["run", path.to_str().expect("path"), "--plot", plots.to_str().expect("dir")]);
+    let (ok, out, err) = mechanica(&[
+        "run",
+        path.to_str().expect("path"),
+        "--plot",
+        plots.to_str().expect("dir"),
+    ]);
     assert!(ok, "{err}");
     assert!(out.contains("stable: every mode oscillates"), "{out}");
     assert!(out.contains("free response"), "{out}");
@@ -139,7 +152,10 @@ fn bad_scenes_give_located_errors() {
         let (ok, out, err) = mechanica(&["run", path.to_str().expect("path")]);
         assert!(!ok, "{name} should fail:\n{out}");
         assert!(err.contains(expected), "{name}: {err}");
-        assert!(err.contains(&format!("{name}.toml")), "{name}: the error names the file: {err}");
+        assert!(
+            err.contains(&format!("{name}.toml")),
+            "{name}: the error names the file: {err}"
+        );
         assert!(out.is_empty(), "{name}: nothing half-written: {out}");
     }
 }
@@ -170,7 +186,10 @@ equilibrium = { max_iterations = 5 }
     .expect("write");
     let (ok, _, err) = mechanica(&["run", path.to_str().expect("path")]);
     assert!(!ok);
-    assert!(err.contains("did not converge") && err.contains("best |grad U*|") && err.contains("at q ="), "{err}");
+    assert!(
+        err.contains("did not converge") && err.contains("best |grad U*|") && err.contains("at q ="),
+        "{err}"
+    );
 }
 
 const URDF: &str = r#"<?xml version="1.0"?>
@@ -218,7 +237,10 @@ fn a_urdf_robot_runs_and_invalid_inertias_are_reported_per_link() {
     std::fs::write(&bad, URDF.replace("IXX", "1.0")).expect("write");
     let (ok, _, err) = mechanica(&["run", bad.to_str().expect("path")]);
     assert!(!ok);
-    assert!(err.contains("link \"upper\"") && err.contains("--repair-inertia"), "{err}");
+    assert!(
+        err.contains("link \"upper\"") && err.contains("--repair-inertia"),
+        "{err}"
+    );
     let (ok, out, err) = mechanica(&["run", bad.to_str().expect("path"), "--repair-inertia"]);
     assert!(ok, "{err}");
     assert!(out.contains("inertia repaired"), "{out}");

@@ -109,7 +109,9 @@ impl<'a> Configuration<'a> {
         let mut rank = Vec::with_capacity(n);
         for k in 0..n {
             let (w, v) = workspace.motion_column(k)?;
-            let i = tree.dof_body(k).ok_or(MechanismError::Numerical("coordinate without a body"))?;
+            let i = tree
+                .dof_body(k)
+                .ok_or(MechanismError::Numerical("coordinate without a body"))?;
             let o = workspace.position(i)?;
             columns.push(Column { w, a: v - w.cross(&o) });
             let joint = tree.joint(i).ok_or(MechanismError::Numerical("body without a joint"))?;

@@ -146,7 +146,7 @@ pub fn find_equilibrium(
         });
     }
     crate::error::check_all_finite(&q, "q0")?;
-    if !(options.max_step > 0.0) {
+    if options.max_step.is_nan() || options.max_step <= 0.0 {
         return Err(MechanismError::OutOfRange {
             what: "maximum equilibrium step",
             requirement: "> 0",
@@ -187,7 +187,10 @@ pub fn find_equilibrium(
         if iteration == options.max_iterations {
             break;
         }
-        let hessian = current.hessian.as_ref().ok_or(MechanismError::Numerical("Hessian missing"))?;
+        let hessian = current
+            .hessian
+            .as_ref()
+            .ok_or(MechanismError::Numerical("Hessian missing"))?;
         // Projected Newton: coordinates held by a limit are frozen, the rest take the Newton
         // step of the reduced problem.
         let moving: Vec<usize> = (0..q.len()).filter(|k| !at_limit.contains(k)).collect();
@@ -209,8 +212,7 @@ pub fn find_equilibrium(
             let sufficient = match options.seek {
                 Seek::Stationary => norm(&trial_free) < (1.0 - 1e-4 * alpha) * gradient_norm,
                 Seek::Minimum => {
-                    evaluation.value <= current.value + 1e-4 * alpha * slope
-                        || norm(&trial_free) < 1e-3 * gradient_norm
+                    evaluation.value <= current.value + 1e-4 * alpha * slope || norm(&trial_free) < 1e-3 * gradient_norm
                 }
             };
             if sufficient {
@@ -252,7 +254,13 @@ pub fn find_equilibria(
         match find_equilibrium(&mut copy, start, options) {
             Ok(eq) => {
                 let duplicate = found.iter().any(|other| {
-                    let d: f64 = other.q.iter().zip(&eq.q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+                    let d: f64 = other
+                        .q
+                        .iter()
+                        .zip(&eq.q)
+                        .map(|(a, b)| (a - b) * (a - b))
+                        .sum::<f64>()
+                        .sqrt();
                     d <= 1e-8 * (1.0 + norm(&eq.q))
                 });
                 if !duplicate {

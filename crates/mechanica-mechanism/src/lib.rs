@@ -22,5 +22,7 @@ pub use configuration::Configuration;
 pub use equilibrium::{Equilibrium, EquilibriumOptions, Seek, find_equilibria, find_equilibrium};
 pub use error::MechanismError;
 pub use mechanism::{Mechanism, RotatingFrame};
-pub use modes::{BodyDisplacement, GyroscopicModes, MechanismModes, Stability, mechanism_modes, mechanism_modes_with_locks};
+pub use modes::{
+    BodyDisplacement, GyroscopicModes, MechanismModes, Stability, mechanism_modes, mechanism_modes_with_locks,
+};
 pub use potentials::{Anchor, Potential, PotentialSum};

@@ -224,11 +224,7 @@ fn propagate_assembly_error(solution: &mut ModalSolution, b: &Mat<f64>) {
 
 type Shapes = (Vec<Vec<BodyDisplacement>>, Vec<[f64; 3]>, f64);
 
-fn shapes_in_space(
-    mechanism: &Mechanism,
-    q: &[f64],
-    solution: &ModalSolution,
-) -> Result<Shapes, MechanismError> {
+fn shapes_in_space(mechanism: &Mechanism, q: &[f64], solution: &ModalSolution) -> Result<Shapes, MechanismError> {
     let tree = mechanism.tree();
     let n = tree.dof();
     let mut ws = tree.workspace();
@@ -277,7 +273,11 @@ fn shapes_in_space(
         // Γ_d = x_kᵀ L_d with L_d = Σ m_i J_iᵀ d = (M J_c)ᵀ d; x_k is A-normalised.
         let participation = combine(&com_jacobian);
         effective.push(if finite {
-            [participation.x.powi(2), participation.y.powi(2), participation.z.powi(2)]
+            [
+                participation.x.powi(2),
+                participation.y.powi(2),
+                participation.z.powi(2),
+            ]
         } else {
             [0.0; 3]
         });
@@ -324,12 +324,17 @@ fn gyroscopic_modes(a: &Mat<f64>, g: &Mat<f64>, b: &Mat<f64>) -> Result<Gyroscop
         let eta = if scale > 0.0 { residual.sqrt() / scale } else { 0.0 };
         pairs.push(((lambda.re, lambda.im), eta));
     }
-    pairs.sort_by(|p, q| (p.0.1.abs(), p.0.0).partial_cmp(&(q.0.1.abs(), q.0.0)).unwrap_or(std::cmp::Ordering::Equal));
+    pairs.sort_by(|p, q| {
+        (p.0.1.abs(), p.0.0)
+            .partial_cmp(&(q.0.1.abs(), q.0.0))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
     let max_real_part = pairs.iter().map(|p| p.0.0).fold(f64::NEG_INFINITY, f64::max);
     let max_modulus = pairs.iter().map(|p| p.0.0.hypot(p.0.1)).fold(0.0, f64::max);
     let max_eta = pairs.iter().map(|p| p.1).fold(0.0, f64::max);
     // A backward error η perturbs s by about η·cond; take the companion scale as the yardstick.
-    let real_part_bound = (max_eta.max(f64::EPSILON) * 2.0 * n as f64 * max_modulus.max(1.0)).sqrt() * max_modulus.max(1.0);
+    let real_part_bound =
+        (max_eta.max(f64::EPSILON) * 2.0 * n as f64 * max_modulus.max(1.0)).sqrt() * max_modulus.max(1.0);
     Ok(GyroscopicModes {
         eigenvalues: pairs.iter().map(|p| p.0).collect(),
         backward_errors: pairs.iter().map(|p| p.1).collect(),

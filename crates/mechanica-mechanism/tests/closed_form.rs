@@ -8,15 +8,11 @@ use mechanica_mass::MassProperties;
 use mechanica_mass::primitives::{Amount, cylinder};
 use mechanica_mechanism::potentials::{JointSpring, PointSpring};
 use mechanica_mechanism::{
-    Anchor, EquilibriumOptions, Mechanism, Seek, MechanismError, RotatingFrame, Stability, find_equilibria,
+    Anchor, EquilibriumOptions, Mechanism, MechanismError, RotatingFrame, Seek, Stability, find_equilibria,
     find_equilibrium, mechanism_modes,
 };
 use mechanica_modal::{ModeKind, SolveOptions};
 use nalgebra::{Isometry3, Unit, Vector3};
-
-fn omega_sq(modes: &mechanica_mechanism::MechanismModes) -> Vec<f64> {
-    modes.solution.modes.iter().map(|m| m.omega_sq).collect()
-}
 
 /// Every computed ω² must be within its own reported bound of the exact value (and the bound
 /// must be honest, i.e. small).
@@ -30,7 +26,11 @@ fn assert_within_bounds(modes: &mechanica_mechanism::MechanismModes, exact: &[f6
             mode.omega_sq,
             mode.error_bound
         );
-        assert!(error <= 1e-12 * w2.abs().max(1e-300), "ω² = {} vs exact {w2}", mode.omega_sq);
+        assert!(
+            error <= 1e-12 * w2.abs().max(1e-300),
+            "ω² = {} vs exact {w2}",
+            mode.omega_sq
+        );
     }
 }
 
@@ -80,20 +80,43 @@ fn spring_mass_chain_built_as_a_mechanism_matches_the_matrix_closed_form() {
         if i == 0 {
             root = Some(builder.add_body(None, Joint::Fixed, Isometry3::identity()));
         }
-        builder.add_body(root, Joint::Prismatic { axis: Vector3::x() }, Isometry3::translation((i + 1) as f64 * spacing, 0.0, 0.0));
+        builder.add_body(
+            root,
+            Joint::Prismatic { axis: Vector3::x() },
+            Isometry3::translation((i + 1) as f64 * spacing, 0.0, 0.0),
+        );
     }
     let tree = builder.build().expect("tree");
     let mut bodies = vec![MassProperties::point(1.0, Vector3::zeros()).expect("mass"); n + 1];
-    bodies[0] = MassProperties { mass: 0.0, p_oc: Vector3::zeros(), inertia_c: nalgebra::Matrix3::zeros() };
+    bodies[0] = MassProperties {
+        mass: 0.0,
+        p_oc: Vector3::zeros(),
+        inertia_c: nalgebra::Matrix3::zeros(),
+    };
     let mut mechanism = Mechanism::new(tree, bodies).expect("mechanism");
-    let ground = |x: f64| Anchor { body: None, point: Vector3::new(x, 0.0, 0.0) };
-    let slider = |i: usize| Anchor { body: Some(i + 1), point: Vector3::zeros() };
-    let spring = |a, b| PointSpring { a, b, stiffness: 1.0, rest_length: spacing };
+    let ground = |x: f64| Anchor {
+        body: None,
+        point: Vector3::new(x, 0.0, 0.0),
+    };
+    let slider = |i: usize| Anchor {
+        body: Some(i + 1),
+        point: Vector3::zeros(),
+    };
+    let spring = |a, b| PointSpring {
+        a,
+        b,
+        stiffness: 1.0,
+        rest_length: spacing,
+    };
     mechanism.add_potential(spring(ground(0.0), slider(0))).expect("wall");
     for i in 0..n - 1 {
-        mechanism.add_potential(spring(slider(i), slider(i + 1))).expect("spring");
+        mechanism
+            .add_potential(spring(slider(i), slider(i + 1)))
+            .expect("spring");
     }
-    mechanism.add_potential(spring(slider(n - 1), ground((n + 1) as f64 * spacing))).expect("wall");
+    mechanism
+        .add_potential(spring(slider(n - 1), ground((n + 1) as f64 * spacing)))
+        .expect("wall");
     let modes = mechanism_modes(&mut mechanism, &vec![0.0; n], &SolveOptions::default()).expect("modes");
     assert_within_bounds(&modes, &mechanica_modal::families::fixed_chain_omega_sq(n));
     // Effective masses along x sum to the moving mass when every mode is kept.
@@ -109,10 +132,16 @@ fn inverted_pendulum_is_found_and_classified_unstable() {
     assert!((eq.q[0] - std::f64::consts::PI).abs() < 1e-12, "upright: {:?}", eq.q);
     let modes = mechanism_modes(&mut mechanism, &eq.q, &SolveOptions::default()).expect("modes");
     match modes.stability {
-        Stability::Unstable { directions, max_growth_rate } => {
+        Stability::Unstable {
+            directions,
+            max_growth_rate,
+        } => {
             assert_eq!(directions, 1);
             let exact = (G / l).sqrt();
-            assert!((max_growth_rate - exact).abs() <= 1e-12 * exact, "γ = {max_growth_rate} vs {exact}");
+            assert!(
+                (max_growth_rate - exact).abs() <= 1e-12 * exact,
+                "γ = {max_growth_rate} vs {exact}"
+            );
         }
         other => panic!("inverted pendulum classified {other:?}"),
     }
@@ -121,7 +150,11 @@ fn inverted_pendulum_is_found_and_classified_unstable() {
     let (found, _) = find_equilibria(&mut mechanism, &starts, &EquilibriumOptions::default()).expect("search");
     for eq in &found {
         let wrapped = eq.q[0].rem_euclid(2.0 * std::f64::consts::PI);
-        assert!(wrapped < 1e-9 || (wrapped - std::f64::consts::PI).abs() < 1e-9 || (wrapped - 2.0 * std::f64::consts::PI).abs() < 1e-9);
+        assert!(
+            wrapped < 1e-9
+                || (wrapped - std::f64::consts::PI).abs() < 1e-9
+                || (wrapped - 2.0 * std::f64::consts::PI).abs() < 1e-9
+        );
     }
 }
 
@@ -137,14 +170,24 @@ fn bead_on_a_rotating_hoop_bifurcates_at_the_critical_speed() {
         let rate = ratio * critical;
         let mut mechanism = pendulum_chain(1, m, r);
         mechanism
-            .set_rotating_frame(Some(RotatingFrame { axis: Unit::new_normalize(Vector3::z()), rate }))
+            .set_rotating_frame(Some(RotatingFrame {
+                axis: Unit::new_normalize(Vector3::z()),
+                rate,
+            }))
             .expect("rotation");
         let bottom = mechanism_modes(&mut mechanism, &[0.0], &SolveOptions::default()).expect("modes");
-        let seek_minimum = EquilibriumOptions { seek: Seek::Minimum, ..EquilibriumOptions::default() };
+        let seek_minimum = EquilibriumOptions {
+            seek: Seek::Minimum,
+            ..EquilibriumOptions::default()
+        };
         let eq = find_equilibrium(&mut mechanism, &[0.3], &seek_minimum).expect("equilibrium");
         let modes = mechanism_modes(&mut mechanism, &eq.q, &SolveOptions::default()).expect("modes");
         if ratio < 1.0 {
-            assert!(eq.q[0].abs() < 1e-10, "below critical speed the bead returns to the bottom: {:?}", eq.q);
+            assert!(
+                eq.q[0].abs() < 1e-10,
+                "below critical speed the bead returns to the bottom: {:?}",
+                eq.q
+            );
             let exact = G / r - rate * rate;
             assert!((modes.solution.modes[0].omega_sq - exact).abs() <= 1e-12 * exact);
             assert_eq!(modes.stability, Stability::Stable);
@@ -176,9 +219,17 @@ fn spherical_compound_pendulum_has_a_double_frequency_and_a_zero_mode() {
     let d = length / 2.0;
     let i_pivot = mass * (radius * radius / 4.0 + length * length / 12.0) + mass * d * d;
     let pendulum = mass * G * d / i_pivot;
-    assert!(matches!(modes.solution.modes[0].kind, ModeKind::Zero), "{:?}", modes.solution.modes);
+    assert!(
+        matches!(modes.solution.modes[0].kind, ModeKind::Zero),
+        "{:?}",
+        modes.solution.modes
+    );
     for mode in &modes.solution.modes[1..] {
-        assert!((mode.omega_sq - pendulum).abs() <= 1e-12 * pendulum, "{} vs {pendulum}", mode.omega_sq);
+        assert!(
+            (mode.omega_sq - pendulum).abs() <= 1e-12 * pendulum,
+            "{} vs {pendulum}",
+            mode.omega_sq
+        );
     }
     assert_eq!(modes.solution.groups.last().map(|g| g.multiplicity), Some(2));
     assert_eq!(modes.stability, Stability::Marginal { zero_modes: 1 });
@@ -187,12 +238,21 @@ fn spherical_compound_pendulum_has_a_double_frequency_and_a_zero_mode() {
 #[test]
 fn joint_limits_stop_the_search_and_are_reported() {
     let mut mechanism = pendulum_chain(1, 1.0, 1.0);
-    mechanism.add_potential(JointSpring { coordinate: 0, stiffness: 100.0, rest: 2.0 }).expect("spring");
+    mechanism
+        .add_potential(JointSpring {
+            coordinate: 0,
+            stiffness: 100.0,
+            rest: 2.0,
+        })
+        .expect("spring");
     mechanism.set_limits(0, 0.5, 1.0).expect("limits");
     let eq = find_equilibrium(&mut mechanism, &[0.7], &EquilibriumOptions::default()).expect("equilibrium");
     assert_eq!(eq.at_limit, vec![0]);
     assert_eq!(eq.q[0], 1.0);
-    assert!(matches!(mechanism.set_limits(0, 1.0, 0.0), Err(MechanismError::BadLimits { .. })));
+    assert!(matches!(
+        mechanism.set_limits(0, 1.0, 0.0),
+        Err(MechanismError::BadLimits { .. })
+    ));
 }
 
 #[test]
@@ -204,10 +264,22 @@ fn a_search_that_cannot_converge_reports_its_best_point() {
     let body = cylinder(0.1, 0.02, Amount::Mass(1.0)).expect("wheel");
     let mut mechanism = Mechanism::new(tree, vec![body]).expect("mechanism");
     mechanism
-        .add_potential(mechanica_mechanism::potentials::GeneralizedForce { coordinate: 0, value: 2.0 })
+        .add_potential(mechanica_mechanism::potentials::GeneralizedForce {
+            coordinate: 0,
+            value: 2.0,
+        })
         .expect("torque");
-    match find_equilibrium(&mut mechanism, &[0.0], &EquilibriumOptions { max_iterations: 10, ..EquilibriumOptions::default() }) {
-        Err(MechanismError::NoEquilibrium { gradient_norm, best_q, .. }) => {
+    match find_equilibrium(
+        &mut mechanism,
+        &[0.0],
+        &EquilibriumOptions {
+            max_iterations: 10,
+            ..EquilibriumOptions::default()
+        },
+    ) {
+        Err(MechanismError::NoEquilibrium {
+            gradient_norm, best_q, ..
+        }) => {
             assert!((gradient_norm - 2.0).abs() < 1e-12);
             assert_eq!(best_q.len(), 1);
         }
@@ -226,18 +298,35 @@ fn gyroscopic_coupling_shifts_frequencies_and_stabilises_a_potential_maximum() {
     for &rate in &[0.5, 1.7, 5.0] {
         let mut builder = TreeBuilder::new();
         let carriage = builder.add_body(None, Joint::Prismatic { axis: Vector3::x() }, Isometry3::identity());
-        builder.add_body(Some(carriage), Joint::Prismatic { axis: Vector3::y() }, Isometry3::identity());
+        builder.add_body(
+            Some(carriage),
+            Joint::Prismatic { axis: Vector3::y() },
+            Isometry3::identity(),
+        );
         let tree = builder.build().expect("tree");
-        let massless = MassProperties { mass: 0.0, p_oc: Vector3::zeros(), inertia_c: nalgebra::Matrix3::zeros() };
+        let massless = MassProperties {
+            mass: 0.0,
+            p_oc: Vector3::zeros(),
+            inertia_c: nalgebra::Matrix3::zeros(),
+        };
         let bodies = vec![massless, MassProperties::point(m, Vector3::zeros()).expect("mass")];
         let mut mechanism = Mechanism::new(tree, bodies).expect("mechanism");
         mechanism
-            .set_rotating_frame(Some(RotatingFrame { axis: Unit::new_normalize(Vector3::z()), rate }))
+            .set_rotating_frame(Some(RotatingFrame {
+                axis: Unit::new_normalize(Vector3::z()),
+                rate,
+            }))
             .expect("rotation");
         mechanism
             .add_potential(PointSpring {
-                a: Anchor { body: Some(1), point: Vector3::zeros() },
-                b: Anchor { body: None, point: Vector3::zeros() },
+                a: Anchor {
+                    body: Some(1),
+                    point: Vector3::zeros(),
+                },
+                b: Anchor {
+                    body: None,
+                    point: Vector3::zeros(),
+                },
                 stiffness: k,
                 rest_length: 0.0,
             })
@@ -246,14 +335,26 @@ fn gyroscopic_coupling_shifts_frequencies_and_stabilises_a_potential_maximum() {
         let gyro = modes.gyroscopic.expect("rotating frame with coupling");
         let mut frequencies: Vec<f64> = gyro.eigenvalues.iter().map(|s| s.1.abs()).collect();
         frequencies.sort_by(f64::total_cmp);
-        let mut expected = vec![(omega0 - rate).abs(), (omega0 - rate).abs(), omega0 + rate, omega0 + rate];
+        let mut expected = vec![
+            (omega0 - rate).abs(),
+            (omega0 - rate).abs(),
+            omega0 + rate,
+            omega0 + rate,
+        ];
         expected.sort_by(f64::total_cmp);
         for (got, want) in frequencies.iter().zip(&expected) {
-            assert!((got - want).abs() <= 1e-10 * want.max(1.0), "Ω = {rate}: {frequencies:?} vs {expected:?}");
+            assert!(
+                (got - want).abs() <= 1e-10 * want.max(1.0),
+                "Ω = {rate}: {frequencies:?} vs {expected:?}"
+            );
         }
         assert!(gyro.stable, "Ω = {rate}: max Re s = {}", gyro.max_real_part);
         if rate > omega0 {
-            assert!(matches!(modes.stability, Stability::Unstable { directions: 2, .. }), "{:?}", modes.stability);
+            assert!(
+                matches!(modes.stability, Stability::Unstable { directions: 2, .. }),
+                "{:?}",
+                modes.stability
+            );
         } else {
             assert_eq!(modes.stability, Stability::Stable);
         }

@@ -59,7 +59,12 @@ fn loaded_mechanism(n: usize, seed: u64, spherical: bool, rotating: bool) -> Mec
             force: Vector3::new(3.0, -2.0, 1.0),
         })
         .expect("force");
-    mechanism.add_potential(GeneralizedForce { coordinate: 0, value: 0.7 }).expect("Q");
+    mechanism
+        .add_potential(GeneralizedForce {
+            coordinate: 0,
+            value: 0.7,
+        })
+        .expect("Q");
     let tree = mechanism.tree().clone();
     for k in 0..tree.dof() {
         let body = tree.dof_body(k).expect("body");
@@ -152,11 +157,17 @@ fn hessian_away_from_zero_rotation_vector_is_refused_and_rebasing_fixes_it() {
         let mut mechanism = Mechanism::new(tree, bodies).expect("mechanism");
         mechanism.set_gravity(Vector3::new(0.0, 0.0, -9.81)).expect("gravity");
         let mut q = random_vector(mechanism.dof(), seed, 0.5);
-        assert!(matches!(mechanism.potential(&q, true), Err(MechanismError::NotRebased { .. })));
+        assert!(matches!(
+            mechanism.potential(&q, true),
+            Err(MechanismError::NotRebased { .. })
+        ));
         let before = mechanism.potential(&q, false).expect("value").value;
         mechanism.rebase(&mut q).expect("rebase");
         let after = mechanism.potential(&q, true).expect("hessian after rebase");
-        assert!((after.value - before).abs() <= 1e-12 * before.abs().max(1.0), "rebasing moved a body");
+        assert!(
+            (after.value - before).abs() <= 1e-12 * before.abs().max(1.0),
+            "rebasing moved a body"
+        );
         check_derivatives(&mechanism, &q);
         return;
     }
@@ -176,7 +187,9 @@ fn gyroscopic_matrix_and_centrifugal_potential_match_point_mass_sums() {
         let axis = Unit::new_normalize(Vector3::new(0.3, -0.4, 1.0));
         let rate = 3.0;
         let mut mechanism = Mechanism::new(tree.clone(), points.clone()).expect("mechanism");
-        mechanism.set_rotating_frame(Some(RotatingFrame { axis, rate })).expect("rotation");
+        mechanism
+            .set_rotating_frame(Some(RotatingFrame { axis, rate }))
+            .expect("rotation");
         let n = tree.dof();
         let q = random_vector(n, seed + 3, 0.7);
         let g = mechanism.gyroscopic_matrix(&q).expect("G");
@@ -221,7 +234,9 @@ fn centrifugal_potential_of_a_solid_body_uses_its_moment_about_the_axis() {
     let axis = Unit::new_normalize(Vector3::new(1.0, 2.0, 2.0));
     let rate = 1.5;
     let mut mechanism = Mechanism::new(tree.clone(), bodies.clone()).expect("mechanism");
-    mechanism.set_rotating_frame(Some(RotatingFrame { axis, rate })).expect("rotation");
+    mechanism
+        .set_rotating_frame(Some(RotatingFrame { axis, rate }))
+        .expect("rotation");
     let q = random_vector(tree.dof(), 9, 0.5);
     let u = mechanism.potential(&q, false).expect("U").value;
     let mut ws = tree.workspace();
@@ -254,35 +269,64 @@ fn bad_inputs_are_typed_errors() {
         Err(MechanismError::GravityNotAlongAxis { .. })
     ));
     assert!(matches!(
-        mechanism.add_potential(JointSpring { coordinate: 99, stiffness: 1.0, rest: 0.0 }),
+        mechanism.add_potential(JointSpring {
+            coordinate: 99,
+            stiffness: 1.0,
+            rest: 0.0
+        }),
         Err(MechanismError::NoSuchCoordinate { .. })
     ));
     assert!(matches!(
         mechanism.add_potential(PointSpring {
-            a: Anchor { body: Some(7), point: Vector3::zeros() },
-            b: Anchor { body: None, point: Vector3::zeros() },
+            a: Anchor {
+                body: Some(7),
+                point: Vector3::zeros()
+            },
+            b: Anchor {
+                body: None,
+                point: Vector3::zeros()
+            },
             stiffness: 1.0,
             rest_length: 0.0
         }),
         Err(MechanismError::NoSuchBody { .. })
     ));
     assert!(matches!(
-        mechanism.add_potential(JointSpring { coordinate: 0, stiffness: -1.0, rest: 0.0 }),
+        mechanism.add_potential(JointSpring {
+            coordinate: 0,
+            stiffness: -1.0,
+            rest: 0.0
+        }),
         Err(MechanismError::OutOfRange { .. })
     ));
     let n = mechanism.dof();
-    assert!(matches!(mechanism.potential(&vec![0.0; n + 1], true), Err(MechanismError::WrongLength { .. })));
+    assert!(matches!(
+        mechanism.potential(&vec![0.0; n + 1], true),
+        Err(MechanismError::WrongLength { .. })
+    ));
     let mut q = vec![0.0; n];
     q[0] = f64::INFINITY;
-    assert!(matches!(mechanism.potential(&q, true), Err(MechanismError::NonFinite { .. })));
+    assert!(matches!(
+        mechanism.potential(&q, true),
+        Err(MechanismError::NonFinite { .. })
+    ));
     // A spring with a rest length whose ends meet has no direction.
     mechanism
         .add_potential(PointSpring {
-            a: Anchor { body: None, point: Vector3::new(5.0, 5.0, 5.0) },
-            b: Anchor { body: None, point: Vector3::new(5.0, 5.0, 5.0) },
+            a: Anchor {
+                body: None,
+                point: Vector3::new(5.0, 5.0, 5.0),
+            },
+            b: Anchor {
+                body: None,
+                point: Vector3::new(5.0, 5.0, 5.0),
+            },
             stiffness: 1.0,
             rest_length: 1.0,
         })
         .expect("valid spring");
-    assert!(matches!(mechanism.potential(&vec![0.0; n], true), Err(MechanismError::ZeroLengthSpring { .. })));
+    assert!(matches!(
+        mechanism.potential(&vec![0.0; n], true),
+        Err(MechanismError::ZeroLengthSpring { .. })
+    ));
 }

@@ -42,6 +42,9 @@ pub enum Refinement {
     Always,
 }
 
+/// Dense problems smaller than this are solved on one thread.
+pub const SEQUENTIAL_BELOW: usize = 192;
+
 /// Auto refinement starts when the reduction guarantees fewer than 8 digits of a mode's ω².
 pub const AUTO_REFINE_RELATIVE_BOUND: f64 = 1e-8;
 
@@ -233,9 +236,14 @@ fn check_interval(selection: Selection) -> Result<(), ModalError> {
 /// infinite modes. A indefinite: [`ModalError::IndefiniteMass`], naming the failed pivot.
 pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSolution, ModalError> {
     check_interval(options.selection)?;
-    let par = faer::get_global_parallelism();
     let (a, b) = (problem.a(), problem.b());
     let n = problem.dim();
+    // Below a few hundred unknowns thread start-up costs more than it saves (mechanisms).
+    let par = if n < SEQUENTIAL_BELOW {
+        Par::Seq
+    } else {
+        faer::get_global_parallelism()
+    };
     if n == 0 {
         return select(&[], options.selection).map(|_| empty_solution());
     }

@@ -38,7 +38,13 @@ impl Potential for ConstantForce {
             point: self.point,
         };
         let x = config.point(anchor.body, &anchor.point)?;
-        sum.add_point_potential(config, &[(anchor, 1.0)], -self.force.dot(&x), &-self.force, &Matrix3::zeros())
+        sum.add_point_potential(
+            config,
+            &[(anchor, 1.0)],
+            -self.force.dot(&x),
+            &-self.force,
+            &Matrix3::zeros(),
+        )
     }
 }
 

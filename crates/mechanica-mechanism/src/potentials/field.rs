@@ -79,8 +79,8 @@ impl Potential for UniformField {
         for c in 0..n {
             let m = config.subtree_moments(body_of(c));
             let col = config.column(c);
-            sum.gradient[c] += col.w.dot(&(axial(&(k * m.second)) - m.first.cross(g)))
-                + (k * m.first - g * m.mass).dot(&col.a);
+            sum.gradient[c] +=
+                col.w.dot(&(axial(&(k * m.second)) - m.first.cross(g))) + (k * m.first - g * m.mass).dot(&col.a);
         }
         let Some(hessian) = sum.hessian.as_mut() else {
             return Ok(());

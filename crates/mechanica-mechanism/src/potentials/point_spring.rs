@@ -34,7 +34,10 @@ impl Potential for PointSpring {
     fn validate(&self, tree: &KinematicTree) -> Result<(), MechanismError> {
         self.a.validate(tree, "spring end a")?;
         self.b.validate(tree, "spring end b")?;
-        for (value, what) in [(self.stiffness, "spring stiffness"), (self.rest_length, "spring rest length")] {
+        for (value, what) in [
+            (self.stiffness, "spring stiffness"),
+            (self.rest_length, "spring rest length"),
+        ] {
             if crate::error::check_finite(value, what)? < 0.0 {
                 return Err(MechanismError::OutOfRange {
                     what,

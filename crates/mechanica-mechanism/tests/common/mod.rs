@@ -33,13 +33,19 @@ pub fn pendulum_chain(n: usize, m: f64, l: f64) -> Mechanism {
 pub fn random_tree(n: usize, seed: u64, spherical: bool) -> (KinematicTree, Vec<MassProperties>) {
     let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
     let mut next = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((state >> 11) as f64) / ((1u64 << 53) as f64)
     };
     let mut builder = TreeBuilder::new();
     let mut bodies = Vec::new();
     for i in 0..n {
-        let parent = if i == 0 { None } else { Some((next() * i as f64) as usize) };
+        let parent = if i == 0 {
+            None
+        } else {
+            Some((next() * i as f64) as usize)
+        };
         let axis = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
         let kind = (next() * if spherical { 4.0 } else { 3.0 }) as usize;
         let joint = match kind {
@@ -49,10 +55,7 @@ pub fn random_tree(n: usize, seed: u64, spherical: bool) -> (KinematicTree, Vec<
             _ => Joint::Spherical,
         };
         let rotation = UnitQuaternion::from_scaled_axis(Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 2.0);
-        let placement = Isometry3::from_parts(
-            Translation3::new(next() - 0.5, next() - 0.5, next() - 0.5),
-            rotation,
-        );
+        let placement = Isometry3::from_parts(Translation3::new(next() - 0.5, next() - 0.5, next() - 0.5), rotation);
         builder.add_body(parent, joint, placement);
         let (a, b, c) = (0.1 + next(), 0.1 + next(), 0.1 + next());
         let mass = 0.5 + next();
@@ -71,7 +74,9 @@ pub fn random_vector(n: usize, seed: u64, s: f64) -> Vec<f64> {
     let mut state = seed ^ 0x9E3779B97F4A7C15;
     (0..n)
         .map(|_| {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (((state >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0) * s
         })
         .collect()

@@ -103,8 +103,13 @@ pub unsafe extern "C" fn mech_mechanism_create(
         let raw = unsafe { read_slice(bodies, n_bodies, "bodies") }?;
         let mut masses = Vec::with_capacity(raw.len());
         for (i, m) in raw.iter().enumerate() {
-            let properties = MassProperties::new(m.mass, m.center_of_mass.into(), m.inertia_about_com.into())
-                .map_err(|e| FfiError::new(FfiError::from(e).status, format!("bodies[{i}]: invalid mass properties")))?;
+            let properties =
+                MassProperties::new(m.mass, m.center_of_mass.into(), m.inertia_about_com.into()).map_err(|e| {
+                    FfiError::new(
+                        FfiError::from(e).status,
+                        format!("bodies[{i}]: invalid mass properties"),
+                    )
+                })?;
             masses.push(properties);
         }
         let mechanism = Mechanism::new(tree.clone(), masses)?;
@@ -148,7 +153,10 @@ pub unsafe extern "C" fn mech_mechanism_dof(mechanism: *mut mech_mechanism_t, do
 /// # Safety
 /// `mechanism` must be a live handle.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn mech_mechanism_set_gravity(mechanism: *mut mech_mechanism_t, gravity: mech_vec3_t) -> mech_status_t {
+pub unsafe extern "C" fn mech_mechanism_set_gravity(
+    mechanism: *mut mech_mechanism_t,
+    gravity: mech_vec3_t,
+) -> mech_status_t {
     boundary(|| {
         // SAFETY: caller's contract.
         let m = unsafe { mechanism_mut(mechanism) }?;
@@ -175,7 +183,10 @@ pub unsafe extern "C" fn mech_mechanism_set_rotating_frame(
         finite(&rate, "rate")?;
         finite(axis.as_slice(), "axis")?;
         if (axis.norm() - 1.0).abs() > 1e-9 {
-            return Err(FfiError::new(MECH_STATUS_INVALID_ARGUMENT, "axis must be a unit vector"));
+            return Err(FfiError::new(
+                MECH_STATUS_INVALID_ARGUMENT,
+                "axis must be a unit vector",
+            ));
         }
         let frame = (rate != 0.0).then(|| RotatingFrame {
             axis: Unit::new_unchecked(axis),
@@ -216,7 +227,12 @@ fn anchor(body: i64, point: mech_vec3_t) -> Result<Anchor, FfiError> {
     let body = match body {
         MECH_GROUND => None,
         b if b >= 0 => Some(b as usize),
-        b => return Err(FfiError::new(MECH_STATUS_INVALID_ARGUMENT, format!("body index {b} is negative"))),
+        b => {
+            return Err(FfiError::new(
+                MECH_STATUS_INVALID_ARGUMENT,
+                format!("body index {b} is negative"),
+            ));
+        }
     };
     Ok(Anchor {
         body,
@@ -321,7 +337,11 @@ pub unsafe extern "C" fn mech_mechanism_potential(
         let hessian = if hessian_out.is_null() {
             None
         } else {
-            Some(OutSlice::new(hessian_out, square_len(n, "hessian_out")?, "hessian_out")?)
+            Some(OutSlice::new(
+                hessian_out,
+                square_len(n, "hessian_out")?,
+                "hessian_out",
+            )?)
         };
         let sum = m.potential(q, hessian.is_some())?;
         // SAFETY: caller's contract.
@@ -329,7 +349,10 @@ pub unsafe extern "C" fn mech_mechanism_potential(
             potential.write(sum.value);
             gradient.write(&sum.gradient);
             if let (Some(out), Some(h)) = (hessian, sum.hessian) {
-                let values: Vec<f64> = (0..n).flat_map(|j| (0..n).map(move |i| (i, j))).map(|(i, j)| h[(i, j)]).collect();
+                let values: Vec<f64> = (0..n)
+                    .flat_map(|j| (0..n).map(move |i| (i, j)))
+                    .map(|(i, j)| h[(i, j)])
+                    .collect();
                 out.write(&values);
             }
         }
@@ -446,7 +469,9 @@ pub unsafe extern "C" fn mech_mechanism_equilibrium(
                 }
                 Err(FfiError::new(
                     MECH_STATUS_NOT_CONVERGED,
-                    format!("equilibrium search did not converge: best |grad U*| = {gradient_norm:.3e} (tolerance {tolerance:.3e}); the best point was written to q_out"),
+                    format!(
+                        "equilibrium search did not converge: best |grad U*| = {gradient_norm:.3e} (tolerance {tolerance:.3e}); the best point was written to q_out"
+                    ),
                 ))
             }
             Err(other) => Err(other.into()),
@@ -510,13 +535,19 @@ pub unsafe extern "C" fn mech_mechanism_modes(
         let shapes = if shapes_out.is_null() {
             None
         } else {
-            let len = n.checked_mul(k).ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n·count overflows"))?;
+            let len = n
+                .checked_mul(k)
+                .ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n·count overflows"))?;
             Some(OutSlice::new(shapes_out, len, "shapes_out")?)
         };
         let modes_out = Out::new(modes_out, "modes_out")?;
         let stability_out = Out::new(stability_out, "stability_out")?;
         let options = SolveOptions {
-            selection: if count == 0 { Selection::All } else { Selection::Lowest(count) },
+            selection: if count == 0 {
+                Selection::All
+            } else {
+                Selection::Lowest(count)
+            },
             ..SolveOptions::default()
         };
         let modes = mechanism_modes(m, &q, &options)?;
@@ -555,7 +586,10 @@ pub unsafe extern "C" fn mech_mechanism_modes(
             ..stability
         };
         let shape_values: Option<Vec<f64>> = modes.solution.vectors.as_ref().map(|x| {
-            (0..k).flat_map(|j| (0..n).map(move |i| (i, j))).map(|(i, j)| if j < x.ncols() { x[(i, j)] } else { 0.0 }).collect()
+            (0..k)
+                .flat_map(|j| (0..n).map(move |i| (i, j)))
+                .map(|(i, j)| if j < x.ncols() { x[(i, j)] } else { 0.0 })
+                .collect()
         });
         // SAFETY: caller's contract.
         unsafe {
