@@ -136,6 +136,8 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
             max_iterations: spec.max_iterations.unwrap_or(100),
             ..EquilibriumOptions::default()
         };
+        let recentred = mechanism.has_rotation_vectors();
+        let mut notes = Vec::new();
         let mut step = timed_step("equilibrium: Newton on grad U* (8.79)", || {
             let eq = find_equilibrium(&mut mechanism, &q, &options).map_err(|e| e.to_string())?;
             let quantities = vec![
@@ -153,8 +155,15 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
             ];
             q = eq.q;
             locked = eq.at_limit;
+            if recentred {
+                notes.push(
+                    "spherical/free joints were re-centred on the equilibrium: their rotation vectors read 0 in the new chart; bodies did not move"
+                        .to_string(),
+                );
+            }
             Ok::<_, String>(quantities)
         })?;
+        step.notes.append(&mut notes);
         if !spec.starts.is_empty() {
             let mut starts = spec.starts.clone();
             starts.insert(0, q.clone());
