@@ -313,6 +313,16 @@ fn mode_quantities(m: &MechanismModes) -> Vec<crate::report::Quantity> {
             None,
         ));
     }
+    for (k, bodies) in m.body_displacements.iter().enumerate().take(3) {
+        for (i, d) in bodies.iter().enumerate() {
+            out.push(quantity(
+                &format!("mode {} body {i}: centre-of-mass translation, rotation", k + 1),
+                d.translation.iter().chain(d.rotation.iter()).copied().collect(),
+                "m | rad per unit amplitude",
+                None,
+            ));
+        }
+    }
     if let Some(x) = &m.solution.vectors {
         for k in 0..x.ncols().min(6) {
             out.push(quantity(
