@@ -418,6 +418,18 @@ impl Scene {
             field,
             message,
         };
+        let check_unit_axis = |axis: &Spanned<[f64; 3]>, field: String| {
+            let norm = axis.get_ref().iter().map(|a| a * a).sum::<f64>().sqrt();
+            if norm.is_finite() && (norm - 1.0).abs() <= 1e-9 {
+                Ok(())
+            } else {
+                Err(error(
+                    Some(axis.span()),
+                    field,
+                    format!("axis must be a unit vector, |axis| = {norm}"),
+                ))
+            }
+        };
         let mut index_of: HashMap<&str, usize> = HashMap::new();
         for (i, body) in self.bodies.iter().enumerate() {
             let name = body.name.get_ref().as_str();
@@ -492,16 +504,7 @@ impl Scene {
                         "this joint type needs an axis".into(),
                     ));
                 }
-                (Some(axis), _) => {
-                    let norm = axis.get_ref().iter().map(|a| a * a).sum::<f64>().sqrt();
-                    if !norm.is_finite() || (norm - 1.0).abs() > 1e-9 {
-                        return Err(error(
-                            Some(axis.span()),
-                            format!("joint[{j}].axis"),
-                            format!("axis must be a unit vector, |axis| = {norm}"),
-                        ));
-                    }
-                }
+                (Some(axis), _) => check_unit_axis(axis, format!("joint[{j}].axis"))?,
                 (None, false) => {}
             }
         }
@@ -570,14 +573,7 @@ impl Scene {
             }
         }
         if let Some(frame) = &self.rotating_frame {
-            let norm = frame.axis.get_ref().iter().map(|a| a * a).sum::<f64>().sqrt();
-            if !norm.is_finite() || (norm - 1.0).abs() > 1e-9 {
-                return Err(error(
-                    Some(frame.axis.span()),
-                    "rotating_frame.axis".into(),
-                    format!("axis must be a unit vector, |axis| = {norm}"),
-                ));
-            }
+            check_unit_axis(&frame.axis, "rotating_frame.axis".into())?;
         }
         for (label, name) in [
             (

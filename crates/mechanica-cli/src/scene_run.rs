@@ -171,32 +171,25 @@ pub(crate) fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
             ),
         );
         debug_assert_eq!(index, i);
-        match &joint.q0 {
-            Some(values) if values.get_ref().len() != lib_joint.dof() => {
-                return Err(format!(
-                    "{}: joint \"{}\": q0 has {} values, the joint has {}",
-                    file.display(),
-                    joint.name,
-                    values.get_ref().len(),
-                    lib_joint.dof()
-                ));
+        let joint_values = |values: &Option<toml::Spanned<Vec<f64>>>, what: &str, out: &mut Vec<f64>| match values {
+            Some(values) if values.get_ref().len() != lib_joint.dof() => Err(format!(
+                "{}: joint \"{}\": {what} has {} values, the joint has {}",
+                file.display(),
+                joint.name,
+                values.get_ref().len(),
+                lib_joint.dof()
+            )),
+            Some(values) => {
+                out.extend_from_slice(values.get_ref());
+                Ok(())
             }
-            Some(values) => q0.extend_from_slice(values.get_ref()),
-            None => q0.extend(std::iter::repeat_n(0.0, lib_joint.dof())),
-        }
-        match &joint.qd0 {
-            Some(values) if values.get_ref().len() != lib_joint.dof() => {
-                return Err(format!(
-                    "{}: joint \"{}\": qd0 has {} values, the joint has {}",
-                    file.display(),
-                    joint.name,
-                    values.get_ref().len(),
-                    lib_joint.dof()
-                ));
+            None => {
+                out.extend(std::iter::repeat_n(0.0, lib_joint.dof()));
+                Ok(())
             }
-            Some(values) => qd0.extend_from_slice(values.get_ref()),
-            None => qd0.extend(std::iter::repeat_n(0.0, lib_joint.dof())),
-        }
+        };
+        joint_values(&joint.q0, "q0", &mut q0)?;
+        joint_values(&joint.qd0, "qd0", &mut qd0)?;
         if joint.limits.is_some() && lib_joint.dof() != 1 {
             return Err(format!(
                 "{}: joint \"{}\": limits apply to one-coordinate joints only",

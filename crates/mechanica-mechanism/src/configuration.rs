@@ -91,7 +91,7 @@ pub struct Configuration<'a> {
     pub q: &'a [f64],
     columns: Vec<Column>,
     subtree: Vec<Moments>,
-    /// For each coordinate, (rank on its root path, is a rotation-vector coordinate, joint body).
+    /// For each coordinate: (rank on its root path, is a rotation-vector coordinate).
     rank: Vec<(usize, bool)>,
 }
 
@@ -114,9 +114,8 @@ impl<'a> Configuration<'a> {
                 .ok_or(MechanismError::Numerical("coordinate without a body"))?;
             let o = workspace.position(i)?;
             columns.push(Column { w, a: v - w.cross(&o) });
-            let joint = tree.joint(i).ok_or(MechanismError::Numerical("body without a joint"))?;
             let start = tree.dof_range(i).start;
-            let rotation_vector = joint.has_rotation_vector() && k - start >= joint.dof() - 3;
+            let rotation_vector = crate::mechanism::is_rotation_vector_coordinate(tree, i, k);
             // Rank along any root path: depth first, then the order within the joint.
             let depth = tree.depth(i).unwrap_or(0);
             rank.push((depth * 8 + (k - start), rotation_vector));
