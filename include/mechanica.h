@@ -734,6 +734,40 @@ typedef int32_t mech_joint_type_t;
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
+ * The prescribed motion of a tree's base frame 0 at the current time, all in world
+ * components: a moving (rheonomic) base makes the drag velocity of a point x equal to
+ * v₀ + ω₀ × (x − p₀) and splits T = T₀ + T₁ + T₂ (9.7–9.10).
+ */
+typedef struct mech_base_state_t {
+    /**
+     * Rotation R_W0 of the base frame (a rotation matrix, column-major).
+     */
+    struct mech_mat3_t rotation;
+    /**
+     * Origin p_W0 of the base frame.
+     */
+    struct mech_vec3_t position;
+    /**
+     * Angular velocity ω₀ of the base.
+     */
+    struct mech_vec3_t omega;
+    /**
+     * Velocity v₀ of the base origin.
+     */
+    struct mech_vec3_t velocity;
+    /**
+     * Angular acceleration ω̇₀ of the base.
+     */
+    struct mech_vec3_t omega_dot;
+    /**
+     * Acceleration a₀ of the base origin.
+     */
+    struct mech_vec3_t acceleration;
+} mech_base_state_t;
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
  * Which Jacobian mech_tree_jacobian computes.
  */
 typedef int32_t mech_jacobian_kind_t;
@@ -2381,6 +2415,24 @@ mech_status_t mech_tree_set_state(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
+ * Prescribes the motion of the base frame of a finalized tree (the default is a base at rest
+ * with R_W0 = I, p_W0 = 0). It applies from the next mech_tree_set_state on: setting the base
+ * discards the computed state, so queries fail with MECH_STATUS_INVALID_ARGUMENT until the
+ * state is set again. Pass the same ω₀ and v₀ to mech_tree_energy_split for the drag field.
+ *
+ * Errors: NULL_POINTER; NON_FINITE for a NaN/inf entry; INVALID_ARGUMENT when `rotation` is
+ * not a rotation matrix (orthonormal to rounding, determinant +1) or the tree is not finalized.
+ * Nothing changes on error.
+ *
+ * # Safety
+ * `tree` must be a live handle; `base` must point to a readable mech_base_state_t.
+ */
+mech_status_t mech_tree_set_base(struct mech_tree_t *tree,
+                                 const struct mech_base_state_t *base);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
  * Sets the accelerations q̈ (`n` = dof doubles) after mech_tree_set_state and computes body
  * accelerations.
  *
@@ -2744,7 +2796,8 @@ mech_status_t mech_tree_center_of_mass(struct mech_tree_t *tree,
 /**
  * The split T = T₀ + T₁ + T₂ (syllabus 9.7–9.10) of a tree whose base moves with angular
  * velocity `base_omega` and base-origin velocity `base_velocity` (world components; the base
- * pose is the tree's, so the drag velocity of a point x is ∂x/∂t = v₀ + ω₀ × (x − p₀)), at the
+ * pose is the tree's, see mech_tree_set_base, whose ω₀ and v₀ these normally are; taking them
+ * here keeps the split available for a base at rest in the tree's frame), so the drag velocity of a point x is ∂x/∂t = v₀ + ω₀ × (x − p₀)), at the
  * state (q, q̇) of the last mech_tree_set_state. Writes the split, b(q, t) = ∂T₁/∂q̇ into
  * `b_out` and the generalized momenta ∂T/∂q̇ = A q̇ + b into `momenta_out` (n = dof doubles
  * each). `bodies` as in mech_tree_mass_matrix.

@@ -516,6 +516,55 @@ static void tree_mechanism(void) {
     CHECK(split.t0 == 0.0 && split.t1 == 0.0 && b[0] == 0.0 && b[1] == 0.0);
     CHECK_NEAR(split.total, t_ref, 64 * EPS * t_ref);
 
+    /* The same moving base prescribed on the tree itself, with its origin moved to p0: body
+       velocities now include the drag, so the rigid-body energies of the world velocities sum to
+       the total above; T of mech_tree_kinetic_energy stays the relative T2, and the split with
+       the same (ω0, v0) is unchanged (it is relative to p0). */
+    mech_base_state_t base = {0};
+    base.rotation.m[0] = base.rotation.m[4] = base.rotation.m[8] = 1.0;
+    base.position = (mech_vec3_t){1.0, 2.0, 0.5};
+    base.omega = omega0;
+    base.velocity = v0;
+    CHECK_STATUS(mech_tree_set_base(tree, &base), MECH_STATUS_OK);
+    CHECK_STATUS(mech_tree_kinetic_energy(tree, bodies, 2, &t, p, 2), MECH_STATUS_INVALID_ARGUMENT); /* state discarded */
+    CHECK_STATUS(mech_tree_set_state(tree, q, qd, 2), MECH_STATUS_OK);
+    CHECK_STATUS(mech_tree_kinetic_energy(tree, bodies, 2, &t, p, 2), MECH_STATUS_OK);
+    CHECK_NEAR(t, t_ref, et);
+    mech_mat3_t r_body;
+    mech_vec3_t p_body, w_body, v_body, joint_point = {0.0, 0.0, 0.0}, w_tip, v_tip;
+    CHECK_STATUS(mech_tree_body_velocity(tree, 0, &bodies[0].center_of_mass, &w_body, &v_body), MECH_STATUS_OK);
+    CHECK_STATUS(mech_tree_body_velocity(tree, 1, &tip, &w_tip, &v_tip), MECH_STATUS_OK);
+    const double t_world = 0.5 * m1 * (v_body.x * v_body.x + v_body.y * v_body.y + v_body.z * v_body.z) +
+                           0.5 * i1 * w_body.z * w_body.z +
+                           0.5 * m2 * (v_tip.x * v_tip.x + v_tip.y * v_tip.y + v_tip.z * v_tip.z);
+    CHECK_NEAR(t_world, total_ref, et);
+    CHECK_STATUS(mech_tree_body_pose(tree, 1, &r_body, &p_body), MECH_STATUS_OK);
+    CHECK_NEAR(p_body.x, 1.0 + l1 * k1, 16 * EPS);
+    CHECK_NEAR(p_body.y, 2.0 + l1 * s1, 16 * EPS);
+    CHECK_NEAR(p_body.z, 0.5, 16 * EPS);
+    CHECK_STATUS(mech_tree_body_velocity(tree, 0, &joint_point, &w_body, &v_body), MECH_STATUS_OK);
+    CHECK_NEAR(w_body.z, w + qd[0], 16 * EPS);
+    CHECK_NEAR(v_body.x, vx, 16 * EPS); /* the joint sits at the base origin */
+    CHECK_NEAR(v_body.y, vy, 16 * EPS);
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &omega0, &v0, &split, b, pm, 2), MECH_STATUS_OK);
+    CHECK_NEAR(split.t0, t0_ref, et);
+    CHECK_NEAR(split.t1, b_ref[0] * qd[0] + b_ref[1] * qd[1], et);
+    CHECK_NEAR(split.total, total_ref, et);
+    /* Bad base states change nothing: the state stays valid. */
+    mech_base_state_t bad_base = base;
+    bad_base.velocity.y = NAN;
+    CHECK_STATUS(mech_tree_set_base(tree, &bad_base), MECH_STATUS_NON_FINITE);
+    bad_base = base;
+    bad_base.rotation.m[0] = 2.0;
+    CHECK_STATUS(mech_tree_set_base(tree, &bad_base), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_tree_set_base(tree, NULL), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_set_base(NULL, &base), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_tree_energy_split(tree, bodies, 2, &omega0, &v0, &split, b, pm, 2), MECH_STATUS_OK);
+    CHECK_NEAR(split.total, total_ref, et);
+    base.omega = base.velocity = still;
+    CHECK_STATUS(mech_tree_set_base(tree, &base), MECH_STATUS_OK);
+    CHECK_STATUS(mech_tree_set_state(tree, q, qd, 2), MECH_STATUS_OK);
+
     /* Error paths: nothing is written. */
     mech_mass_properties_t bad[2] = {bodies[0], bodies[1]};
     FILL_SENTINEL(a, sizeof a);

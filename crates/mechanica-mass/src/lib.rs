@@ -5,7 +5,7 @@
 //! - [`principal`]: principal moments and a canonical principal frame;
 //! - [`validity`]: the physical validity check and repair;
 //! - [`primitives`]: closed forms for points, rods, laminae and solids;
-//! - [`mesh`] and [`io`]: triangle meshes and their file formats;
+//! - [`mesh`], [`topology`] and [`io`]: triangle meshes, their edge checks and file formats;
 //! - [`mechanism`]: the mass matrix A(q) of a kinematic tree (composite-rigid-body recursion);
 //! - [`momenta`]: momentum, angular momentum and kinetic energy of a rigid body.
 
@@ -14,11 +14,14 @@ pub mod error;
 pub mod io;
 pub mod mechanism;
 pub mod mesh;
+mod mesh_integrals;
 pub mod momenta;
+mod parallel;
 pub mod primitives;
 pub mod principal;
 pub mod properties;
 pub mod tessellation;
+pub mod topology;
 pub mod validity;
 
 pub use error::MassError;

@@ -10,7 +10,7 @@ use mechanica_kinematics::nalgebra::{Isometry3, Matrix3, Translation3, UnitQuate
 use mechanica_kinematics::relative_motion::{self, RelativeMotion};
 use mechanica_kinematics::rigid_motion::RigidMotion;
 use mechanica_kinematics::rotation::{self, QuaternionNorm};
-use mechanica_kinematics::tree::{Joint, KinematicTree, TreeBuilder, Workspace};
+use mechanica_kinematics::tree::{BaseState, Joint, KinematicTree, TreeBuilder, Workspace};
 
 impl From<KinematicsError> for FfiError {
     fn from(error: KinematicsError) -> Self {
@@ -812,6 +812,68 @@ pub unsafe extern "C" fn mech_tree_set_state(
         let (kt, ws) = built(t)?;
         kt.update_positions(ws, q)?;
         kt.update_velocities(ws, qd)?;
+        Ok(())
+    })
+}
+
+/// The prescribed motion of a tree's base frame 0 at the current time, all in world
+/// components: a moving (rheonomic) base makes the drag velocity of a point x equal to
+/// v₀ + ω₀ × (x − p₀) and splits T = T₀ + T₁ + T₂ (9.7–9.10).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_base_state_t {
+    /// Rotation R_W0 of the base frame (a rotation matrix, column-major).
+    pub rotation: mech_mat3_t,
+    /// Origin p_W0 of the base frame.
+    pub position: mech_vec3_t,
+    /// Angular velocity ω₀ of the base.
+    pub omega: mech_vec3_t,
+    /// Velocity v₀ of the base origin.
+    pub velocity: mech_vec3_t,
+    /// Angular acceleration ω̇₀ of the base.
+    pub omega_dot: mech_vec3_t,
+    /// Acceleration a₀ of the base origin.
+    pub acceleration: mech_vec3_t,
+}
+
+/// Prescribes the motion of the base frame of a finalized tree (the default is a base at rest
+/// with R_W0 = I, p_W0 = 0). It applies from the next mech_tree_set_state on: setting the base
+/// discards the computed state, so queries fail with MECH_STATUS_INVALID_ARGUMENT until the
+/// state is set again. Pass the same ω₀ and v₀ to mech_tree_energy_split for the drag field.
+///
+/// Errors: NULL_POINTER; NON_FINITE for a NaN/inf entry; INVALID_ARGUMENT when `rotation` is
+/// not a rotation matrix (orthonormal to rounding, determinant +1) or the tree is not finalized.
+/// Nothing changes on error.
+///
+/// # Safety
+/// `tree` must be a live handle; `base` must point to a readable mech_base_state_t.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_tree_set_base(tree: *mut mech_tree_t, base: *const mech_base_state_t) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let t = unsafe { tree_mut(tree) }?;
+        // SAFETY: caller's contract.
+        let b = unsafe { read(base, "base") }?;
+        for (v, what) in [
+            (&b.position, "base.position"),
+            (&b.omega, "base.omega"),
+            (&b.velocity, "base.velocity"),
+            (&b.omega_dot, "base.omega_dot"),
+            (&b.acceleration, "base.acceleration"),
+        ] {
+            finite(v, what)?;
+        }
+        finite(&b.rotation, "base.rotation")?;
+        let rotation = rotation::rotation_from_matrix(&Matrix3::from(b.rotation))?;
+        let (_, ws) = built(t)?;
+        ws.set_base(BaseState {
+            rotation,
+            position: b.position.into(),
+            omega: b.omega.into(),
+            velocity: b.velocity.into(),
+            omega_dot: b.omega_dot.into(),
+            acceleration: b.acceleration.into(),
+        })?;
         Ok(())
     })
 }

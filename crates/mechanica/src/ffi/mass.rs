@@ -1077,7 +1077,8 @@ pub unsafe extern "C" fn mech_tree_center_of_mass(
 
 /// The split T = T₀ + T₁ + T₂ (syllabus 9.7–9.10) of a tree whose base moves with angular
 /// velocity `base_omega` and base-origin velocity `base_velocity` (world components; the base
-/// pose is the tree's, so the drag velocity of a point x is ∂x/∂t = v₀ + ω₀ × (x − p₀)), at the
+/// pose is the tree's, see mech_tree_set_base, whose ω₀ and v₀ these normally are; taking them
+/// here keeps the split available for a base at rest in the tree's frame), so the drag velocity of a point x is ∂x/∂t = v₀ + ω₀ × (x − p₀)), at the
 /// state (q, q̇) of the last mech_tree_set_state. Writes the split, b(q, t) = ∂T₁/∂q̇ into
 /// `b_out` and the generalized momenta ∂T/∂q̇ = A q̇ + b into `momenta_out` (n = dof doubles
 /// each). `bodies` as in mech_tree_mass_matrix.
