@@ -414,7 +414,8 @@ impl Scene {
     fn validate(&self, text: &str, file: &Path) -> Result<(), SceneError> {
         let error = |span: Option<std::ops::Range<usize>>, field: String, message: String| SceneError {
             file: file.to_path_buf(),
-            position: span.map(|s| line_column(text, s.start)),
+            // A scene built in memory (no source text) has no positions to report.
+            position: span.filter(|_| !text.is_empty()).map(|s| line_column(text, s.start)),
             field,
             message,
         };

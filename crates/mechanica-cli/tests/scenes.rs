@@ -244,4 +244,16 @@ fn a_urdf_robot_runs_and_invalid_inertias_are_reported_per_link() {
     let (ok, out, err) = mechanica(&["run", bad.to_str().expect("path"), "--repair-inertia"]);
     assert!(ok, "{err}");
     assert!(out.contains("inertia repaired"), "{out}");
+    // A dangling reference is named by field; a URDF-built scene has no TOML positions to show.
+    let dangling = dir.join("dangling.urdf");
+    let text = URDF
+        .replace("IXX", "0.0833")
+        .replace(r#"<parent link="upper"/>"#, r#"<parent link="nowhere"/>"#);
+    std::fs::write(&dangling, text).expect("write");
+    let (ok, _, err) = mechanica(&["run", dangling.to_str().expect("path")]);
+    assert!(!ok);
+    assert!(
+        err.contains("joint[2].parent") && err.contains("no body named \"nowhere\"") && !err.contains(":1:1"),
+        "{err}"
+    );
 }
