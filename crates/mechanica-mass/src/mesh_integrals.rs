@@ -117,12 +117,6 @@ fn block_sums_avx2(
     block_sums_lanes(vertices, triangles, r, offset, integrand)
 }
 
-/// A lane array from its per-lane values.
-#[inline(always)]
-fn lanes(f: impl FnMut(usize) -> f64) -> Lanes {
-    std::array::from_fn(f)
-}
-
 /// The sums over one block, [`LANES`] triangles at a time.
 #[inline(always)]
 fn block_sums_lanes(
@@ -164,11 +158,21 @@ fn block_sums_lanes(
 #[inline(always)]
 fn gather(vertices: &[[f64; 3]], group: &[[u32; 3]], r: &[f64; 3]) -> [[Lanes; 3]; 3] {
     let mut p = [[[0.0; LANES]; 3]; 3];
+    let mut used = [0.0; LANES];
     for (lane, t) in group.iter().enumerate() {
+        used[lane] = 1.0;
         for (i, &index) in t.iter().enumerate() {
             let v = &vertices[index as usize];
             for a in 0..3 {
-                p[i][a][lane] = v[a] - r[a];
+                p[i][a][lane] = v[a];
+            }
+        }
+    }
+    // Relative to r, lane-parallel; an unused lane stays at zero.
+    for corner in &mut p {
+        for a in 0..3 {
+            for l in 0..LANES {
+                corner[a][l] = (corner[a][l] - r[a]) * used[l];
             }
         }
     }
@@ -187,53 +191,57 @@ fn add_group(
     acc: &mut [Lanes; 11],
     sums: &mut Sums,
 ) {
-    let e1: [Lanes; 3] = std::array::from_fn(|a| lanes(|l| p[1][a][l] - p[0][a][l]));
-    let e2: [Lanes; 3] = std::array::from_fn(|a| lanes(|l| p[2][a][l] - p[0][a][l]));
-    let n: [Lanes; 3] = std::array::from_fn(|a| {
-        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-        lanes(|l| e1[b][l] * e2[c][l] - e1[c][l] * e2[b][l])
-    });
-    let nn = lanes(|l| n[0][l] * n[0][l] + n[1][l] * n[1][l] + n[2][l] * n[2][l]);
-    let l1 = lanes(|l| e1[0][l] * e1[0][l] + e1[1][l] * e1[1][l] + e1[2][l] * e1[2][l]);
-    let l2 = lanes(|l| e2[0][l] * e2[0][l] + e2[1][l] * e2[1][l] + e2[2][l] * e2[2][l]);
-    // Zero-area test: |n|² ≤ (8ε)²|e₁|²|e₂|² (the cross product is at rounding level); a
-    // repeated index, or an unused lane, gives n = 0 exactly.
-    const T: f64 = 64.0 * f64::EPSILON * f64::EPSILON;
-    let kept: [bool; LANES] = std::array::from_fn(|l| nn[l] > T * l1[l] * l2[l]);
+    // One loop over the lanes with no cross-lane dependence: the compiler turns it into
+    // vector instructions of the lane width.
+    let mut kept = [false; LANES];
+    for l in 0..LANES {
+        let c = |i: usize, a: usize| p[i][a][l];
+        let e1 = [c(1, 0) - c(0, 0), c(1, 1) - c(0, 1), c(1, 2) - c(0, 2)];
+        let e2 = [c(2, 0) - c(0, 0), c(2, 1) - c(0, 1), c(2, 2) - c(0, 2)];
+        let n = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+        let l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+        let l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+        // Zero-area test: |n|² ≤ (8ε)²|e₁|²|e₂|² (the cross product is at rounding level); a
+        // repeated index, or an unused lane, gives n = 0 exactly.
+        const T: f64 = 64.0 * f64::EPSILON * f64::EPSILON;
+        kept[l] = nn > T * l1 * l2;
+        let s = [
+            c(0, 0) + c(1, 0) + c(2, 0),
+            c(0, 1) + c(1, 1) + c(2, 1),
+            c(0, 2) + c(1, 2) + c(2, 2),
+        ];
+        // Weights of the measure, first-moment and second-moment terms.
+        let (measure, first_weight, second_weight) = match integrand {
+            Integrand::Solid => {
+                let d = c(0, 0) * n[0] + c(0, 1) * n[1] + c(0, 2) * n[2];
+                let d = if kept[l] { d } else { 0.0 };
+                (d, d, d)
+            }
+            Integrand::Shell => {
+                let area = if kept[l] { 0.5 * nn.sqrt() } else { 0.0 };
+                (area, area / 3.0, area / 12.0)
+            }
+        };
+        acc[0][l] += measure;
+        acc[10][l] += measure.abs();
+        for a in 0..3 {
+            acc[1 + a][l] += first_weight * s[a];
+        }
+        // Σᵢ pᵢⱼpᵢₖ + sⱼsₖ for jk = xx, yy, zz, xy, yz, zx.
+        for (k, (j, m)) in [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0)].into_iter().enumerate() {
+            let second = c(0, j) * c(0, m) + c(1, j) * c(1, m) + c(2, j) * c(2, m) + s[j] * s[m];
+            acc[4 + k][l] += second_weight * second;
+        }
+    }
     for (lane, &keep) in kept.iter().enumerate().take(used) {
         if !keep {
             sums.degenerate += 1;
             sums.first_degenerate.get_or_insert(first + lane);
-        }
-    }
-    let s: [Lanes; 3] = std::array::from_fn(|a| lanes(|l| p[0][a][l] + p[1][a][l] + p[2][a][l]));
-    // Weight of the measure term and of the moment terms per lane.
-    let (measure, moment_weight, first_scale) = match integrand {
-        Integrand::Solid => {
-            let d = lanes(|l| p[0][0][l] * n[0][l] + p[0][1][l] * n[1][l] + p[0][2][l] * n[2][l]);
-            let d = lanes(|l| if kept[l] { d[l] } else { 0.0 });
-            (d, d, d)
-        }
-        Integrand::Shell => {
-            let area = lanes(|l| if kept[l] { 0.5 * nn[l].sqrt() } else { 0.0 });
-            (area, lanes(|l| area[l] / 12.0), lanes(|l| area[l] / 3.0))
-        }
-    };
-    for l in 0..LANES {
-        acc[0][l] += measure[l];
-        acc[10][l] += measure[l].abs();
-    }
-    for a in 0..3 {
-        for l in 0..LANES {
-            acc[1 + a][l] += first_scale[l] * s[a][l];
-        }
-    }
-    // Σᵢ pᵢⱼpᵢₖ + sⱼsₖ for jk = xx, yy, zz, xy, yz, zx.
-    for (k, (j, m)) in [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0)].into_iter().enumerate() {
-        for l in 0..LANES {
-            let second =
-                p[0][j][l] * p[0][m][l] + p[1][j][l] * p[1][m][l] + p[2][j][l] * p[2][m][l] + s[j][l] * s[m][l];
-            acc[4 + k][l] += moment_weight[l] * second;
         }
     }
 }
