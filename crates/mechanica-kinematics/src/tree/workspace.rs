@@ -429,18 +429,29 @@ impl KinematicTree {
         ws.check(Stage::Positions, body)?;
         self.check_jacobian_out(out, 3)?;
         check_finite_vec(p_bq, "body point")?;
-        out.fill(0.0);
         let x = ws.rotation[body] * p_bq + ws.position[body];
+        self.fill_path_columns::<3>(body, out, |i, k| {
+            (ws.col_w[k].cross(&(x - ws.position[i])) + ws.col_v[k]).into()
+        });
+        Ok(())
+    }
+
+    /// Zeroes `out` (W×dof, column-major) and writes column k = `column(i, k)` for every
+    /// coordinate k on the path from `body` to the root, i being the body that k moves.
+    fn fill_path_columns<const W: usize>(
+        &self,
+        body: usize,
+        out: &mut [f64],
+        column: impl Fn(usize, usize) -> [f64; W],
+    ) {
+        out.fill(0.0);
         let mut b = Some(body);
         while let Some(i) = b {
-            let r = x - ws.position[i];
             for k in self.dof_range(i) {
-                let col = ws.col_w[k].cross(&r) + ws.col_v[k];
-                out[3 * k..3 * k + 3].copy_from_slice(col.as_slice());
+                out[W * k..W * k + W].copy_from_slice(&column(i, k));
             }
             b = self.parent[i];
         }
-        Ok(())
     }
 
     /// The angular-velocity Jacobian ∂ω_B/∂q̇ of `body` into `out` (3×dof, column-major).
@@ -448,14 +459,7 @@ impl KinematicTree {
         self.check_workspace(ws)?;
         ws.check(Stage::Positions, body)?;
         self.check_jacobian_out(out, 3)?;
-        out.fill(0.0);
-        let mut b = Some(body);
-        while let Some(i) = b {
-            for k in self.dof_range(i) {
-                out[3 * k..3 * k + 3].copy_from_slice(ws.col_w[k].as_slice());
-            }
-            b = self.parent[i];
-        }
+        self.fill_path_columns::<3>(body, out, |_, k| ws.col_w[k].into());
         Ok(())
     }
 
@@ -472,19 +476,12 @@ impl KinematicTree {
         ws.check(Stage::Positions, body)?;
         self.check_jacobian_out(out, 6)?;
         check_finite_vec(p_bq, "body point")?;
-        out.fill(0.0);
         let x = ws.rotation[body] * p_bq + ws.position[body];
-        let mut b = Some(body);
-        while let Some(i) = b {
-            let r = x - ws.position[i];
-            for k in self.dof_range(i) {
-                let w = ws.col_w[k];
-                let v = w.cross(&r) + ws.col_v[k];
-                out[6 * k..6 * k + 3].copy_from_slice(w.as_slice());
-                out[6 * k + 3..6 * k + 6].copy_from_slice(v.as_slice());
-            }
-            b = self.parent[i];
-        }
+        self.fill_path_columns::<6>(body, out, |i, k| {
+            let w = ws.col_w[k];
+            let v = w.cross(&(x - ws.position[i])) + ws.col_v[k];
+            [w.x, w.y, w.z, v.x, v.y, v.z]
+        });
         Ok(())
     }
 
@@ -502,20 +499,13 @@ impl KinematicTree {
         ws.check(Stage::Velocities, body)?;
         self.check_jacobian_out(out, 3)?;
         check_finite_vec(p_bq, "body point")?;
-        out.fill(0.0);
         let rb = ws.rotation[body] * p_bq;
         let x = rb + ws.position[body];
         let x_dot = ws.velocity[body] + ws.omega[body].cross(&rb);
-        let mut b = Some(body);
-        while let Some(i) = b {
-            let r = x - ws.position[i];
-            let r_dot = x_dot - ws.velocity[i];
-            for k in self.dof_range(i) {
-                let col = ws.col_w_dot[k].cross(&r) + ws.col_w[k].cross(&r_dot) + ws.col_v_dot[k];
-                out[3 * k..3 * k + 3].copy_from_slice(col.as_slice());
-            }
-            b = self.parent[i];
-        }
+        self.fill_path_columns::<3>(body, out, |i, k| {
+            let (r, r_dot) = (x - ws.position[i], x_dot - ws.velocity[i]);
+            (ws.col_w_dot[k].cross(&r) + ws.col_w[k].cross(&r_dot) + ws.col_v_dot[k]).into()
+        });
         Ok(())
     }
 
@@ -525,14 +515,7 @@ impl KinematicTree {
         self.check_workspace(ws)?;
         ws.check(Stage::Velocities, body)?;
         self.check_jacobian_out(out, 3)?;
-        out.fill(0.0);
-        let mut b = Some(body);
-        while let Some(i) = b {
-            for k in self.dof_range(i) {
-                out[3 * k..3 * k + 3].copy_from_slice(ws.col_w_dot[k].as_slice());
-            }
-            b = self.parent[i];
-        }
+        self.fill_path_columns::<3>(body, out, |_, k| ws.col_w_dot[k].into());
         Ok(())
     }
 
