@@ -4,7 +4,9 @@
 //! (vertex and index checks, edge topology, exact volume integrals) on tessellated tori of
 //! 20k, 205k and 2.1M triangles, the same meshes that tools/mass_trimesh_bench.py times with
 //! trimesh (committed output: tools/mass_trimesh_bench.out). `mesh_topology` times the
-//! closedness/orientation check alone, to show how the total splits.
+//! closedness/orientation check alone, to show how the total splits, and
+//! `mesh_mass_properties_known_topology` the pipeline without it (a deforming body whose
+//! connectivity was checked once).
 //!
 //! `mass_matrix_crba_44dof`: forward kinematics plus the composite-rigid-body mass matrix of a
 //! 44-DOF humanoid-like tree; tools/mass_pinocchio_bench.py builds the same tree in Pinocchio
@@ -15,7 +17,7 @@ use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_m
 use mechanica::kinematics::nalgebra::{Isometry3, Vector3};
 use mechanica::kinematics::tree::{Joint, KinematicTree, TreeBuilder};
 use mechanica::mass::mechanism::TreeMass;
-use mechanica::mass::mesh::{MeshOptions, mesh_topology};
+use mechanica::mass::mesh::{MeshOptions, TopologySource, mesh_topology};
 use mechanica::mass::tessellation::torus_mesh;
 use mechanica::mass::{Amount, MassProperties, primitives};
 use std::hint::black_box;
@@ -32,6 +34,28 @@ fn meshes(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::new("mechanica", n), &mesh, |b, mesh| {
             b.iter(|| {
                 mesh.mass_properties(Amount::Density(1.0), &MeshOptions::default())
+                    .map(|r| r.properties.inertia_c[(2, 2)])
+            })
+        });
+    }
+    group.finish();
+    // A deforming body re-integrated with the topology of an earlier call (TopologySource::Known).
+    let mut group = c.benchmark_group("mesh_mass_properties_known_topology");
+    group.sample_size(10);
+    for (nu, nv) in SIZES {
+        let mesh = torus_mesh(2.0, 0.5, nu, nv);
+        let n = mesh.triangles.len() as u64;
+        let Ok(first) = mesh.mass_properties(Amount::Density(1.0), &MeshOptions::default()) else {
+            panic!("the benchmark torus is closed")
+        };
+        let known = MeshOptions {
+            topology: TopologySource::Known(first.diagnostics.topology),
+            ..MeshOptions::default()
+        };
+        group.throughput(Throughput::Elements(n));
+        group.bench_with_input(BenchmarkId::new("mechanica", n), &mesh, |b, mesh| {
+            b.iter(|| {
+                mesh.mass_properties(Amount::Density(1.0), black_box(&known))
                     .map(|r| r.properties.inertia_c[(2, 2)])
             })
         });

@@ -406,6 +406,55 @@ static void meshes(void) {
     CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, NULL, &rs), MECH_STATUS_NULL_POINTER);
 }
 
+/* A deforming box: the report of the first call carries the topology to later calls on the same
+ * triangles, whose results equal a fresh mech_mass_mesh bit for bit and the closed form. */
+static void deforming_mesh(void) {
+    double v[24];
+    uint32_t tri[36];
+    box_mesh(0.0, v, tri);
+    mech_mass_properties_t first, checked, reused;
+    mech_mesh_report_t earlier, rep_checked, rep_reused;
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &first, &earlier), MECH_STATUS_OK);
+    for (int k = 0; k < 8; ++k) {
+        v[3 * k] *= 2.0; /* now 2 × 2 × 3 */
+    }
+    CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &checked, &rep_checked),
+                 MECH_STATUS_OK);
+    CHECK_STATUS(mech_mass_mesh_same_connectivity(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &earlier, &reused,
+                                                  &rep_reused),
+                 MECH_STATUS_OK);
+    CHECK(memcmp(&checked, &reused, sizeof checked) == 0);
+    CHECK(memcmp(&rep_checked, &rep_reused, sizeof rep_checked) == 0);
+    CHECK_NEAR(reused.mass, 24.0, 64 * EPS * 24.0);
+    CHECK_NEAR(entry(&reused.inertia_about_com, 0, 0), 24.0 * (4.0 + 9.0) / 12.0, 64 * EPS * 26.0);
+    CHECK_NEAR(entry(&reused.inertia_about_com, 2, 2), 24.0 * (4.0 + 4.0) / 12.0, 64 * EPS * 26.0);
+
+    /* Errors: nothing written. */
+    mech_mass_properties_t s;
+    mech_mesh_report_t rs;
+    FILL_SENTINEL(&s, sizeof s);
+    FILL_SENTINEL(&rs, sizeof rs);
+    CHECK_STATUS(mech_mass_mesh_same_connectivity(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, NULL, &s, &rs),
+                 MECH_STATUS_NULL_POINTER);
+    mech_mesh_report_t other = earlier;
+    other.triangles = 11;
+    CHECK_STATUS(mech_mass_mesh_same_connectivity(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &other, &s, &rs),
+                 MECH_STATUS_BAD_DIMENSION);
+    uint32_t range[36];
+    memcpy(range, tri, sizeof range);
+    range[4] = 8;
+    CHECK_STATUS(mech_mass_mesh_same_connectivity(v, 8, range, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &earlier, &s, &rs),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    other = earlier;
+    other.boundary_edges = 3; /* an open mesh is still refused as a solid */
+    CHECK_STATUS(mech_mass_mesh_same_connectivity(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &other, &s, &rs),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    v[5] = NAN;
+    CHECK_STATUS(mech_mass_mesh_same_connectivity(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &earlier, &s, &rs),
+                 MECH_STATUS_NON_FINITE);
+    CHECK(mech_untouched(&s, sizeof s) && mech_untouched(&rs, sizeof rs));
+}
+
 /* A double pendulum in the xy plane: revolute z joints; link 1 a uniform thin rod of mass m1 and
  * length l1 along its x axis, link 2 a point mass m2 at distance l2 from its joint. Closed forms:
  * A11 = m1 l1²/3 + m2 (l1² + l2² + 2 l1 l2 cos q2), A12 = m2 (l2² + l1 l2 cos q2), A22 = m2 l2²;
@@ -640,6 +689,7 @@ int main(void) {
     validity_and_repair();
     momenta_and_energy();
     meshes();
+    deforming_mesh();
     tree_mechanism();
     return CHECK_DONE();
 }

@@ -25,7 +25,7 @@ pub mod topology;
 pub mod validity;
 
 pub use error::MassError;
-pub use mesh::{MeshMassProperties, MeshOptions, TriangleMesh, mesh_mass_properties};
+pub use mesh::{MeshMassProperties, MeshOptions, TopologySource, TriangleMesh, mesh_mass_properties};
 pub use primitives::Amount;
 pub use principal::PrincipalAxes;
 pub use properties::MassProperties;

@@ -189,6 +189,17 @@ fn classify_runs(list: &[u32], topology: &mut MeshTopology) {
     }
 }
 
+/// Fails with [`MassError::IndexOutOfRange`] (naming the first offending corner) unless every
+/// index is below `vertex_count`; a vectorisable maximum first, the search only on failure.
+pub(crate) fn check_indices(triangles: &[[u32; 3]], vertex_count: usize) -> Result<(), MassError> {
+    let max = triangles.as_flattened().iter().copied().max().unwrap_or(0);
+    if (max as usize) < vertex_count {
+        Ok(())
+    } else {
+        Err(first_index_error(triangles, vertex_count))
+    }
+}
+
 /// The error for the first corner of `triangles` that is not below `vertex_count`.
 fn first_index_error(triangles: &[[u32; 3]], vertex_count: usize) -> MassError {
     for (triangle, t) in triangles.iter().enumerate() {

@@ -336,3 +336,58 @@ mod files {
         ));
     }
 }
+
+/// A deforming body: the topology of the first call, passed back as known, gives bitwise the
+/// same result as a fresh check on every later shape; a bad index is still refused, an
+/// inside-out shape still flipped, and a known-open topology still refused as a solid.
+#[test]
+fn known_topology_skips_the_edge_check_and_nothing_else() {
+    use mechanica_mass::mesh::{MeshTopology, TopologySource};
+    let mut mesh = torus_mesh(2.0, 0.5, 60, 40);
+    let first = mesh
+        .mass_properties(Amount::Density(1.0), &MeshOptions::default())
+        .expect("closed torus");
+    let known = MeshOptions {
+        topology: TopologySource::Known(first.diagnostics.topology),
+        ..MeshOptions::default()
+    };
+    for step in 1..4 {
+        let squash = 1.0 + 0.1 * f64::from(step);
+        for v in &mut mesh.vertices {
+            v[2] /= squash;
+            v[0] *= squash;
+        }
+        let checked = mesh
+            .mass_properties(Amount::Density(1.0), &MeshOptions::default())
+            .expect("closed");
+        let reused = mesh.mass_properties(Amount::Density(1.0), &known).expect("closed");
+        assert_eq!(checked, reused);
+    }
+    let mut inverted = mesh.clone();
+    for t in &mut inverted.triangles {
+        t.swap(1, 2);
+    }
+    let flipped = inverted.mass_properties(Amount::Density(1.0), &known).expect("flipped");
+    assert!(flipped.diagnostics.flipped);
+    let mut bad = mesh.clone();
+    bad.triangles[7][1] = bad.vertices.len() as u32;
+    assert!(matches!(
+        bad.mass_properties(Amount::Density(1.0), &known),
+        Err(MassError::IndexOutOfRange {
+            triangle: 7,
+            corner: 1,
+            ..
+        })
+    ));
+    let open = MeshOptions {
+        topology: TopologySource::Known(MeshTopology {
+            boundary_edges: 3,
+            ..MeshTopology::default()
+        }),
+        ..MeshOptions::default()
+    };
+    assert!(matches!(
+        mesh.mass_properties(Amount::Density(1.0), &open),
+        Err(MassError::OpenMesh { boundary_edges: 3, .. })
+    ));
+}

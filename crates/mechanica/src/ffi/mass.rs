@@ -8,7 +8,9 @@ use super::validate::*;
 use mechanica_kinematics::nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 use mechanica_kinematics::rotation::{self, QuaternionNorm};
 use mechanica_mass::mechanism::{DragField, EnergySplit, SplitBuffers, TreeMass};
-use mechanica_mass::mesh::{DegeneratePolicy, InsideOutPolicy, MeshModel, MeshOptions, OpenMeshPolicy};
+use mechanica_mass::mesh::{
+    DegeneratePolicy, InsideOutPolicy, MeshModel, MeshOptions, MeshTopology, OpenMeshPolicy, TopologySource,
+};
 use mechanica_mass::validity::{self, InertiaClass, InertiaIssue, ValidityTolerance};
 use mechanica_mass::{Amount, MassError, MassProperties, primitives};
 
@@ -839,6 +841,85 @@ pub unsafe extern "C" fn mech_mass_mesh(
     out: *mut mech_mass_properties_t,
     report_out: *mut mech_mesh_report_t,
 ) -> mech_status_t {
+    // SAFETY: the caller's contract is mesh_call's.
+    unsafe {
+        mesh_call(
+            vertices,
+            vertex_count,
+            indices,
+            triangle_count,
+            amount_kind,
+            amount,
+            options,
+            None,
+            out,
+            report_out,
+        )
+    }
+}
+
+/// As mech_mass_mesh, for a mesh whose vertices moved since an earlier call on the same
+/// triangle array (a deforming body re-integrated every step): the edge-topology check, about
+/// two thirds of the time of a large mesh, is skipped and its result taken from `earlier`, the
+/// report of that call (its `triangles` must equal `triangle_count`). The caller vouches that
+/// the triangles are unchanged; indices are still checked and an inside-out mesh is still
+/// flipped or refused.
+///
+/// Errors: as mech_mass_mesh; NULL_POINTER when `earlier` is NULL; BAD_DIMENSION when its
+/// triangle count differs.
+///
+/// # Safety
+/// As mech_mass_mesh; `earlier` must point to a readable mech_mesh_report_t.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_mass_mesh_same_connectivity(
+    vertices: *const f64,
+    vertex_count: usize,
+    indices: *const u32,
+    triangle_count: usize,
+    amount_kind: mech_amount_t,
+    amount: f64,
+    options: *const mech_mesh_options_t,
+    earlier: *const mech_mesh_report_t,
+    out: *mut mech_mass_properties_t,
+    report_out: *mut mech_mesh_report_t,
+) -> mech_status_t {
+    if earlier.is_null() {
+        return boundary(|| Err(FfiError::new(MECH_STATUS_NULL_POINTER, "earlier is NULL")));
+    }
+    // SAFETY: the caller's contract is mesh_call's.
+    unsafe {
+        mesh_call(
+            vertices,
+            vertex_count,
+            indices,
+            triangle_count,
+            amount_kind,
+            amount,
+            options,
+            Some(earlier),
+            out,
+            report_out,
+        )
+    }
+}
+
+/// The body of mech_mass_mesh and mech_mass_mesh_same_connectivity; `earlier` is the report
+/// whose topology is reused, if any.
+///
+/// # Safety
+/// As mech_mass_mesh; `earlier`, when given, readable.
+unsafe fn mesh_call(
+    vertices: *const f64,
+    vertex_count: usize,
+    indices: *const u32,
+    triangle_count: usize,
+    amount_kind: mech_amount_t,
+    amount: f64,
+    options: *const mech_mesh_options_t,
+    earlier: Option<*const mech_mesh_report_t>,
+    out: *mut mech_mass_properties_t,
+    report_out: *mut mech_mesh_report_t,
+) -> mech_status_t {
     boundary(|| {
         if triangle_count == 0 {
             return Err(FfiError::new(MECH_STATUS_BAD_DIMENSION, "triangle_count is 0"));
@@ -863,11 +944,33 @@ pub unsafe extern "C" fn mech_mass_mesh(
         } else {
             Some(Out::new(report_out, "report_out")?)
         };
+        let topology = match earlier {
+            None => TopologySource::Check,
+            Some(ptr) => {
+                // SAFETY: caller's contract.
+                let e = unsafe { read(ptr, "earlier") }?;
+                if e.triangles != triangle_count {
+                    return Err(FfiError::new(
+                        MECH_STATUS_BAD_DIMENSION,
+                        format!(
+                            "earlier report is for {} triangles, this call has {triangle_count}",
+                            e.triangles
+                        ),
+                    ));
+                }
+                TopologySource::Known(MeshTopology {
+                    boundary_edges: e.boundary_edges,
+                    non_manifold_edges: e.non_manifold_edges,
+                    misoriented_edges: e.misoriented_edges,
+                })
+            }
+        };
         let options = MeshOptions {
             model: enum_value(opts.model, "options.model")?,
             open_mesh: enum_value(opts.open_mesh, "options.open_mesh")?,
             inside_out: enum_value(opts.inside_out, "options.inside_out")?,
             degenerate: enum_value(opts.degenerate, "options.degenerate")?,
+            topology,
         };
         let amount = amount_of(amount_kind, amount)?;
         let (verts, _) = flat_v.as_chunks::<3>();
