@@ -6,18 +6,28 @@
 //!   well separated. A successful Cholesky factorization of K certifies that no mode lies below σ
 //!   (Sylvester). The automatic σ is −√u·‖B‖_F/‖A‖_F, lowered by factors of 1000 while K is not
 //!   positive definite (unstable modes).
-//! - **Iteration.** Lanczos in the A-inner product with full (twice-applied, Gram–Schmidt)
-//!   reorthogonalisation and thick restarts (Wu & Simon, SIMAX 22, 2000; in Krylov–Schur form,
-//!   Stewart, SIMAX 23, 2001): the basis holds at most m = max(2·nev + 8, 20) vectors, so memory
-//!   is O(nnz(L) + n·m).
+//! - **Iteration.** Block Lanczos in the A-inner product with full reorthogonalisation (block
+//!   Gram–Schmidt, repeated when a column loses more than 1 − 1/√2 of its A-norm) and thick
+//!   restarts (Wu & Simon, SIMAX 22, 2000; in Krylov–Schur form, Stewart, SIMAX 23, 2001): the
+//!   basis holds about m = max(2·nev + 2b, 24) vectors (a multiple of the block size b), so
+//!   memory is O(nnz(L) + n·m).
 //! - **Refinement.** The converged Ritz vectors are Rayleigh–Ritz-projected onto the original
 //!   pencil (the dense solver on XᵀBX, XᵀAX), which makes them A-orthonormal and gives each ω²
 //!   as a Rayleigh quotient.
 //! - **Certification.** The inertia of B − τA ([`crate::count_below_sparse`]) at a shift τ in the
-//!   widest gap above the k-th mode must equal the number of computed modes below τ. When it is
-//!   larger, modes were missed (a single-vector Krylov space sees one vector per eigenspace of a
-//!   repeated eigenvalue in exact arithmetic): Lanczos is rerun deflated against every found
-//!   vector until the counts agree.
+//!   widest gap above the k-th mode must equal the number of computed modes below τ. Only gaps
+//!   wider than max(√u, 100·tolerance) relative count, so τ never falls inside a numerically
+//!   repeated eigenvalue (where the count could split the group); when the modes found above
+//!   the k-th have no such gap, τ goes above the last one. When the count is larger, modes were
+//!   missed (a block Krylov space of block size b holds at most b directions of each
+//!   eigenspace in exact arithmetic; further copies appear only from rounding, if at all):
+//!   Lanczos is rerun deflated against every found vector, with a block of as many vectors as
+//!   are missing (at most 32), so one rerun sees every missing copy of an eigenvalue. After
+//!   [`SparseOptions::max_runs`] runs without agreement the solve fails with
+//!   [`ModalError::LanczosNoConvergence`] (found vs. counted below τ).
+//! - **Repeated eigenvalues at the cut.** Exactly k modes are returned; when the k-th and
+//!   (k+1)-th are equal, [`SparseReport::kth_group_multiplicity`] gives the full multiplicity of
+//!   the k-th mode's eigenvalue (all its copies lie below τ and were computed).
 //! - **Bounds.** For a pair with θ = 1/(ω² − σ) the residual s = Ax − θKx gives
 //!   δ = ‖s‖_{K⁻¹}/‖x‖_K (one solve with K): the pencil (A, K) has an eigenvalue within δ of θ
 //!   (Parlett, "The Symmetric Eigenvalue Problem", Thm 15.9.1), and within δ²/gap (Kato–Temple)
@@ -53,6 +63,10 @@ pub struct SparseOptions {
     /// Block size b of the block Lanczos iteration (≥ 1): b vectors share each pass over the
     /// Cholesky factor, and an eigenvalue of multiplicity ≤ b is seen in one run.
     pub block_size: usize,
+    /// Maximal number of Lanczos runs: the first one plus deflated reruns for modes that the
+    /// inertia count shows missing (0 is taken as 1). When exhausted the solve fails with
+    /// [`ModalError::LanczosNoConvergence`] instead of returning an uncertified result.
+    pub max_runs: usize,
 }
 
 impl Default for SparseOptions {
@@ -64,6 +78,7 @@ impl Default for SparseOptions {
             max_restarts: 300,
             seed: 1,
             block_size: 2,
+            max_runs: 6,
         }
     }
 }
@@ -101,8 +116,13 @@ pub struct SparseReport {
     pub restarts: usize,
     /// Applications of K⁻¹A.
     pub operator_applications: usize,
-    /// Lanczos runs (1 + deflated reruns for missed modes).
+    /// Lanczos runs (1 + deflated reruns for missed modes); 0 on the dense path.
     pub lanczos_runs: usize,
+    /// Multiplicity of the k-th (highest returned) mode's eigenvalue among all modes computed
+    /// below the inertia shift τ, which is the whole eigenspace when `consistent` (τ lies in a
+    /// real gap above the k-th mode). It exceeds the last returned group's multiplicity when
+    /// the count k cuts through a repeated eigenvalue.
+    pub kth_group_multiplicity: usize,
     /// Largest backward error η of the returned pairs.
     pub max_backward_error: f64,
     /// max |(XᵀAX − I)_ij| of the returned vectors.
@@ -132,7 +152,7 @@ pub struct SparseModalSolution {
     pub report: SparseReport,
 }
 
-/// At or below this order the sparse solver converts to dense and calls [`crate::solve`].
+/// At or below this order the sparse solver converts to dense and calls [`crate::solve()`].
 pub const DENSE_LIMIT: usize = 400;
 
 /// Shift-invert operator x ↦ K⁻¹(Ax) with the Cholesky factor of K = B − σA.
@@ -220,8 +240,10 @@ fn mul_block(m: faer::sparse::SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mu
 }
 
 /// A-orthogonalises the n × b block `w` against the first `cols` columns of `basis` and all of
-/// `locked`, twice (block classical Gram–Schmidt with reorthogonalisation); returns the
-/// accumulated cols × b coefficients.
+/// `locked` by block classical Gram–Schmidt, repeated once when a column lost more than
+/// 1 − 1/√2 of its A-norm ("twice is enough": Daniel, Gragg, Kaufman & Stewart, Math. Comp. 30,
+/// 1976; Giraud, Langou & Rozložník, Comput. Math. Appl. 50, 2005); returns the accumulated
+/// cols × b coefficients.
 fn orthogonalise_block(
     a: faer::sparse::SparseColMatRef<'_, usize, f64>,
     basis: &[f64],
@@ -234,8 +256,25 @@ fn orthogonalise_block(
     let n = a.nrows();
     let b = w.len() / n;
     let mut total = Mat::<f64>::zeros(cols, b);
+    let a_norms = |w: &[f64], aw: &[f64]| -> Vec<f64> {
+        w.chunks_exact(n)
+            .zip(aw.chunks_exact(n))
+            .map(|(x, y)| dot(x, y).max(0.0).sqrt())
+            .collect()
+    };
+    let mut before: Option<Vec<f64>> = None;
     for _ in 0..2 {
         mul_block(a, w, scratch, n);
+        let norms = a_norms(w, scratch);
+        if let Some(previous) = &before
+            && norms
+                .iter()
+                .zip(previous)
+                .all(|(now, then)| *now >= std::f64::consts::FRAC_1_SQRT_2 * then)
+        {
+            break;
+        }
+        before = Some(norms);
         let z = MatRef::from_column_major_slice(scratch, n, b);
         for (part, count, accumulate) in [(basis, cols, true), (locked, locked_cols, false)] {
             if count == 0 {
@@ -243,13 +282,14 @@ fn orthogonalise_block(
             }
             let v = MatRef::from_column_major_slice(&part[..n * count], n, count);
             let h = product(v.transpose(), z);
-            let update = product(v, h.as_ref());
-            for c in 0..b {
-                let wc = &mut w[n * c..n * (c + 1)];
-                for (i, x) in wc.iter_mut().enumerate() {
-                    *x -= update[(i, c)];
-                }
-            }
+            faer::linalg::matmul::matmul(
+                MatMut::from_column_major_slice_mut(w, n, b),
+                faer::Accum::Add,
+                v,
+                h.as_ref(),
+                -1.0,
+                Par::Seq,
+            );
             if accumulate {
                 total += &h;
             }
@@ -331,7 +371,9 @@ fn normalise_block(
 }
 
 /// One block thick-restart Lanczos run for the `nev` largest θ of T restricted to the
-/// A-orthogonal complement of `locked`. Returns (θ descending, n × nev Ritz vectors, restarts).
+/// A-orthogonal complement of `locked`, from the n × b column-major `start` block when given
+/// with that size (tests), else from a pseudo-random block. Returns (θ descending, n × nev Ritz
+/// vectors, restarts).
 #[allow(clippy::too_many_arguments)]
 fn lanczos_run(
     op: &mut Operator<'_>,
@@ -342,6 +384,7 @@ fn lanczos_run(
     tolerance: f64,
     max_restarts: usize,
     rng: &mut Lcg,
+    start: Option<&[f64]>,
 ) -> Result<(Vec<f64>, Vec<f64>, usize), ModalError> {
     let a = op.a;
     let n = a.nrows();
@@ -360,8 +403,11 @@ fn lanczos_run(
     let mut h = Mat::<f64>::zeros(m + b, m);
     let mut scratch = vec![0.0; n * b];
     let mut w = vec![0.0; n * b];
-    // Start block: random, A-orthonormal, A-orthogonal to the locked vectors.
-    w.iter_mut().for_each(|x| *x = rng.next());
+    // Start block: given or random, A-orthonormal, A-orthogonal to the locked vectors.
+    match start {
+        Some(given) if given.len() == w.len() => w.copy_from_slice(given),
+        _ => w.iter_mut().for_each(|x| *x = rng.next()),
+    }
     let _ = orthogonalise_block(a, &[], 0, locked, locked_cols, &mut w, &mut scratch);
     normalise_block(a, &[], 0, locked, locked_cols, &mut w, 1.0, rng)?;
     basis[..n * b].copy_from_slice(&w);
@@ -448,7 +494,29 @@ fn lanczos_run(
 }
 
 /// Solves for the `options.count` lowest modes of the sparse pencil. See the module documentation.
+///
+/// Exactly k = `options.count` modes are returned, ascending. When the k-th and (k+1)-th ω² are
+/// equal (k cuts through a repeated eigenvalue), the last returned group is an A-orthonormal basis
+/// of only part of that eigenspace; [`SparseReport::kth_group_multiplicity`] then exceeds the
+/// last group's multiplicity and says how many modes the whole eigenspace has.
+///
+/// Errors: [`ModalError::TooManyModes`] for k = 0 or k > n (or when the deflated reruns would
+/// need more vectors than the pencil has), [`ModalError::BadShift`], [`ModalError::NoDefiniteShift`],
+/// [`ModalError::MassNotSemidefinite`], and [`ModalError::LanczosNoConvergence`] when a run does not
+/// converge within `max_restarts`, or when after `max_runs` Lanczos runs the inertia count still
+/// shows modes missing below the check shift τ (then `converged` = modes found below τ, `wanted` =
+/// the inertia count below τ, `restarts` = restarts over all runs).
 pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<SparseModalSolution, ModalError> {
+    solve_sparse_from(pencil, options, None)
+}
+
+/// [`solve_sparse`] with an optional first start block (n × block size, column-major): lets tests
+/// start the first run exactly A-orthogonal to an eigenvector, which no rounding can then reach.
+fn solve_sparse_from(
+    pencil: &SparsePencil,
+    options: &SparseOptions,
+    start: Option<&[f64]>,
+) -> Result<SparseModalSolution, ModalError> {
     let n = pencil.dim();
     let k = options.count;
     if k == 0 || k > n {
@@ -524,9 +592,18 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
         options.tolerance,
         options.max_restarts,
         &mut rng,
+        start,
     )?;
     timings.lanczos += clock.elapsed();
     let mut runs = 1;
+    let max_runs = options.max_runs.max(1);
+    // Gaps narrower than this (relative, plus an absolute floor at the rounding level of ω²
+    // near zero, e.g. rigid-body modes) may lie inside a numerically repeated eigenvalue: an
+    // inertia shift there could split the group, so τ is never placed in one.
+    let min_gap = f64::EPSILON.sqrt().max(100.0 * options.tolerance);
+    let floor = 100.0 * f64::EPSILON * ratio;
+    let real_gap =
+        |omega: &[f64], j: usize| omega[j + 1] - omega[j] > min_gap * omega[j].abs().max(omega[j + 1].abs()) + floor;
     let inertia_symbolic = symbolic_supernodal(&pattern)?;
     loop {
         let clock = Instant::now();
@@ -534,16 +611,24 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
         let refined = rayleigh_ritz(pencil, &found, cols)?;
         timings.refine += clock.elapsed();
         let omega = &refined.omega_sq;
-        // τ in the widest gap between the k-th mode and the last one found.
+        let cols = omega.len();
+        if cols == 0 {
+            return Err(ModalError::LanczosNoConvergence {
+                converged: 0,
+                wanted: k,
+                restarts,
+            });
+        }
+        // τ in the widest real gap between the k-th mode and the last one found; above the last
+        // one when every gap there is within a cluster.
         let last = cols - 1;
         let kth = (k - 1).min(last);
-        let tau = if kth < last {
-            let j = (kth..last)
-                .max_by(|&i, &j| gap(omega, i).total_cmp(&gap(omega, j)))
-                .unwrap_or(kth);
-            0.5 * (omega[j] + omega[j + 1])
-        } else {
-            omega[last] + 0.5 * (omega[last] - sigma).abs()
+        let tau = match (kth..last)
+            .filter(|&j| real_gap(omega, j))
+            .max_by(|&i, &j| gap(omega, i).total_cmp(&gap(omega, j)))
+        {
+            Some(j) => 0.5 * (omega[j] + omega[j + 1]),
+            None => omega[last] + 0.5 * (omega[last] - sigma).abs(),
         };
         let below = omega.partition_point(|&w| w < tau);
         let clock = Instant::now();
@@ -551,7 +636,7 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
         let inertia = inertia_with(&inertia_symbolic, &kmat, tau)?;
         timings.inertia += clock.elapsed();
         let missing = inertia.count.below.saturating_sub(below);
-        if missing == 0 || runs >= 6 {
+        if missing == 0 {
             let clock = Instant::now();
             let solution = finish(
                 pencil,
@@ -574,17 +659,27 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
             solution.report.timings.solves = op.solve_time;
             return Ok(solution);
         }
-        // Missed modes (repeated eigenvalues): rerun deflated against everything found.
+        if runs >= max_runs {
+            return Err(ModalError::LanczosNoConvergence {
+                converged: below,
+                wanted: inertia.count.below,
+                restarts,
+            });
+        }
+        // Missed modes (repeated eigenvalues): rerun deflated against everything found. A block
+        // of `missing` vectors (≤ MAX_RERUN_BLOCK) sees every missing copy of an eigenvalue in one
+        // run, whatever its multiplicity.
         let clock = Instant::now();
         let (_, more, r) = lanczos_run(
             &mut op,
-            (missing + 1).min(n - cols - 1).max(1),
-            options.block_size,
+            (missing + 1).min(n.saturating_sub(cols + 1)).max(1),
+            options.block_size.max(missing.min(MAX_RERUN_BLOCK)),
             &refined.vectors,
             cols,
             options.tolerance,
             options.max_restarts,
             &mut rng,
+            None,
         )?;
         timings.lanczos += clock.elapsed();
         restarts += r;
@@ -593,6 +688,9 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
         found.extend_from_slice(&more);
     }
 }
+
+/// Largest block size of a deflated rerun.
+const MAX_RERUN_BLOCK: usize = 32;
 
 /// ω²_{j+1} − ω²_j relative to max(|ω²_j|, |ω²_{j+1}|) (0 past the end).
 fn gap(omega: &[f64], j: usize) -> f64 {
@@ -739,7 +837,7 @@ fn finish(
         bounds[c] = omega_bound + rounding[c];
     }
     let take = k.min(cols);
-    let mut modes: Vec<Mode> = (0..take)
+    let mut modes: Vec<Mode> = (0..cols)
         .map(|c| Mode {
             lambda: -omega_sq[c],
             omega_sq: omega_sq[c],
@@ -749,6 +847,8 @@ fn finish(
             group: 0,
         })
         .collect();
+    let kth_group_multiplicity = kth_group_multiplicity(&mut modes, take);
+    modes.truncate(take);
     let groups = group_modes(&mut modes);
     let vectors = Mat::from_fn(n, take, |i, c| refined.vectors[i + n * c]);
     let orthogonality_error = orthogonality(a, &vectors);
@@ -762,6 +862,7 @@ fn finish(
             restarts: 0,
             operator_applications: op.applications,
             lanczos_runs: 0,
+            kth_group_multiplicity,
             max_backward_error: eta[..take].iter().copied().fold(0.0, f64::max),
             orthogonality_error,
             inertia: Some(inertia),
@@ -774,6 +875,16 @@ fn finish(
         vectors,
         groups,
     })
+}
+
+/// The multiplicity, among all of `modes` (ascending), of the group of mode `k` − 1 (0 when
+/// k = 0), grouped as the returned modes are (ω² within the sum of their bounds).
+fn kth_group_multiplicity(modes: &mut [Mode], k: usize) -> usize {
+    if k == 0 || k > modes.len() {
+        return 0;
+    }
+    let groups = group_modes(modes);
+    groups.get(modes[k - 1].group).map_or(0, |g| g.multiplicity)
 }
 
 /// Largest number of stored entries in a column (= row, symmetric).
@@ -810,7 +921,9 @@ fn orthogonality(a: faer::sparse::SparseColMatRef<'_, usize, f64>, x: &Mat<f64>)
     worst
 }
 
-/// Small problems: the dense solver, with its report mapped onto the sparse one.
+/// Small problems: the dense solver, with its report mapped onto the sparse one. The dense solve
+/// asks for more than k modes until the k-th mode's group is seen to end; its accuracy fields
+/// (backward error, orthogonality, inertia check) cover that superset of the returned modes.
 fn dense_fallback(
     pencil: &SparsePencil,
     k: usize,
@@ -830,15 +943,48 @@ fn dense_fallback(
     };
     let clock = Instant::now();
     let problem = PencilProblem::new(dense(pencil.a()).as_ref(), dense(pencil.b()).as_ref())?;
-    let sol = solve(
-        &problem,
-        &SolveOptions {
-            selection: Selection::Lowest(k),
-            vectors: true,
-            refinement: Refinement::Auto,
-        },
-    )?;
-    let vectors = sol.vectors.clone().unwrap_or_else(|| Mat::zeros(n, 0));
+    let lowest = |count: usize| {
+        solve(
+            &problem,
+            &SolveOptions {
+                selection: Selection::Lowest(count),
+                vectors: true,
+                refinement: Refinement::Auto,
+            },
+        )
+    };
+    // Ask for more than k until the k-th mode's group is seen to end, so that a count cutting
+    // through a repeated eigenvalue is reported (kth_group_multiplicity).
+    let mut wanted = (k + 1).min(n);
+    let mut sol = match lowest(wanted) {
+        Ok(sol) => sol,
+        Err(ModalError::TooManyModes { .. }) if wanted > k => {
+            wanted = k;
+            lowest(k)?
+        }
+        Err(e) => return Err(e),
+    };
+    while wanted > k && wanted < n && sol.modes.len() == wanted && sol.modes[wanted - 1].group == sol.modes[k - 1].group
+    {
+        wanted = (2 * wanted).min(n);
+        match lowest(wanted) {
+            Ok(more) => sol = more,
+            Err(ModalError::TooManyModes { .. }) => break,
+            Err(e) => return Err(e),
+        }
+    }
+    let kth_group_multiplicity = sol
+        .modes
+        .get(k - 1)
+        .and_then(|m| sol.groups.get(m.group))
+        .map_or(0, |g| g.multiplicity);
+    let mut modes = sol.modes;
+    modes.truncate(k);
+    let groups = group_modes(&mut modes);
+    let vectors = match &sol.vectors {
+        Some(v) => v.subcols(0, modes.len()).to_owned(),
+        None => Mat::zeros(n, 0),
+    };
     let check = sol.accuracy.inertia_check;
     Ok(SparseModalSolution {
         report: SparseReport {
@@ -850,6 +996,7 @@ fn dense_fallback(
             restarts: 0,
             operator_applications: 0,
             lanczos_runs: 0,
+            kth_group_multiplicity,
             max_backward_error: sol.accuracy.max_backward_error.unwrap_or(0.0),
             orthogonality_error: sol.accuracy.orthogonality_error.unwrap_or(0.0),
             inertia: check.map(|c| SparseInertia {
@@ -865,8 +1012,122 @@ fn dense_fallback(
                 ..SparseTimings::default()
             },
         },
-        modes: sol.modes,
+        modes,
         vectors,
-        groups: sol.groups,
+        groups,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::Triplet;
+    use std::f64::consts::PI;
+
+    /// Two uncoupled consistent-mass chains of `len` nodes (A = tridiag(1, 4, 1),
+    /// B = 6s·tridiag(−1, 2, −1), s = 1 for the first and 2 for the second):
+    /// ω²_j = 12 s sin²(θ_j/2)/(2 + cos θ_j), θ_j = jπ/(len + 1).
+    fn two_chains(len: usize) -> (SparsePencil, Vec<f64>) {
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for (c, s) in [(0, 1.0), (1, 2.0)] {
+            for i in 0..len {
+                let r = c * len + i;
+                a.push(Triplet::new(r, r, 4.0));
+                b.push(Triplet::new(r, r, 12.0 * s));
+                if i + 1 < len {
+                    for (p, q) in [(r, r + 1), (r + 1, r)] {
+                        a.push(Triplet::new(p, q, 1.0));
+                        b.push(Triplet::new(p, q, -6.0 * s));
+                    }
+                }
+            }
+        }
+        let mut exact: Vec<f64> = [1.0, 2.0]
+            .iter()
+            .flat_map(|s| {
+                (1..=len).map(move |j| {
+                    let theta = j as f64 * PI / (len as f64 + 1.0);
+                    let h = (0.5 * theta).sin();
+                    12.0 * s * h * h / (2.0 + theta.cos())
+                })
+            })
+            .collect();
+        exact.sort_by(f64::total_cmp);
+        let pencil = SparsePencil::from_triplets(2 * len, &a, &b).expect("valid");
+        (pencil, exact)
+    }
+
+    /// Every returned ω² within its bound (plus 8u for the rounding of the closed form) of the
+    /// closed form, and the certificate holds.
+    fn assert_matches(sol: &SparseModalSolution, exact: &[f64]) {
+        for (i, (m, w)) in sol.modes.iter().zip(exact).enumerate() {
+            let err = (m.omega_sq - w).abs();
+            assert!(
+                err <= m.error_bound + 8.0 * f64::EPSILON * w,
+                "mode {i}: {} vs {w} (bound {:e})",
+                m.omega_sq,
+                m.error_bound
+            );
+        }
+        assert!(sol.report.consistent, "{:?}", sol.report);
+        assert!(sol.report.orthogonality_error <= 1e3 * f64::EPSILON, "{:?}", sol.report);
+    }
+
+    /// A start vector that is exactly zero on the first chain: every Krylov vector stays exactly
+    /// zero there (block-diagonal A and Cholesky factor, products with exact zeros), so the first
+    /// run cannot see the lowest modes in any arithmetic. The inertia count must notice and the
+    /// deflated rerun (random start) must find them.
+    #[test]
+    fn modes_invisible_from_the_start_block_are_recovered() {
+        let len = 300;
+        let (p, exact) = two_chains(len);
+        let options = SparseOptions {
+            count: 6,
+            block_size: 1,
+            ..SparseOptions::default()
+        };
+        let mut start = vec![0.0; 2 * len];
+        for (i, x) in start[len..].iter_mut().enumerate() {
+            *x = 1.0 + (i % 7) as f64;
+        }
+        let sol = solve_sparse_from(&p, &options, Some(&start)).expect("solve");
+        assert!(sol.report.lanczos_runs >= 2, "{:?}", sol.report);
+        assert_eq!(sol.modes.len(), 6);
+        assert_matches(&sol, &exact);
+        // With a single run allowed the missed modes are a typed error naming both counts.
+        let single = SparseOptions { max_runs: 1, ..options };
+        match solve_sparse_from(&p, &single, Some(&start)) {
+            Err(ModalError::LanczosNoConvergence { converged, wanted, .. }) => {
+                assert!(converged < wanted, "{converged} of {wanted}");
+            }
+            other => panic!("expected a missed-mode error, got {other:?}"),
+        }
+    }
+
+    /// A start vector nearly orthogonal (1e-13 relative) to the first chain: rounding-level
+    /// components may or may not grow within the first run; either way the result is certified.
+    #[test]
+    fn nearly_invisible_modes_are_recovered() {
+        let len = 300;
+        let (p, exact) = two_chains(len);
+        let mut start = vec![0.0; 2 * len];
+        for (i, x) in start.iter_mut().enumerate() {
+            let scale = if i < len { 1e-13 } else { 1.0 };
+            *x = scale * (1.0 + (i % 5) as f64);
+        }
+        for block in [1, 2] {
+            let options = SparseOptions {
+                count: 8,
+                block_size: block,
+                ..SparseOptions::default()
+            };
+            let mut s = start.clone();
+            if block == 2 {
+                s.extend(start.iter().enumerate().map(|(i, x)| x * (1.0 + (i % 3) as f64)));
+            }
+            let sol = solve_sparse_from(&p, &options, Some(&s)).expect("solve");
+            assert_eq!(sol.modes.len(), 8);
+            assert_matches(&sol, &exact);
+        }
+    }
 }

@@ -662,9 +662,13 @@ unsafe fn read_csc(
 /// inertia count. Writes ω²_k ascending into `omega_sq_out` (count), their error bounds into
 /// `error_bound_out` (count, may be NULL), the A-orthonormal shapes as an n × count column-major
 /// matrix into `vectors_out` (may be NULL) and the summary into `report_out` (may be NULL).
+/// Exactly `count` modes are returned: when `count` cuts through a repeated eigenvalue, only
+/// part of its eigenspace is (ask for more to get the whole group). Copies of a repeated
+/// eigenvalue missed by the first Lanczos run are found by the inertia count and recovered by
+/// deflated reruns; a result is never returned uncertified.
 /// Errors: BAD_DIMENSION for an index ≥ n, NON_FINITE, INVALID_ARGUMENT for asymmetry, bad
 /// column pointers or count ∉ [1, n]; NOT_POSITIVE_DEFINITE when no shift below the spectrum
-/// was found (A indefinite); NOT_CONVERGED.
+/// was found (A indefinite); NOT_CONVERGED (also when the reruns run out).
 ///
 /// # Safety
 /// Each `*_col_ptr` must point to n + 1 readable size_t, each `*_row_idx` / `*_values` to
