@@ -1,7 +1,10 @@
 //! Criterion benchmarks: the dense symmetric-definite solver of det(λA + B) = 0.
 //!
-//! Problem: a fixed–fixed spring chain with masses 1..2, rotated by a random orthogonal Q
-//! (dense A and B with a known spectrum), at n = 200 and 1000.
+//! Problem: [`rotated_fixed_chain`]: a fixed–fixed spring chain with masses 1..2, rotated by a
+//! random orthogonal Q (dense A and B with the closed-form spectrum of the unit chain), at
+//! n = 200 and 1000. Larger n (2000, 4000) are timed by the report generator
+//! `benches/modal_report.rs` (median of 3 runs; criterion's minimum of 10 samples would take
+//! minutes per series there), which also measures the errors of every method.
 //!
 //! Series, all in the same run:
 //! - `mechanica_all_pairs`: `solve` with all pairs, the full accuracy report and Sturm check;
@@ -11,9 +14,15 @@
 //! - `faer_evd_of_c`: faer's self-adjoint eigensolver on the reduced C alone;
 //! - `nalgebra_all_pairs`: the peer pipeline in nalgebra (Cholesky, L⁻¹BL⁻ᵀ by two triangular
 //!   solves, SymmetricEigen, back-transform).
+//! - `lapack_dsygvd_all_pairs`, `lapack_dsygvd_values_only`: LAPACK `dsygvd` (divide and
+//!   conquer, the driver of SciPy `eigh`) from the system OpenBLAS with its default threads,
+//!   linked by `benches/build.rs` when found (skipped with a note otherwise). Run with
+//!   `OPENBLAS_CORETYPE=Haswell` where OpenBLAS falls back to its slow `Prescott` kernels (see
+//!   `modal_report.rs`). The input copies
+//!   LAPACK needs (it overwrites A and B) are inside the timed region, as mechanica copies too.
 //!
-//! LAPACK `dsygvd` (SciPy eigh) is timed by tools/modal_scipy_bench.py on the same family; its
-//! numbers are committed in tools/modal_scipy_bench.out.
+//! tools/modal_scipy_bench.py times SciPy's `eigh` on the same family from Python
+//! (tools/modal_scipy_bench.out).
 //!
 //! Group `modal_sparse`: the 10 lowest modes of the 300×300 grid Laplacian (n = 90 000) by
 //! `solve_sparse` (shift-invert block Lanczos, inertia-certified). Peer: SciPy `eigsh`
@@ -21,42 +30,21 @@
 //! numbers in tools/modal_sparse_scipy.out (the issue quotes Spectra at 1.6 s, unloaded).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use mechanica::kinematics::nalgebra::{DMatrix, SymmetricEigen};
-use mechanica::modal::faer::{Mat, Par};
+use mechanica::modal::faer::Par;
 use mechanica::modal::reduce::{cholesky_and_reduce, reduce_two_solves};
 use mechanica::modal::{PencilProblem, SolveOptions, SparseOptions, SparsePencil, families, solve, solve_sparse};
+use mechanica_benches::lapack;
+use mechanica_benches::modal::{nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra};
 use std::hint::black_box;
 
 const SIZES: [usize; 2] = [200, 1000];
-
-/// The benchmark pencil of order n.
-fn pencil(n: usize) -> (Mat<f64>, Mat<f64>) {
-    let a = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 / n as f64 } else { 0.0 });
-    let (_, b) = families::fixed_chain(n);
-    families::rotate(&a, &b, &families::random_orthogonal(n, 42))
-}
-
-fn to_nalgebra(m: &Mat<f64>) -> DMatrix<f64> {
-    DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)])
-}
-
-/// The nalgebra peer: all pairs of the definite pencil.
-fn nalgebra_all_pairs(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Option<(f64, f64)> {
-    let chol = a.clone().cholesky()?;
-    let l = chol.l();
-    let lb = l.solve_lower_triangular(b)?;
-    let c = l.solve_lower_triangular(&lb.transpose())?;
-    let eig = SymmetricEigen::new(c);
-    let x = l.transpose().solve_upper_triangular(&eig.eigenvectors)?;
-    Some((eig.eigenvalues[0], x[(0, 0)]))
-}
 
 fn dense(c: &mut Criterion) {
     let mut group = c.benchmark_group("modal_dense");
     group.sample_size(10);
     let par = mechanica::modal::faer::get_global_parallelism();
     for n in SIZES {
-        let (a, b) = pencil(n);
+        let (a, b) = rotated_fixed_chain(n);
         let problem = match PencilProblem::new(a.as_ref(), b.as_ref()) {
             Ok(p) => p,
             Err(e) => panic!("benchmark pencil is valid: {e}"),
@@ -90,10 +78,22 @@ fn dense(c: &mut Criterion) {
                     .map(|e| e.S()[0])
             })
         });
-        let (na, nb) = (to_nalgebra(&a), to_nalgebra(&b));
+        let (na, nb) = (to_nalgebra(a.as_ref()), to_nalgebra(b.as_ref()));
         group.bench_with_input(BenchmarkId::new("nalgebra_all_pairs", n), &(), |bch, _| {
-            bch.iter(|| nalgebra_all_pairs(black_box(&na), &nb))
+            bch.iter(|| nalgebra_all_pairs(black_box(&na), &nb).map(|(w, _)| w[0]))
         });
+        if lapack::available() {
+            // LAPACK solves K z = ω² M z: stiffness first, then mass.
+            let (k, m) = (to_col_major(b.as_ref()), to_col_major(a.as_ref()));
+            group.bench_with_input(BenchmarkId::new("lapack_dsygvd_all_pairs", n), &(), |bch, _| {
+                bch.iter(|| lapack::dsygvd(black_box(&k), &m, n, true).map(|e| e.values[0]))
+            });
+            group.bench_with_input(BenchmarkId::new("lapack_dsygvd_values_only", n), &(), |bch, _| {
+                bch.iter(|| lapack::dsygvd(black_box(&k), &m, n, false).map(|e| e.values[0]))
+            });
+        } else {
+            println!("note: built without OpenBLAS, the lapack_dsygvd series are skipped");
+        }
         let _ = (&l, Par::Seq);
     }
     group.finish();

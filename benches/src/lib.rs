@@ -4,6 +4,30 @@
 use plotters::prelude::*;
 use std::io::Write as _;
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+pub mod lapack;
+pub mod modal;
+
+/// Median wall time of `f` in seconds, and its last result. Runs `f` at least `min_runs` times
+/// and keeps repeating (up to 1000 runs) until `budget` has elapsed: for report generators whose
+/// problems are too slow for criterion's sampling (a run of several seconds is timed
+/// `min_runs` times).
+pub fn median_seconds<T>(min_runs: usize, budget: Duration, mut f: impl FnMut() -> T) -> (f64, T) {
+    let start = Instant::now();
+    let mut times = Vec::new();
+    let mut last;
+    loop {
+        let t = Instant::now();
+        last = std::hint::black_box(f());
+        times.push(t.elapsed().as_secs_f64());
+        if (times.len() >= min_runs.max(1) && start.elapsed() >= budget) || times.len() >= 1000 {
+            break;
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    (times[times.len() / 2], last)
+}
 
 /// `target/reports/` (honouring `CARGO_TARGET_DIR`), created if missing.
 pub fn reports_dir() -> std::io::Result<PathBuf> {

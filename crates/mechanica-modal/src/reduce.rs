@@ -58,7 +58,7 @@ pub(crate) fn cholesky(a: MatRef<'_, f64>, par: Par) -> Cholesky {
 
 /// C = L⁻¹ B L⁻ᵀ, reading only the lower triangle of `b`; returns C with its lower triangle
 /// valid (the upper triangle is unspecified).
-pub(crate) fn reduce(l: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Mat<f64> {
+pub fn reduce(l: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Mat<f64> {
     let mut c = b.to_owned();
     reduce_in_place(l, c.as_mut(), par);
     c
@@ -130,8 +130,17 @@ pub fn reduce_two_solves(l: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Ma
 }
 
 /// X = L⁻ᵀ Y in place (back-transformation of eigenvectors of C to those of the pencil).
-pub(crate) fn back_transform(l: MatRef<'_, f64>, y: MatMut<'_, f64>, par: Par) {
+pub fn back_transform(l: MatRef<'_, f64>, y: MatMut<'_, f64>, par: Par) {
     solve_upper_triangular_in_place(l.transpose(), y, par);
+}
+
+/// The Cholesky factor L (lower, upper triangle zeroed) of A = LLᵀ exactly as [`crate::solve`]
+/// computes it, or None if A is not numerically positive definite (for stage benchmarks).
+pub fn cholesky_lower(a: MatRef<'_, f64>, par: Par) -> Option<Mat<f64>> {
+    match cholesky(a, par) {
+        Cholesky::Factor(l) => Some(l),
+        Cholesky::Failed { .. } => None,
+    }
 }
 
 /// Public entry to the symmetric reduction for benchmarks: returns (L, C) with C's lower
