@@ -22,7 +22,10 @@ fn main() {
         &p,
         &SparseOptions {
             count: k,
-            block_size: std::env::var("BLOCK").ok().and_then(|b| b.parse().ok()).unwrap_or(4),
+            block_size: std::env::var("BLOCK")
+                .ok()
+                .and_then(|b| b.parse().ok())
+                .unwrap_or(SparseOptions::default().block_size),
             tolerance: std::env::var("TOL").ok().and_then(|b| b.parse().ok()).unwrap_or(1e-12),
             ..SparseOptions::default()
         },

@@ -155,15 +155,6 @@ pub struct SparseModalSolution {
 /// At or below this order the sparse solver converts to dense and calls [`crate::solve()`].
 pub const DENSE_LIMIT: usize = 400;
 
-/// The factor kind of K = B − σA: faer's rule (supernodal when the factorization's flops per
-/// factor entry exceed a threshold) with the threshold raised 4×, because shift-invert Lanczos
-/// applies K⁻¹ some 10² times per factorization and a simplicial factor's triangular solves
-/// have less overhead per entry than supernodal ones with few right-hand sides. 2-D-like fill
-/// (the 300×300 grid: solves 0.47 s against 0.75 s, factorization 0.36 s against 0.18 s) then
-/// stays simplicial; 3-D-like fill, with large dense supernodes, stays supernodal.
-const SOLVE_BIASED_SUPERNODAL_THRESHOLD: faer::sparse::linalg::SupernodalThreshold =
-    faer::sparse::linalg::SupernodalThreshold(4.0);
-
 /// Shift-invert operator x ↦ K⁻¹(Ax) with the Cholesky factor of K = B − σA.
 struct Operator<'a> {
     symbolic: SymbolicCholesky<usize>,
@@ -554,10 +545,10 @@ fn solve_sparse_from(
         pattern.to_faer().symbolic(),
         Side::Lower,
         SymmetricOrdering::Amd,
-        CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: SOLVE_BIASED_SUPERNODAL_THRESHOLD,
-            ..CholeskySymbolicParams::default()
-        },
+        // faer's own choice (supernodal here): a simplicial factor has cheaper solves but on the
+        // 300×300 grid its slower factorization cost more than that saved (idle: 1.63 s against
+        // 1.89 s in all at block size 2).
+        CholeskySymbolicParams::default(),
     )
     .map_err(|e| ModalError::Factorization {
         what: "B − σA (symbolic)",
