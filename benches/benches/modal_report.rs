@@ -664,31 +664,44 @@ fn main() {
         Nalgebra,
     ];
     let chain_sizes = [100, 400, 1000, 2000];
-    if wanted("fixed") {
-        let cases: Vec<Case> = chain_sizes
-            .iter()
-            .map(|&n| chain_case("fixed chain", n, families::fixed_chain, families::fixed_chain_omega_sq))
-            .collect();
-        report("fixed", "Fixed-fixed spring chain", &cases, &chain_methods);
-    }
-    if wanted("free") {
-        let cases: Vec<Case> = chain_sizes
-            .iter()
-            .map(|&n| chain_case("free chain", n, families::free_chain, families::free_chain_omega_sq))
-            .collect();
-        report(
+    type Family = (
+        &'static str,
+        &'static str,
+        &'static str,
+        fn(usize) -> (Mat<f64>, Mat<f64>),
+        fn(usize) -> Vec<f64>,
+    );
+    let chains: [Family; 3] = [
+        (
+            "fixed",
+            "fixed chain",
+            "Fixed-fixed spring chain",
+            families::fixed_chain,
+            families::fixed_chain_omega_sq,
+        ),
+        (
             "free",
+            "free chain",
             "Free-free spring chain (rigid-body mode)",
-            &cases,
-            &chain_methods,
-        );
-    }
-    if wanted("ring") {
-        let cases: Vec<Case> = chain_sizes
-            .iter()
-            .map(|&n| chain_case("ring", n, families::ring, families::ring_omega_sq))
-            .collect();
-        report("ring", "Spring ring (double eigenvalues)", &cases, &chain_methods);
+            families::free_chain,
+            families::free_chain_omega_sq,
+        ),
+        (
+            "ring",
+            "ring",
+            "Spring ring (double eigenvalues)",
+            families::ring,
+            families::ring_omega_sq,
+        ),
+    ];
+    for (key, label, title, pencil, exact) in chains {
+        if wanted(key) {
+            let cases: Vec<Case> = chain_sizes
+                .iter()
+                .map(|&n| chain_case(label, n, pencil, exact))
+                .collect();
+            report(key, title, &cases, &chain_methods);
+        }
     }
     if wanted("rotated") {
         let cases: Vec<Case> = [200, 1000, 2000, 4000].into_iter().map(rotated_case).collect();

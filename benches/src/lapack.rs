@@ -231,57 +231,40 @@ mod ffi {
         let nn = order(n)?;
         let (itype, jz) = (1 as c_int, jobz(vectors));
         let mut w = vec![0.0; n];
-        let mut info: c_int = 0;
-        let (mut qwork, mut qiwork) = (0.0_f64, 0 as c_int);
-        let query: c_int = -1;
-        // SAFETY: workspace query (lwork = liwork = −1); every pointer is valid for the sizes
-        // LAPACK reads: k, m hold n·n entries with leading dimension n, w holds n.
-        unsafe {
-            dsygvd_(
-                &itype,
-                &jz,
-                &LOWER,
-                &nn,
-                k.as_mut_ptr(),
-                &nn,
-                m.as_mut_ptr(),
-                &nn,
-                w.as_mut_ptr(),
-                &mut qwork,
-                &query,
-                &mut qiwork,
-                &query,
-                &mut info,
-                1,
-                1,
-            );
-        }
-        status(info, n)?;
-        let (lwork, liwork) = sizes(qwork, qiwork);
+        // One dsygvd call with the given workspace (lwork = liwork = −1: a workspace query).
+        let mut call = |work: &mut [f64], lwork: c_int, iwork: &mut [c_int], liwork: c_int| {
+            let mut info: c_int = 0;
+            // SAFETY: every pointer is valid for the sizes LAPACK reads: k, m hold n·n entries
+            // with leading dimension n, w holds n, work and iwork at least lwork and liwork
+            // (one entry each for a query).
+            unsafe {
+                dsygvd_(
+                    &itype,
+                    &jz,
+                    &LOWER,
+                    &nn,
+                    k.as_mut_ptr(),
+                    &nn,
+                    m.as_mut_ptr(),
+                    &nn,
+                    w.as_mut_ptr(),
+                    work.as_mut_ptr(),
+                    &lwork,
+                    iwork.as_mut_ptr(),
+                    &liwork,
+                    &mut info,
+                    1,
+                    1,
+                );
+            }
+            status(info, n)
+        };
+        let (mut qwork, mut qiwork) = ([0.0_f64], [0 as c_int]);
+        call(&mut qwork, -1, &mut qiwork, -1)?;
+        let (lwork, liwork) = sizes(qwork[0], qiwork[0]);
         let mut work = vec![0.0; lwork.max(1) as usize];
-        let mut iwork = vec![0 as c_int; liwork as usize];
-        // SAFETY: as above, with work/iwork of the queried sizes.
-        unsafe {
-            dsygvd_(
-                &itype,
-                &jz,
-                &LOWER,
-                &nn,
-                k.as_mut_ptr(),
-                &nn,
-                m.as_mut_ptr(),
-                &nn,
-                w.as_mut_ptr(),
-                work.as_mut_ptr(),
-                &lwork,
-                iwork.as_mut_ptr(),
-                &liwork,
-                &mut info,
-                1,
-                1,
-            );
-        }
-        status(info, n)?;
+        let mut iwork = vec![0 as c_int; (liwork as usize).max(1)];
+        call(&mut work, lwork, &mut iwork, liwork)?;
         Ok(w)
     }
 
@@ -303,56 +286,41 @@ mod ffi {
         let nn = order(n)?;
         let jz = jobz(vectors);
         let mut w = vec![0.0; n];
-        let mut info: c_int = 0;
-        let (mut qwork, mut qiwork) = (0.0_f64, 0 as c_int);
-        let query: c_int = -1;
-        // SAFETY: workspace query; c holds n·n entries (leading dimension n), w holds n.
-        unsafe {
-            dsyevd_(
-                &jz,
-                &LOWER,
-                &nn,
-                c.as_mut_ptr(),
-                &nn,
-                w.as_mut_ptr(),
-                &mut qwork,
-                &query,
-                &mut qiwork,
-                &query,
-                &mut info,
-                1,
-                1,
-            );
-        }
-        if info != 0 {
-            return Err(LapackError::IllegalArgument(-info));
-        }
-        let (lwork, liwork) = sizes(qwork, qiwork);
+        // One dsyevd call with the given workspace (lwork = liwork = −1: a workspace query).
+        let mut call = |work: &mut [f64], lwork: c_int, iwork: &mut [c_int], liwork: c_int| {
+            let mut info: c_int = 0;
+            // SAFETY: c holds n·n entries (leading dimension n), w holds n, work and iwork at
+            // least lwork and liwork (one entry each for a query).
+            unsafe {
+                dsyevd_(
+                    &jz,
+                    &LOWER,
+                    &nn,
+                    c.as_mut_ptr(),
+                    &nn,
+                    w.as_mut_ptr(),
+                    work.as_mut_ptr(),
+                    &lwork,
+                    iwork.as_mut_ptr(),
+                    &liwork,
+                    &mut info,
+                    1,
+                    1,
+                );
+            }
+            match info {
+                0 => Ok(()),
+                i if i < 0 => Err(LapackError::IllegalArgument(-i)),
+                i => Err(LapackError::NoConvergence(i)),
+            }
+        };
+        let (mut qwork, mut qiwork) = ([0.0_f64], [0 as c_int]);
+        call(&mut qwork, -1, &mut qiwork, -1)?;
+        let (lwork, liwork) = sizes(qwork[0], qiwork[0]);
         let mut work = vec![0.0; lwork.max(1) as usize];
-        let mut iwork = vec![0 as c_int; liwork as usize];
-        // SAFETY: as above, with work/iwork of the queried sizes.
-        unsafe {
-            dsyevd_(
-                &jz,
-                &LOWER,
-                &nn,
-                c.as_mut_ptr(),
-                &nn,
-                w.as_mut_ptr(),
-                work.as_mut_ptr(),
-                &lwork,
-                iwork.as_mut_ptr(),
-                &liwork,
-                &mut info,
-                1,
-                1,
-            );
-        }
-        match info {
-            0 => Ok(w),
-            i if i < 0 => Err(LapackError::IllegalArgument(-i)),
-            i => Err(LapackError::NoConvergence(i)),
-        }
+        let mut iwork = vec![0 as c_int; (liwork as usize).max(1)];
+        call(&mut work, lwork, &mut iwork, liwork)?;
+        Ok(w)
     }
 
     pub(super) fn potrf(a: &mut [f64], n: usize) -> Result<(), LapackError> {

@@ -883,9 +883,6 @@ pub unsafe extern "C" fn mech_mass_mesh_same_connectivity(
     out: *mut mech_mass_properties_t,
     report_out: *mut mech_mesh_report_t,
 ) -> mech_status_t {
-    if earlier.is_null() {
-        return boundary(|| Err(FfiError::new(MECH_STATUS_NULL_POINTER, "earlier is NULL")));
-    }
     // SAFETY: the caller's contract is mesh_call's.
     unsafe {
         mesh_call(
