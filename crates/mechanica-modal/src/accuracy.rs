@@ -90,78 +90,173 @@ impl AccuracyReport {
     }
 }
 
-/// Backward errors, orthogonality and first-order bounds of the pairs (ω²_i, X[:, i]).
-pub(crate) fn a_posteriori(
-    a: MatRef<'_, f64>,
-    b: MatRef<'_, f64>,
-    x: MatRef<'_, f64>,
-    omega_sq: &[f64],
-    norm_a: f64,
-    norm_b: f64,
-    par: Par,
-) -> AccuracyReport {
-    let m = omega_sq.len();
-    let mut ax = Mat::<f64>::zeros(a.nrows(), m);
-    let mut bx = Mat::<f64>::zeros(a.nrows(), m);
-    faer::linalg::matmul::matmul(ax.as_mut(), faer::Accum::Replace, a, x, 1.0, par);
-    faer::linalg::matmul::matmul(bx.as_mut(), faer::Accum::Replace, b, x, 1.0, par);
-    let mut backward = Vec::with_capacity(m);
-    let mut bounds = Vec::with_capacity(m);
-    for i in 0..m {
-        let w = omega_sq[i];
-        let (xi, axi, bxi) = (x.col(i), ax.col(i), bx.col(i));
-        let r = (0..xi.nrows())
-            .map(|k| (bxi[k] - w * axi[k]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        let xnorm = xi.norm_l2();
-        let xax: f64 = (0..xi.nrows()).map(|k| xi[k] * axi[k]).sum();
-        let scale = norm_b + w.abs() * norm_a;
+/// ‖M‖_F, summed in one pass; only when the sum of squares over- or underflows does it fall back
+/// to faer's scaled (slower) norm.
+pub(crate) fn frobenius_norm(m: MatRef<'_, f64>) -> f64 {
+    let sum: f64 = (0..m.ncols()).map(|j| sum_of_squares(m.col(j))).sum();
+    if sum.is_finite() && sum > 1e-280 {
+        sum.sqrt()
+    } else {
+        m.norm_l2()
+    }
+}
+
+/// Σ v_i² with four independent partial sums (vectorisable when `v` is contiguous).
+fn sum_of_squares(v: faer::ColRef<'_, f64>) -> f64 {
+    match v.try_as_col_major() {
+        Some(c) => {
+            let s = c.as_slice();
+            let mut acc = [0.0_f64; 4];
+            let mut chunks = s.chunks_exact(4);
+            for q in &mut chunks {
+                for l in 0..4 {
+                    acc[l] += q[l] * q[l];
+                }
+            }
+            let tail: f64 = chunks.remainder().iter().map(|x| x * x).sum();
+            (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+        }
+        None => v.iter().map(|x| x * x).sum(),
+    }
+}
+
+/// ‖v‖₂ with the one-pass sum of squares and the scaled fallback of [`frobenius_norm`].
+fn vector_norm(v: faer::ColRef<'_, f64>) -> f64 {
+    let sum = sum_of_squares(v);
+    if sum.is_finite() && sum > 1e-280 {
+        sum.sqrt()
+    } else {
+        v.norm_l2()
+    }
+}
+
+/// The products A X and B X behind the residuals of a set of pairs; refined columns are
+/// recomputed one by one, so the report after refinement costs O(n²) per refined mode.
+pub(crate) struct PairProducts {
+    ax: Mat<f64>,
+    bx: Mat<f64>,
+}
+
+impl PairProducts {
+    /// A X and B X (2n²m flops each).
+    pub(crate) fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: MatRef<'_, f64>, par: Par) -> Self {
+        let (n, m) = (a.nrows(), x.ncols());
+        let mut ax = Mat::<f64>::zeros(n, m);
+        let mut bx = Mat::<f64>::zeros(n, m);
+        faer::linalg::matmul::matmul(ax.as_mut(), faer::Accum::Replace, a, x, 1.0, par);
+        faer::linalg::matmul::matmul(bx.as_mut(), faer::Accum::Replace, b, x, 1.0, par);
+        Self { ax, bx }
+    }
+
+    /// Recomputes column `i` of A X and B X after x_i changed.
+    pub(crate) fn update_column(
+        &mut self,
+        a: MatRef<'_, f64>,
+        b: MatRef<'_, f64>,
+        x: MatRef<'_, f64>,
+        i: usize,
+        par: Par,
+    ) {
+        let xi = x.subcols(i, 1);
+        faer::linalg::matmul::matmul(
+            self.ax.as_mut().subcols_mut(i, 1),
+            faer::Accum::Replace,
+            a,
+            xi,
+            1.0,
+            par,
+        );
+        faer::linalg::matmul::matmul(
+            self.bx.as_mut().subcols_mut(i, 1),
+            faer::Accum::Replace,
+            b,
+            xi,
+            1.0,
+            par,
+        );
+    }
+
+    /// Backward error η_i and first-order bound η_i·κ_i of the pair (ω²_i, x_i).
+    pub(crate) fn pair_error(
+        &self,
+        x: MatRef<'_, f64>,
+        i: usize,
+        omega_sq: f64,
+        norm_a: f64,
+        norm_b: f64,
+    ) -> (f64, f64) {
+        let (xi, axi, bxi) = (x.col(i), self.ax.col(i), self.bx.col(i));
+        let n = xi.nrows();
+        let r = (0..n).map(|k| (bxi[k] - omega_sq * axi[k]).powi(2)).sum::<f64>().sqrt();
+        let xnorm = vector_norm(xi);
+        let xax: f64 = (0..n).map(|k| xi[k] * axi[k]).sum();
+        let scale = norm_b + omega_sq.abs() * norm_a;
         let eta = if scale * xnorm > 0.0 { r / (scale * xnorm) } else { 0.0 };
         let kappa = if xax > 0.0 {
             scale * xnorm * xnorm / xax
         } else {
             f64::INFINITY
         };
-        backward.push(Some(eta));
-        bounds.push(eta.max(f64::EPSILON) * kappa);
+        (eta, eta.max(f64::EPSILON) * kappa)
     }
-    // XᵀAX is symmetric: only its lower triangle is formed (half the flops of a full product).
-    let mut g = Mat::<f64>::zeros(m, m);
-    faer::linalg::matmul::triangular::matmul(
-        g.as_mut(),
-        faer::linalg::matmul::triangular::BlockStructure::TriangularLower,
-        faer::Accum::Replace,
-        x.transpose(),
-        faer::linalg::matmul::triangular::BlockStructure::Rectangular,
-        ax.as_ref(),
-        faer::linalg::matmul::triangular::BlockStructure::Rectangular,
-        1.0,
-        par,
-    );
-    let mut orth = 0.0_f64;
-    for j in 0..m {
-        for i in j..m {
-            let target = if i == j { 1.0 } else { 0.0 };
-            orth = orth.max((g[(i, j)] - target).abs());
+
+    /// max |(XᵀAX − I)_ij| over the lower triangle (only the lower triangle of XᵀAX is formed).
+    pub(crate) fn orthogonality_error(&self, x: MatRef<'_, f64>, par: Par) -> f64 {
+        let m = x.ncols();
+        let mut g = Mat::<f64>::zeros(m, m);
+        faer::linalg::matmul::triangular::matmul(
+            g.as_mut(),
+            faer::linalg::matmul::triangular::BlockStructure::TriangularLower,
+            faer::Accum::Replace,
+            x.transpose(),
+            faer::linalg::matmul::triangular::BlockStructure::Rectangular,
+            self.ax.as_ref(),
+            faer::linalg::matmul::triangular::BlockStructure::Rectangular,
+            1.0,
+            par,
+        );
+        let mut orth = 0.0_f64;
+        for j in 0..m {
+            for i in j..m {
+                let target = if i == j { 1.0 } else { 0.0 };
+                orth = orth.max((g[(i, j)] - target).abs());
+            }
         }
+        orth
     }
-    let max_eta = backward
-        .iter()
-        .flatten()
-        .copied()
-        .fold(None, |acc: Option<f64>, e| Some(acc.map_or(e, |a| a.max(e))));
-    AccuracyReport {
-        norm_a,
-        norm_b,
-        backward_errors: backward,
-        max_backward_error: max_eta,
-        orthogonality_error: (m > 0).then_some(orth),
-        error_bounds: bounds,
-        bound_kinds: vec![BoundKind::FirstOrder; m],
-        residual_norms_a_inv: vec![None; m],
-        refinement_steps: vec![0; m],
-        inertia_check: None,
+}
+
+impl AccuracyReport {
+    /// Backward errors and first-order bounds of every pair from `products` (max η and the
+    /// orthogonality are left to [`AccuracyReport::finish`], once the vectors are final).
+    pub(crate) fn from_products(
+        products: &PairProducts,
+        x: MatRef<'_, f64>,
+        omega_sq: &[f64],
+        norm_a: f64,
+        norm_b: f64,
+    ) -> Self {
+        let m = omega_sq.len();
+        let mut report = Self::a_priori(norm_a, norm_b, vec![0.0; m]);
+        report.bound_kinds = vec![BoundKind::FirstOrder; m];
+        for i in 0..m {
+            report.set_pair_error(products, x, i, omega_sq[i]);
+        }
+        report
+    }
+
+    /// Recomputes η and the first-order bound of pair i.
+    pub(crate) fn set_pair_error(&mut self, products: &PairProducts, x: MatRef<'_, f64>, i: usize, omega_sq: f64) {
+        let (eta, bound) = products.pair_error(x, i, omega_sq, self.norm_a, self.norm_b);
+        self.backward_errors[i] = Some(eta);
+        self.error_bounds[i] = bound;
+    }
+
+    /// Sets max η and the A-orthogonality error once the vectors are final.
+    pub(crate) fn finish(&mut self, products: &PairProducts, x: MatRef<'_, f64>, par: Par) {
+        let m = x.ncols();
+        self.max_backward_error = (m > 0).then(|| self.backward_errors.iter().flatten().copied().fold(0.0, f64::max));
+        self.orthogonality_error = (m > 0).then(|| products.orthogonality_error(x, par));
     }
 }
 
@@ -207,25 +302,46 @@ pub(crate) fn residual_bounds(
     omega_sq: &[f64],
     omega_all: &[f64],
     first: usize,
-    residuals: &[Option<Vec<f64>>],
+    residuals: &[(usize, Vec<f64>)],
     basis: &ModeBasis<'_>,
+    par: Par,
 ) {
     let m = omega_sq.len();
     let n = basis.x.nrows();
+    let k = residuals.len();
+    if k == 0 {
+        return;
+    }
     let others_bound = report.error_bounds.iter().copied().fold(0.0, f64::max);
     let linear: Vec<f64> = (0..m)
         .map(|i| {
             report.residual_norms_a_inv[i].map_or(report.error_bounds[i], |e| e + f64::EPSILON * omega_sq[i].abs())
         })
         .collect();
-    for i in 0..m {
-        let (Some(eps), Some(r)) = (report.residual_norms_a_inv[i], residuals[i].as_ref()) else {
+    // All refined residuals at once: C = Xᵀ R, and R_⊥ = L⁻¹(R − A X C) in the A⁻¹-norm.
+    let r = Mat::from_fn(n, k, |row, col| residuals[col].1[row]);
+    let mut c = Mat::<f64>::zeros(m, k);
+    faer::linalg::matmul::matmul(
+        c.as_mut(),
+        faer::Accum::Replace,
+        basis.x.transpose(),
+        r.as_ref(),
+        1.0,
+        par,
+    );
+    let mut xc = Mat::<f64>::zeros(n, k);
+    faer::linalg::matmul::matmul(xc.as_mut(), faer::Accum::Replace, basis.x, c.as_ref(), 1.0, par);
+    let mut rest = r;
+    faer::linalg::matmul::matmul(rest.as_mut(), faer::Accum::Add, basis.a, xc.as_ref(), -1.0, par);
+    solve_lower_triangular_in_place(basis.l, rest.as_mut(), par);
+    for (col, (i, _)) in residuals.iter().enumerate() {
+        let i = *i;
+        let Some(eps) = report.residual_norms_a_inv[i] else {
             continue;
         };
         let rho = omega_sq[i];
         let mut gap = f64::INFINITY;
         let mut weighted = 0.0;
-        let c: Vec<f64> = (0..m).map(|j| (0..n).map(|k| basis.x[(k, j)] * r[k]).sum()).collect();
         let mut usable = true;
         for j in 0..m {
             if j == i {
@@ -234,7 +350,7 @@ pub(crate) fn residual_bounds(
             let d = (rho - omega_sq[j]).abs() - linear[j];
             gap = gap.min(d);
             if d > 0.0 {
-                weighted += c[j] * c[j] / d;
+                weighted += c[(j, col)] * c[(j, col)] / d;
             } else {
                 usable = false;
             }
@@ -244,12 +360,7 @@ pub(crate) fn residual_bounds(
                 gap = gap.min((rho - w).abs() - others_bound);
             }
         }
-        // r_⊥ = r − A X c (the part of r the selected modes do not explain), in the A⁻¹-norm.
-        let mut rest = Mat::from_fn(n, 1, |k, _| r[k]);
-        let xc = Mat::from_fn(n, 1, |k, _| (0..m).map(|j| basis.x[(k, j)] * c[j]).sum::<f64>());
-        faer::linalg::matmul::matmul(rest.as_mut(), faer::Accum::Add, basis.a, xc.as_ref(), -1.0, Par::Seq);
-        solve_lower_triangular_in_place(basis.l, rest.as_mut(), Par::Seq);
-        let eps_rest = rest.norm_l2();
+        let eps_rest = vector_norm(rest.col(col));
         let mut bound = eps;
         if gap > eps {
             bound = bound.min(eps * eps / gap);

@@ -8,9 +8,9 @@
 //! (ω² < 0) first, then rigid-body modes, then oscillatory modes, then infinite ones.
 
 use crate::accuracy::{self, AccuracyReport};
-use crate::inertia::{InertiaCount, count_below};
+use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
-use crate::refine::refine_pair;
+use crate::refine::{ReducedSpectrum, refine_pair, refine_pair_spectral};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par, Side};
 
@@ -153,6 +153,9 @@ pub(crate) struct Definite {
     pub first: usize,
     pub end: usize,
     pub vectors: Option<Mat<f64>>,
+    /// All n eigenvectors Y of the reduced matrix C (when vectors were computed), for
+    /// refinement without a new factorization ([`crate::refine::ReducedSpectrum`]).
+    pub reduced_vectors: Option<Mat<f64>>,
 }
 
 fn select(omega_sq: &[f64], selection: Selection) -> Result<(usize, usize), ModalError> {
@@ -189,6 +192,7 @@ pub(crate) fn solve_definite(
             first,
             end,
             vectors: vectors.then(|| Mat::zeros(0, 0)),
+            reduced_vectors: None,
         });
     }
     let c = reduce(l, b, par);
@@ -205,6 +209,7 @@ pub(crate) fn solve_definite(
             first,
             end,
             vectors: Some(x),
+            reduced_vectors: Some(eig.U().to_owned()),
         })
     } else {
         let omega_sq = c
@@ -216,6 +221,7 @@ pub(crate) fn solve_definite(
             first,
             end,
             vectors: None,
+            reduced_vectors: None,
         })
     }
 }
@@ -247,8 +253,8 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     if n == 0 {
         return select(&[], options.selection).map(|_| empty_solution());
     }
-    let norm_a = a.norm_l2();
-    let norm_b = b.norm_l2();
+    let norm_a = accuracy::frobenius_norm(a);
+    let norm_b = accuracy::frobenius_norm(b);
     // The refinement and the residual bounds need the vectors even when the caller does not.
     let want_vectors = options.vectors || options.refinement == Refinement::Always;
     match cholesky(a, par) {
@@ -323,21 +329,28 @@ impl Finish<'_> {
             (v, _) => v,
         };
         let m = omega.len();
-        let mut report = match &x {
-            Some(x) => accuracy::a_posteriori(a, b, x.as_ref(), &omega, self.norm_a, self.norm_b, self.par),
-            None => {
+        let mut products = x
+            .as_ref()
+            .map(|x| accuracy::PairProducts::new(a, b, x.as_ref(), self.par));
+        let mut report = match (&x, &products) {
+            (Some(x), Some(p)) => AccuracyReport::from_products(p, x.as_ref(), &omega, self.norm_a, self.norm_b),
+            _ => {
                 let bounds = accuracy::a_priori_bounds(self.l, self.norm_a, self.norm_b, &omega, self.par);
                 AccuracyReport::a_priori(self.norm_a, self.norm_b, bounds)
             }
         };
         // Refinement of poorly bounded simple modes (needs vectors in the original coordinates).
-        if let Some(xm) = x.as_mut()
+        if let (Some(xm), Some(products)) = (x.as_mut(), products.as_mut())
             && self.options.refinement != Refinement::Off
             && lift.is_none()
         {
+            let spectrum = def.reduced_vectors.as_ref().map(|y| ReducedSpectrum {
+                l: self.l,
+                y: y.as_ref(),
+                omega_sq: &omega_all,
+            });
             let simple = simple_modes(&omega, &report.error_bounds);
-            let mut refined_any = false;
-            let mut residuals: Vec<Option<Vec<f64>>> = vec![None; m];
+            let mut residuals: Vec<(usize, Vec<f64>)> = Vec::new();
             for i in 0..m {
                 let poor = report.error_bounds[i] > AUTO_REFINE_RELATIVE_BOUND * omega[i].abs();
                 let wanted = self.options.refinement == Refinement::Always || poor;
@@ -345,32 +358,41 @@ impl Finish<'_> {
                     continue;
                 }
                 let col: Vec<f64> = (0..n).map(|r| xm[(r, i)]).collect();
-                if let Some(p) = refine_pair(a, b, self.l, &col, omega[i]) {
+                let refined = spectrum
+                    .as_ref()
+                    .and_then(|s| refine_pair_spectral(a, b, s, def.first + i, &col))
+                    .or_else(|| refine_pair(a, b, self.l, &col, omega[i]));
+                if let Some(p) = refined {
                     for r in 0..n {
                         xm[(r, i)] = p.x[r];
                     }
                     omega[i] = p.omega_sq;
+                    products.update_column(a, b, xm.as_ref(), i, self.par);
+                    report.set_pair_error(products, xm.as_ref(), i, omega[i]);
                     report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
                     report.refinement_steps[i] = p.steps;
-                    residuals[i] = Some(p.residual);
-                    refined_any = true;
+                    residuals.push((i, p.residual));
                 }
             }
-            if refined_any {
-                let refined = report.refinement_steps.clone();
-                let norms = report.residual_norms_a_inv.clone();
-                report = accuracy::a_posteriori(a, b, xm.as_ref(), &omega, self.norm_a, self.norm_b, self.par);
-                report.refinement_steps = refined;
-                report.residual_norms_a_inv = norms;
-                let basis = accuracy::ModeBasis {
-                    a,
-                    l: self.l,
-                    x: xm.as_ref(),
-                };
-                accuracy::residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, &basis);
-            }
+            let basis = accuracy::ModeBasis {
+                a,
+                l: self.l,
+                x: xm.as_ref(),
+            };
+            accuracy::residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, &basis, self.par);
         }
-        report.inertia_check = inertia_check(self.problem, &omega_all, def.first, def.end, &report.error_bounds, lift)?;
+        if let (Some(x), Some(p)) = (&x, &products) {
+            report.finish(p, x.as_ref(), self.par);
+        }
+        report.inertia_check = inertia_check(
+            self.problem,
+            &omega_all,
+            def.first,
+            def.end,
+            &report.error_bounds,
+            lift,
+            self.par,
+        )?;
         if !self.options.vectors {
             x = None;
             report.backward_errors.iter_mut().for_each(|e| *e = None);
@@ -476,8 +498,12 @@ pub(crate) fn group_modes(modes: &mut [Mode]) -> Vec<ModeGroup> {
     groups
 }
 
-/// Places a shift in the widest gap next to the selection (or of the whole spectrum for All)
-/// and compares the LBLᵀ inertia count with the number of computed ω² below it.
+/// The Sturm check of a solve. With every mode selected it first tries the cheap certificate
+/// that B − sA is positive definite for s just below the lowest computed ω² (by half its size or
+/// twice its bound): nothing was missed at the bottom of the spectrum, where stability is
+/// decided. Otherwise, or when that Cholesky fails, it places a shift in the widest gap next to
+/// the selection (or of the whole spectrum) and compares the LBLᵀ inertia count with the number
+/// of computed ω² below it.
 fn inertia_check(
     problem: &PencilProblem,
     omega_all: &[f64],
@@ -485,12 +511,31 @@ fn inertia_check(
     end: usize,
     bounds: &[f64],
     lift: Option<Lift<'_>>,
+    par: Par,
 ) -> Result<Option<InertiaCheck>, ModalError> {
     // With a condensed pencil the count of B − sA mixes in the massless directions; skip it.
     if lift.is_some() || omega_all.is_empty() {
         return Ok(None);
     }
     let n = omega_all.len();
+    if first == 0 && end == n && !bounds.is_empty() {
+        // Every mode selected: certify the bottom of the spectrum (no mode, and so no
+        // instability, below the lowest computed ω²) with a Cholesky factorization.
+        let lowest = omega_all[0];
+        let shift = lowest - (0.5 * lowest.abs()).max(2.0 * bounds[0]);
+        if shift < lowest && all_above(problem, shift, par) {
+            return Ok(Some(InertiaCheck {
+                count: InertiaCount {
+                    shift,
+                    below: 0,
+                    zero: 0,
+                    above: n,
+                },
+                computed_below: 0,
+                consistent: true,
+            }));
+        }
+    }
     let margin = bounds.iter().copied().fold(0.0, f64::max);
     let shift = if end < n && end > 0 {
         0.5 * (omega_all[end - 1] + omega_all[end])
