@@ -1066,6 +1066,13 @@ typedef struct mech_modal_options_t {
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * How the accuracy report measures residuals (int32_t; see MECH_MODAL_RESIDUALS_*).
+ */
+typedef int32_t mech_modal_residuals_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * Scalar data of one mode.
  */
 typedef struct mech_modal_mode_t {
@@ -1892,6 +1899,21 @@ typedef struct mech_modal_sparse_report_t {
  * Massless direction (A x = 0): infinite frequency.
  */
 #define MECH_MODAL_KIND_INFINITE 3
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * A X, B X and XᵀAX formed in full: exact backward errors and orthogonality (5n²m flops).
+ */
+#define MECH_MODAL_RESIDUALS_EXACT 0
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Gaussian sketches (O(32·n²) flops): each backward error and the orthogonality error (then a
+ * bound on ‖XᵀAX − I‖_F) is an upper bound that fails with probability ≤ 1e-12.
+ */
+#define MECH_MODAL_RESIDUALS_SKETCHED 1
 #endif
 
 #ifdef __cplusplus
@@ -3058,6 +3080,24 @@ mech_status_t mech_modal_solve(size_t n,
                                const double *b,
                                const struct mech_modal_options_t *options,
                                struct mech_modal_result_t **out);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * mech_modal_solve with a choice of how the accuracy report measures residuals:
+ * MECH_MODAL_RESIDUALS_EXACT (what mech_modal_solve does) or MECH_MODAL_RESIDUALS_SKETCHED
+ * (probabilistic upper bounds at O(n²) cost, for large all-pairs solves). Errors as
+ * mech_modal_solve, and MECH_STATUS_BAD_ENUM for an unknown `residuals`.
+ *
+ * # Safety
+ * As mech_modal_solve.
+ */
+mech_status_t mech_modal_solve_with_residuals(size_t n,
+                                              const double *a,
+                                              const double *b,
+                                              const struct mech_modal_options_t *options,
+                                              mech_modal_residuals_t residuals,
+                                              struct mech_modal_result_t **out);
 #endif
 
 #if defined(MECH_FEATURE_MODAL)

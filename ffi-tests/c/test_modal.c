@@ -368,9 +368,55 @@ static void sparse_lowest(void) {
     CHECK(mech_untouched(ws, sizeof ws));
 }
 
+/* The sketched report (mech_modal_solve_with_residuals) bounds the exact one from above, within
+ * the factor its Gaussian lower tail allows (plus the n·u rounding both carry), on a chain with
+ * graded masses; the eigenvalues are the same to their bounds; an unknown kind is refused. */
+#define NS 50
+static void sketched_report(void) {
+    static double a[NS * NS], b[NS * NS];
+    for (int j = 0; j < NS; ++j) {
+        for (int i = 0; i < NS; ++i) {
+            double mi = 1.0 + (double)i / NS, mj = 1.0 + (double)j / NS;
+            double t = (i == j) ? 2.0 : ((i - j == 1 || j - i == 1) ? -1.0 : 0.0);
+            a[i + NS * j] = (i == j) ? mi : 0.0;
+            b[i + NS * j] = sqrt(mi * mj) * t; /* ω² = 4 sin²(kπ/(2(NS+1))) */
+        }
+    }
+    mech_modal_options_t o = default_options();
+    mech_modal_result_t *exact = NULL, *sketched = NULL;
+    CHECK_STATUS(mech_modal_solve_with_residuals(NS, a, b, &o, MECH_MODAL_RESIDUALS_EXACT, &exact), MECH_STATUS_OK);
+    CHECK_STATUS(mech_modal_solve_with_residuals(NS, a, b, &o, MECH_MODAL_RESIDUALS_SKETCHED, &sketched),
+                 MECH_STATUS_OK);
+    static mech_modal_mode_t me[NS], ms[NS];
+    CHECK_STATUS(mech_modal_result_modes(exact, me, NS), MECH_STATUS_OK);
+    CHECK_STATUS(mech_modal_result_modes(sketched, ms, NS), MECH_STATUS_OK);
+    const double pi = 3.14159265358979323846, u = 2.220446049250313e-16, floor = NS * u;
+    for (int k = 0; k < NS; ++k) {
+        double s = sin((k + 1) * pi / (2.0 * (NS + 1)));
+        CHECK_NEAR(ms[k].omega_sq, 4.0 * s * s, ms[k].error_bound);
+        if (me[k].omega_sq == ms[k].omega_sq) {
+            CHECK(ms[k].backward_error + floor >= me[k].backward_error);
+            CHECK(ms[k].backward_error <= 8.0 * me[k].backward_error + floor);
+        }
+    }
+    mech_modal_accuracy_t ae, as;
+    CHECK_STATUS(mech_modal_result_accuracy(exact, &ae), MECH_STATUS_OK);
+    CHECK_STATUS(mech_modal_result_accuracy(sketched, &as), MECH_STATUS_OK);
+    CHECK(as.orthogonality_error >= ae.orthogonality_error);
+    CHECK(as.max_backward_error <= 10.0 * NS * u);
+    CHECK(as.inertia_checked == 1 && as.inertia_consistent == 1);
+    mech_modal_result_destroy(exact);
+    mech_modal_result_destroy(sketched);
+
+    mech_modal_result_t *untouched = (mech_modal_result_t *)&o;
+    CHECK_STATUS(mech_modal_solve_with_residuals(NS, a, b, &o, 7, &untouched), MECH_STATUS_BAD_ENUM);
+    CHECK(untouched == (mech_modal_result_t *)&o);
+}
+
 int main(void) {
     all_pairs();
     sparse_lowest();
+    sketched_report();
     free_response();
     subsets_and_values_only();
     massless_coordinate();

@@ -1,20 +1,28 @@
 //! Times the dense solver on the rotated fixed chain (masses 1 + i/n, random rotation) and
 //! prints the worst relative error of the lowest 10 ω² against the closed form, the reported
 //! bound, the refined modes and the wall time.
-//! `cargo run --release -p mechanica-modal --example dense_timing -- 2000 [auto|off|always] [values]`
+//! `cargo run --release -p mechanica-modal --example dense_timing -- 2000 [auto|off|always] [values] [sketched]`
 use mechanica_modal::faer::Mat;
-use mechanica_modal::{PencilProblem, Refinement, SolveOptions, families, solve};
+use mechanica_modal::{PencilProblem, Refinement, Residuals, SolveOptions, families, solve};
 use std::time::Instant;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let n: usize = args.first().and_then(|a| a.parse().ok()).unwrap_or(2000);
-    let refinement = match args.get(1).map(String::as_str) {
-        Some("off") => Refinement::Off,
-        Some("always") => Refinement::Always,
-        _ => Refinement::Auto,
+    let has = |word: &str| args.iter().any(|a| a == word);
+    let refinement = if has("off") {
+        Refinement::Off
+    } else if has("always") {
+        Refinement::Always
+    } else {
+        Refinement::Auto
     };
-    let vectors = args.get(2).map(String::as_str) != Some("values");
+    let vectors = !has("values");
+    let residuals = if has("sketched") {
+        Residuals::Sketched
+    } else {
+        Residuals::Exact
+    };
     let d: Vec<f64> = (0..n).map(|i| 1.0 + i as f64 / n as f64).collect();
     let a = Mat::from_fn(n, n, |i, j| if i == j { d[i] } else { 0.0 });
     let (_, t) = families::fixed_chain(n);
@@ -27,6 +35,7 @@ fn main() {
     let options = SolveOptions {
         refinement,
         vectors,
+        residuals,
         ..SolveOptions::default()
     };
     let exact = families::fixed_chain_omega_sq(n);
@@ -44,7 +53,7 @@ fn main() {
         }
         let refined = sol.accuracy.refinement_steps.iter().filter(|&&s| s > 0).count();
         println!(
-            "n {n} {refinement:?} vectors {vectors}: {time:.3} s, lowest-10 rel err {err:.2e} (bound {bound:.2e}), refined {refined}, max eta {:?}, orth {:?}, sturm {:?}",
+            "n {n} {refinement:?} {residuals:?} vectors {vectors}: {time:.3} s, lowest-10 rel err {err:.2e} (bound {bound:.2e}), refined {refined}, max eta {:?}, orth {:?}, sturm {:?}",
             sol.accuracy.max_backward_error,
             sol.accuracy.orthogonality_error,
             sol.accuracy

@@ -11,6 +11,7 @@
 //!   |Δλ| ≤ min(ε, ε²/δ) (residual and Kato–Temple bounds, Parlett, "The Symmetric Eigenvalue
 //!   Problem", §4.5 and §10.5, applied to L⁻¹(B)L⁻ᵀ) ([`BoundKind::Residual`]).
 
+use crate::sketch::Sketch;
 use crate::solve::InertiaCheck;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, MatRef, Par};
@@ -49,6 +50,8 @@ pub struct AccuracyReport {
     pub refinement_steps: Vec<usize>,
     /// The Sturm check: LBLᵀ inertia of B − sA against the computed spectrum.
     pub inertia_check: Option<InertiaCheck>,
+    /// How the backward errors and the orthogonality error were measured.
+    pub residuals: Residuals,
 }
 
 impl AccuracyReport {
@@ -64,6 +67,7 @@ impl AccuracyReport {
             residual_norms_a_inv: Vec::new(),
             refinement_steps: Vec::new(),
             inertia_check: None,
+            residuals: Residuals::Exact,
         }
     }
 
@@ -80,6 +84,7 @@ impl AccuracyReport {
             residual_norms_a_inv: vec![None; m],
             refinement_steps: vec![0; m],
             inertia_check: None,
+            residuals: Residuals::Exact,
         }
     }
 
@@ -130,25 +135,49 @@ fn vector_norm(v: faer::ColRef<'_, f64>) -> f64 {
     }
 }
 
-/// The products A X and B X behind the residuals of a set of pairs; refined columns are
-/// recomputed one by one, so the report after refinement costs O(n²) per refined mode.
-pub(crate) struct PairProducts {
-    ax: Mat<f64>,
-    bx: Mat<f64>,
+/// How the accuracy report measures the residuals and the A-orthogonality of dense pairs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Residuals {
+    /// A X, B X and XᵀAX formed in full (5n²m flops for m pairs): every backward error and the
+    /// orthogonality error are computed exactly (to rounding).
+    #[default]
+    Exact,
+    /// Gaussian sketches ([`crate::sketch`], O(k·n²) flops with k = 32): each backward error and
+    /// the orthogonality error (then a bound on ‖XᵀAX − I‖_F) is an upper bound that fails with
+    /// probability at most 1e-12; typically 2–4 times the exact value.
+    Sketched,
+}
+
+/// The products behind the residuals of a set of pairs; refined columns are recomputed one by
+/// one, so the report after refinement costs O(n²) per refined mode.
+pub(crate) enum PairProducts {
+    /// A X and B X.
+    Exact { ax: Mat<f64>, bx: Mat<f64> },
+    /// S A X and S B X, and the current bound on ‖XᵀAX − I‖_F.
+    Sketched { sketch: Sketch, orthogonality: f64 },
 }
 
 impl PairProducts {
-    /// A X and B X (2n²m flops each).
-    pub(crate) fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: MatRef<'_, f64>, par: Par) -> Self {
-        let (n, m) = (a.nrows(), x.ncols());
-        let mut ax = Mat::<f64>::zeros(n, m);
-        let mut bx = Mat::<f64>::zeros(n, m);
-        faer::linalg::matmul::matmul(ax.as_mut(), faer::Accum::Replace, a, x, 1.0, par);
-        faer::linalg::matmul::matmul(bx.as_mut(), faer::Accum::Replace, b, x, 1.0, par);
-        Self { ax, bx }
+    /// A X and B X (2n²m flops each), or their sketches.
+    pub(crate) fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: MatRef<'_, f64>, how: Residuals, par: Par) -> Self {
+        match how {
+            Residuals::Exact => {
+                let (n, m) = (a.nrows(), x.ncols());
+                let mut ax = Mat::<f64>::zeros(n, m);
+                let mut bx = Mat::<f64>::zeros(n, m);
+                faer::linalg::matmul::matmul(ax.as_mut(), faer::Accum::Replace, a, x, 1.0, par);
+                faer::linalg::matmul::matmul(bx.as_mut(), faer::Accum::Replace, b, x, 1.0, par);
+                Self::Exact { ax, bx }
+            }
+            Residuals::Sketched => {
+                let sketch = Sketch::new(a, b, x, par);
+                let orthogonality = sketch.orthogonality_bound(a, x, par);
+                Self::Sketched { sketch, orthogonality }
+            }
+        }
     }
 
-    /// Recomputes column `i` of A X and B X after x_i changed.
+    /// Recomputes column `i` after x_i changed.
     pub(crate) fn update_column(
         &mut self,
         a: MatRef<'_, f64>,
@@ -157,26 +186,18 @@ impl PairProducts {
         i: usize,
         par: Par,
     ) {
-        let xi = x.subcols(i, 1);
-        faer::linalg::matmul::matmul(
-            self.ax.as_mut().subcols_mut(i, 1),
-            faer::Accum::Replace,
-            a,
-            xi,
-            1.0,
-            par,
-        );
-        faer::linalg::matmul::matmul(
-            self.bx.as_mut().subcols_mut(i, 1),
-            faer::Accum::Replace,
-            b,
-            xi,
-            1.0,
-            par,
-        );
+        match self {
+            Self::Exact { ax, bx } => {
+                let xi = x.subcols(i, 1);
+                faer::linalg::matmul::matmul(ax.as_mut().subcols_mut(i, 1), faer::Accum::Replace, a, xi, 1.0, par);
+                faer::linalg::matmul::matmul(bx.as_mut().subcols_mut(i, 1), faer::Accum::Replace, b, xi, 1.0, par);
+            }
+            Self::Sketched { sketch, .. } => sketch.update_column(x, i),
+        }
     }
 
-    /// Backward error η_i and first-order bound η_i·κ_i of the pair (ω²_i, x_i).
+    /// Backward error η_i and first-order bound η_i·κ_i of the pair (ω²_i, x_i). Sketched, the
+    /// residual is its probabilistic upper bound and x_iᵀAx_i ≥ 1 − ‖XᵀAX − I‖_F.
     pub(crate) fn pair_error(
         &self,
         x: MatRef<'_, f64>,
@@ -185,11 +206,17 @@ impl PairProducts {
         norm_a: f64,
         norm_b: f64,
     ) -> (f64, f64) {
-        let (xi, axi, bxi) = (x.col(i), self.ax.col(i), self.bx.col(i));
+        let xi = x.col(i);
         let n = xi.nrows();
-        let r = (0..n).map(|k| (bxi[k] - omega_sq * axi[k]).powi(2)).sum::<f64>().sqrt();
+        let (r, xax) = match self {
+            Self::Exact { ax, bx } => {
+                let (axi, bxi) = (ax.col(i), bx.col(i));
+                let r = (0..n).map(|k| (bxi[k] - omega_sq * axi[k]).powi(2)).sum::<f64>().sqrt();
+                (r, (0..n).map(|k| xi[k] * axi[k]).sum::<f64>())
+            }
+            Self::Sketched { sketch, orthogonality } => (sketch.residual_bound(i, omega_sq), 1.0 - orthogonality),
+        };
         let xnorm = vector_norm(xi);
-        let xax: f64 = (0..n).map(|k| xi[k] * axi[k]).sum();
         let scale = norm_b + omega_sq.abs() * norm_a;
         let eta = if scale * xnorm > 0.0 { r / (scale * xnorm) } else { 0.0 };
         let kappa = if xax > 0.0 {
@@ -200,8 +227,16 @@ impl PairProducts {
         (eta, eta.max(f64::EPSILON) * kappa)
     }
 
-    /// max |(XᵀAX − I)_ij| over the lower triangle (only the lower triangle of XᵀAX is formed).
-    pub(crate) fn orthogonality_error(&self, x: MatRef<'_, f64>, par: Par) -> f64 {
+    /// max |(XᵀAX − I)_ij| over the lower triangle (only the lower triangle of XᵀAX is formed),
+    /// or, sketched, the bound on ‖XᵀAX − I‖_F of the final vectors.
+    fn orthogonality_error(&mut self, a: MatRef<'_, f64>, x: MatRef<'_, f64>, par: Par) -> f64 {
+        let ax = match self {
+            Self::Exact { ax, .. } => ax,
+            Self::Sketched { sketch, orthogonality } => {
+                *orthogonality = sketch.orthogonality_bound(a, x, par);
+                return *orthogonality;
+            }
+        };
         let m = x.ncols();
         let mut g = Mat::<f64>::zeros(m, m);
         faer::linalg::matmul::triangular::matmul(
@@ -210,7 +245,7 @@ impl PairProducts {
             faer::Accum::Replace,
             x.transpose(),
             faer::linalg::matmul::triangular::BlockStructure::Rectangular,
-            self.ax.as_ref(),
+            ax.as_ref(),
             faer::linalg::matmul::triangular::BlockStructure::Rectangular,
             1.0,
             par,
@@ -239,6 +274,9 @@ impl AccuracyReport {
         let m = omega_sq.len();
         let mut report = Self::a_priori(norm_a, norm_b, vec![0.0; m]);
         report.bound_kinds = vec![BoundKind::FirstOrder; m];
+        if matches!(products, PairProducts::Sketched { .. }) {
+            report.residuals = Residuals::Sketched;
+        }
         for i in 0..m {
             report.set_pair_error(products, x, i, omega_sq[i]);
         }
@@ -252,11 +290,26 @@ impl AccuracyReport {
         self.error_bounds[i] = bound;
     }
 
-    /// Sets max η and the A-orthogonality error once the vectors are final.
-    pub(crate) fn finish(&mut self, products: &PairProducts, x: MatRef<'_, f64>, par: Par) {
+    /// Sets the A-orthogonality error and max η once the vectors are final. Sketched, the
+    /// first-order bounds of unrefined modes are recomputed with the final orthogonality bound.
+    pub(crate) fn finish(
+        &mut self,
+        products: &mut PairProducts,
+        a: MatRef<'_, f64>,
+        x: MatRef<'_, f64>,
+        omega_sq: &[f64],
+        par: Par,
+    ) {
         let m = x.ncols();
+        self.orthogonality_error = (m > 0).then(|| products.orthogonality_error(a, x, par));
+        if matches!(products, PairProducts::Sketched { .. }) {
+            for i in 0..m {
+                if self.bound_kinds[i] == BoundKind::FirstOrder {
+                    self.set_pair_error(products, x, i, omega_sq[i]);
+                }
+            }
+        }
         self.max_backward_error = (m > 0).then(|| self.backward_errors.iter().flatten().copied().fold(0.0, f64::max));
-        self.orthogonality_error = (m > 0).then(|| products.orthogonality_error(x, par));
     }
 }
 

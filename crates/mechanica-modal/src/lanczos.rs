@@ -731,6 +731,7 @@ fn rayleigh_ritz(pencil: &SparsePencil, x: &[f64], cols: usize) -> Result<Refine
             selection: Selection::All,
             vectors: true,
             refinement: Refinement::Off,
+            ..SolveOptions::default()
         },
     )?;
     let y = sol.vectors.ok_or(ModalError::NoConvergence { n: cols })?;
@@ -953,6 +954,7 @@ fn dense_fallback(
                 selection: Selection::Lowest(count),
                 vectors: true,
                 refinement: Refinement::Auto,
+                ..SolveOptions::default()
             },
         )
     };

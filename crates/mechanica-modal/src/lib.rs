@@ -40,11 +40,12 @@ pub mod problem;
 pub mod reduce;
 mod refine;
 pub mod response;
+pub mod sketch;
 pub mod solve;
 pub mod sparse_inertia;
 pub mod sparse_pencil;
 
-pub use accuracy::{AccuracyReport, BoundKind};
+pub use accuracy::{AccuracyReport, BoundKind, Residuals};
 pub use error::ModalError;
 pub use faer;
 pub use inertia::{InertiaCount, count_below};

@@ -27,12 +27,17 @@ pub(crate) enum Cholesky {
 /// Cholesky factor L (lower) of A = L Lᵀ. A pivot l_ii² ≤ n·u·max_j A_jj counts as failed,
 /// since A is then semidefinite to working precision.
 pub(crate) fn cholesky(a: MatRef<'_, f64>, par: Par) -> Cholesky {
-    let n = a.nrows();
-    let mut l = a.to_owned();
+    cholesky_owned(a.to_owned(), par)
+}
+
+/// [`cholesky`] of a matrix the caller no longer needs (factored in place, no copy).
+pub(crate) fn cholesky_owned(mut l: Mat<f64>, par: Par) -> Cholesky {
+    let n = l.nrows();
     let mut mem = faer::dyn_stack::MemBuffer::new(
         faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(n, par, Default::default()),
     );
     let stack = faer::dyn_stack::MemStack::new(&mut mem);
+    let diagonal: Vec<f64> = (0..n).map(|i| l[(i, i)]).collect();
     let result = faer::linalg::cholesky::llt::factor::cholesky_in_place(
         l.as_mut(),
         Default::default(),
@@ -43,7 +48,7 @@ pub(crate) fn cholesky(a: MatRef<'_, f64>, par: Par) -> Cholesky {
     if let Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) = result {
         return Cholesky::Failed { pivot: index };
     }
-    let max_diag = (0..n).map(|i| a[(i, i)]).fold(0.0_f64, f64::max);
+    let max_diag = diagonal.iter().copied().fold(0.0_f64, f64::max);
     let tolerance = n as f64 * f64::EPSILON * max_diag;
     if let Some(pivot) = (0..n).find(|&i| l[(i, i)] * l[(i, i)] <= tolerance) {
         return Cholesky::Failed { pivot };

@@ -7,7 +7,7 @@
 //! (8.90). Internally and in every ordering the solver uses ω² = −λ, ascending: unstable modes
 //! (ω² < 0) first, then rigid-body modes, then oscillatory modes, then infinite ones.
 
-use crate::accuracy::{self, AccuracyReport};
+use crate::accuracy::{self, AccuracyReport, Residuals};
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
 use crate::refine::{ReducedSpectrum, refine_pair, refine_pair_spectral};
@@ -57,6 +57,8 @@ pub struct SolveOptions {
     pub vectors: bool,
     /// Low-mode refinement policy.
     pub refinement: Refinement,
+    /// How the accuracy report measures residuals and orthogonality (exact by default).
+    pub residuals: Residuals,
 }
 
 impl Default for SolveOptions {
@@ -65,6 +67,7 @@ impl Default for SolveOptions {
             selection: Selection::All,
             vectors: true,
             refinement: Refinement::Auto,
+            residuals: Residuals::Exact,
         }
     }
 }
@@ -153,9 +156,9 @@ pub(crate) struct Definite {
     pub first: usize,
     pub end: usize,
     pub vectors: Option<Mat<f64>>,
-    /// All n eigenvectors Y of the reduced matrix C (when vectors were computed), for
+    /// The eigen-decomposition of the reduced matrix C (when vectors were computed), for
     /// refinement without a new factorization ([`crate::refine::ReducedSpectrum`]).
-    pub reduced_vectors: Option<Mat<f64>>,
+    pub reduced: Option<faer::linalg::solvers::SelfAdjointEigen<f64>>,
 }
 
 fn select(omega_sq: &[f64], selection: Selection) -> Result<(usize, usize), ModalError> {
@@ -192,7 +195,7 @@ pub(crate) fn solve_definite(
             first,
             end,
             vectors: vectors.then(|| Mat::zeros(0, 0)),
-            reduced_vectors: None,
+            reduced: None,
         });
     }
     let c = reduce(l, b, par);
@@ -209,7 +212,7 @@ pub(crate) fn solve_definite(
             first,
             end,
             vectors: Some(x),
-            reduced_vectors: Some(eig.U().to_owned()),
+            reduced: Some(eig),
         })
     } else {
         let omega_sq = c
@@ -221,7 +224,7 @@ pub(crate) fn solve_definite(
             first,
             end,
             vectors: None,
-            reduced_vectors: None,
+            reduced: None,
         })
     }
 }
@@ -331,7 +334,7 @@ impl Finish<'_> {
         let m = omega.len();
         let mut products = x
             .as_ref()
-            .map(|x| accuracy::PairProducts::new(a, b, x.as_ref(), self.par));
+            .map(|x| accuracy::PairProducts::new(a, b, x.as_ref(), self.options.residuals, self.par));
         let mut report = match (&x, &products) {
             (Some(x), Some(p)) => AccuracyReport::from_products(p, x.as_ref(), &omega, self.norm_a, self.norm_b),
             _ => {
@@ -344,9 +347,9 @@ impl Finish<'_> {
             && self.options.refinement != Refinement::Off
             && lift.is_none()
         {
-            let spectrum = def.reduced_vectors.as_ref().map(|y| ReducedSpectrum {
+            let spectrum = def.reduced.as_ref().map(|eig| ReducedSpectrum {
                 l: self.l,
-                y: y.as_ref(),
+                y: eig.U(),
                 omega_sq: &omega_all,
             });
             let simple = simple_modes(&omega, &report.error_bounds);
@@ -381,8 +384,8 @@ impl Finish<'_> {
             };
             accuracy::residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, &basis, self.par);
         }
-        if let (Some(x), Some(p)) = (&x, &products) {
-            report.finish(p, x.as_ref(), self.par);
+        if let (Some(x), Some(p)) = (&x, products.as_mut()) {
+            report.finish(p, a, x.as_ref(), &omega, self.par);
         }
         report.inertia_check = inertia_check(
             self.problem,

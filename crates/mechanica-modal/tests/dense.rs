@@ -2,8 +2,8 @@
 
 use mechanica_modal::faer::Mat;
 use mechanica_modal::{
-    BoundKind, Method, ModalError, ModeKind, PencilProblem, Refinement, Selection, SolveOptions, count_below, families,
-    solve,
+    BoundKind, Method, ModalError, ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions,
+    count_below, families, solve,
 };
 use proptest::prelude::*;
 
@@ -207,6 +207,7 @@ fn subsets_agree_with_the_full_spectrum() {
             selection: Selection::Interval { lower: 1.0, upper: 2.0 },
             vectors: false,
             refinement: Refinement::Auto,
+            residuals: Residuals::Exact,
         },
     )
     .expect("interval");
@@ -326,22 +327,79 @@ fn tiny_orders_do_not_reach_faer_size_limits() {
         for selection in [Selection::All, Selection::Lowest(0), Selection::Lowest(n)] {
             for vectors in [false, true] {
                 for refinement in [Refinement::Auto, Refinement::Off, Refinement::Always] {
-                    let sol = solve(
-                        &p,
-                        &SolveOptions {
-                            selection,
-                            vectors,
-                            refinement,
-                        },
-                    )
-                    .expect("solve");
-                    assert!(
-                        sol.modes
-                            .iter()
-                            .all(|m| m.omega_sq.is_finite() && m.error_bound.is_finite())
-                    );
+                    for residuals in [Residuals::Exact, Residuals::Sketched] {
+                        let sol = solve(
+                            &p,
+                            &SolveOptions {
+                                selection,
+                                vectors,
+                                refinement,
+                                residuals,
+                            },
+                        )
+                        .expect("solve");
+                        assert!(
+                            sol.modes
+                                .iter()
+                                .all(|m| m.omega_sq.is_finite() && m.error_bound.is_finite())
+                        );
+                    }
                 }
             }
         }
+    }
+}
+
+/// The sketched report bounds the exact one from above, within the factor its lower tail
+/// allows, on a rotated chain, a free chain (rigid-body mode) and a graded 1e12 chain; every
+/// ω² still lies within its (sketched) bound of the closed form.
+#[test]
+fn sketched_residuals_bound_the_exact_ones() {
+    let n = 240;
+    let d = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 / n as f64 } else { 0.0 });
+    let (_, t) = families::fixed_chain(n);
+    let b = Mat::from_fn(n, n, |i, j| (d[(i, i)] * d[(j, j)]).sqrt() * t[(i, j)]);
+    let (ra, rb) = families::rotate(&d, &b, &families::random_orthogonal(n, 9));
+    let (fa, fb) = families::free_chain(60);
+    let graded = families::spring_chain(&families::graded_exponents(24, 12), &[0; 24]);
+    let cases = [
+        (pencil(&ra, &rb), families::fixed_chain_omega_sq(n)),
+        (pencil(&fa, &fb), families::free_chain_omega_sq(60)),
+        (pencil(&graded.0, &graded.1), Vec::new()),
+    ];
+    for (p, exact) in &cases {
+        let exact_report = solve(p, &all_pairs()).expect("exact");
+        let sketched = solve(
+            p,
+            &SolveOptions {
+                residuals: Residuals::Sketched,
+                ..SolveOptions::default()
+            },
+        )
+        .expect("sketched");
+        assert_eq!(sketched.accuracy.residuals, Residuals::Sketched);
+        assert_eq!(exact_report.accuracy.residuals, Residuals::Exact);
+        for (i, (e, s)) in exact_report.modes.iter().zip(&sketched.modes).enumerate() {
+            let (e_eta, s_eta) = (e.backward_error.expect("vectors"), s.backward_error.expect("vectors"));
+            // Both are computed residuals: each carries rounding of order n·u (exactly 0 for the
+            // rigid-body mode of the free chain, where B·1 = 0 without rounding).
+            if e.omega_sq == s.omega_sq {
+                let floor = p.dim() as f64 * U;
+                assert!(
+                    s_eta + floor >= e_eta && s_eta <= 8.0 * e_eta + floor,
+                    "mode {i}: {s_eta:e} vs {e_eta:e}"
+                );
+            }
+            if let Some(w) = exact.get(i) {
+                assert!((s.omega_sq - w).abs() <= s.error_bound, "mode {i}");
+            }
+        }
+        let (e_orth, s_orth) = (
+            exact_report.accuracy.orthogonality_error.expect("vectors"),
+            sketched.accuracy.orthogonality_error.expect("vectors"),
+        );
+        assert!(s_orth >= e_orth, "{s_orth:e} < {e_orth:e}");
+        assert!(sketched.accuracy.meets_backward_error_target(p.dim()));
+        assert!(sketched.accuracy.inertia_check.expect("check").consistent);
     }
 }

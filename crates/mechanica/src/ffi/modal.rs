@@ -7,8 +7,8 @@ use super::validate::*;
 use mechanica_modal::faer::MatRef;
 use mechanica_modal::faer::sparse::Triplet;
 use mechanica_modal::{
-    FreeResponse, Method, ModalError, ModalSolution, ModeKind, PencilProblem, Refinement, Selection, SolveOptions,
-    SparseOptions, SparsePencil, count_below, solve, solve_sparse,
+    FreeResponse, Method, ModalError, ModalSolution, ModeKind, PencilProblem, Refinement, Residuals, Selection,
+    SolveOptions, SparseOptions, SparsePencil, count_below, solve, solve_sparse,
 };
 
 impl From<ModalError> for FfiError {
@@ -68,6 +68,24 @@ pub const MECH_MODAL_KIND_ZERO: mech_modal_kind_t = 1;
 pub const MECH_MODAL_KIND_UNSTABLE: mech_modal_kind_t = 2;
 /// Massless direction (A x = 0): infinite frequency.
 pub const MECH_MODAL_KIND_INFINITE: mech_modal_kind_t = 3;
+
+/// How the accuracy report measures residuals (int32_t; see MECH_MODAL_RESIDUALS_*).
+pub type mech_modal_residuals_t = i32;
+/// A X, B X and XᵀAX formed in full: exact backward errors and orthogonality (5n²m flops).
+pub const MECH_MODAL_RESIDUALS_EXACT: mech_modal_residuals_t = 0;
+/// Gaussian sketches (O(32·n²) flops): each backward error and the orthogonality error (then a
+/// bound on ‖XᵀAX − I‖_F) is an upper bound that fails with probability ≤ 1e-12.
+pub const MECH_MODAL_RESIDUALS_SKETCHED: mech_modal_residuals_t = 1;
+
+impl CEnum for Residuals {
+    fn from_c(raw: i32) -> Option<Self> {
+        match raw {
+            MECH_MODAL_RESIDUALS_EXACT => Some(Residuals::Exact),
+            MECH_MODAL_RESIDUALS_SKETCHED => Some(Residuals::Sketched),
+            _ => None,
+        }
+    }
+}
 
 struct SelectionTag(i32);
 impl CEnum for SelectionTag {
@@ -214,8 +232,29 @@ pub unsafe extern "C" fn mech_modal_solve(
     options: *const mech_modal_options_t,
     out: *mut *mut mech_modal_result_t,
 ) -> mech_status_t {
+    // SAFETY: the same contract.
+    unsafe { mech_modal_solve_with_residuals(n, a, b, options, MECH_MODAL_RESIDUALS_EXACT, out) }
+}
+
+/// mech_modal_solve with a choice of how the accuracy report measures residuals:
+/// MECH_MODAL_RESIDUALS_EXACT (what mech_modal_solve does) or MECH_MODAL_RESIDUALS_SKETCHED
+/// (probabilistic upper bounds at O(n²) cost, for large all-pairs solves). Errors as
+/// mech_modal_solve, and MECH_STATUS_BAD_ENUM for an unknown `residuals`.
+///
+/// # Safety
+/// As mech_modal_solve.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_modal_solve_with_residuals(
+    n: usize,
+    a: *const f64,
+    b: *const f64,
+    options: *const mech_modal_options_t,
+    residuals: mech_modal_residuals_t,
+    out: *mut *mut mech_modal_result_t,
+) -> mech_status_t {
     boundary(|| {
         let out = Out::new(out, "out")?;
+        let residuals = enum_value(residuals, "residuals")?;
         // SAFETY: caller's contract.
         let opts = unsafe { read(options, "options") }?;
         let SelectionTag(tag) = enum_value(opts.selection, "options.selection")?;
@@ -250,6 +289,7 @@ pub unsafe extern "C" fn mech_modal_solve(
                 selection,
                 vectors,
                 refinement,
+                residuals,
             },
         )?;
         let handle = Box::into_raw(Box::new(mech_modal_result_t { n, problem, solution }));
