@@ -4,6 +4,7 @@
 mod default_scene;
 mod mass_command;
 mod mechanism_run;
+mod modes_command;
 mod plots;
 mod progress;
 mod report;
@@ -43,6 +44,10 @@ enum Command {
     /// The inertia calculator: mass, centre of mass, inertia, principal moments and axes of a
     /// triangle mesh file (STL or OBJ), with the mesh's diagnostics.
     Mass(mass_command::MassArgs),
+    /// Small-oscillation modes of a pencil (A, B) from Matrix Market files: det(λA + B) = 0
+    /// with the accuracy report and each stage's wall time (sparse Lanczos for --lowest k on
+    /// large pencils).
+    Modes(modes_command::ModesArgs),
     /// Print the library version, the C ABI version and the compiled-in features.
     Version,
 }
@@ -64,6 +69,7 @@ fn main() -> ExitCode {
             .map_err(|e| e.to_string())
             .and_then(|scene| scene_run::run(&scene, &path, cli.plot.as_deref())),
         Command::Mass(args) => mass_command::run(&args),
+        Command::Modes(args) => modes_command::run(&args),
         Command::Version => report::version_report(),
     };
     match report {

@@ -52,6 +52,16 @@ fn main() {
             bound = bound.max(m.error_bound / w);
         }
         let refined = sol.accuracy.refinement_steps.iter().filter(|&&s| s > 0).count();
+        if std::env::var("STAGES").is_ok() {
+            let steps: Vec<usize> = sol
+                .accuracy
+                .refinement_steps
+                .iter()
+                .copied()
+                .filter(|&s| s > 0)
+                .collect();
+            eprintln!("  stages {:?} refinement steps {steps:?}", sol.timings);
+        }
         println!(
             "n {n} {refinement:?} {residuals:?} vectors {vectors}: {time:.3} s, lowest-10 rel err {err:.2e} (bound {bound:.2e}), refined {refined}, max eta {:?}, orth {:?}, sturm {:?}",
             sol.accuracy.max_backward_error,

@@ -21,6 +21,7 @@ pub(crate) fn solve_semidefinite(
 ) -> Result<ModalSolution, ModalError> {
     let (a, b) = (problem.a(), problem.b());
     let n = problem.dim();
+    let clock = std::time::Instant::now();
     let eig = a
         .self_adjoint_eigen(Side::Lower)
         .map_err(|_| ModalError::NoConvergence { n })?;
@@ -63,7 +64,9 @@ pub(crate) fn solve_semidefinite(
     let s = Mat::from_fn(n - r, n - r, |i, j| 0.5 * (s_raw[(i, j)] + s_raw[(j, i)]));
     let l1 = Mat::from_fn(n - r, n - r, |i, j| if i == j { values[r + i].sqrt() } else { 0.0 });
     let want_vectors = options.vectors || options.refinement == crate::Refinement::Always;
-    let def = solve_definite(l1.as_ref(), s.as_ref(), options.selection, want_vectors, par)?;
+    let condensation = clock.elapsed();
+    let mut def = solve_definite(l1.as_ref(), s.as_ref(), options.selection, want_vectors, par)?;
+    def.timings.factor += condensation;
     let infinite: Vec<Vec<f64>> = (0..r).map(|c| (0..n).map(|i| q0[(i, c)]).collect()).collect();
     let lift = |z: MatRef<'_, f64>| -> Mat<f64> { q1 * z - q0 * (&g * z) };
     let finish = Finish {

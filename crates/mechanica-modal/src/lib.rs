@@ -54,8 +54,8 @@ pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use problem::PencilProblem;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use solve::{
-    InertiaCheck, Method, ModalSolution, Mode, ModeGroup, ModeKind, Refinement, Selection, SolveOptions, classify,
-    solve,
+    DenseTimings, InertiaCheck, Method, ModalSolution, Mode, ModeGroup, ModeKind, Refinement, Selection, SolveOptions,
+    classify, solve,
 };
 pub use sparse_inertia::{SparseInertia, count_below_sparse};
 pub use sparse_pencil::SparsePencil;

@@ -13,6 +13,7 @@ use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
 use crate::refine::{ReducedSpectrum, refine_pair, refine_pair_spectral};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par, Side};
+use std::time::{Duration, Instant};
 
 /// Which eigenpairs to return.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -147,6 +148,23 @@ pub struct ModalSolution {
     pub accuracy: AccuracyReport,
     /// Algorithm used.
     pub method: Method,
+    /// Wall time of each stage.
+    pub timings: DenseTimings,
+}
+
+/// Wall time of each stage of a dense [`solve`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DenseTimings {
+    /// Cholesky of A (or the condensation of a semidefinite A) and the reduction C = L⁻¹BL⁻ᵀ.
+    pub factor: Duration,
+    /// Eigen-decomposition of C and back-transformation X = L⁻ᵀY.
+    pub eigen: Duration,
+    /// Accuracy report: residual products, per-mode bounds, orthogonality.
+    pub accuracy: Duration,
+    /// Refinement of poorly bounded modes (with their residual bounds).
+    pub refine: Duration,
+    /// Sturm (inertia) check.
+    pub inertia: Duration,
 }
 
 /// Finite spectrum of a definite pencil: all ω² ascending, the selected index range, and
@@ -159,6 +177,8 @@ pub(crate) struct Definite {
     /// The eigen-decomposition of the reduced matrix C (when vectors were computed), for
     /// refinement without a new factorization ([`crate::refine::ReducedSpectrum`]).
     pub reduced: Option<faer::linalg::solvers::SelfAdjointEigen<f64>>,
+    /// The reduction's time (as `factor`) and the eigensolver's (as `eigen`).
+    pub timings: DenseTimings,
 }
 
 fn select(omega_sq: &[f64], selection: Selection) -> Result<(usize, usize), ModalError> {
@@ -196,9 +216,16 @@ pub(crate) fn solve_definite(
             end,
             vectors: vectors.then(|| Mat::zeros(0, 0)),
             reduced: None,
+            timings: DenseTimings::default(),
         });
     }
+    let clock = Instant::now();
     let c = reduce(l, b, par);
+    let mut timings = DenseTimings {
+        factor: clock.elapsed(),
+        ..DenseTimings::default()
+    };
+    let clock = Instant::now();
     if vectors {
         let eig = c
             .self_adjoint_eigen(Side::Lower)
@@ -207,24 +234,28 @@ pub(crate) fn solve_definite(
         let (first, end) = select(&omega_sq, selection)?;
         let mut x = eig.U().subcols(first, end - first).to_owned();
         back_transform(l, x.as_mut(), par);
+        timings.eigen = clock.elapsed();
         Ok(Definite {
             omega_sq,
             first,
             end,
             vectors: Some(x),
             reduced: Some(eig),
+            timings,
         })
     } else {
         let omega_sq = c
             .self_adjoint_eigenvalues(Side::Lower)
             .map_err(|_| ModalError::NoConvergence { n })?;
         let (first, end) = select(&omega_sq, selection)?;
+        timings.eigen = clock.elapsed();
         Ok(Definite {
             omega_sq,
             first,
             end,
             vectors: None,
             reduced: None,
+            timings,
         })
     }
 }
@@ -260,8 +291,10 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     let norm_b = accuracy::frobenius_norm(b);
     // The refinement and the residual bounds need the vectors even when the caller does not.
     let want_vectors = options.vectors || options.refinement == Refinement::Always;
+    let clock = Instant::now();
     match cholesky(a, par) {
         Cholesky::Factor(l) => {
+            let cholesky_time = clock.elapsed();
             let mut def = solve_definite(l.as_ref(), b, options.selection, want_vectors, par)?;
             if !want_vectors && options.refinement == Refinement::Auto {
                 // Values only: decide from the a-priori bounds whether refinement is needed.
@@ -271,9 +304,13 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                     .zip(&pri)
                     .any(|(w, e)| *e > AUTO_REFINE_RELATIVE_BOUND * w.abs());
                 if bounds_need_vectors {
+                    let first_try = def.timings;
                     def = solve_definite(l.as_ref(), b, options.selection, true, par)?;
+                    def.timings.factor += first_try.factor;
+                    def.timings.eigen += first_try.eigen;
                 }
             }
+            def.timings.factor += cholesky_time;
             let finish = Finish {
                 problem,
                 l: l.as_ref(),
@@ -295,6 +332,7 @@ fn empty_solution() -> ModalSolution {
         groups: Vec::new(),
         accuracy: AccuracyReport::empty(),
         method: Method::CholeskyReduction,
+        timings: DenseTimings::default(),
     }
 }
 
@@ -332,6 +370,8 @@ impl Finish<'_> {
             (v, _) => v,
         };
         let m = omega.len();
+        let mut timings = def.timings;
+        let clock = Instant::now();
         let mut products = x
             .as_ref()
             .map(|x| accuracy::PairProducts::new(a, b, x.as_ref(), self.options.residuals, self.par));
@@ -342,6 +382,8 @@ impl Finish<'_> {
                 AccuracyReport::a_priori(self.norm_a, self.norm_b, bounds)
             }
         };
+        timings.accuracy = clock.elapsed();
+        let clock = Instant::now();
         // Refinement of poorly bounded simple modes (needs vectors in the original coordinates).
         if let (Some(xm), Some(products)) = (x.as_mut(), products.as_mut())
             && self.options.refinement != Refinement::Off
@@ -384,9 +426,13 @@ impl Finish<'_> {
             };
             accuracy::residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, &basis, self.par);
         }
+        timings.refine = clock.elapsed();
+        let clock = Instant::now();
         if let (Some(x), Some(p)) = (&x, products.as_mut()) {
             report.finish(p, a, x.as_ref(), &omega, self.par);
         }
+        timings.accuracy += clock.elapsed();
+        let clock = Instant::now();
         report.inertia_check = inertia_check(
             self.problem,
             &omega_all,
@@ -396,6 +442,7 @@ impl Finish<'_> {
             lift,
             self.par,
         )?;
+        timings.inertia = clock.elapsed();
         if !self.options.vectors {
             x = None;
             report.backward_errors.iter_mut().for_each(|e| *e = None);
@@ -440,6 +487,7 @@ impl Finish<'_> {
             groups,
             accuracy: report,
             method,
+            timings,
         })
     }
 }

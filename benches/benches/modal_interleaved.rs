@@ -1,0 +1,94 @@
+//! Dense all-pairs solves against LAPACK `dsygvd`, interleaved: every round runs each method
+//! once, in turn, so that a machine whose speed drifts (shared cores, other tenants) slows all
+//! methods alike; the median over the rounds and its ratio to dsygvd's median are printed.
+//!
+//! `OPENBLAS_CORETYPE=Haswell cargo bench -p mechanica-benches --bench modal_interleaved -- 1000 2000 4000`
+//! (sizes optional; rounds: `ROUNDS=7`, default 5). Problem: [`rotated_fixed_chain`].
+
+use mechanica::modal::{PencilProblem, Refinement, Residuals, SolveOptions, solve};
+use mechanica_benches::lapack;
+use mechanica_benches::modal::{rotated_fixed_chain, to_col_major};
+use std::time::{Duration, Instant};
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let sizes: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
+    let sizes = if sizes.is_empty() { vec![1000, 2000] } else { sizes };
+    let rounds: usize = std::env::var("ROUNDS").ok().and_then(|r| r.parse().ok()).unwrap_or(5);
+    if !lapack::available() {
+        println!("LAPACK not available (built without OpenBLAS): nothing to compare");
+        return;
+    }
+    println!(
+        "LAPACK: OpenBLAS {} threads, kernels {}; {rounds} interleaved rounds",
+        lapack::threads().unwrap_or(0),
+        lapack::core_name().unwrap_or_default()
+    );
+    let mech = |refinement, residuals| SolveOptions {
+        refinement,
+        residuals,
+        ..SolveOptions::default()
+    };
+    let methods: [(&str, Option<SolveOptions>); 5] = [
+        (
+            "mechanica all pairs (Auto, exact report)",
+            Some(SolveOptions::default()),
+        ),
+        (
+            "mechanica all pairs (Auto, sketched report)",
+            Some(mech(Refinement::Auto, Residuals::Sketched)),
+        ),
+        (
+            "mechanica all pairs (Off, exact report)",
+            Some(mech(Refinement::Off, Residuals::Exact)),
+        ),
+        (
+            "mechanica all pairs (Off, sketched report)",
+            Some(mech(Refinement::Off, Residuals::Sketched)),
+        ),
+        ("LAPACK dsygvd all pairs", None),
+    ];
+    println!("| n | method | median s | ratio to dsygvd | min s | max s |");
+    println!("|---|---|---|---|---|---|");
+    for n in sizes {
+        let (a, b) = rotated_fixed_chain(n);
+        let Ok(problem) = PencilProblem::new(a.as_ref(), b.as_ref()) else {
+            println!("| {n} | the pencil is invalid | | | | |");
+            continue;
+        };
+        let (ka, kb) = (to_col_major(b.as_ref()), to_col_major(a.as_ref()));
+        let mut times = vec![Vec::new(); methods.len()];
+        for _ in 0..rounds {
+            for (k, (_, options)) in methods.iter().enumerate() {
+                let clock = Instant::now();
+                let ok = match options {
+                    Some(o) => std::hint::black_box(solve(&problem, o)).is_ok(),
+                    None => std::hint::black_box(lapack::dsygvd(&ka, &kb, n, true)).is_ok(),
+                };
+                times[k].push(clock.elapsed().as_secs_f64());
+                if !ok {
+                    println!("| {n} | {} failed | | | | |", methods[k].0);
+                }
+                // OpenBLAS threads spin after a call; let them sleep before the next method.
+                std::thread::sleep(Duration::from_millis(200));
+            }
+        }
+        let lapack_median = median(times[methods.len() - 1].clone());
+        for (k, (label, _)) in methods.iter().enumerate() {
+            let t = &times[k];
+            let (lo, hi) = (
+                t.iter().copied().fold(f64::INFINITY, f64::min),
+                t.iter().copied().fold(0.0, f64::max),
+            );
+            let m = median(t.clone());
+            println!(
+                "| {n} | {label} | {m:.3} | {:.2} | {lo:.3} | {hi:.3} |",
+                m / lapack_median
+            );
+        }
+    }
+}

@@ -1,0 +1,177 @@
+//! `mechanica modes`: Matrix Market pencils through the CLI, against closed-form spectra, on
+//! the dense and the sparse path, and a malformed file.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn mechanica(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_mechanica"))
+        .args(args)
+        .output()
+        .expect("run mechanica");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn scratch() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mechanica-modes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+/// Writes the lower triangle of a symmetric matrix given as (row, col, value), 0-based.
+fn write_symmetric(path: &PathBuf, n: usize, entries: &[(usize, usize, f64)]) {
+    let mut text = format!(
+        "%%MatrixMarket matrix coordinate real symmetric\n{n} {n} {}\n",
+        entries.len()
+    );
+    for (i, j, v) in entries {
+        text.push_str(&format!("{} {} {v:e}\n", i + 1, j + 1));
+    }
+    std::fs::write(path, text).expect("write mtx");
+}
+
+fn values(json: &serde_json::Value, name: &str) -> Vec<f64> {
+    for step in json["steps"].as_array().expect("steps") {
+        for q in step["quantities"].as_array().expect("quantities") {
+            if q["name"].as_str().is_some_and(|n| n.starts_with(name)) {
+                return q["values"]
+                    .as_array()
+                    .expect("values")
+                    .iter()
+                    .map(|v| v.as_f64().unwrap_or(f64::NAN))
+                    .collect();
+            }
+        }
+    }
+    panic!("no quantity {name}");
+}
+
+fn run_json(args: &[&str]) -> serde_json::Value {
+    let (ok, out, err) = mechanica(args);
+    assert!(ok, "{err}");
+    serde_json::from_str(&out).expect("json")
+}
+
+/// Free–free unit chain of n masses: ω²_k = 4 sin²(kπ/(2n)), k = 0..n−1 (one rigid-body mode).
+#[test]
+fn free_chain_dense_all_modes_match_the_closed_form() {
+    let n = 12;
+    let dir = scratch();
+    let (a, b) = (dir.join("free_a.mtx"), dir.join("free_b.mtx"));
+    write_symmetric(&a, n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>());
+    let mut kb = Vec::new();
+    for i in 0..n {
+        kb.push((i, i, if i == 0 || i == n - 1 { 1.0 } else { 2.0 }));
+        if i > 0 {
+            kb.push((i, i - 1, -1.0));
+        }
+    }
+    write_symmetric(&b, n, &kb);
+    let json = run_json(&[
+        "--json",
+        "modes",
+        "--mass",
+        a.to_str().unwrap(),
+        "--stiffness",
+        b.to_str().unwrap(),
+    ]);
+    let omega_sq = values(&json, "ω² = −λ");
+    let bounds = values(&json, "error bound of ω²");
+    let kinds = values(&json, "classification");
+    assert_eq!(omega_sq.len(), n);
+    for k in 0..n {
+        let exact = 4.0 * (k as f64 * std::f64::consts::PI / (2.0 * n as f64)).sin().powi(2);
+        assert!(
+            (omega_sq[k] - exact).abs() <= bounds[k].max(1e-15),
+            "mode {k}: {} vs {exact}",
+            omega_sq[k]
+        );
+    }
+    assert_eq!(kinds[0], 1.0, "the rigid-body mode is classified zero");
+    assert!(kinds[1..].iter().all(|&c| c == 0.0));
+    let check = values(&json, "shift, count below, computed below");
+    assert_eq!(check[1], check[2], "the Sturm count agrees");
+    // Every stage has a wall time.
+    let stages: Vec<&str> = json["steps"]
+        .as_array()
+        .expect("steps")
+        .iter()
+        .map(|s| s["analysis"].as_str().expect("name"))
+        .collect();
+    assert!(stages.iter().any(|s| s.starts_with("read")) && stages.iter().any(|s| s.starts_with("factor")));
+}
+
+/// A 25×25 grid Laplacian (n = 625 > the dense limit) with --lowest 4 goes through the sparse
+/// solver: ω²_pq = 4 sin²(pπ/52) + 4 sin²(qπ/52), the second and third equal.
+#[test]
+fn grid_lowest_modes_use_the_sparse_solver() {
+    let side = 25;
+    let n = side * side;
+    let dir = scratch();
+    let (a, b) = (dir.join("grid_a.mtx"), dir.join("grid_b.mtx"));
+    write_symmetric(&a, n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>());
+    let mut kb = Vec::new();
+    for j in 0..side {
+        for i in 0..side {
+            let r = i + side * j;
+            kb.push((r, r, 4.0));
+            if i > 0 {
+                kb.push((r, r - 1, -1.0));
+            }
+            if j > 0 {
+                kb.push((r, r - side, -1.0));
+            }
+        }
+    }
+    write_symmetric(&b, n, &kb);
+    let json = run_json(&[
+        "--json",
+        "modes",
+        "--mass",
+        a.to_str().unwrap(),
+        "--stiffness",
+        b.to_str().unwrap(),
+        "--lowest",
+        "4",
+    ]);
+    assert!(
+        json["steps"]
+            .as_array()
+            .expect("steps")
+            .iter()
+            .any(|s| s["analysis"].as_str().is_some_and(|a| a.contains("Lanczos")))
+    );
+    let s = |p: f64| 4.0 * (p * std::f64::consts::PI / 52.0).sin().powi(2);
+    let exact = [s(1.0) + s(1.0), s(1.0) + s(2.0), s(1.0) + s(2.0), s(2.0) + s(2.0)];
+    let omega_sq = values(&json, "ω² = −λ");
+    let bounds = values(&json, "error bound of ω²");
+    for k in 0..4 {
+        assert!((omega_sq[k] - exact[k]).abs() <= bounds[k], "mode {k}");
+    }
+    assert_eq!(values(&json, "group multiplicity")[1], 2.0);
+}
+
+#[test]
+fn a_malformed_file_is_reported_with_its_line() {
+    let dir = scratch();
+    let (a, b) = (dir.join("bad_a.mtx"), dir.join("bad_b.mtx"));
+    std::fs::write(
+        &a,
+        "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1.0\n2 x 1.0\n",
+    )
+    .expect("write");
+    write_symmetric(&b, 2, &[(0, 0, 1.0), (1, 1, 1.0)]);
+    let (ok, _, err) = mechanica(&[
+        "modes",
+        "--mass",
+        a.to_str().unwrap(),
+        "--stiffness",
+        b.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(err.contains("bad_a.mtx") && err.contains("line 4"), "{err}");
+}
