@@ -75,9 +75,9 @@ fn free_chain_dense_all_modes_match_the_closed_form() {
         "--json",
         "modes",
         "--mass",
-        a.to_str().unwrap(),
+        a.to_str().expect("utf-8 path"),
         "--stiffness",
-        b.to_str().unwrap(),
+        b.to_str().expect("utf-8 path"),
     ]);
     let omega_sq = values(&json, "ω² = −λ");
     let bounds = values(&json, "error bound of ω²");
@@ -132,9 +132,9 @@ fn grid_lowest_modes_use_the_sparse_solver() {
         "--json",
         "modes",
         "--mass",
-        a.to_str().unwrap(),
+        a.to_str().expect("utf-8 path"),
         "--stiffness",
-        b.to_str().unwrap(),
+        b.to_str().expect("utf-8 path"),
         "--lowest",
         "4",
     ]);
@@ -168,9 +168,9 @@ fn a_malformed_file_is_reported_with_its_line() {
     let (ok, _, err) = mechanica(&[
         "modes",
         "--mass",
-        a.to_str().unwrap(),
+        a.to_str().expect("utf-8 path"),
         "--stiffness",
-        b.to_str().unwrap(),
+        b.to_str().expect("utf-8 path"),
     ]);
     assert!(!ok);
     assert!(err.contains("bad_a.mtx") && err.contains("line 4"), "{err}");
