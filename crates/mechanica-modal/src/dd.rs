@@ -72,20 +72,56 @@ impl Dd {
 }
 
 /// Σ_j m[i, j]·x[j] in double-double, for every row i (the product M x as if computed in twice
-/// the working precision, then kept unrounded).
+/// the working precision, then kept unrounded). Accumulated column by column into separate
+/// high and low parts, which vectorises; on CPUs with FMA and AVX2 the same operations run four
+/// rows per instruction (the fused multiply-add is exact either way, so results are identical).
 pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     let n = m.nrows();
-    let mut acc = vec![Dd::default(); n];
-    for (j, &xj) in x.iter().enumerate() {
-        let col = m.col(j);
-        for i in 0..n {
-            let (p, e) = two_prod(col[i], xj);
-            let (s, e2) = two_sum(acc[i].hi, p);
-            acc[i].hi = s;
-            acc[i].lo += e + e2;
+    let (mut hi, mut lo) = (vec![0.0; n], vec![0.0; n]);
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("fma") && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the running CPU supports FMA and AVX2, checked just above; the function
+            // has no other requirement.
+            unsafe { accumulate_fma(m, x, &mut hi, &mut lo) };
+            return hi.into_iter().zip(lo).map(|(hi, lo)| Dd { hi, lo }).collect();
         }
     }
-    acc
+    accumulate(m, x, &mut hi, &mut lo);
+    hi.into_iter().zip(lo).map(|(hi, lo)| Dd { hi, lo }).collect()
+}
+
+/// [`accumulate`] compiled for FMA and AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma,avx2")]
+fn accumulate_fma(m: MatRef<'_, f64>, x: &[f64], hi: &mut [f64], lo: &mut [f64]) {
+    accumulate(m, x, hi, lo);
+}
+
+/// hi + lo += M x, column by column: hi[i] + p = s + e₂ (TwoSum), p = m_ij·x_j − e (TwoProd).
+#[inline(always)]
+fn accumulate(m: MatRef<'_, f64>, x: &[f64], hi: &mut [f64], lo: &mut [f64]) {
+    for (j, &xj) in x.iter().enumerate() {
+        let col = m.col(j);
+        match col.try_as_col_major() {
+            Some(c) => {
+                for ((h, l), &mij) in hi.iter_mut().zip(lo.iter_mut()).zip(c.as_slice()) {
+                    let (p, e) = two_prod(mij, xj);
+                    let (s, e2) = two_sum(*h, p);
+                    *h = s;
+                    *l += e + e2;
+                }
+            }
+            None => {
+                for (i, (h, l)) in hi.iter_mut().zip(lo.iter_mut()).enumerate() {
+                    let (p, e) = two_prod(col[i], xj);
+                    let (s, e2) = two_sum(*h, p);
+                    *h = s;
+                    *l += e + e2;
+                }
+            }
+        }
+    }
 }
 
 /// M x in double-double for a sparse M (compressed columns).
