@@ -2,19 +2,8 @@
 //! the dense and the sparse path, and a malformed file.
 
 use std::path::PathBuf;
-use std::process::Command;
-
-fn mechanica(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_mechanica"))
-        .args(args)
-        .output()
-        .expect("run mechanica");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::{mechanica, values};
 
 fn scratch() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mechanica-modes-{}", std::process::id()));
@@ -32,22 +21,6 @@ fn write_symmetric(path: &PathBuf, n: usize, entries: &[(usize, usize, f64)]) {
         text.push_str(&format!("{} {} {v:e}\n", i + 1, j + 1));
     }
     std::fs::write(path, text).expect("write mtx");
-}
-
-fn values(json: &serde_json::Value, name: &str) -> Vec<f64> {
-    for step in json["steps"].as_array().expect("steps") {
-        for q in step["quantities"].as_array().expect("quantities") {
-            if q["name"].as_str().is_some_and(|n| n.starts_with(name)) {
-                return q["values"]
-                    .as_array()
-                    .expect("values")
-                    .iter()
-                    .map(|v| v.as_f64().unwrap_or(f64::NAN))
-                    .collect();
-            }
-        }
-    }
-    panic!("no quantity {name}");
 }
 
 fn run_json(args: &[&str]) -> serde_json::Value {

@@ -2,19 +2,8 @@
 //! whole pipeline, and located errors for bad input.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn mechanica(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_mechanica"))
-        .args(args)
-        .output()
-        .expect("run mechanica");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::{mechanica, values};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mechanica-scenes-{}-{name}", std::process::id()));
@@ -24,23 +13,6 @@ fn scratch(name: &str) -> PathBuf {
 
 fn examples() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes")
-}
-
-/// The values of the first quantity whose name starts with `name`.
-fn values(json: &serde_json::Value, name: &str) -> Vec<f64> {
-    for step in json["steps"].as_array().expect("steps") {
-        for q in step["quantities"].as_array().expect("quantities") {
-            if q["name"].as_str().is_some_and(|n| n.starts_with(name)) {
-                return q["values"]
-                    .as_array()
-                    .expect("values")
-                    .iter()
-                    .map(|v| v.as_f64().unwrap_or(f64::NAN))
-                    .collect();
-            }
-        }
-    }
-    panic!("no quantity {name} in {json}");
 }
 
 #[test]

@@ -2,6 +2,8 @@
 //! error bounds and the Sturm (inertia) check.
 //!
 //! Norms ‖A‖, ‖B‖ are Frobenius norms (upper bounds of the 2-norms, so the bounds stay valid).
+//! The residuals Bx − ω²Ax and XᵀAX − I are formed exactly ([`Residuals::Exact`]) or bounded
+//! through Gaussian sketches ([`Residuals::Sketched`], see [`crate::sketch`]).
 //! For a pair (ω², x) with λ = −ω²:
 //! - backward error η = ‖Bx + λAx‖ / ((‖B‖ + |λ|‖A‖)‖x‖) (Higham & Higham, "Structured backward
 //!   error and condition of generalized eigenvalue problems", SIMAX 20, 1998);
