@@ -2753,7 +2753,7 @@ mech_status_t mech_mass_mesh(const double *vertices,
 /**
  * As mech_mass_mesh, for a mesh whose vertices moved since an earlier call on the same
  * triangle array (a deforming body re-integrated every step): the edge-topology check, about
- * two thirds of the time of a large mesh, is skipped and its result taken from `earlier`, the
+ * 60 % of the time of a large mesh, is skipped and its result taken from `earlier`, the
  * report of that call (its `triangles` must equal `triangle_count`). The caller vouches that
  * the triangles are unchanged; indices are still checked and an inside-out mesh is still
  * flipped or refused.

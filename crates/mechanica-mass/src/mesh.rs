@@ -91,7 +91,8 @@ impl Default for MeshOptions {
 /// Where [`mesh_mass_properties`] takes the edge topology from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TopologySource {
-    /// Classify every edge (the default). On large meshes this is about two thirds of the time.
+    /// Classify every edge (the default). On large meshes this is about 60 % of the time
+    /// (32.9 of 55.6 ms at 2.1 M triangles, idle).
     Check,
     /// The topology an earlier call found for the same triangle array, for meshes whose
     /// vertices move while their connectivity stays (a deforming body re-integrated every step):

@@ -860,7 +860,7 @@ pub unsafe extern "C" fn mech_mass_mesh(
 
 /// As mech_mass_mesh, for a mesh whose vertices moved since an earlier call on the same
 /// triangle array (a deforming body re-integrated every step): the edge-topology check, about
-/// two thirds of the time of a large mesh, is skipped and its result taken from `earlier`, the
+/// 60 % of the time of a large mesh, is skipped and its result taken from `earlier`, the
 /// report of that call (its `triangles` must equal `triangle_count`). The caller vouches that
 /// the triangles are unchanged; indices are still checked and an inside-out mesh is still
 /// flipped or refused.
