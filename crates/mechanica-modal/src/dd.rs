@@ -19,25 +19,63 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
     (s, (a - (s - bb)) + (b - bb))
 }
 
-/// a·b = p + e exactly (TwoProd with a fused multiply-add).
-#[inline]
-fn two_prod(a: f64, b: f64) -> (f64, f64) {
+/// a·b = p + e exactly (TwoProd with a fused multiply-add). Only for code compiled with FMA
+/// (see [`two_prod`]).
+#[inline(always)]
+fn two_prod_fused(a: f64, b: f64) -> (f64, f64) {
     let p = a * b;
     (p, a.mul_add(b, -p))
 }
 
+/// a·b = p + e exactly. Without FMA in the build, `mul_add` is a library call costing about a
+/// hundred plain flops (and LLVM may hoist it out of any branch), so Dekker's product of
+/// Veltkamp halves is used instead. A factor above 2^995, whose split could overflow, is first
+/// scaled by 2^−64 (exact) and the result scaled back.
+#[inline]
+fn two_prod(a: f64, b: f64) -> (f64, f64) {
+    if cfg!(target_feature = "fma") {
+        return two_prod_fused(a, b);
+    }
+    const SPLIT_LIMIT: f64 = 1e299;
+    const DOWN: f64 = 1.0 / 18_446_744_073_709_551_616.0; // 2^−64
+    const UP: f64 = 18_446_744_073_709_551_616.0; // 2^64
+    if a.abs() > SPLIT_LIMIT {
+        let (p, e) = two_prod(a * DOWN, b);
+        return (p * UP, e * UP);
+    }
+    if b.abs() > SPLIT_LIMIT {
+        let (p, e) = two_prod(a, b * DOWN);
+        return (p * UP, e * UP);
+    }
+    let p = a * b;
+    let (ah, al) = split(a);
+    let (bh, bl) = split(b);
+    (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
+}
+
+/// Veltkamp's split a = hi + lo, each half with at most 26 significant bits.
+#[inline(always)]
+fn split(a: f64) -> (f64, f64) {
+    let c = 134_217_729.0 * a; // 2^27 + 1
+    let hi = c - (c - a);
+    (hi, a - hi)
+}
+
 impl Dd {
     /// The double-double value of a double.
+    #[inline]
     pub fn of(x: f64) -> Self {
         Self { hi: x, lo: 0.0 }
     }
 
     /// Rounded to the nearest double.
+    #[inline]
     pub fn to_f64(self) -> f64 {
         self.hi + self.lo
     }
 
     /// self + other.
+    #[inline]
     pub fn plus(self, other: Self) -> Self {
         let (s, e) = two_sum(self.hi, other.hi);
         let e = e + self.lo + other.lo;
@@ -46,6 +84,7 @@ impl Dd {
     }
 
     /// self − other.
+    #[inline]
     pub fn minus(self, other: Self) -> Self {
         self.plus(Self {
             hi: -other.hi,
@@ -54,6 +93,7 @@ impl Dd {
     }
 
     /// self · other.
+    #[inline]
     pub fn times(self, other: Self) -> Self {
         let (p, e) = two_prod(self.hi, other.hi);
         let e = e + (self.hi * other.lo + self.lo * other.hi);
@@ -62,6 +102,7 @@ impl Dd {
     }
 
     /// self / other (one Newton correction of the double quotient).
+    #[inline]
     pub fn over(self, other: Self) -> Self {
         let q1 = self.hi / other.hi;
         let r = self.minus(other.times(Self::of(q1)));
@@ -74,7 +115,7 @@ impl Dd {
 /// Σ_j m[i, j]·x[j] in double-double, for every row i (the product M x as if computed in twice
 /// the working precision, then kept unrounded). Accumulated column by column into separate
 /// high and low parts, which vectorises; on CPUs with FMA and AVX2 the same operations run four
-/// rows per instruction (the fused multiply-add is exact either way, so results are identical).
+/// rows per instruction (both products are exact, so results are identical).
 pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     let n = m.nrows();
     let (mut hi, mut lo) = (vec![0.0; n], vec![0.0; n]);
@@ -87,7 +128,7 @@ pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
             return hi.into_iter().zip(lo).map(|(hi, lo)| Dd { hi, lo }).collect();
         }
     }
-    accumulate(m, x, &mut hi, &mut lo);
+    accumulate(m, x, &mut hi, &mut lo, two_prod);
     hi.into_iter().zip(lo).map(|(hi, lo)| Dd { hi, lo }).collect()
 }
 
@@ -95,12 +136,18 @@ pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "fma,avx2")]
 fn accumulate_fma(m: MatRef<'_, f64>, x: &[f64], hi: &mut [f64], lo: &mut [f64]) {
-    accumulate(m, x, hi, lo);
+    accumulate(m, x, hi, lo, two_prod_fused);
 }
 
 /// hi + lo += M x, column by column: hi[i] + p = s + e₂ (TwoSum), p = m_ij·x_j − e (TwoProd).
 #[inline(always)]
-fn accumulate(m: MatRef<'_, f64>, x: &[f64], hi: &mut [f64], lo: &mut [f64]) {
+fn accumulate(
+    m: MatRef<'_, f64>,
+    x: &[f64],
+    hi: &mut [f64],
+    lo: &mut [f64],
+    two_prod: impl Fn(f64, f64) -> (f64, f64),
+) {
     for (j, &xj) in x.iter().enumerate() {
         let col = m.col(j);
         match col.try_as_col_major() {
@@ -162,6 +209,22 @@ mod tests {
         let third = Dd::of(1.0).over(Dd::of(3.0));
         // 3·(1/3) − 1 is at the 1e-32 level.
         assert!(third.times(Dd::of(3.0)).minus(Dd::of(1.0)).to_f64().abs() < 1e-31);
+    }
+
+    #[test]
+    fn split_product_is_exact() {
+        // (1 + u)(1 − u) = 1 − u², error −u² (not representable in one double's product).
+        let u = f64::EPSILON;
+        assert_eq!(two_prod(1.0 + u, 1.0 - u), (1.0, -u * u));
+        // (1 + 2^−30)² = 1 + 2^−29 + 2^−60, error 2^−60; and the same near the overflow limit,
+        // where the factor is scaled first.
+        let a = 1.0 + 2f64.powi(-30);
+        assert_eq!(two_prod(a, a), (1.0 + 2f64.powi(-29), 2f64.powi(-60)));
+        let big = 2f64.powi(1000) * a;
+        assert_eq!(
+            two_prod(big, a),
+            (2f64.powi(1000) * (1.0 + 2f64.powi(-29)), 2f64.powi(940))
+        );
     }
 
     #[test]

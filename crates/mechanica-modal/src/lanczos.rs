@@ -9,7 +9,7 @@
 //! - **Iteration.** Block Lanczos in the A-inner product with full reorthogonalisation (block
 //!   Gram–Schmidt, repeated when a column loses more than 1 − 1/√2 of its A-norm) and thick
 //!   restarts (Wu & Simon, SIMAX 22, 2000; in Krylov–Schur form, Stewart, SIMAX 23, 2001): the
-//!   basis holds about m = max(2·nev + 2b, 24) vectors (a multiple of the block size b), so
+//!   basis holds about m = max(2·nev + 4b, 24) vectors (a multiple of the block size b), so
 //!   memory is O(nnz(L) + n·m).
 //! - **Refinement.** The converged Ritz vectors are Rayleigh–Ritz-projected onto the original
 //!   pencil (the dense solver on XᵀBX, XᵀAX), which makes them A-orthonormal and gives each ω²
@@ -39,10 +39,12 @@ use crate::dd::{self, Dd};
 use crate::solve::{Mode, ModeGroup, classify, group_modes};
 use crate::sparse_inertia::{SparseInertia, inertia_with, symbolic_supernodal};
 use crate::sparse_pencil::{Csc, SparsePencil, abs_quadratic, frobenius, mul};
+use crate::supernodal_solve::SupernodalSolver;
 use crate::{ModalError, PencilProblem, Refinement, Selection, SolveOptions, solve};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
 };
 use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 use std::time::{Duration, Instant};
@@ -157,27 +159,38 @@ pub const DENSE_LIMIT: usize = 400;
 
 /// Shift-invert operator x ↦ K⁻¹(Ax) with the Cholesky factor of K = B − σA.
 struct Operator<'a> {
-    symbolic: SymbolicCholesky<usize>,
+    symbolic: &'a SymbolicCholesky<usize>,
     values: Vec<f64>,
     a: faer::sparse::SparseColMatRef<'a, usize, f64>,
     applications: usize,
     solve_time: Duration,
+    /// Row-interleaved copy of the block being solved (kept: no page faults per solve).
+    work: Vec<f64>,
 }
 
 impl Operator<'_> {
-    /// x ← K⁻¹x for an n × b column-major block (one pass over the factor for all columns).
-    /// Sequential: on a shared machine faer's threaded triangular solves contend badly.
+    /// x ← K⁻¹x for an n × b column-major block (one pass over the factor for all columns):
+    /// [`SupernodalSolver`] for a supernodal factor, faer's solve for a simplicial one.
+    /// Sequential: on a shared machine threaded triangular solves contend badly.
     fn solve_block(&mut self, x: &mut [f64], b: usize) {
         let clock = Instant::now();
         let n = self.a.nrows();
-        let req = self.symbolic.solve_in_place_scratch::<f64>(b, Par::Seq);
-        let mut mem = MemBuffer::new(req);
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(x, n, b),
-            Par::Seq,
-            MemStack::new(&mut mem),
-        );
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(supernodal) => {
+                let fwd = self.symbolic.perm().map(|p| p.arrays().0);
+                SupernodalSolver::new(supernodal, &self.values, fwd).solve_in_place(x, b, &mut self.work);
+            }
+            SymbolicCholeskyRaw::Simplicial(_) => {
+                let req = self.symbolic.solve_in_place_scratch::<f64>(b, Par::Seq);
+                let mut mem = MemBuffer::new(req);
+                LltRef::new(self.symbolic, &self.values).solve_in_place_with_conj(
+                    Conj::No,
+                    MatMut::from_column_major_slice_mut(x, n, b),
+                    Par::Seq,
+                    MemStack::new(&mut mem),
+                );
+            }
+        }
         self.applications += b;
         self.solve_time += clock.elapsed();
     }
@@ -187,7 +200,9 @@ impl Operator<'_> {
 /// non-positive pivot returns its index.
 fn factor_llt(symbolic: &SymbolicCholesky<usize>, k: &Csc) -> Result<Result<Vec<f64>, usize>, ModalError> {
     let m = k.to_faer();
-    let par = faer::get_global_parallelism();
+    // Sequential: faster than two threads on this 2-D grid (125 against 140 ms), and no
+    // contention on a shared machine.
+    let par = Par::Seq;
     let req = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
     let mut mem = MemBuffer::try_new(req).map_err(|_| ModalError::Factorization {
         what: "B − σA",
@@ -302,6 +317,7 @@ fn orthogonalise_block(
 /// column against the earlier ones, twice); returns the b × b upper triangular R with
 /// W_old = W_new R. A column that vanishes (invariant subspace) is replaced by a random vector
 /// orthogonal to everything, with a zero column in R. Errors if A gives a negative norm.
+/// `aw` (length n) is scratch.
 #[allow(clippy::too_many_arguments)]
 fn normalise_block(
     a: faer::sparse::SparseColMatRef<'_, usize, f64>,
@@ -312,28 +328,27 @@ fn normalise_block(
     w: &mut [f64],
     scale: f64,
     rng: &mut Lcg,
+    aw: &mut [f64],
 ) -> Result<Mat<f64>, ModalError> {
     let n = a.nrows();
     let b = w.len() / n;
     let mut r = Mat::<f64>::zeros(b, b);
-    let mut aw = vec![0.0; n];
-    let mut scratch = vec![0.0; n];
     for c in 0..b {
         let (done, rest) = w.split_at_mut(n * c);
         let wc = &mut rest[..n];
         for _ in 0..2 {
-            mul(a, wc, &mut aw);
+            mul(a, wc, aw);
             for d in 0..c {
                 let wd = &done[n * d..n * (d + 1)];
-                let h = dot(wd, &aw);
+                let h = dot(wd, aw);
                 r[(d, c)] += h;
                 for (x, y) in wc.iter_mut().zip(wd) {
                     *x -= h * y;
                 }
             }
         }
-        mul(a, wc, &mut aw);
-        let norm_sq = dot(wc, &aw);
+        mul(a, wc, aw);
+        let norm_sq = dot(wc, aw);
         if norm_sq < -1e4 * (f64::EPSILON * scale).powi(2) {
             return Err(ModalError::MassNotSemidefinite { value: norm_sq });
         }
@@ -345,13 +360,14 @@ fn normalise_block(
         }
         // Deflated direction: a fresh random vector, A-orthogonal to everything so far.
         let mut replaced = false;
+        let mut scratch = vec![0.0; n];
         for _ in 0..8 {
             wc.iter_mut().for_each(|x| *x = rng.next());
             let mut all = basis[..n * cols].to_vec();
             all.extend_from_slice(done);
             let _ = orthogonalise_block(a, &all, cols + c, locked, locked_cols, wc, &mut scratch);
-            mul(a, wc, &mut aw);
-            let fresh = dot(wc, &aw);
+            mul(a, wc, aw);
+            let fresh = dot(wc, aw);
             if fresh > 0.0 {
                 let s = fresh.sqrt();
                 wc.iter_mut().for_each(|x| *x /= s);
@@ -372,12 +388,14 @@ fn normalise_block(
 
 /// One block thick-restart Lanczos run for the `nev` largest θ of T restricted to the
 /// A-orthogonal complement of `locked`, from the n × b column-major `start` block when given
-/// with that size (tests), else from a pseudo-random block. Returns (θ descending, n × nev Ritz
-/// vectors, restarts).
+/// with that size (tests), else from a pseudo-random block. The first `strict` of them converge
+/// to `tolerance`, the rest (a buffer that only has to show where the spectrum has a gap) to
+/// [`BUFFER_TOLERANCE`]. Returns (θ descending, n × nev Ritz vectors, restarts).
 #[allow(clippy::too_many_arguments)]
 fn lanczos_run(
     op: &mut Operator<'_>,
     nev: usize,
+    strict: usize,
     block: usize,
     locked: &[f64],
     locked_cols: usize,
@@ -391,7 +409,9 @@ fn lanczos_run(
     let room = n.saturating_sub(locked_cols);
     let b = block.clamp(1, (room / 4).max(1));
     // m basis columns (a multiple of b) plus one residual block.
-    let wanted_m = (2 * nev + 2 * b).max(24);
+    // 2·nev + 4b: on the 300×300 grid (k = 10, b = 2) 74 operator applications against 80
+    // with 2·nev + 2b.
+    let wanted_m = (2 * nev + 4 * b).max(24);
     let m = (wanted_m.div_ceil(b) * b).min((room.saturating_sub(b) / b) * b);
     if m < 2 * b || nev >= m {
         return Err(ModalError::TooManyModes {
@@ -409,7 +429,7 @@ fn lanczos_run(
         _ => w.iter_mut().for_each(|x| *x = rng.next()),
     }
     let _ = orthogonalise_block(a, &[], 0, locked, locked_cols, &mut w, &mut scratch);
-    normalise_block(a, &[], 0, locked, locked_cols, &mut w, 1.0, rng)?;
+    normalise_block(a, &[], 0, locked, locked_cols, &mut w, 1.0, rng, &mut scratch[..n])?;
     basis[..n * b].copy_from_slice(&w);
     let mut cols = 0usize;
     let mut restarts = 0usize;
@@ -422,7 +442,17 @@ fn lanczos_run(
             let scale = (0..cols + b)
                 .flat_map(|i| (0..b).map(move |c| (i, c)))
                 .fold(0.0_f64, |s, (i, c)| s.max(coefficients[(i, c)].abs()));
-            let r = normalise_block(a, &basis, cols + b, locked, locked_cols, &mut w, scale, rng)?;
+            let r = normalise_block(
+                a,
+                &basis,
+                cols + b,
+                locked,
+                locked_cols,
+                &mut w,
+                scale,
+                rng,
+                &mut scratch[..n],
+            )?;
             for c in 0..b {
                 for i in 0..cols + b {
                     h[(i, cols + c)] = coefficients[(i, c)];
@@ -446,7 +476,15 @@ fn lanczos_run(
         let wanted: Vec<usize> = (0..nev).map(|r| m - 1 - r).collect();
         let converged = wanted
             .iter()
-            .filter(|&&c| residual(c) <= tolerance * theta[c].abs())
+            .enumerate()
+            .filter(|&(r, &c)| {
+                let goal = if r < strict {
+                    tolerance
+                } else {
+                    tolerance.max(BUFFER_TOLERANCE)
+                };
+                residual(c) <= goal * theta[c].abs()
+            })
             .count();
         let v = MatRef::from_column_major_slice(&basis[..n * m], n, m);
         if converged == nev {
@@ -576,11 +614,12 @@ fn solve_sparse_from(
     };
     timings.factor = clock.elapsed();
     let mut op = Operator {
-        symbolic,
+        symbolic: &symbolic,
         values,
         a,
         applications: 0,
         solve_time: Duration::ZERO,
+        work: Vec::new(),
     };
     let mut rng = Lcg(options.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x5851_f42d_4c95_7f2d);
     // First run: k plus a buffer, so that a gap above the k-th mode is seen.
@@ -589,6 +628,7 @@ fn solve_sparse_from(
     let (_, mut found, mut restarts) = lanczos_run(
         &mut op,
         (k + buffer).min(n - 1),
+        k,
         options.block_size,
         &[],
         0,
@@ -607,7 +647,12 @@ fn solve_sparse_from(
     let floor = 100.0 * f64::EPSILON * ratio;
     let real_gap =
         |omega: &[f64], j: usize| omega[j + 1] - omega[j] > min_gap * omega[j].abs().max(omega[j + 1].abs()) + floor;
-    let inertia_symbolic = symbolic_supernodal(&pattern)?;
+    // The inertia count needs a supernodal analysis of the same pattern: the Cholesky one when
+    // faer chose supernodal (as on large problems), else a forced one.
+    let forced_supernodal = match op.symbolic.raw() {
+        SymbolicCholeskyRaw::Supernodal(_) => None,
+        SymbolicCholeskyRaw::Simplicial(_) => Some(symbolic_supernodal(&pattern)?),
+    };
     loop {
         let clock = Instant::now();
         let cols = found.len() / n;
@@ -634,20 +679,48 @@ fn solve_sparse_from(
             None => omega[last] + 0.5 * (omega[last] - sigma).abs(),
         };
         let below = omega.partition_point(|&w| w < tau);
-        let clock = Instant::now();
         let kmat = Csc::combine(1.0, &cb, -tau, &ca);
-        let inertia = inertia_with(&inertia_symbolic, &kmat, tau)?;
-        timings.inertia += clock.elapsed();
+        let inertia_symbolic = forced_supernodal.as_ref().unwrap_or(&symbolic);
+        let count = || {
+            let clock = Instant::now();
+            (inertia_with(inertia_symbolic, &kmat, tau), clock.elapsed())
+        };
+        // The inertia count (one LBLᵀ factorization) and the residuals of the refined pairs are
+        // independent: on two threads unless faer's global parallelism is sequential.
+        let residuals = |op: &mut Operator<'_>| {
+            let clock = Instant::now();
+            (
+                pair_residuals(pencil, op, &refined, sigma, (norm_a, norm_b)),
+                clock.elapsed(),
+            )
+        };
+        let ((inertia, inertia_time), (residuals, residual_time)) = match faer::get_global_parallelism() {
+            Par::Seq => (count(), residuals(&mut op)),
+            _ => std::thread::scope(|scope| {
+                let counting = scope.spawn(count);
+                let residuals = residuals(&mut op);
+                let counted = counting.join().unwrap_or_else(|_| {
+                    let failure = ModalError::Factorization {
+                        what: "B − τA",
+                        detail: "the inertia count failed".into(),
+                    };
+                    (Err(failure), Duration::ZERO)
+                });
+                (counted, residuals)
+            }),
+        };
+        timings.inertia += inertia_time;
+        timings.refine += residual_time;
+        let inertia = inertia?;
         let missing = inertia.count.below.saturating_sub(below);
         if missing == 0 {
             let clock = Instant::now();
             let solution = finish(
                 pencil,
-                &mut op,
-                refined,
+                &refined,
+                residuals,
                 k,
-                sigma,
-                tau,
+                (sigma, tau),
                 inertia,
                 below,
                 (norm_a, norm_b),
@@ -655,7 +728,8 @@ fn solve_sparse_from(
             timings.refine += clock.elapsed();
             let mut solution = solution;
             solution.report.shift_attempts = attempts;
-            solution.report.factor_nnz = op.symbolic.len_val();
+            solution.report.factor_nnz = symbolic.len_val();
+            solution.report.operator_applications = op.applications;
             solution.report.restarts = restarts;
             solution.report.lanczos_runs = runs;
             solution.report.timings = timings;
@@ -673,9 +747,11 @@ fn solve_sparse_from(
         // of `missing` vectors (≤ MAX_RERUN_BLOCK) sees every missing copy of an eigenvalue in one
         // run, whatever its multiplicity.
         let clock = Instant::now();
+        let rerun_nev = (missing + 1).min(n.saturating_sub(cols + 1)).max(1);
         let (_, more, r) = lanczos_run(
             &mut op,
-            (missing + 1).min(n.saturating_sub(cols + 1)).max(1),
+            rerun_nev,
+            rerun_nev,
             options.block_size.max(missing.min(MAX_RERUN_BLOCK)),
             &refined.vectors,
             cols,
@@ -691,6 +767,11 @@ fn solve_sparse_from(
         found.extend_from_slice(&more);
     }
 }
+
+/// Relative Ritz residual to which the buffer modes above the k-th converge. They serve only to
+/// place the inertia shift τ in a real gap (relative width ≥ √u); after Rayleigh–Ritz their ω²
+/// err by about the square of this, far inside such a gap.
+const BUFFER_TOLERANCE: f64 = 1e-8;
 
 /// Largest block size of a deflated rerun.
 const MAX_RERUN_BLOCK: usize = 32;
@@ -749,24 +830,29 @@ fn rayleigh_ritz(pencil: &SparsePencil, x: &[f64], cols: usize) -> Result<Refine
     })
 }
 
-/// Bounds, backward errors, classification and the report for the lowest k refined modes.
-#[allow(clippy::too_many_arguments)]
-fn finish(
+/// What the bounds of the refined pairs need: each Rayleigh quotient and its rounding, θ, the
+/// first-order θ bound δ and the backward error η.
+struct PairResiduals {
+    omega_sq: Vec<f64>,
+    theta: Vec<f64>,
+    delta: Vec<f64>,
+    eta: Vec<f64>,
+    rounding: Vec<f64>,
+}
+
+/// The residuals of every refined pair: Rayleigh quotients and residuals in double-double, the
+/// residual s = Ax − θKx solved with K in one block (δ = ‖s‖_{K⁻¹}/‖x‖_K).
+fn pair_residuals(
     pencil: &SparsePencil,
     op: &mut Operator<'_>,
-    refined: Refined,
-    k: usize,
+    refined: &Refined,
     sigma: f64,
-    tau: f64,
-    inertia: SparseInertia,
-    below: usize,
     (norm_a, norm_b): (f64, f64),
-) -> Result<SparseModalSolution, ModalError> {
+) -> PairResiduals {
     let n = pencil.dim();
     let (a, b) = (pencil.a(), pencil.b());
     let cols = refined.omega_sq.len();
     let max_row = row_lengths(a).max(row_lengths(b)) as f64;
-    // θ and the first-order θ bound δ of every refined pair.
     let mut theta = vec![0.0; cols];
     let mut delta = vec![0.0; cols];
     let mut eta = vec![0.0; cols];
@@ -789,12 +875,17 @@ fn finish(
         theta[c] = t;
         // s = Ax − θ(Bx − σAx); ‖x‖²_K = xᵀBx − σxᵀAx.
         let (td, sd) = (Dd::of(t), Dd::of(sigma));
-        for i in 0..n {
-            residuals[i + n * c] = ax_dd[i].minus(td.times(bx_dd[i].minus(sd.times(ax_dd[i])))).to_f64();
+        let residual = &mut residuals[n * c..n * (c + 1)];
+        for ((s, ax), bx) in residual.iter_mut().zip(&ax_dd).zip(&bx_dd) {
+            *s = ax.minus(td.times(bx.minus(sd.times(*ax)))).to_f64();
         }
         xkx[c] = xbx.minus(sd.times(xax)).to_f64();
         let wd = Dd::of(w);
-        let r: Vec<f64> = (0..n).map(|i| bx_dd[i].minus(wd.times(ax_dd[i])).to_f64()).collect();
+        let r: Vec<f64> = ax_dd
+            .iter()
+            .zip(&bx_dd)
+            .map(|(ax, bx)| bx.minus(wd.times(*ax)).to_f64())
+            .collect();
         let xn = dot(x, x).sqrt();
         eta[c] = dot(&r, &r).sqrt() / ((norm_b + w.abs() * norm_a) * xn).max(f64::MIN_POSITIVE);
         let xax = xax.to_f64().max(f64::MIN_POSITIVE);
@@ -809,6 +900,38 @@ fn finish(
         let kc = &solved[n * c..n * (c + 1)];
         delta[c] = (dot(sc, kc).max(0.0) / xkx[c].max(f64::MIN_POSITIVE)).sqrt();
     }
+    PairResiduals {
+        omega_sq,
+        theta,
+        delta,
+        eta,
+        rounding,
+    }
+}
+
+/// Bounds, classification and the report for the lowest k refined modes, from their residuals
+/// and the inertia count at τ (σ the operator's shift).
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    pencil: &SparsePencil,
+    refined: &Refined,
+    residuals: PairResiduals,
+    k: usize,
+    (sigma, tau): (f64, f64),
+    inertia: SparseInertia,
+    below: usize,
+    (norm_a, norm_b): (f64, f64),
+) -> Result<SparseModalSolution, ModalError> {
+    let n = pencil.dim();
+    let a = pencil.a();
+    let cols = refined.omega_sq.len();
+    let PairResiduals {
+        omega_sq,
+        theta,
+        delta,
+        eta,
+        rounding,
+    } = residuals;
     // Clusters of θ whose δ-intervals overlap; Kato–Temple with the gap to other clusters and to
     // θ(τ) (no eigenvalue with ω² < τ is unaccounted for when the inertia check passed).
     let theta_tau = 1.0 / (tau - sigma);
@@ -864,7 +987,7 @@ fn finish(
             norm_a,
             norm_b,
             restarts: 0,
-            operator_applications: op.applications,
+            operator_applications: 0,
             lanczos_runs: 0,
             kth_group_multiplicity,
             max_backward_error: eta[..take].iter().copied().fold(0.0, f64::max),

@@ -50,6 +50,7 @@ pub mod sketch;
 pub mod solve;
 pub mod sparse_inertia;
 pub mod sparse_pencil;
+mod supernodal_solve;
 
 pub use accuracy::{AccuracyReport, BoundKind, Residuals};
 pub use error::ModalError;
