@@ -23,7 +23,7 @@ cargo build -q --release -p mechanica-modal --example sparse_grid
     "$bin" "$n"
     for rep in 1 2 3; do
         echo "# mechanica solve_sparse (default block size 2, tolerance 1e-12, inertia-certified), run $rep:"
-        target/release/examples/sparse_grid "$n" 10 | sed -n 1p
+        ${CARGO_TARGET_DIR:-target}/release/examples/sparse_grid "$n" 10 | sed -n 1p
     done
     echo "# load average at end: $(cut -d' ' -f1-3 /proc/loadavg)"
 } | tee "$out"
