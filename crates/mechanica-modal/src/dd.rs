@@ -12,7 +12,7 @@ pub(crate) struct Dd {
 }
 
 /// a + b = s + e exactly (Knuth's TwoSum).
-#[inline]
+#[inline(always)]
 fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     let bb = s - a;
@@ -31,7 +31,7 @@ fn two_prod_fused(a: f64, b: f64) -> (f64, f64) {
 /// hundred plain flops (and LLVM may hoist it out of any branch), so Dekker's product of
 /// Veltkamp halves is used instead. A factor above 2^995, whose split could overflow, is first
 /// scaled by 2^−64 (exact) and the result scaled back.
-#[inline]
+#[inline(always)]
 fn two_prod(a: f64, b: f64) -> (f64, f64) {
     if cfg!(target_feature = "fma") {
         return two_prod_fused(a, b);

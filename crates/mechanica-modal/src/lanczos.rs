@@ -431,7 +431,9 @@ fn normalise_block(
 /// A-orthogonal complement of `locked`, from the n × b column-major `start` block when given
 /// with that size (tests), else from a pseudo-random block. The first `strict` of them converge
 /// to `tolerance`, the rest (a buffer that only has to show where the spectrum has a gap) to
-/// [`BUFFER_TOLERANCE`]. Returns (θ descending, n × nev Ritz vectors, restarts).
+/// [`BUFFER_TOLERANCE`]. `rough`, when given, is called once with the nev θ (descending) as
+/// soon as all of them have converged to [`ROUGH_TOLERANCE`] (not when they converge fully at
+/// the first check). Returns (θ descending, n × nev Ritz vectors, restarts).
 #[allow(clippy::too_many_arguments)]
 fn lanczos_run(
     op: &mut Operator<'_>,
@@ -444,6 +446,7 @@ fn lanczos_run(
     max_restarts: usize,
     rng: &mut Lcg,
     start: Option<&[f64]>,
+    mut rough: Option<&mut dyn FnMut(&[f64])>,
 ) -> Result<(Vec<f64>, Vec<f64>, usize), ModalError> {
     let a = op.a;
     let n = a.nrows();
@@ -527,6 +530,12 @@ fn lanczos_run(
                 residual(c) <= goal * theta[c].abs()
             })
             .count();
+        if converged < nev
+            && wanted.iter().all(|&c| residual(c) <= ROUGH_TOLERANCE * theta[c].abs())
+            && let Some(hook) = rough.take()
+        {
+            hook(&wanted.iter().map(|&c| theta[c]).collect::<Vec<_>>());
+        }
         let v = MatRef::from_column_major_slice(&basis[..n * m], n, m);
         if converged == nev {
             let ys = Mat::from_fn(m, nev, |i, r| y[(i, wanted[r])]);
@@ -663,24 +672,6 @@ fn solve_sparse_from(
         work: Vec::new(),
     };
     let mut rng = Lcg(options.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x5851_f42d_4c95_7f2d);
-    // First run: k plus a buffer, so that a gap above the k-th mode is seen.
-    let buffer = (k / 4).clamp(2, 10);
-    let clock = Instant::now();
-    let (_, mut found, mut restarts) = lanczos_run(
-        &mut op,
-        (k + buffer).min(n - 1),
-        k,
-        options.block_size,
-        &[],
-        0,
-        options.tolerance,
-        options.max_restarts,
-        &mut rng,
-        start,
-    )?;
-    timings.lanczos += clock.elapsed();
-    let mut runs = 1;
-    let max_runs = options.max_runs.max(1);
     // Gaps narrower than this (relative, plus an absolute floor at the rounding level of ω²
     // near zero, e.g. rigid-body modes) may lie inside a numerically repeated eigenvalue: an
     // inertia shift there could split the group, so τ is never placed in one.
@@ -688,46 +679,104 @@ fn solve_sparse_from(
     let floor = 100.0 * f64::EPSILON * ratio;
     let real_gap =
         |omega: &[f64], j: usize| omega[j + 1] - omega[j] > min_gap * omega[j].abs().max(omega[j + 1].abs()) + floor;
+    // τ in the widest real gap between the k-th mode and the last one found (ω² ascending);
+    // above the last one when every gap there is within a cluster.
+    let choose_tau = |omega: &[f64]| -> f64 {
+        let last = omega.len() - 1;
+        let kth = (k - 1).min(last);
+        match (kth..last)
+            .filter(|&j| real_gap(omega, j))
+            .max_by(|&i, &j| gap(omega, i).total_cmp(&gap(omega, j)))
+        {
+            Some(j) => 0.5 * (omega[j] + omega[j + 1]),
+            None => omega[last] + 0.5 * (omega[last] - sigma).abs(),
+        }
+    };
+    // A τ chosen from rough Ritz values still serves for the final ones when it lies above the
+    // k-th of them and in the middle half of a real gap (or, above the last, a real gap away).
+    let tau_is_clear = |omega: &[f64], tau: f64| -> bool {
+        let j = omega.partition_point(|&w| w < tau);
+        let margin = |w: f64| min_gap * w.abs().max(tau.abs()) + floor;
+        if j < k.min(omega.len()) || j == 0 {
+            return false;
+        }
+        match omega.get(j) {
+            Some(&above) => {
+                let below = omega[j - 1];
+                let quarter = 0.25 * (above - below);
+                real_gap(omega, j - 1) && tau - below >= quarter && above - tau >= quarter
+            }
+            None => tau - omega[j - 1] > margin(omega[j - 1]),
+        }
+    };
     // The inertia count needs a supernodal analysis of the same pattern: the Cholesky one when
     // faer chose supernodal (as on large problems), else a forced one.
-    let forced_supernodal = match op.symbolic.raw() {
+    let forced_supernodal = match symbolic.raw() {
         SymbolicCholeskyRaw::Supernodal(_) => None,
         SymbolicCholeskyRaw::Simplicial(_) => Some(symbolic_supernodal(&pattern)?),
     };
+    let inertia_symbolic = forced_supernodal.as_ref().unwrap_or(&symbolic);
+    let count_at = |tau: f64| {
+        let clock = Instant::now();
+        let kmat = Csc::combine(1.0, &cb, -tau, &ca);
+        (inertia_with(inertia_symbolic, &kmat, tau), clock.elapsed())
+    };
+    let joined = |counted: std::thread::Result<(Result<SparseInertia, ModalError>, Duration)>| {
+        counted.unwrap_or_else(|_| {
+            let failure = ModalError::Factorization {
+                what: "B − τA",
+                detail: "the inertia count failed".into(),
+            };
+            (Err(failure), Duration::ZERO)
+        })
+    };
+    // Independent stages run on two threads unless faer's global parallelism is sequential.
+    let concurrent = !matches!(faer::get_global_parallelism(), Par::Seq);
+    // First run: k plus a buffer, so that a gap above the k-th mode is seen. Once its θ are
+    // roughly converged the inertia count at a τ chosen from them starts on a second thread.
+    let buffer = (k / 4).clamp(2, 10);
+    let clock = Instant::now();
+    let (first, mut early) = std::thread::scope(|scope| {
+        let mut pending = None;
+        let mut start_count = |theta: &[f64]| {
+            let omega: Vec<f64> = theta.iter().map(|t| sigma + 1.0 / t).collect();
+            let tau = choose_tau(&omega);
+            pending = Some((tau, scope.spawn(move || count_at(tau))));
+        };
+        let run = lanczos_run(
+            &mut op,
+            (k + buffer).min(n - 1),
+            k,
+            options.block_size,
+            &[],
+            0,
+            options.tolerance,
+            options.max_restarts,
+            &mut rng,
+            start,
+            if concurrent { Some(&mut start_count) } else { None },
+        );
+        let early = pending.map(|(tau, handle)| (tau, joined(handle.join())));
+        (run, early)
+    });
+    let (_, mut found, mut restarts) = first?;
+    timings.lanczos += clock.elapsed();
+    let mut runs = 1;
+    let max_runs = options.max_runs.max(1);
     loop {
         let clock = Instant::now();
         let cols = found.len() / n;
         let refined = rayleigh_ritz(pencil, &found, cols)?;
         timings.refine += clock.elapsed();
         let omega = &refined.omega_sq;
-        let cols = omega.len();
-        if cols == 0 {
+        if omega.is_empty() {
             return Err(ModalError::LanczosNoConvergence {
                 converged: 0,
                 wanted: k,
                 restarts,
             });
         }
-        // τ in the widest real gap between the k-th mode and the last one found; above the last
-        // one when every gap there is within a cluster.
-        let last = cols - 1;
-        let kth = (k - 1).min(last);
-        let tau = match (kth..last)
-            .filter(|&j| real_gap(omega, j))
-            .max_by(|&i, &j| gap(omega, i).total_cmp(&gap(omega, j)))
-        {
-            Some(j) => 0.5 * (omega[j] + omega[j + 1]),
-            None => omega[last] + 0.5 * (omega[last] - sigma).abs(),
-        };
-        let below = omega.partition_point(|&w| w < tau);
-        let kmat = Csc::combine(1.0, &cb, -tau, &ca);
-        let inertia_symbolic = forced_supernodal.as_ref().unwrap_or(&symbolic);
-        let count = || {
-            let clock = Instant::now();
-            (inertia_with(inertia_symbolic, &kmat, tau), clock.elapsed())
-        };
-        // The inertia count (one LBLᵀ factorization) and the residuals of the refined pairs are
-        // independent: on two threads unless faer's global parallelism is sequential.
+        let cols = omega.len();
         let residuals = |op: &mut Operator<'_>| {
             let clock = Instant::now();
             (
@@ -735,21 +784,25 @@ fn solve_sparse_from(
                 clock.elapsed(),
             )
         };
-        let ((inertia, inertia_time), (residuals, residual_time)) = match faer::get_global_parallelism() {
-            Par::Seq => (count(), residuals(&mut op)),
-            _ => std::thread::scope(|scope| {
-                let counting = scope.spawn(count);
-                let residuals = residuals(&mut op);
-                let counted = counting.join().unwrap_or_else(|_| {
-                    let failure = ModalError::Factorization {
-                        what: "B − τA",
-                        detail: "the inertia count failed".into(),
-                    };
-                    (Err(failure), Duration::ZERO)
-                });
-                (counted, residuals)
-            }),
-        };
+        // The early count when its τ still fits the refined modes; else a count now, beside the
+        // residuals of the refined pairs.
+        let (tau, (inertia, inertia_time), (residuals, residual_time)) =
+            match early.take().filter(|(tau, _)| tau_is_clear(omega, *tau)) {
+                Some((tau, counted)) => (tau, counted, residuals(&mut op)),
+                None => {
+                    let tau = choose_tau(omega);
+                    if concurrent {
+                        std::thread::scope(|scope| {
+                            let counting = scope.spawn(|| count_at(tau));
+                            let residuals = residuals(&mut op);
+                            (tau, joined(counting.join()), residuals)
+                        })
+                    } else {
+                        (tau, count_at(tau), residuals(&mut op))
+                    }
+                }
+            };
+        let below = omega.partition_point(|&w| w < tau);
         timings.inertia += inertia_time;
         timings.refine += residual_time;
         let inertia = inertia?;
@@ -800,6 +853,7 @@ fn solve_sparse_from(
             options.max_restarts,
             &mut rng,
             None,
+            None,
         )?;
         timings.lanczos += clock.elapsed();
         restarts += r;
@@ -813,6 +867,11 @@ fn solve_sparse_from(
 /// place the inertia shift τ in a real gap (relative width ≥ √u); after Rayleigh–Ritz their ω²
 /// err by about the square of this, far inside such a gap.
 const BUFFER_TOLERANCE: f64 = 1e-8;
+
+/// Relative Ritz residual at which the first run's θ are good enough to place the inertia shift
+/// τ (their ω² then err by about 1e-12 relative): the inertia count starts on a second thread
+/// while Lanczos converges the rest of the way.
+const ROUGH_TOLERANCE: f64 = 1e-6;
 
 /// Largest block size of a deflated rerun.
 const MAX_RERUN_BLOCK: usize = 32;

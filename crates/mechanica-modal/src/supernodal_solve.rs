@@ -50,16 +50,21 @@ impl<'a> SupernodalSolver<'a> {
                 work[i * b + c] = column[self.fwd.map_or(i, |f| f[i])];
             }
         }
-        // Column groups of at most 4 share one kernel call; their values stay in registers.
+        // Column groups of 8, 4 or fewer share one kernel call; their values stay in registers.
         let mut first = 0;
         let mut local = Vec::new();
         while first < b {
-            let group = (b - first).min(4);
+            let group = match b - first {
+                8.. => 8,
+                4..8 => 4,
+                rest => rest,
+            };
             match group {
                 1 => self.dispatch::<1>(work, b, first, &mut local),
                 2 => self.dispatch::<2>(work, b, first, &mut local),
                 3 => self.dispatch::<3>(work, b, first, &mut local),
-                _ => self.dispatch::<4>(work, b, first, &mut local),
+                4 => self.dispatch::<4>(work, b, first, &mut local),
+                _ => self.dispatch::<8>(work, b, first, &mut local),
             }
             first += group;
         }
@@ -230,7 +235,7 @@ mod tests {
 
     #[test]
     fn agrees_with_faer_and_solves_the_system() {
-        for (side, dense, b) in [(12, 0, 1), (20, 0, 3), (15, 40, 2), (9, 81, 5)] {
+        for (side, dense, b) in [(12, 0, 1), (20, 0, 3), (15, 40, 2), (9, 81, 5), (10, 30, 13)] {
             let (n, entries) = test_matrix(side, dense);
             let k = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &entries).expect("valid");
             let symbolic = factorize_symbolic_cholesky(
