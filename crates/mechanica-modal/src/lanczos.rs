@@ -427,6 +427,9 @@ fn normalise_block(
     Ok(r)
 }
 
+/// Called once with roughly converged θ (see [`lanczos_run`]).
+type RoughHook<'a> = &'a mut dyn FnMut(&[f64]);
+
 /// One block thick-restart Lanczos run for the `nev` largest θ of T restricted to the
 /// A-orthogonal complement of `locked`, from the n × b column-major `start` block when given
 /// with that size (tests), else from a pseudo-random block. The first `strict` of them converge
@@ -446,7 +449,7 @@ fn lanczos_run(
     max_restarts: usize,
     rng: &mut Lcg,
     start: Option<&[f64]>,
-    mut rough: Option<&mut dyn FnMut(&[f64])>,
+    mut rough: Option<RoughHook<'_>>,
 ) -> Result<(Vec<f64>, Vec<f64>, usize), ModalError> {
     let a = op.a;
     let n = a.nrows();
