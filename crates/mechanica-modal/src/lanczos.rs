@@ -964,6 +964,7 @@ fn pair_residuals(
     // Residuals s = Ax − θKx of every pair, solved with K in one block.
     let mut residuals = vec![0.0; n * cols];
     let mut xkx = vec![0.0; cols];
+    let mut r = vec![0.0; n];
     for c in 0..cols {
         let x = &refined.vectors[n * c..n * (c + 1)];
         // Rayleigh quotient and residuals in double-double: the bounds below then need no
@@ -976,19 +977,15 @@ fn pair_residuals(
         omega_sq[c] = w;
         let t = 1.0 / (w - sigma);
         theta[c] = t;
-        // s = Ax − θ(Bx − σAx); ‖x‖²_K = xᵀBx − σxᵀAx.
-        let (td, sd) = (Dd::of(t), Dd::of(sigma));
-        let residual = &mut residuals[n * c..n * (c + 1)];
-        for ((s, ax), bx) in residual.iter_mut().zip(&ax_dd).zip(&bx_dd) {
-            *s = ax.minus(td.times(bx.minus(sd.times(*ax)))).to_f64();
-        }
-        xkx[c] = xbx.minus(sd.times(xax)).to_f64();
-        let wd = Dd::of(w);
-        let r: Vec<f64> = ax_dd
-            .iter()
-            .zip(&bx_dd)
-            .map(|(ax, bx)| bx.minus(wd.times(*ax)).to_f64())
-            .collect();
+        // s = Ax − θ(Bx − σAx), r = Bx − ω²Ax; ‖x‖²_K = xᵀBx − σxᵀAx.
+        dd::pencil_residuals(
+            &ax_dd,
+            &bx_dd,
+            (w, t, sigma),
+            &mut r,
+            &mut residuals[n * c..n * (c + 1)],
+        );
+        xkx[c] = xbx.minus(Dd::of(sigma).times(xax)).to_f64();
         let xn = dot(x, x).sqrt();
         eta[c] = dot(&r, &r).sqrt() / ((norm_b + w.abs() * norm_a) * xn).max(f64::MIN_POSITIVE);
         let xax = xax.to_f64().max(f64::MIN_POSITIVE);
