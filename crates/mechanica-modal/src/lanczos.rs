@@ -1,7 +1,8 @@
 //! The k lowest modes of a large sparse pencil (A, B) by shift-invert Lanczos (issue part 5).
 //!
 //! - **Operator.** With a shift σ below the lowest mode, K = B − σA is positive definite and
-//!   factored once by faer's sparse Cholesky (AMD ordering). T = K⁻¹A is self-adjoint in the
+//!   factored once by faer's sparse Cholesky (AMD ordering; solved by this crate's
+//!   supernodal block solve, `supernodal_solve`, about 1.5× faster than faer's on a 2-D grid). T = K⁻¹A is self-adjoint in the
 //!   A-inner product and has the eigenvalues θ = 1/(ω² − σ) > 0: the lowest ω² are the largest θ,
 //!   well separated. A successful Cholesky factorization of K certifies that no mode lies below σ
 //!   (Sylvester). The automatic σ is −√u·‖B‖_F/‖A‖_F, lowered by factors of 1000 while K is not
@@ -15,7 +16,12 @@
 //!   pencil (the dense solver on XᵀBX, XᵀAX), which makes them A-orthonormal and gives each ω²
 //!   as a Rayleigh quotient.
 //! - **Certification.** The inertia of B − τA ([`crate::count_below_sparse`]) at a shift τ in the
-//!   widest gap above the k-th mode must equal the number of computed modes below τ. Only gaps
+//!   widest gap above the k-th mode must equal the number of computed modes below τ. The
+//!   count runs on a second thread (unless faer's global parallelism is sequential): started
+//!   once the first run's Ritz values have converged to 1e-6, and kept when its τ still lies in
+//!   the middle half of a real gap of the refined modes; otherwise recounted beside the
+//!   residual computation. Only the k wanted modes converge to `tolerance`; the buffer above
+//!   them, which only has to show the gap, to 1e-8. Only gaps
 //!   wider than max(√u, 100·tolerance) relative count, so τ never falls inside a numerically
 //!   repeated eigenvalue (where the count could split the group); when the modes found above
 //!   the k-th have no such gap, τ goes above the last one. When the count is larger, modes were
@@ -94,7 +100,8 @@ pub struct SparseTimings {
     pub lanczos: Duration,
     /// Rayleigh–Ritz refinement, residuals and bounds.
     pub refine: Duration,
-    /// Inertia (Sturm) checks.
+    /// Inertia (Sturm) checks, on their own thread: this time overlaps `lanczos` or `refine`
+    /// unless faer's global parallelism is sequential.
     pub inertia: Duration,
     /// Of lanczos + refine: the triangular solves with the factor of B − σA.
     pub solves: Duration,
