@@ -46,11 +46,11 @@ pub fn count_below(problem: &PencilProblem, shift: f64) -> Result<InertiaCount, 
 /// costs a third of the LBLᵀ of [`count_below`] (n³/3 flops at Cholesky speed).
 pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> bool {
     let (a, b) = (problem.a(), problem.b());
-    let k = Mat::from_fn(problem.dim(), problem.dim(), |i, j| b[(i, j)] - shift * a[(i, j)]);
-    matches!(
-        crate::reduce::cholesky(k.as_ref(), par),
-        crate::reduce::Cholesky::Factor(_)
-    )
+    // Only the lower triangle is formed and factored.
+    let mut k = Mat::from_fn(problem.dim(), problem.dim(), |i, j| {
+        if i >= j { b[(i, j)] - shift * a[(i, j)] } else { 0.0 }
+    });
+    crate::reduce::factor_in_place(k.as_mut(), par).is_ok()
 }
 
 /// (negative, zero, positive) eigenvalue counts of the symmetric matrix `k` (lower triangle read).

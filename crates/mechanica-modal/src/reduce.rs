@@ -8,6 +8,7 @@
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{BlockStructure, matmul as tri_matmul};
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
+use faer::reborrow::ReborrowMut;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
 /// Below this order the reduction uses two plain triangular solves (cheap at that size).
@@ -32,33 +33,43 @@ pub(crate) fn cholesky(a: MatRef<'_, f64>, par: Par) -> Cholesky {
 
 /// [`cholesky`] of a matrix the caller no longer needs (factored in place, no copy).
 pub(crate) fn cholesky_owned(mut l: Mat<f64>, par: Par) -> Cholesky {
-    let n = l.nrows();
-    let mut mem = faer::dyn_stack::MemBuffer::new(
-        faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(n, par, Default::default()),
-    );
-    let stack = faer::dyn_stack::MemStack::new(&mut mem);
-    let diagonal: Vec<f64> = (0..n).map(|i| l[(i, i)]).collect();
-    let result = faer::linalg::cholesky::llt::factor::cholesky_in_place(
-        l.as_mut(),
-        Default::default(),
-        par,
-        stack,
-        Default::default(),
-    );
-    if let Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) = result {
-        return Cholesky::Failed { pivot: index };
-    }
-    let max_diag = diagonal.iter().copied().fold(0.0_f64, f64::max);
-    let tolerance = n as f64 * f64::EPSILON * max_diag;
-    if let Some(pivot) = (0..n).find(|&i| l[(i, i)] * l[(i, i)] <= tolerance) {
+    if let Err(pivot) = factor_in_place(l.as_mut(), par) {
         return Cholesky::Failed { pivot };
     }
+    let n = l.nrows();
     for j in 0..n {
         for i in 0..j {
             l[(i, j)] = 0.0;
         }
     }
     Cholesky::Factor(l)
+}
+
+/// Factors the lower triangle of `l` in place (the strict upper triangle is neither read nor
+/// cleared); Err(pivot) at the first pivot that is not positive or is negligible (l_ii² ≤
+/// n·u·max_j l_jj before factoring).
+pub(crate) fn factor_in_place(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
+    let n = l.nrows();
+    let mut mem = faer::dyn_stack::MemBuffer::new(
+        faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(n, par, Default::default()),
+    );
+    let stack = faer::dyn_stack::MemStack::new(&mut mem);
+    let max_diag = (0..n).map(|i| l[(i, i)]).fold(0.0_f64, f64::max);
+    let result = faer::linalg::cholesky::llt::factor::cholesky_in_place(
+        l.rb_mut(),
+        Default::default(),
+        par,
+        stack,
+        Default::default(),
+    );
+    if let Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) = result {
+        return Err(index);
+    }
+    let tolerance = n as f64 * f64::EPSILON * max_diag;
+    match (0..n).find(|&i| l[(i, i)] * l[(i, i)] <= tolerance) {
+        Some(pivot) => Err(pivot),
+        None => Ok(()),
+    }
 }
 
 /// C = L⁻¹ B L⁻ᵀ, reading only the lower triangle of `b`; returns C with its lower triangle
