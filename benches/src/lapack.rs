@@ -219,9 +219,19 @@ mod ffi {
         Some(name.to_string_lossy().into_owned())
     }
 
-    /// Workspace sizes (lwork, liwork) from a query result.
-    fn sizes(work: f64, iwork: c_int) -> (c_int, c_int) {
-        (work.ceil() as c_int, iwork.max(1))
+    /// Runs `call(work, lwork, iwork, liwork)` (one LAPACK call, returning INFO) as a workspace
+    /// query (lwork = liwork = −1), then with the optimal workspace. INFO of the query if nonzero,
+    /// else of the real call.
+    fn with_workspace(mut call: impl FnMut(&mut [f64], c_int, &mut [c_int], c_int) -> c_int) -> c_int {
+        let (mut qwork, mut qiwork) = ([0.0_f64], [0 as c_int]);
+        let info = call(&mut qwork, -1, &mut qiwork, -1);
+        if info != 0 {
+            return info;
+        }
+        let (lwork, liwork) = (qwork[0].ceil() as c_int, qiwork[0].max(1));
+        let mut work = vec![0.0; lwork.max(1) as usize];
+        let mut iwork = vec![0 as c_int; (liwork as usize).max(1)];
+        call(&mut work, lwork, &mut iwork, liwork)
     }
 
     pub(super) fn sygvd(k: &mut [f64], m: &mut [f64], n: usize, vectors: bool) -> Result<Vec<f64>, LapackError> {
@@ -231,8 +241,7 @@ mod ffi {
         let nn = order(n)?;
         let (itype, jz) = (1 as c_int, jobz(vectors));
         let mut w = vec![0.0; n];
-        // One dsygvd call with the given workspace (lwork = liwork = −1: a workspace query).
-        let mut call = |work: &mut [f64], lwork: c_int, iwork: &mut [c_int], liwork: c_int| {
+        let info = with_workspace(|work, lwork, iwork, liwork| {
             let mut info: c_int = 0;
             // SAFETY: every pointer is valid for the sizes LAPACK reads: k, m hold n·n entries
             // with leading dimension n, w holds n, work and iwork at least lwork and liwork
@@ -257,14 +266,9 @@ mod ffi {
                     1,
                 );
             }
-            status(info, n)
-        };
-        let (mut qwork, mut qiwork) = ([0.0_f64], [0 as c_int]);
-        call(&mut qwork, -1, &mut qiwork, -1)?;
-        let (lwork, liwork) = sizes(qwork[0], qiwork[0]);
-        let mut work = vec![0.0; lwork.max(1) as usize];
-        let mut iwork = vec![0 as c_int; (liwork as usize).max(1)];
-        call(&mut work, lwork, &mut iwork, liwork)?;
+            info
+        });
+        status(info, n)?;
         Ok(w)
     }
 
@@ -286,8 +290,7 @@ mod ffi {
         let nn = order(n)?;
         let jz = jobz(vectors);
         let mut w = vec![0.0; n];
-        // One dsyevd call with the given workspace (lwork = liwork = −1: a workspace query).
-        let mut call = |work: &mut [f64], lwork: c_int, iwork: &mut [c_int], liwork: c_int| {
+        let info = with_workspace(|work, lwork, iwork, liwork| {
             let mut info: c_int = 0;
             // SAFETY: c holds n·n entries (leading dimension n), w holds n, work and iwork at
             // least lwork and liwork (one entry each for a query).
@@ -308,19 +311,13 @@ mod ffi {
                     1,
                 );
             }
-            match info {
-                0 => Ok(()),
-                i if i < 0 => Err(LapackError::IllegalArgument(-i)),
-                i => Err(LapackError::NoConvergence(i)),
-            }
-        };
-        let (mut qwork, mut qiwork) = ([0.0_f64], [0 as c_int]);
-        call(&mut qwork, -1, &mut qiwork, -1)?;
-        let (lwork, liwork) = sizes(qwork[0], qiwork[0]);
-        let mut work = vec![0.0; lwork.max(1) as usize];
-        let mut iwork = vec![0 as c_int; (liwork as usize).max(1)];
-        call(&mut work, lwork, &mut iwork, liwork)?;
-        Ok(w)
+            info
+        });
+        match info {
+            0 => Ok(w),
+            i if i < 0 => Err(LapackError::IllegalArgument(-i)),
+            i => Err(LapackError::NoConvergence(i)),
+        }
     }
 
     pub(super) fn potrf(a: &mut [f64], n: usize) -> Result<(), LapackError> {

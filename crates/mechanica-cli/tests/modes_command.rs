@@ -1,7 +1,7 @@
 //! `mechanica modes`: Matrix Market pencils through the CLI, against closed-form spectra, on
 //! the dense and the sparse path, and a malformed file.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 mod common;
 use common::{mechanica, values};
 
@@ -23,6 +23,20 @@ fn write_symmetric(path: &PathBuf, n: usize, entries: &[(usize, usize, f64)]) {
     std::fs::write(path, text).expect("write mtx");
 }
 
+/// Writes the pencil `{name}_a.mtx` (mass A) and `{name}_b.mtx` (stiffness B) into `dir`.
+fn write_pencil(
+    dir: &Path,
+    name: &str,
+    n: usize,
+    mass: &[(usize, usize, f64)],
+    stiffness: &[(usize, usize, f64)],
+) -> (PathBuf, PathBuf) {
+    let (a, b) = (dir.join(format!("{name}_a.mtx")), dir.join(format!("{name}_b.mtx")));
+    write_symmetric(&a, n, mass);
+    write_symmetric(&b, n, stiffness);
+    (a, b)
+}
+
 fn run_json(args: &[&str]) -> serde_json::Value {
     let (ok, out, err) = mechanica(args);
     assert!(ok, "{err}");
@@ -33,9 +47,6 @@ fn run_json(args: &[&str]) -> serde_json::Value {
 #[test]
 fn free_chain_dense_all_modes_match_the_closed_form() {
     let n = 12;
-    let dir = scratch();
-    let (a, b) = (dir.join("free_a.mtx"), dir.join("free_b.mtx"));
-    write_symmetric(&a, n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>());
     let mut kb = Vec::new();
     for i in 0..n {
         kb.push((i, i, if i == 0 || i == n - 1 { 1.0 } else { 2.0 }));
@@ -43,7 +54,8 @@ fn free_chain_dense_all_modes_match_the_closed_form() {
             kb.push((i, i - 1, -1.0));
         }
     }
-    write_symmetric(&b, n, &kb);
+    let mass: Vec<_> = (0..n).map(|i| (i, i, 1.0)).collect();
+    let (a, b) = write_pencil(&scratch(), "free", n, &mass, &kb);
     let json = run_json(&[
         "--json",
         "modes",
@@ -84,9 +96,6 @@ fn free_chain_dense_all_modes_match_the_closed_form() {
 fn grid_lowest_modes_use_the_sparse_solver() {
     let side = 25;
     let n = side * side;
-    let dir = scratch();
-    let (a, b) = (dir.join("grid_a.mtx"), dir.join("grid_b.mtx"));
-    write_symmetric(&a, n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>());
     let mut kb = Vec::new();
     for j in 0..side {
         for i in 0..side {
@@ -100,7 +109,8 @@ fn grid_lowest_modes_use_the_sparse_solver() {
             }
         }
     }
-    write_symmetric(&b, n, &kb);
+    let mass: Vec<_> = (0..n).map(|i| (i, i, 1.0)).collect();
+    let (a, b) = write_pencil(&scratch(), "grid", n, &mass, &kb);
     let json = run_json(&[
         "--json",
         "modes",
