@@ -10,8 +10,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::Mutex;
 
-/// Serialises library builds: builds with different features share cargo's output paths.
-static BUILD_LOCK: Mutex<()> = Mutex::new(());
+/// Serialises library builds (builds with different features share cargo's output paths)
+/// and remembers each finished build by label, so that tests asking for the same label share
+/// one copy instead of building and copying it again.
+static BUILT: Mutex<Vec<(String, BuiltLibrary)>> = Mutex::new(Vec::new());
 
 /// The workspace root (the parent of `ffi-tests/`).
 pub fn workspace_root() -> PathBuf {
@@ -72,9 +74,13 @@ fn host_triple() -> Result<String, String> {
 
 /// Builds the library with `cargo build -p mechanica --lib` and the given feature arguments
 /// in `dir`, then copies the static and shared libraries into `target/ffi-tests/<label>/`, so
-/// that later builds cannot change them under a running test.
+/// that later builds cannot change them under a running test. A label built before in this
+/// process is returned as it is.
 pub fn build_library(label: &str, feature_args: &[&str], dir: BuildDir) -> Result<BuiltLibrary, String> {
-    let _guard = BUILD_LOCK.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let mut built_before = BUILT.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    if let Some((_, library)) = built_before.iter().find(|(built_label, _)| built_label == label) {
+        return Ok(library.clone());
+    }
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut command = Command::new(cargo);
     command
@@ -96,7 +102,9 @@ pub fn build_library(label: &str, feature_args: &[&str], dir: BuildDir) -> Resul
     for file in ["libmechanica.a", "libmechanica.so"] {
         std::fs::copy(built.join(file), copy_dir.join(file)).map_err(|e| format!("copy {file}: {e}"))?;
     }
-    Ok(BuiltLibrary { dir: copy_dir })
+    let library = BuiltLibrary { dir: copy_dir };
+    built_before.push((label.to_string(), library.clone()));
+    Ok(library)
 }
 
 /// How a test program links the library.
