@@ -155,8 +155,13 @@ pub enum Residuals {
 pub(crate) enum PairProducts {
     /// A X and B X.
     Exact { ax: Mat<f64>, bx: Mat<f64> },
-    /// S A X and S B X, and the current bound on ‖XᵀAX − I‖_F.
-    Sketched { sketch: Sketch, orthogonality: f64 },
+    /// S A X and S B X, and the bound on ‖XᵀAX − I‖_F; `stale` once a column changed after
+    /// the bound was computed.
+    Sketched {
+        sketch: Sketch,
+        orthogonality: f64,
+        stale: bool,
+    },
 }
 
 impl PairProducts {
@@ -174,7 +179,11 @@ impl PairProducts {
             Residuals::Sketched => {
                 let sketch = Sketch::new(a, b, x, par);
                 let orthogonality = sketch.orthogonality_bound(a, x, par);
-                Self::Sketched { sketch, orthogonality }
+                Self::Sketched {
+                    sketch,
+                    orthogonality,
+                    stale: false,
+                }
             }
         }
     }
@@ -194,7 +203,10 @@ impl PairProducts {
                 faer::linalg::matmul::matmul(ax.as_mut().subcols_mut(i, 1), faer::Accum::Replace, a, xi, 1.0, par);
                 faer::linalg::matmul::matmul(bx.as_mut().subcols_mut(i, 1), faer::Accum::Replace, b, xi, 1.0, par);
             }
-            Self::Sketched { sketch, .. } => sketch.update_column(x, i),
+            Self::Sketched { sketch, stale, .. } => {
+                sketch.update_column(x, i);
+                *stale = true;
+            }
         }
     }
 
@@ -216,7 +228,9 @@ impl PairProducts {
                 let r = (0..n).map(|k| (bxi[k] - omega_sq * axi[k]).powi(2)).sum::<f64>().sqrt();
                 (r, (0..n).map(|k| xi[k] * axi[k]).sum::<f64>())
             }
-            Self::Sketched { sketch, orthogonality } => (sketch.residual_bound(i, omega_sq), 1.0 - orthogonality),
+            Self::Sketched {
+                sketch, orthogonality, ..
+            } => (sketch.residual_bound(i, omega_sq), 1.0 - orthogonality),
         };
         let xnorm = vector_norm(xi);
         let scale = norm_b + omega_sq.abs() * norm_a;
@@ -230,12 +244,20 @@ impl PairProducts {
     }
 
     /// max |(XᵀAX − I)_ij| over the lower triangle (only the lower triangle of XᵀAX is formed),
-    /// or, sketched, the bound on ‖XᵀAX − I‖_F of the final vectors.
+    /// or, sketched, the bound on ‖XᵀAX − I‖_F of the final vectors (recomputed only when a
+    /// column changed since the first one).
     fn orthogonality_error(&mut self, a: MatRef<'_, f64>, x: MatRef<'_, f64>, par: Par) -> f64 {
         let ax = match self {
             Self::Exact { ax, .. } => ax,
-            Self::Sketched { sketch, orthogonality } => {
-                *orthogonality = sketch.orthogonality_bound(a, x, par);
+            Self::Sketched {
+                sketch,
+                orthogonality,
+                stale,
+            } => {
+                if *stale {
+                    *orthogonality = sketch.orthogonality_bound(a, x, par);
+                    *stale = false;
+                }
                 return *orthogonality;
             }
         };

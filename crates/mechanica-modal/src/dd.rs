@@ -140,7 +140,7 @@ pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     let (mut hi, mut lo) = (vec![0.0; n], vec![0.0; n]);
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("fma") && std::arch::is_x86_feature_detected!("avx2") {
+        if fused_available() {
             // SAFETY: the running CPU supports FMA and AVX2, checked just above; the function
             // has no other requirement.
             unsafe { accumulate_fma(m, x, &mut hi, &mut lo) };

@@ -688,8 +688,8 @@ fn solve_sparse_from(
     // inertia shift there could split the group, so τ is never placed in one.
     let min_gap = f64::EPSILON.sqrt().max(100.0 * options.tolerance);
     let floor = 100.0 * f64::EPSILON * ratio;
-    let real_gap =
-        |omega: &[f64], j: usize| omega[j + 1] - omega[j] > min_gap * omega[j].abs().max(omega[j + 1].abs()) + floor;
+    let is_real_gap = |below: f64, above: f64| above - below > min_gap * below.abs().max(above.abs()) + floor;
+    let real_gap = |omega: &[f64], j: usize| is_real_gap(omega[j], omega[j + 1]);
     // τ in the widest real gap between the k-th mode and the last one found (ω² ascending);
     // above the last one when every gap there is within a cluster.
     let choose_tau = |omega: &[f64]| -> f64 {
@@ -707,7 +707,6 @@ fn solve_sparse_from(
     // k-th of them and in the middle half of a real gap (or, above the last, a real gap away).
     let tau_is_clear = |omega: &[f64], tau: f64| -> bool {
         let j = omega.partition_point(|&w| w < tau);
-        let margin = |w: f64| min_gap * w.abs().max(tau.abs()) + floor;
         if j < k.min(omega.len()) || j == 0 {
             return false;
         }
@@ -717,7 +716,7 @@ fn solve_sparse_from(
                 let quarter = 0.25 * (above - below);
                 real_gap(omega, j - 1) && tau - below >= quarter && above - tau >= quarter
             }
-            None => tau - omega[j - 1] > margin(omega[j - 1]),
+            None => is_real_gap(omega[j - 1], tau),
         }
     };
     // The inertia count needs a supernodal analysis of the same pattern: the Cholesky one when
@@ -777,7 +776,7 @@ fn solve_sparse_from(
     loop {
         let clock = Instant::now();
         let cols = found.len() / n;
-        let refined = rayleigh_ritz(pencil, &found, cols)?;
+        let refined = rayleigh_ritz(op.a, b, &found, cols)?;
         timings.refine += clock.elapsed();
         let omega = &refined.omega_sq;
         if omega.is_empty() {
@@ -820,8 +819,8 @@ fn solve_sparse_from(
         let missing = inertia.count.below.saturating_sub(below);
         if missing == 0 {
             let clock = Instant::now();
-            let solution = finish(
-                pencil,
+            let mut solution = finish(
+                op.a,
                 &refined,
                 residuals,
                 k,
@@ -829,9 +828,8 @@ fn solve_sparse_from(
                 inertia,
                 below,
                 (norm_a, norm_b),
-            )?;
+            );
             timings.refine += clock.elapsed();
-            let mut solution = solution;
             solution.report.shift_attempts = attempts;
             solution.report.factor_nnz = symbolic.len_val();
             solution.report.operator_applications = op.applications;
@@ -903,13 +901,19 @@ struct Refined {
     vectors: Vec<f64>,
 }
 
-fn rayleigh_ritz(pencil: &SparsePencil, x: &[f64], cols: usize) -> Result<Refined, ModalError> {
-    let n = pencil.dim();
-    let (a, b) = (pencil.a(), pencil.b());
+/// Rayleigh–Ritz on span(X) (n × cols, column-major) for the pencil (A, B): the finite Ritz
+/// pairs of the projected pencil, ω² ascending, the vectors A-orthonormal.
+fn rayleigh_ritz(
+    a: Mass<'_>,
+    b: faer::sparse::SparseColMatRef<'_, usize, f64>,
+    x: &[f64],
+    cols: usize,
+) -> Result<Refined, ModalError> {
+    let n = a.nrows();
     let mut ax = vec![0.0; n * cols];
     let mut bx = vec![0.0; n * cols];
+    a.apply_block(&x[..n * cols], &mut ax);
     for c in 0..cols {
-        mul(a, &x[n * c..n * (c + 1)], &mut ax[n * c..n * (c + 1)]);
         mul(b, &x[n * c..n * (c + 1)], &mut bx[n * c..n * (c + 1)]);
     }
     let xm = MatRef::from_column_major_slice(x, n, cols);
@@ -1021,7 +1025,7 @@ fn pair_residuals(
 /// and the inertia count at τ (σ the operator's shift).
 #[allow(clippy::too_many_arguments)]
 fn finish(
-    pencil: &SparsePencil,
+    a: Mass<'_>,
     refined: &Refined,
     residuals: PairResiduals,
     k: usize,
@@ -1029,9 +1033,8 @@ fn finish(
     inertia: SparseInertia,
     below: usize,
     (norm_a, norm_b): (f64, f64),
-) -> Result<SparseModalSolution, ModalError> {
-    let n = pencil.dim();
-    let a = pencil.a();
+) -> SparseModalSolution {
+    let n = a.nrows();
     let cols = refined.omega_sq.len();
     let PairResiduals {
         omega_sq,
@@ -1087,7 +1090,7 @@ fn finish(
     let groups = group_modes(&mut modes);
     let vectors = Mat::from_fn(n, take, |i, c| refined.vectors[i + n * c]);
     let orthogonality_error = orthogonality(a, &vectors);
-    Ok(SparseModalSolution {
+    SparseModalSolution {
         report: SparseReport {
             shift: sigma,
             shift_attempts: 0,
@@ -1109,7 +1112,7 @@ fn finish(
         modes,
         vectors,
         groups,
-    })
+    }
 }
 
 /// The multiplicity, among all of `modes` (ascending), of the group of mode `k` − 1 (0 when
@@ -1131,19 +1134,17 @@ fn row_lengths(m: faer::sparse::SparseColMatRef<'_, usize, f64>) -> usize {
 }
 
 /// max |(XᵀAX − I)_ij|.
-fn orthogonality(a: faer::sparse::SparseColMatRef<'_, usize, f64>, x: &Mat<f64>) -> f64 {
+fn orthogonality(a: Mass<'_>, x: &Mat<f64>) -> f64 {
     let (n, c) = (x.nrows(), x.ncols());
     let mut ax = Mat::<f64>::zeros(n, c);
-    let mut col = vec![0.0; n];
-    let mut out = vec![0.0; n];
     for j in 0..c {
-        for i in 0..n {
-            col[i] = x[(i, j)];
-        }
-        mul(a, &col, &mut out);
-        for i in 0..n {
-            ax[(i, j)] = out[i];
-        }
+        let (Some(xj), Some(axj)) = (
+            x.col(j).try_as_col_major().map(|col| col.as_slice()),
+            ax.col_mut(j).try_as_col_major_mut().map(|col| col.as_slice_mut()),
+        ) else {
+            continue;
+        };
+        a.apply(xj, axj);
     }
     let g = product(x.transpose(), ax.as_ref());
     let mut worst = 0.0_f64;
@@ -1315,32 +1316,18 @@ mod tests {
     #[test]
     fn mass_applies_diagonal_and_general_matrices_alike() {
         use faer::sparse::{SparseColMat, Triplet};
+        let matrix = |entries: &[(usize, usize, f64)]| {
+            let triplets: Vec<_> = entries.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+            SparseColMat::<usize, f64>::try_new_from_triplets(3, 3, &triplets).expect("valid")
+        };
         let x = [1.5, -2.0, 0.25];
-        let diagonal = SparseColMat::<usize, f64>::try_new_from_triplets(
-            3,
-            3,
-            &[
-                Triplet::new(0, 0, 2.0),
-                Triplet::new(1, 1, 3.0),
-                Triplet::new(2, 2, 4.0),
-            ],
-        )
-        .expect("valid");
+        let diagonal = matrix(&[(0, 0, 2.0), (1, 1, 3.0), (2, 2, 4.0)]);
         let mass = Mass::of(diagonal.as_ref());
         assert!(matches!(mass, Mass::Diagonal(_)));
         let mut y = [0.0; 3];
         mass.apply(&x, &mut y);
         assert_eq!(y, [3.0, -6.0, 1.0]);
-        let shifted = SparseColMat::<usize, f64>::try_new_from_triplets(
-            3,
-            3,
-            &[
-                Triplet::new(0, 0, 2.0),
-                Triplet::new(1, 0, 3.0),
-                Triplet::new(2, 2, 4.0),
-            ],
-        )
-        .expect("valid");
+        let shifted = matrix(&[(0, 0, 2.0), (1, 0, 3.0), (2, 2, 4.0)]);
         let mass = Mass::of(shifted.as_ref());
         assert!(matches!(mass, Mass::Sparse(_)));
         mass.apply(&x, &mut y);
