@@ -307,10 +307,17 @@ impl<'a> Mass<'a> {
 /// 1 − 1/√2 of its A-norm ("twice is enough": Daniel, Gragg, Kaufman & Stewart, Math. Comp. 30,
 /// 1976; Giraud, Langou & Rozložník, Comput. Math. Appl. 50, 2005); returns the accumulated
 /// cols × b coefficients.
+///
+/// When only the columns from `coupled_from` on carry w's large components (the blocks the
+/// Lanczos recurrence couples it to), a first pass against those alone removes them; one pass
+/// against everything then usually keeps 1/√2 of what is left, so the whole basis is read
+/// twice per block step instead of four times.
+#[allow(clippy::too_many_arguments)]
 fn orthogonalise_block(
     a: Mass<'_>,
     basis: &[f64],
     cols: usize,
+    coupled_from: usize,
     locked: &[f64],
     locked_cols: usize,
     w: &mut [f64],
@@ -319,6 +326,22 @@ fn orthogonalise_block(
     let n = a.nrows();
     let b = w.len() / n;
     let mut total = Mat::<f64>::zeros(cols, b);
+    if coupled_from > 0 && coupled_from < cols {
+        a.apply_block(w, scratch);
+        let z = MatRef::from_column_major_slice(scratch, n, b);
+        let count = cols - coupled_from;
+        let v = MatRef::from_column_major_slice(&basis[n * coupled_from..n * cols], n, count);
+        let h = product(v.transpose(), z);
+        faer::linalg::matmul::matmul(
+            MatMut::from_column_major_slice_mut(w, n, b),
+            faer::Accum::Add,
+            v,
+            h.as_ref(),
+            -1.0,
+            Par::Seq,
+        );
+        total.as_mut().subrows_mut(coupled_from, count).copy_from(&h);
+    }
     let a_norms = |w: &[f64], aw: &[f64]| -> Vec<f64> {
         w.chunks_exact(n)
             .zip(aw.chunks_exact(n))
@@ -414,7 +437,7 @@ fn normalise_block(
             wc.iter_mut().for_each(|x| *x = rng.next());
             let mut all = basis[..n * cols].to_vec();
             all.extend_from_slice(done);
-            let _ = orthogonalise_block(a, &all, cols + c, locked, locked_cols, wc, &mut scratch);
+            let _ = orthogonalise_block(a, &all, cols + c, 0, locked, locked_cols, wc, &mut scratch);
             a.apply(wc, aw);
             let fresh = dot(wc, aw);
             if fresh > 0.0 {
@@ -484,17 +507,31 @@ fn lanczos_run(
         Some(given) if given.len() == w.len() => w.copy_from_slice(given),
         _ => w.iter_mut().for_each(|x| *x = rng.next()),
     }
-    let _ = orthogonalise_block(a, &[], 0, locked, locked_cols, &mut w, &mut scratch);
+    let _ = orthogonalise_block(a, &[], 0, 0, locked, locked_cols, &mut w, &mut scratch);
     normalise_block(a, &[], 0, locked, locked_cols, &mut w, 1.0, rng, &mut scratch[..n])?;
     basis[..n * b].copy_from_slice(&w);
     let mut cols = 0usize;
+    // Columns kept by the last restart (0 before the first).
+    let mut kept = 0usize;
     let mut restarts = 0usize;
     loop {
         // Expand by one block.
         let current = &basis[n * cols..n * (cols + b)];
         a.apply_block(current, &mut w);
         op.solve_block(&mut w, b);
-        let coefficients = orthogonalise_block(a, &basis, cols + b, locked, locked_cols, &mut w, &mut scratch);
+        // The recurrence couples the block to the previous one, or after a restart (and at the
+        // start) to every kept Ritz vector.
+        let coupled_from = if cols == kept { 0 } else { cols - b };
+        let coefficients = orthogonalise_block(
+            a,
+            &basis,
+            cols + b,
+            coupled_from,
+            locked,
+            locked_cols,
+            &mut w,
+            &mut scratch,
+        );
         let scale = (0..cols + b)
             .flat_map(|i| (0..b).map(move |c| (i, c)))
             .fold(0.0_f64, |s, (i, c)| s.max(coefficients[(i, c)].abs()));
@@ -592,6 +629,7 @@ fn lanczos_run(
             }
         }
         cols = p;
+        kept = p;
     }
 }
 
