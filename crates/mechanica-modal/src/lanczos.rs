@@ -257,6 +257,12 @@ fn product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
     out
 }
 
+/// out ← lhs · rhs, with `out` the column-major storage of the product (sequential).
+fn product_into(out: &mut [f64], lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) {
+    let target = MatMut::from_column_major_slice_mut(out, lhs.nrows(), rhs.ncols());
+    faer::linalg::matmul::matmul(target, faer::Accum::Replace, lhs, rhs, 1.0, Par::Seq);
+}
+
 fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
 }
@@ -505,6 +511,8 @@ fn lanczos_run(
         });
     }
     let mut basis = vec![0.0; n * (m + b)];
+    // Second basis buffer for the restarts (allocated at the first).
+    let mut spare = Vec::new();
     let mut h = Mat::<f64>::zeros(m + b, m);
     let mut scratch = vec![0.0; n * b];
     let mut w = vec![0.0; n * b];
@@ -593,13 +601,8 @@ fn lanczos_run(
         let v = MatRef::from_column_major_slice(&basis[..n * cols], n, cols);
         if converged == nev {
             let ys = Mat::from_fn(cols, nev, |i, r| ritz.y[(i, wanted[r])]);
-            let x = product(v, ys.as_ref());
             let mut out = vec![0.0; n * nev];
-            for r in 0..nev {
-                for i in 0..n {
-                    out[i + n * r] = x[(i, r)];
-                }
-            }
+            product_into(&mut out, v, ys.as_ref());
             return Ok((wanted.iter().map(|&c| ritz.theta[c]).collect(), out, restarts));
         }
         if cols < m {
@@ -619,14 +622,11 @@ fn lanczos_run(
         let p = m - (m - p_wanted).div_ceil(b) * b;
         let keep: Vec<usize> = (0..p).map(|r| m - 1 - r).collect();
         let ys = Mat::from_fn(m, p, |i, r| ritz.y[(i, keep[r])]);
-        let x = product(v, ys.as_ref());
-        let residual_block: Vec<f64> = basis[n * m..n * (m + b)].to_vec();
-        for r in 0..p {
-            for i in 0..n {
-                basis[i + n * r] = x[(i, r)];
-            }
-        }
-        basis[n * p..n * (p + b)].copy_from_slice(&residual_block);
+        // The new basis is formed in the spare buffer, which then becomes the basis.
+        spare.resize(basis.len(), 0.0);
+        product_into(&mut spare[..n * p], v, ys.as_ref());
+        spare[n * p..n * (p + b)].copy_from_slice(&basis[n * m..n * (m + b)]);
+        std::mem::swap(&mut basis, &mut spare);
         h.fill(0.0);
         for r in 0..p {
             h[(r, r)] = ritz.theta[keep[r]];
@@ -1012,13 +1012,8 @@ fn rayleigh_ritz(
     )?;
     let y = sol.vectors.ok_or(ModalError::NoConvergence { n: cols })?;
     let finite = sol.modes.iter().take_while(|m| m.omega_sq.is_finite()).count();
-    let z = product(xm, y.subcols(0, finite));
     let mut vectors = vec![0.0; n * finite];
-    for c in 0..finite {
-        for i in 0..n {
-            vectors[i + n * c] = z[(i, c)];
-        }
-    }
+    product_into(&mut vectors, xm, y.subcols(0, finite));
     Ok(Refined {
         omega_sq: sol.modes[..finite].iter().map(|m| m.omega_sq).collect(),
         vectors,
