@@ -5,6 +5,7 @@
 # Needs Debian's libspectra-dev and libeigen3-dev (apt-get install -y libspectra-dev
 # libeigen3-dev); they are a peer's, used only here, never by the build or the tests.
 # Rerun:  bash tools/modal_sparse_spectra.sh [N]      (default 300: n = 90 000)
+# SEQ=1 in the environment runs mechanica sequentially (faer's global parallelism Seq).
 # Writes tools/modal_sparse_spectra.out.
 set -euo pipefail
 cd "$(dirname "$0")/.."
