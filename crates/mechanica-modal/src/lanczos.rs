@@ -340,19 +340,11 @@ fn orthogonalise_block(
     let mut total = Mat::<f64>::zeros(cols, b);
     if coupled_from > 0 && coupled_from < cols {
         a.apply_block(w, scratch);
-        let z = MatRef::from_column_major_slice(scratch, n, b);
-        let count = cols - coupled_from;
-        let v = MatRef::from_column_major_slice(&basis[n * coupled_from..n * cols], n, count);
-        let h = product(v.transpose(), z);
-        faer::linalg::matmul::matmul(
-            MatMut::from_column_major_slice_mut(w, n, b),
-            faer::Accum::Add,
-            v,
-            h.as_ref(),
-            -1.0,
-            Par::Seq,
-        );
-        total.as_mut().subrows_mut(coupled_from, count).copy_from(&h);
+        let h = project_out(&basis[n * coupled_from..n * cols], scratch, w, n);
+        total
+            .as_mut()
+            .subrows_mut(coupled_from, cols - coupled_from)
+            .copy_from(&h);
     }
     let a_norms = |w: &[f64], aw: &[f64]| -> Vec<f64> {
         w.chunks_exact(n)
@@ -373,27 +365,34 @@ fn orthogonalise_block(
             break;
         }
         before = Some(norms);
-        let z = MatRef::from_column_major_slice(scratch, n, b);
         for (part, count, accumulate) in [(basis, cols, true), (locked, locked_cols, false)] {
             if count == 0 {
                 continue;
             }
-            let v = MatRef::from_column_major_slice(&part[..n * count], n, count);
-            let h = product(v.transpose(), z);
-            faer::linalg::matmul::matmul(
-                MatMut::from_column_major_slice_mut(w, n, b),
-                faer::Accum::Add,
-                v,
-                h.as_ref(),
-                -1.0,
-                Par::Seq,
-            );
+            let h = project_out(&part[..n * count], scratch, w, n);
             if accumulate {
                 total += &h;
             }
         }
     }
     total
+}
+
+/// One classical Gram–Schmidt projection: W ← W − V H with H = Vᵀz (returned), for the n × count
+/// columns `v`, the n × b block `w` and z = A·W (all column-major, n > 0).
+fn project_out(v: &[f64], z: &[f64], w: &mut [f64], n: usize) -> Mat<f64> {
+    let b = w.len() / n;
+    let v = MatRef::from_column_major_slice(v, n, v.len() / n);
+    let h = product(v.transpose(), MatRef::from_column_major_slice(z, n, b));
+    faer::linalg::matmul::matmul(
+        MatMut::from_column_major_slice_mut(w, n, b),
+        faer::Accum::Add,
+        v,
+        h.as_ref(),
+        -1.0,
+        Par::Seq,
+    );
+    h
 }
 
 /// A-orthonormalises the columns of the block `w` among themselves (modified Gram–Schmidt, each
