@@ -62,7 +62,7 @@ fn two_prod_as<const FUSED: bool>(a: f64, b: f64) -> (f64, f64) {
 /// Whether this CPU runs the FMA and AVX2 variants of the kernels below (detected once, cached
 /// by the standard library).
 #[cfg(target_arch = "x86_64")]
-fn fused_available() -> bool {
+pub(crate) fn fused_available() -> bool {
     std::arch::is_x86_feature_detected!("fma") && std::arch::is_x86_feature_detected!("avx2")
 }
 

@@ -51,6 +51,7 @@ pub mod solve;
 pub mod sparse_inertia;
 pub mod sparse_pencil;
 mod supernodal_solve;
+pub mod symmetric_eigen;
 
 pub use accuracy::{AccuracyReport, BoundKind, Residuals};
 pub use error::ModalError;

@@ -11,8 +11,9 @@ use crate::accuracy::{self, AccuracyReport, Residuals};
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
 use crate::refine::{ReducedSpectrum, refine_pair, refine_pair_spectral};
+use crate::symmetric_eigen::symmetric_eigen;
 use crate::{ModalError, PencilProblem};
-use faer::{Mat, MatRef, Par, Side};
+use faer::{Mat, MatRef, Par};
 use std::time::{Duration, Instant};
 
 /// Which eigenpairs to return.
@@ -174,9 +175,9 @@ pub(crate) struct Definite {
     pub first: usize,
     pub end: usize,
     pub vectors: Option<Mat<f64>>,
-    /// The eigen-decomposition of the reduced matrix C (when vectors were computed), for
-    /// refinement without a new factorization ([`crate::refine::ReducedSpectrum`]).
-    pub reduced: Option<faer::linalg::solvers::SelfAdjointEigen<f64>>,
+    /// All n orthonormal eigenvectors Y of the reduced matrix C (when vectors were computed),
+    /// for refinement without a new factorization ([`crate::refine::ReducedSpectrum`]).
+    pub reduced: Option<Mat<f64>>,
     /// The reduction's time (as `factor`) and the eigensolver's (as `eigen`).
     pub timings: DenseTimings,
 }
@@ -226,38 +227,27 @@ pub(crate) fn solve_definite(
         ..DenseTimings::default()
     };
     let clock = Instant::now();
-    if vectors {
-        let eig = c
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|_| ModalError::NoConvergence { n })?;
-        let omega_sq: Vec<f64> = (0..n).map(|i| eig.S()[i]).collect();
-        let (first, end) = select(&omega_sq, selection)?;
-        let mut x = eig.U().subcols(first, end - first).to_owned();
+    let eigen = symmetric_eigen(c, vectors, par)?;
+    let omega_sq = eigen.values;
+    let (first, end) = select(&omega_sq, selection)?;
+    let vectors = eigen.vectors.map(|y| {
+        let mut x = y.subcols(first, end - first).to_owned();
         back_transform(l, x.as_mut(), par);
-        timings.eigen = clock.elapsed();
-        Ok(Definite {
-            omega_sq,
-            first,
-            end,
-            vectors: Some(x),
-            reduced: Some(eig),
-            timings,
-        })
-    } else {
-        let omega_sq = c
-            .self_adjoint_eigenvalues(Side::Lower)
-            .map_err(|_| ModalError::NoConvergence { n })?;
-        let (first, end) = select(&omega_sq, selection)?;
-        timings.eigen = clock.elapsed();
-        Ok(Definite {
-            omega_sq,
-            first,
-            end,
-            vectors: None,
-            reduced: None,
-            timings,
-        })
-    }
+        (x, y)
+    });
+    timings.eigen = clock.elapsed();
+    let (vectors, reduced) = match vectors {
+        Some((x, y)) => (Some(x), Some(y)),
+        None => (None, None),
+    };
+    Ok(Definite {
+        omega_sq,
+        first,
+        end,
+        vectors,
+        reduced,
+        timings,
+    })
 }
 
 fn check_interval(selection: Selection) -> Result<(), ModalError> {
@@ -389,9 +379,9 @@ impl Finish<'_> {
             && self.options.refinement != Refinement::Off
             && lift.is_none()
         {
-            let spectrum = def.reduced.as_ref().map(|eig| ReducedSpectrum {
+            let spectrum = def.reduced.as_ref().map(|y| ReducedSpectrum {
                 l: self.l,
-                y: eig.U(),
+                y: y.as_ref(),
                 omega_sq: &omega_all,
             });
             let simple = simple_modes(&omega, &report.error_bounds);

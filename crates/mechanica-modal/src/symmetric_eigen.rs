@@ -1,0 +1,533 @@
+//! Eigen-decomposition C = Y diag(ω²) Yᵀ of the reduced symmetric matrix C = L⁻¹BL⁻ᵀ (8.89
+//! after the reduction): a blocked Householder tridiagonalization C = Q T Qᵀ, faer's tridiagonal
+//! divide and conquer T = Z Λ Zᵀ, and faer's blocked Householder application Y = Q Z.
+//!
+//! Why not faer's `self_adjoint_eigen`: faer 0.24 tridiagonalizes column by column, reading and
+//! writing the whole trailing matrix once per column (a rank-2 update fused with a
+//! matrix-vector product). Here the panel algorithm of LAPACK `dsytrd`/`dlatrd` (Dongarra,
+//! Hammarling & Sorensen, "Block reduction of matrices to condensed forms for eigenvalue
+//! computations", J. Comput. Appl. Math. 27, 1989) is used: a panel of [`PANEL`] columns is
+//! reduced with one read-only symmetric matrix-vector product per column, and the trailing
+//! matrix is updated once per panel by a symmetric rank-2·[`PANEL`] update (half the flops,
+//! as matrix products). Only the lower triangle of C is read.
+
+use crate::ModalError;
+use faer::dyn_stack::StackReq;
+use faer::linalg::evd::{ComputeEigenvectors, self_adjoint_evd_scratch, tridiagonal_self_adjoint_evd};
+use faer::linalg::householder::{
+    apply_block_householder_sequence_on_the_left_in_place_scratch,
+    apply_block_householder_sequence_on_the_left_in_place_with_conj, make_householder_in_place,
+    upgrade_householder_factor,
+};
+use faer::linalg::matmul::matmul;
+use faer::linalg::matmul::triangular::{BlockStructure, matmul as tri_matmul};
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::{Accum, ColMut, ColRef, Conj, Mat, Par};
+use rayon::prelude::*;
+
+/// Columns reduced per panel before the trailing matrix is updated (LAPACK's `dsytrd` default).
+pub const PANEL: usize = 32;
+
+/// Trailing orders below this use one thread for the symmetric matrix-vector product.
+const PARALLEL_SYMV_FROM: usize = 320;
+
+/// The eigen-decomposition of a symmetric matrix: values ascending, vectors orthonormal.
+#[derive(Debug, Clone)]
+pub struct SymmetricEigen {
+    /// Eigenvalues, ascending.
+    pub values: Vec<f64>,
+    /// Orthonormal eigenvectors as columns, in the order of `values` (None: values only).
+    pub vectors: Option<Mat<f64>>,
+}
+
+/// T = Qᵀ C Q: the diagonal and subdiagonal of T; Q = H₀ H₁ ⋯ H_{n−2} with H_k = I − v_k v_kᵀ/τ_k
+/// (faer's convention) stored below the subdiagonal of the matrix that was reduced.
+struct Tridiagonal {
+    diag: Vec<f64>,
+    subdiag: Vec<f64>,
+    tau: Vec<f64>,
+}
+
+/// Eigen-decomposition of the symmetric matrix `c` (only its lower triangle is read; `c` is
+/// overwritten by the Householder vectors).
+pub fn symmetric_eigen(mut c: Mat<f64>, vectors: bool, par: Par) -> Result<SymmetricEigen, ModalError> {
+    let n = c.nrows();
+    if n == 0 {
+        return Ok(SymmetricEigen {
+            values: Vec::new(),
+            vectors: vectors.then(|| Mat::zeros(0, 0)),
+        });
+    }
+    let t = tridiagonalize(&mut c, par);
+    let compute = if vectors {
+        ComputeEigenvectors::Yes
+    } else {
+        ComputeEigenvectors::No
+    };
+    // faer's full-EVD workspace bounds that of its tridiagonal solver and the Householder
+    // application alike (it is allocated, not touched, beyond what they use).
+    let mut mem = faer::dyn_stack::MemBuffer::new(StackReq::any_of(&[
+        self_adjoint_evd_scratch::<f64>(n, compute, par, Default::default()),
+        apply_block_householder_sequence_on_the_left_in_place_scratch::<f64>(n, block_size(n), n),
+    ]));
+    let stack = faer::dyn_stack::MemStack::new(&mut mem);
+    let mut values = vec![0.0; n];
+    let mut z = vectors.then(|| Mat::<f64>::zeros(n, n));
+    tridiagonal_self_adjoint_evd(
+        ColRef::from_slice(&t.diag).as_diagonal(),
+        ColRef::from_slice(&t.subdiag).as_diagonal(),
+        ColMut::from_slice_mut(&mut values).as_diagonal_mut(),
+        z.as_mut().map(|z| z.as_mut()),
+        par,
+        stack,
+        Default::default(),
+    )
+    .map_err(|_| ModalError::NoConvergence { n })?;
+    if let Some(z) = z.as_mut()
+        && n > 1
+    {
+        let factor = block_factor(&c, &t.tau, par);
+        apply_block_householder_sequence_on_the_left_in_place_with_conj(
+            c.as_ref().submatrix(1, 0, n - 1, n - 1),
+            factor.as_ref(),
+            Conj::No,
+            z.as_mut().subrows_mut(1, n - 1),
+            par,
+            stack,
+        );
+    }
+    Ok(SymmetricEigen { values, vectors: z })
+}
+
+/// Block size of the compact WY factors used to apply Q (faer's own choice for this order).
+fn block_size(n: usize) -> usize {
+    faer::linalg::qr::no_pivoting::factor::recommended_block_size::<f64>(n, n)
+}
+
+/// The triangular factors of Q's blocks of reflectors (compact WY form, Schreiber & Van Loan
+/// 1989) in faer's layout: block j occupies columns j..j+b of a b_max × (n−1) matrix.
+fn block_factor(c: &Mat<f64>, tau: &[f64], par: Par) -> Mat<f64> {
+    let n = c.nrows();
+    let m = n - 1;
+    let bs = block_size(n);
+    let basis = c.as_ref().submatrix(1, 0, m, m);
+    let mut factor = Mat::<f64>::zeros(bs, m);
+    let mut j = 0;
+    while j < m {
+        let b = bs.min(m - j);
+        let mut block = factor.as_mut().submatrix_mut(0, j, b, b);
+        for k in 0..b {
+            block[(k, k)] = tau[j + k];
+        }
+        upgrade_householder_factor(block, basis.submatrix(j, j, m - j, b), b, 1, par);
+        j += b;
+    }
+    factor
+}
+
+/// Reduces the lower triangle of `a` to tridiagonal form T = Qᵀ A Q by panels (`dsytrd`, lower).
+fn tridiagonalize(a: &mut Mat<f64>, par: Par) -> Tridiagonal {
+    let n = a.nrows();
+    let mut t = Tridiagonal {
+        diag: vec![0.0; n],
+        subdiag: vec![0.0; n],
+        tau: vec![f64::INFINITY; n.saturating_sub(1)],
+    };
+    let mut w = Mat::<f64>::zeros(n, PANEL);
+    let mut p = 0;
+    while p + 1 < n {
+        let nb = PANEL.min(n - 1 - p);
+        reduce_panel(a, &mut w, p, nb, &mut t, par);
+        // A(q.., q..) −= V Wᵀ + W Vᵀ on the lower triangle, q = p + nb (the syr2k of dsytrd).
+        let q = p + nb;
+        let (left, right) = a.as_mut().split_at_col_mut(q);
+        let v2 = left.rb().submatrix(q, p, n - q, nb);
+        let w2 = w.as_ref().submatrix(q, 0, n - q, nb);
+        let mut trailing = right.subrows_mut(q, n - q);
+        for (lhs, rhs) in [(v2, w2), (w2, v2)] {
+            tri_matmul(
+                trailing.as_mut(),
+                BlockStructure::TriangularLower,
+                Accum::Add,
+                lhs,
+                BlockStructure::Rectangular,
+                rhs.transpose(),
+                BlockStructure::Rectangular,
+                -1.0,
+                par,
+            );
+        }
+        for k in p..q {
+            t.diag[k] = a[(k, k)];
+            a[(k + 1, k)] = t.subdiag[k];
+        }
+        p = q;
+    }
+    t.diag[n - 1] = a[(n - 1, n - 1)];
+    t.subdiag.truncate(n - 1);
+    t
+}
+
+/// Reduces columns p..p+nb (`dlatrd`, lower): for each column k it applies the panel's earlier
+/// reflectors to column k, generates H_k, and stores w_k = τ⁻¹(A v_k − V Wᵀv_k − W Vᵀv_k) −
+/// ½τ⁻²(…ᵀv_k) v_k in column k − p of `w`, so that the trailing update is A −= V Wᵀ + W Vᵀ.
+/// While the panel is open, A(k+1, k) holds the reflector's unit head; T's subdiagonal goes to
+/// `t.subdiag`.
+fn reduce_panel(a: &mut Mat<f64>, w: &mut Mat<f64>, p: usize, nb: usize, t: &mut Tridiagonal, par: Par) {
+    let n = a.nrows();
+    let mut y = vec![0.0; n];
+    let mut coefficients = Mat::<f64>::zeros(PANEL, 1);
+    for i in 0..nb {
+        let k = p + i;
+        if i > 0 {
+            // a(k.., k) −= V(k.., p..k) W(k, 0..i)ᵀ + W(k.., 0..i) V(k, p..k)ᵀ
+            let (left, mut right) = a.as_mut().split_at_col_mut(k);
+            let v = left.rb().submatrix(k, p, n - k, i);
+            let mut col = right.rb_mut().submatrix_mut(k, 0, n - k, 1);
+            let wk = w.as_ref().submatrix(k, 0, n - k, i);
+            matmul(
+                col.rb_mut(),
+                Accum::Add,
+                v,
+                wk.row(0).transpose().as_mat(),
+                -1.0,
+                Par::Seq,
+            );
+            matmul(
+                col.rb_mut(),
+                Accum::Add,
+                wk,
+                v.row(0).transpose().as_mat(),
+                -1.0,
+                Par::Seq,
+            );
+        }
+        // H_k annihilates a(k+2.., k).
+        let tau = {
+            let col = a.col_as_slice_mut(k);
+            let (head, tail) = col[k + 1..].split_at_mut(1);
+            make_householder_in_place(&mut head[0], ColMut::from_slice_mut(tail)).tau
+        };
+        t.subdiag[k] = a[(k + 1, k)];
+        t.tau[k] = tau;
+        a[(k + 1, k)] = 1.0;
+        let tau_inv = tau.recip();
+        let m = n - k - 1;
+        // y = A(k+1.., k+1..) v, v = a(k+1.., k), with the not yet updated trailing matrix.
+        let y = &mut y[..m];
+        symv_lower(a, k + 1, y, par);
+        let mut y_mat = faer::MatMut::from_column_major_slice_mut(&mut *y, m, 1);
+        if i > 0 {
+            let v_panel = a.as_ref().submatrix(k + 1, p, m, i);
+            let w_panel = w.as_ref().submatrix(k + 1, 0, m, i);
+            let v = a.as_ref().submatrix(k + 1, k, m, 1);
+            let mut c = coefficients.as_mut().subrows_mut(0, i);
+            // y −= V (Wᵀ v) + W (Vᵀ v)
+            matmul(c.rb_mut(), Accum::Replace, w_panel.transpose(), v, 1.0, Par::Seq);
+            matmul(y_mat.rb_mut(), Accum::Add, v_panel, c.rb(), -1.0, Par::Seq);
+            matmul(c.rb_mut(), Accum::Replace, v_panel.transpose(), v, 1.0, Par::Seq);
+            matmul(y_mat.rb_mut(), Accum::Add, w_panel, c.rb(), -1.0, Par::Seq);
+        }
+        let v = &a.col_as_slice(k)[k + 1..];
+        let mut dot = 0.0;
+        for (yr, vr) in y.iter_mut().zip(v) {
+            *yr *= tau_inv;
+            dot += *yr * vr;
+        }
+        let alpha = -0.5 * tau_inv * dot;
+        let wk = &mut w.col_as_slice_mut(i)[k + 1..];
+        for ((wr, yr), vr) in wk.iter_mut().zip(y.iter()).zip(v) {
+            *wr = yr + alpha * vr;
+        }
+    }
+}
+
+/// y = S v for the trailing symmetric block S = A(q.., q..) (lower triangle read) and
+/// v = A(q.., q − 1), the current reflector; both threads of a parallel run read disjoint
+/// column ranges of equal area and sum their partial products.
+fn symv_lower(a: &Mat<f64>, q: usize, y: &mut [f64], par: Par) {
+    let m = a.nrows() - q;
+    let v = &a.col_as_slice(q - 1)[q..];
+    let threads = par.degree();
+    if threads < 2 || m < PARALLEL_SYMV_FROM {
+        y.iter_mut().for_each(|e| *e = 0.0);
+        symv_columns(a, q, 0..m, v, y);
+        return;
+    }
+    // Column j costs m − j: split where the remaining triangle's area falls by 1/threads.
+    let start = |t: usize| ((1.0 - (1.0 - t as f64 / threads as f64).sqrt()) * m as f64) as usize;
+    let partials: Vec<Vec<f64>> = (0..threads)
+        .into_par_iter()
+        .map(|t| {
+            let mut part = vec![0.0; m];
+            let end = if t + 1 == threads { m } else { start(t + 1) };
+            symv_columns(a, q, start(t)..end, v, &mut part);
+            part
+        })
+        .collect();
+    y.copy_from_slice(&partials[0]);
+    for part in &partials[1..] {
+        y.iter_mut().zip(part).for_each(|(e, p)| *e += p);
+    }
+}
+
+/// Adds the contributions of columns `cols` of S = A(q.., q..) to y = S v.
+fn symv_columns(a: &Mat<f64>, q: usize, cols: std::ops::Range<usize>, v: &[f64], y: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::dd::fused_available() {
+        // SAFETY: the running CPU supports FMA and AVX2, checked just above.
+        return unsafe { avx2::symv_columns(a, q, cols, v, y) };
+    }
+    symv_columns_as::<false>(a, q, cols, v, y);
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    //! The symmetric matrix-vector kernel with AVX2 and FMA: four columns at a time, so that
+    //! each load and store of y serves four columns of S (OpenBLAS's `dsymv` kernels do the same).
+    use super::{mul_add, symv_columns_as};
+    use faer::Mat;
+    use std::arch::x86_64::{
+        __m256d, _mm_add_pd, _mm_cvtsd_f64, _mm_unpackhi_pd, _mm256_castpd256_pd128, _mm256_extractf128_pd,
+        _mm256_fmadd_pd, _mm256_loadu_pd, _mm256_set1_pd, _mm256_setzero_pd, _mm256_storeu_pd,
+    };
+
+    /// Sum of the four lanes.
+    #[target_feature(enable = "fma,avx2")]
+    fn lane_sum(x: __m256d) -> f64 {
+        let pair = _mm_add_pd(_mm256_castpd256_pd128(x), _mm256_extractf128_pd::<1>(x));
+        _mm_cvtsd_f64(_mm_add_pd(pair, _mm_unpackhi_pd(pair, pair)))
+    }
+
+    /// [`super::symv_columns`] for CPUs with AVX2 and FMA.
+    #[target_feature(enable = "fma,avx2")]
+    pub(super) fn symv_columns(a: &Mat<f64>, q: usize, cols: std::ops::Range<usize>, v: &[f64], y: &mut [f64]) {
+        let m = v.len();
+        let mut j = cols.start;
+        while j + 4 <= cols.end && j + 4 <= m {
+            // The 4×4 diagonal block (lower triangle) in scalar arithmetic.
+            let mut dots = [0.0; 4];
+            for c in 0..4 {
+                let col = &a.col_as_slice(q + j + c)[q + j + c..q + j + 4];
+                dots[c] = mul_add::<true>(col[0], v[j + c], dots[c]);
+                for (r, s) in col.iter().enumerate().skip(1) {
+                    let i = j + c + r;
+                    dots[c] = mul_add::<true>(*s, v[i], dots[c]);
+                    y[i] = mul_add::<true>(*s, v[j + c], y[i]);
+                }
+            }
+            // Rows j+4..m of the four columns.
+            let below = |c: usize| &a.col_as_slice(q + j + c)[q + j + 4..q + m];
+            let (s0, rest0) = below(0).as_chunks::<4>();
+            let (s1, rest1) = below(1).as_chunks::<4>();
+            let (s2, rest2) = below(2).as_chunks::<4>();
+            let (s3, rest3) = below(3).as_chunks::<4>();
+            let (vb, v_rest) = v[j + 4..].as_chunks::<4>();
+            let (yb, y_rest) = y[j + 4..].as_chunks_mut::<4>();
+            let vj = [
+                _mm256_set1_pd(v[j]),
+                _mm256_set1_pd(v[j + 1]),
+                _mm256_set1_pd(v[j + 2]),
+                _mm256_set1_pd(v[j + 3]),
+            ];
+            let mut acc = [_mm256_setzero_pd(); 4];
+            let rows = s0.iter().zip(s1).zip(s2).zip(s3).zip(vb).zip(yb.iter_mut());
+            for (((((c0, c1), c2), c3), vv), yy) in rows {
+                // SAFETY: every pointer comes from a [f64; 4] chunk, so each 4-lane load or
+                // store stays inside its slice.
+                unsafe {
+                    let x = _mm256_loadu_pd(vv.as_ptr());
+                    let mut out = _mm256_loadu_pd(yy.as_ptr());
+                    for (k, chunk) in [c0, c1, c2, c3].into_iter().enumerate() {
+                        let s = _mm256_loadu_pd(chunk.as_ptr());
+                        acc[k] = _mm256_fmadd_pd(s, x, acc[k]);
+                        out = _mm256_fmadd_pd(s, vj[k], out);
+                    }
+                    _mm256_storeu_pd(yy.as_mut_ptr(), out);
+                }
+            }
+            for (r, (vv, yy)) in v_rest.iter().zip(y_rest.iter_mut()).enumerate() {
+                for (c, rest) in [rest0, rest1, rest2, rest3].into_iter().enumerate() {
+                    dots[c] = mul_add::<true>(rest[r], *vv, dots[c]);
+                    *yy = mul_add::<true>(rest[r], v[j + c], *yy);
+                }
+            }
+            for c in 0..4 {
+                y[j + c] += dots[c] + lane_sum(acc[c]);
+            }
+            j += 4;
+        }
+        symv_columns_as::<true>(a, q, j..cols.end, v, y);
+    }
+}
+
+/// x·y + z, with one rounding when `FUSED` (only in code compiled for FMA: elsewhere
+/// `f64::mul_add` is a library call).
+#[inline(always)]
+fn mul_add<const FUSED: bool>(x: f64, y: f64, z: f64) -> f64 {
+    if FUSED { x.mul_add(y, z) } else { x * y + z }
+}
+
+/// Column j of S (rows j..) contributes s_jj v_j + Σ s_ij v_i to y_j and s_ij v_j to y_i (i > j):
+/// one pass over the column does both (a dot product fused with an axpy).
+#[inline(always)]
+fn symv_columns_as<const FUSED: bool>(a: &Mat<f64>, q: usize, cols: std::ops::Range<usize>, v: &[f64], y: &mut [f64]) {
+    const LANES: usize = 8;
+    for j in cols {
+        let col = &a.col_as_slice(q + j)[q + j..];
+        let vj = v[j];
+        let (yj, y_below) = y[j..].split_at_mut(1);
+        let (below, v_below) = (&col[1..], &v[j + 1..]);
+        let mut acc = [0.0; LANES];
+        let (s_chunks, s_rest) = below.as_chunks::<LANES>();
+        let (v_chunks, v_rest) = v_below.as_chunks::<LANES>();
+        let (y_chunks, y_rest) = y_below.as_chunks_mut::<LANES>();
+        for ((s, vv), yy) in s_chunks.iter().zip(v_chunks).zip(y_chunks.iter_mut()) {
+            for l in 0..LANES {
+                acc[l] = mul_add::<FUSED>(s[l], vv[l], acc[l]);
+                yy[l] = mul_add::<FUSED>(s[l], vj, yy[l]);
+            }
+        }
+        let mut dot = mul_add::<FUSED>(col[0], vj, 0.0);
+        for ((s, vv), yy) in s_rest.iter().zip(v_rest).zip(y_rest.iter_mut()) {
+            dot = mul_add::<FUSED>(*s, *vv, dot);
+            *yy = mul_add::<FUSED>(*s, vj, *yy);
+        }
+        let lanes = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
+        yj[0] += dot + lanes;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn symmetric(n: usize, seed: u64) -> Mat<f64> {
+        let mut s = seed;
+        let mut next = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let g = Mat::from_fn(n, n, |_, _| next());
+        Mat::from_fn(n, n, |i, j| g[(i, j)] + g[(j, i)])
+    }
+
+    /// ‖C Y − Y Λ‖_max / ‖C‖_max and ‖YᵀY − I‖_max: a backward-stable decomposition keeps both
+    /// at a small multiple of n·u.
+    fn residuals(c: &Mat<f64>, e: &SymmetricEigen) -> (f64, f64) {
+        let n = c.nrows();
+        let y = e.vectors.as_ref().expect("vectors");
+        let cy = c * y;
+        let mut res = 0.0_f64;
+        for j in 0..n {
+            for i in 0..n {
+                res = res.max((cy[(i, j)] - y[(i, j)] * e.values[j]).abs());
+            }
+        }
+        let yty = y.transpose() * y;
+        let mut orth = 0.0_f64;
+        for j in 0..n {
+            for i in 0..n {
+                orth = orth.max((yty[(i, j)] - if i == j { 1.0 } else { 0.0 }).abs());
+            }
+        }
+        (res / c.norm_max(), orth)
+    }
+
+    #[test]
+    fn decomposition_is_backward_stable_across_panel_and_thread_boundaries() {
+        // Orders around the panel width, the parallel threshold and faer's D&C threshold (128).
+        for (n, par) in [
+            (1, Par::Seq),
+            (2, Par::Seq),
+            (3, Par::Seq),
+            (31, Par::Seq),
+            (32, Par::Seq),
+            (33, Par::Seq),
+            (65, Par::Seq),
+            (200, Par::Seq),
+            (333, Par::rayon(2)),
+            (700, Par::rayon(2)),
+        ] {
+            let c = symmetric(n, n as u64);
+            let e = symmetric_eigen(c.clone(), true, par).expect("converges");
+            let (res, orth) = residuals(&c, &e);
+            let tol = 20.0 * n as f64 * f64::EPSILON;
+            assert!(
+                res <= tol && orth <= tol,
+                "n = {n}: residual {res:.2e}, orthogonality {orth:.2e}"
+            );
+            // faer's own decomposition is an independent method: the eigenvalues must agree
+            // to the same backward-error level (Weyl: |Δλ| ≤ ‖ΔC‖₂).
+            let reference = c.self_adjoint_eigenvalues(faer::Side::Lower).expect("faer converges");
+            let scale = c.norm_l2().max(f64::MIN_POSITIVE);
+            for (mine, theirs) in e.values.iter().zip(&reference) {
+                assert!((mine - theirs).abs() <= tol * scale, "n = {n}: {mine} vs {theirs}");
+            }
+            let values_only = symmetric_eigen(c.clone(), false, par).expect("converges");
+            assert!(values_only.vectors.is_none());
+            for (a, b) in values_only.values.iter().zip(&e.values) {
+                assert!((a - b).abs() <= tol * scale, "n = {n}: values-only {a} vs {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn symmetric_products_match_the_dense_product_on_every_kernel_and_split() {
+        // Orders around the 4-column blocks and the 4-row chunks, offsets q > 0, odd splits.
+        for n in [2, 5, 9, 12, 37, 400] {
+            let a = symmetric(n, 7 + n as u64);
+            for q in [1, 2, n / 2].into_iter().filter(|&q| q >= 1 && q < n) {
+                let m = n - q;
+                let v = &a.col_as_slice(q - 1)[q..];
+                let exact: Vec<f64> = (0..m)
+                    .map(|i| (0..m).map(|j| a[(q + i.max(j), q + i.min(j))] * v[j]).sum())
+                    .collect();
+                let scale = a.norm_max() * v.iter().map(|x| x.abs()).sum::<f64>();
+                let tol = 4.0 * m as f64 * f64::EPSILON * scale;
+                let split = m / 3;
+                let mut plain = vec![0.0; m];
+                symv_columns_as::<false>(&a, q, 0..split, v, &mut plain);
+                symv_columns_as::<false>(&a, q, split..m, v, &mut plain);
+                let mut dispatched = vec![0.0; m];
+                symv_columns(&a, q, 0..split, v, &mut dispatched);
+                symv_columns(&a, q, split..m, v, &mut dispatched);
+                let mut parallel = vec![0.0; m];
+                symv_lower(&a, q, &mut parallel, Par::rayon(2));
+                for i in 0..m {
+                    for (name, got) in [("plain", &plain), ("dispatched", &dispatched), ("parallel", &parallel)] {
+                        assert!(
+                            (got[i] - exact[i]).abs() <= tol,
+                            "n {n} q {q} row {i}: {name} {} vs {}",
+                            got[i],
+                            exact[i]
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn already_diagonal_and_zero_columns_give_identity_reflectors() {
+        // Zero subdiagonal columns make faer's reflector τ = ∞ (H = I); the panel must cope.
+        let n = 70;
+        let c = Mat::from_fn(n, n, |i, j| if i == j { (n - i) as f64 } else { 0.0 });
+        let e = symmetric_eigen(c.clone(), true, Par::Seq).expect("converges");
+        // T is already diagonal; faer's divide and conquer still rounds (within n·u·‖C‖).
+        let tol = 4.0 * n as f64 * f64::EPSILON;
+        for (k, v) in e.values.iter().enumerate() {
+            assert!((v - (k + 1) as f64).abs() <= tol * n as f64, "{v} vs {}", k + 1);
+        }
+        let (res, orth) = residuals(&c, &e);
+        assert!(
+            res <= tol && orth <= tol,
+            "residual {res:.2e}, orthogonality {orth:.2e}"
+        );
+        let zero = Mat::<f64>::zeros(40, 40);
+        let e = symmetric_eigen(zero.clone(), true, Par::Seq).expect("converges");
+        assert!(e.values.iter().all(|v| *v == 0.0));
+        let (_, orth) = residuals(&zero, &e);
+        assert!(orth <= tol, "orthogonality {orth:.2e}");
+    }
+}
