@@ -3,7 +3,8 @@
 //! methods alike; the median over the rounds and its ratio to dsygvd's median are printed.
 //!
 //! `OPENBLAS_CORETYPE=Haswell cargo bench -p mechanica-benches --bench modal_interleaved -- 1000 2000 4000`
-//! (sizes optional; rounds: `ROUNDS=7`, default 5). Problem: [`rotated_fixed_chain`].
+//! (sizes optional; rounds: `ROUNDS=7`, default 5). Problem: [`rotated_fixed_chain`]. Values-only
+//! rows are compared with `dsygvd` without vectors, the others with `dsygvd` with vectors.
 
 use mechanica::modal::{PencilProblem, Refinement, Residuals, SolveOptions, solve};
 use mechanica_benches::lapack;
@@ -33,24 +34,36 @@ fn main() {
         residuals,
         ..SolveOptions::default()
     };
-    let methods: [(&str, Option<SolveOptions>); 5] = [
+    let values_only = SolveOptions {
+        vectors: false,
+        refinement: Refinement::Off,
+        ..SolveOptions::default()
+    };
+    // (label, mechanica's options or None for LAPACK, whether vectors are computed)
+    let methods: [(&str, Option<SolveOptions>, bool); 7] = [
         (
             "mechanica all pairs (Auto, exact report)",
             Some(SolveOptions::default()),
+            true,
         ),
         (
             "mechanica all pairs (Auto, sketched report)",
             Some(mech(Refinement::Auto, Residuals::Sketched)),
+            true,
         ),
         (
             "mechanica all pairs (Off, exact report)",
             Some(mech(Refinement::Off, Residuals::Exact)),
+            true,
         ),
         (
             "mechanica all pairs (Off, sketched report)",
             Some(mech(Refinement::Off, Residuals::Sketched)),
+            true,
         ),
-        ("LAPACK dsygvd all pairs", None),
+        ("LAPACK dsygvd all pairs", None, true),
+        ("mechanica values only (Off, a-priori bounds)", Some(values_only), false),
+        ("LAPACK dsygvd values only", None, false),
     ];
     println!("| n | method | median s | ratio to dsygvd | min s | max s |");
     println!("|---|---|---|---|---|---|");
@@ -63,11 +76,11 @@ fn main() {
         let (ka, kb) = (to_col_major(b.as_ref()), to_col_major(a.as_ref()));
         let mut times = vec![Vec::new(); methods.len()];
         for _ in 0..rounds {
-            for (k, (_, options)) in methods.iter().enumerate() {
+            for (k, (_, options, vectors)) in methods.iter().enumerate() {
                 let clock = Instant::now();
                 let ok = match options {
                     Some(o) => std::hint::black_box(solve(&problem, o)).is_ok(),
-                    None => std::hint::black_box(lapack::dsygvd(&ka, &kb, n, true)).is_ok(),
+                    None => std::hint::black_box(lapack::dsygvd(&ka, &kb, n, *vectors)).is_ok(),
                 };
                 times[k].push(clock.elapsed().as_secs_f64());
                 if !ok {
@@ -77,8 +90,15 @@ fn main() {
                 std::thread::sleep(Duration::from_millis(200));
             }
         }
-        let lapack_median = median(times[methods.len() - 1].clone());
-        for (k, (label, _)) in methods.iter().enumerate() {
+        // Each mechanica row is compared with LAPACK computing the same (with or without vectors).
+        let lapack_median = |vectors: bool| {
+            let k = methods
+                .iter()
+                .position(|(_, o, v)| o.is_none() && *v == vectors)
+                .unwrap_or(methods.len() - 1);
+            median(times[k].clone())
+        };
+        for (k, (label, _, vectors)) in methods.iter().enumerate() {
             let t = &times[k];
             let (lo, hi) = (
                 t.iter().copied().fold(f64::INFINITY, f64::min),
@@ -87,7 +107,7 @@ fn main() {
             let m = median(t.clone());
             println!(
                 "| {n} | {label} | {m:.3} | {:.2} | {lo:.3} | {hi:.3} |",
-                m / lapack_median
+                m / lapack_median(*vectors)
             );
         }
     }
