@@ -7,6 +7,7 @@
 //! Numer. Anal. 9, 1972, in its simplest form). B₀₀ singular makes det(λA + B) ≡ 0.
 
 use crate::solve::{Finish, Method, ModalSolution, SolveOptions, solve_definite};
+use crate::symmetric_eigen::symmetric_eigen;
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par, Side};
 
@@ -22,10 +23,9 @@ pub(crate) fn solve_semidefinite(
     let (a, b) = (problem.a(), problem.b());
     let n = problem.dim();
     let clock = std::time::Instant::now();
-    let eig = a
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|_| ModalError::NoConvergence { n })?;
-    let values: Vec<f64> = (0..n).map(|i| eig.S()[i]).collect();
+    let eig = symmetric_eigen(a.to_owned(), true, par)?;
+    let values = eig.values;
+    let q = eig.vectors.ok_or(ModalError::NoConvergence { n })?;
     let amax = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let tolerance = 2.0 * n as f64 * f64::EPSILON * amax;
     if values[0] < -tolerance {
@@ -36,10 +36,9 @@ pub(crate) fn solve_semidefinite(
         });
     }
     let r = values.partition_point(|&v| v <= tolerance).max(1);
-    let q = eig.U();
     let q0 = q.subcols(0, r);
     let q1 = q.subcols(r, n - r);
-    let bq = q.transpose() * b * q;
+    let bq = q.transpose() * b * &q;
     let b00 = bq.as_ref().submatrix(0, 0, r, r).to_owned();
     let b10 = bq.as_ref().submatrix(r, 0, n - r, r).to_owned();
     let b11 = bq.as_ref().submatrix(r, r, n - r, n - r).to_owned();

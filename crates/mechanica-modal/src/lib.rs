@@ -7,8 +7,9 @@
 //! - **Sign convention.** det(λA + B) = 0 (8.89): an oscillatory mode has λ = −ω² < 0. Modes
 //!   are ordered by ω² = −λ ascending (unstable, rigid-body, oscillatory, infinite).
 //! - **Dense method** ([`solve`]): Cholesky A = LLᵀ, the symmetric reduction C = L⁻¹BL⁻ᵀ in
-//!   about n³ flops ([`reduce`], as LAPACK `dsygst`), faer's self-adjoint eigensolver,
-//!   X = L⁻ᵀY. faer's QZ (`generalized_eigen`) is not used: on this machine it loses accuracy
+//!   about n³ flops ([`reduce`], as LAPACK `dsygst`), the eigen-decomposition of C
+//!   ([`symmetric_eigen`]: this crate's blocked tridiagonalization, faer's tridiagonal divide
+//!   and conquer and blocked Householder application), X = L⁻ᵀY. faer's QZ (`generalized_eigen`) is not used: on this machine it loses accuracy
 //!   and speed at a few hundred unknowns (see `examples/faer_facts.rs`).
 //! - **Accuracy** ([`accuracy`]): per-pair backward error, ‖XᵀAX − I‖, a bound per eigenvalue
 //!   and a Sturm check with every solve. The residuals are exact by default (5n²m flops);

@@ -1,5 +1,5 @@
 //! The dense solver of det(λA + B) = 0 (8.89): Cholesky reduction to a standard symmetric
-//! problem, faer's self-adjoint eigensolver, back-transformation, an accuracy report, mode
+//! problem, its eigen-decomposition ([`crate::symmetric_eigen`]), back-transformation, an accuracy report, mode
 //! classification, grouping of repeated frequencies, static condensation of massless
 //! coordinates, and refinement of the low modes of stiff problems.
 //!
@@ -125,7 +125,7 @@ pub struct ModeGroup {
 /// How the modes were computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
-    /// Cholesky A = LLᵀ, C = L⁻¹BL⁻ᵀ, self-adjoint eigensolver, X = L⁻ᵀY.
+    /// Cholesky A = LLᵀ, C = L⁻¹BL⁻ᵀ, C = Y Λ Yᵀ ([`crate::symmetric_eigen`]), X = L⁻ᵀY.
     CholeskyReduction,
     /// Massless coordinates condensed out first (A semidefinite), then the reduction.
     CondensedReduction {
