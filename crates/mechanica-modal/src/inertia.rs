@@ -47,9 +47,15 @@ pub fn count_below(problem: &PencilProblem, shift: f64) -> Result<InertiaCount, 
 pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> bool {
     let (a, b) = (problem.a(), problem.b());
     // Only the lower triangle is formed and factored.
-    let mut k = Mat::from_fn(problem.dim(), problem.dim(), |i, j| {
-        if i >= j { b[(i, j)] - shift * a[(i, j)] } else { 0.0 }
-    });
+    let n = problem.dim();
+    let mut k = Mat::<f64>::zeros(n, n);
+    for j in 0..n {
+        let column = &mut k.col_as_slice_mut(j)[j..];
+        let (b_col, a_col) = (b.col(j).subrows(j, n - j), a.col(j).subrows(j, n - j));
+        for ((kij, bij), aij) in column.iter_mut().zip(b_col.iter()).zip(a_col.iter()) {
+            *kij = bij - shift * aij;
+        }
+    }
     crate::reduce::factor_in_place(k.as_mut(), par).is_ok()
 }
 

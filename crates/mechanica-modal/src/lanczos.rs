@@ -253,13 +253,21 @@ impl Lcg {
 /// lhs · rhs, sequential (faer's threaded kernels contend on a shared machine at these sizes).
 fn product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) -> Mat<f64> {
     let mut out = Mat::<f64>::zeros(lhs.nrows(), rhs.ncols());
-    faer::linalg::matmul::matmul(out.as_mut(), faer::Accum::Replace, lhs, rhs, 1.0, Par::Seq);
+    product_to(out.as_mut(), lhs, rhs);
     out
 }
 
 /// out ← lhs · rhs, with `out` the column-major storage of the product (sequential).
 fn product_into(out: &mut [f64], lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) {
-    let target = MatMut::from_column_major_slice_mut(out, lhs.nrows(), rhs.ncols());
+    product_to(
+        MatMut::from_column_major_slice_mut(out, lhs.nrows(), rhs.ncols()),
+        lhs,
+        rhs,
+    );
+}
+
+/// target ← lhs · rhs, sequential.
+fn product_to(target: MatMut<'_, f64>, lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>) {
     faer::linalg::matmul::matmul(target, faer::Accum::Replace, lhs, rhs, 1.0, Par::Seq);
 }
 
@@ -1041,39 +1049,49 @@ fn pair_residuals(
     two_threads: bool,
 ) -> PairResiduals {
     let cols = refined.omega_sq.len();
-    let clock = Instant::now();
     let (symbolic, values) = (op.symbolic, op.values.as_slice());
-    let residuals = if two_threads && cols > 1 {
+    let max_row = row_lengths(pencil.a()).max(row_lengths(pencil.b())) as f64;
+    let shared = ResidualInputs {
+        pencil,
+        factor: (symbolic, values),
+        refined,
+        sigma,
+        norms,
+        max_row,
+    };
+    let (residuals, solve_time) = if two_threads && cols > 1 {
         let half = cols / 2;
-        let mut work = Vec::new();
-        let (mut first, second) = std::thread::scope(|scope| {
-            let second = scope.spawn(|| {
-                let mut work = Vec::new();
-                residuals_of(pencil, (symbolic, values), refined, sigma, norms, half..cols, &mut work)
-            });
-            let first = residuals_of(pencil, (symbolic, values), refined, sigma, norms, 0..half, &mut work);
+        let work = &mut op.work;
+        let (first, second) = std::thread::scope(|scope| {
+            let second = scope.spawn(|| residuals_of(&shared, half..cols, &mut Vec::new()));
+            let first = residuals_of(&shared, 0..half, work);
             (first, second.join())
         });
-        match second {
-            Ok(second) => first.append(second),
-            // (A panic on the second thread is a bug; the pairs are then redone here.)
-            Err(_) => first.append(residuals_of(
-                pencil,
-                (symbolic, values),
-                refined,
-                sigma,
-                norms,
-                half..cols,
-                &mut work,
-            )),
-        }
-        first
+        // (A panic on the second thread is a bug; the pairs are then redone here.)
+        let second = second.unwrap_or_else(|_| residuals_of(&shared, half..cols, work));
+        let ((mut first, first_time), (second, second_time)) = (first, second);
+        first.append(second);
+        // The two halves' solves ran at the same time: the stage took the longer one.
+        (first, first_time.max(second_time))
     } else {
-        residuals_of(pencil, (symbolic, values), refined, sigma, norms, 0..cols, &mut op.work)
+        residuals_of(&shared, 0..cols, &mut op.work)
     };
     op.applications += cols;
-    op.solve_time += clock.elapsed();
+    op.solve_time += solve_time;
     residuals
+}
+
+/// What every range of [`residuals_of`] reads.
+struct ResidualInputs<'a> {
+    pencil: &'a SparsePencil,
+    /// The symbolic and numeric Cholesky factor of K.
+    factor: (&'a SymbolicCholesky<usize>, &'a [f64]),
+    refined: &'a Refined,
+    sigma: f64,
+    /// (‖A‖_F, ‖B‖_F).
+    norms: (f64, f64),
+    /// The longest row of A or B (entries), for the rounding term.
+    max_row: f64,
 }
 
 impl PairResiduals {
@@ -1088,20 +1106,23 @@ impl PairResiduals {
 }
 
 /// [`pair_residuals`] of the refined pairs in `range`, their residuals solved in one block with
-/// the factor of K.
+/// the factor of K; also returns the wall time of that solve.
 fn residuals_of(
-    pencil: &SparsePencil,
-    (symbolic, values): (&SymbolicCholesky<usize>, &[f64]),
-    refined: &Refined,
-    sigma: f64,
-    (norm_a, norm_b): (f64, f64),
+    inputs: &ResidualInputs<'_>,
     range: std::ops::Range<usize>,
     work: &mut Vec<f64>,
-) -> PairResiduals {
+) -> (PairResiduals, Duration) {
+    let ResidualInputs {
+        pencil,
+        factor: (symbolic, values),
+        refined,
+        sigma,
+        norms: (norm_a, norm_b),
+        max_row,
+    } = *inputs;
     let n = pencil.dim();
     let (a, b) = (pencil.a(), pencil.b());
     let cols = range.len();
-    let max_row = row_lengths(a).max(row_lengths(b)) as f64;
     let mut theta = vec![0.0; cols];
     let mut delta = vec![0.0; cols];
     let mut eta = vec![0.0; cols];
@@ -1140,19 +1161,22 @@ fn residuals_of(
             + max_row * f64::EPSILON * f64::EPSILON * (abs_quadratic(b, x) + w.abs() * abs_quadratic(a, x)) / xax;
     }
     let mut solved = residuals.clone();
+    let clock = Instant::now();
     solve_with(symbolic, values, &mut solved, cols, work);
+    let solve_time = clock.elapsed();
     for c in 0..cols {
         let sc = &residuals[n * c..n * (c + 1)];
         let kc = &solved[n * c..n * (c + 1)];
         delta[c] = (dot(sc, kc).max(0.0) / xkx[c].max(f64::MIN_POSITIVE)).sqrt();
     }
-    PairResiduals {
+    let residuals = PairResiduals {
         omega_sq,
         theta,
         delta,
         eta,
         rounding,
-    }
+    };
+    (residuals, solve_time)
 }
 
 /// Bounds, classification and the report for the lowest k refined modes, from their residuals
