@@ -53,6 +53,8 @@ pub mod sparse_inertia;
 pub mod sparse_pencil;
 mod supernodal_solve;
 pub mod symmetric_eigen;
+mod symv_team;
+mod tridiagonal_values;
 
 pub use accuracy::{AccuracyReport, BoundKind, Residuals};
 pub use error::ModalError;

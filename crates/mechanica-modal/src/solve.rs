@@ -11,7 +11,7 @@ use crate::accuracy::{self, AccuracyReport, Residuals};
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
 use crate::refine::{ReducedSpectrum, refine_pair, refine_pair_spectral};
-use crate::symmetric_eigen::symmetric_eigen;
+use crate::symmetric_eigen::symmetric_eigen_returning_input;
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
 use std::time::{Duration, Instant};
@@ -227,13 +227,15 @@ pub(crate) fn solve_definite(
         ..DenseTimings::default()
     };
     let clock = Instant::now();
-    let eigen = symmetric_eigen(c, vectors, par)?;
+    let (eigen, mut spent) = symmetric_eigen_returning_input(c, vectors, par)?;
     let omega_sq = eigen.values;
     let (first, end) = select(&omega_sq, selection)?;
     let vectors = eigen.vectors.map(|y| {
-        let mut x = y.subcols(first, end - first).to_owned();
-        back_transform(l, x.as_mut(), par);
-        (x, y)
+        // X = L⁻ᵀ Y(:, first..end), written into the reduced matrix's spent storage.
+        spent.truncate(n, end - first);
+        spent.copy_from(y.subcols(first, end - first));
+        back_transform(l, spent.as_mut(), par);
+        (spent, y)
     });
     timings.eigen = clock.elapsed();
     let (vectors, reduced) = match vectors {

@@ -1,0 +1,167 @@
+//! A second thread for the symmetric matrix-vector products of one tridiagonalization
+//! ([`crate::symmetric_eigen`]): the panel reduction needs one product per column, each a few
+//! tens of microseconds at orders 1000–2000, and a pool thread that has gone to sleep between
+//! them takes about as long to wake. The team's helper waits for the next column by spinning
+//! (then parking, so that it leaves the core to the pool during the trailing updates), and a
+//! half that it has not claimed yet when the caller's own half is done is computed by the
+//! caller instead, so a late helper never delays a product.
+
+use faer::Mat;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
+use std::thread::Thread;
+use std::time::{Duration, Instant};
+
+/// How long the helper spins for the next job before it parks.
+const SPIN: Duration = Duration::from_micros(200);
+
+/// One posted job: the columns `start..end` of S = A(q.., q..) times the reflector A(q.., q − 1).
+struct Job {
+    matrix: AtomicPtr<Mat<f64>>,
+    q: AtomicUsize,
+    start: AtomicUsize,
+    end: AtomicUsize,
+}
+
+/// The state shared by the caller and the helper. Jobs are numbered 1, 2, …; job g is posted
+/// when `posted` = g, owned by whoever moves `claimed` from g − 1 to g, and done by the helper
+/// when `finished` = g.
+pub(crate) struct SymvTeam {
+    job: Job,
+    posted: AtomicUsize,
+    claimed: AtomicUsize,
+    finished: AtomicUsize,
+    stop: AtomicBool,
+    /// Whether the helper's last job completed (false after a panic in it, a bug).
+    helper_ok: AtomicBool,
+    /// The helper's partial product.
+    partial: Mutex<Vec<f64>>,
+}
+
+/// The kernel both threads run: adds columns `cols` of S = A(q.., q..) times v = A(q.., q − 1)
+/// to `y` (see `symmetric_eigen::symv_columns`).
+pub(crate) type Kernel = fn(&Mat<f64>, usize, std::ops::Range<usize>, &[f64], &mut [f64]);
+
+impl SymvTeam {
+    pub(crate) fn new() -> Self {
+        Self {
+            job: Job {
+                matrix: AtomicPtr::new(std::ptr::null_mut()),
+                q: AtomicUsize::new(0),
+                start: AtomicUsize::new(0),
+                end: AtomicUsize::new(0),
+            },
+            posted: AtomicUsize::new(0),
+            claimed: AtomicUsize::new(0),
+            finished: AtomicUsize::new(0),
+            stop: AtomicBool::new(false),
+            helper_ok: AtomicBool::new(true),
+            partial: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The helper's loop: run until [`SymvTeam::stop`].
+    pub(crate) fn serve(&self, kernel: Kernel) {
+        let mut seen = 0;
+        loop {
+            let since = Instant::now();
+            let mut spins = 0_u32;
+            let posted = loop {
+                if self.stop.load(Ordering::Acquire) {
+                    return;
+                }
+                let posted = self.posted.load(Ordering::Acquire);
+                if posted != seen {
+                    break posted;
+                }
+                spins = spins.wrapping_add(1);
+                if spins.is_multiple_of(256) && since.elapsed() > SPIN {
+                    std::thread::park();
+                } else {
+                    std::hint::spin_loop();
+                }
+            };
+            seen = posted;
+            if self
+                .claimed
+                .compare_exchange(posted - 1, posted, Ordering::AcqRel, Ordering::Acquire)
+                .is_err()
+            {
+                continue; // the caller took this job itself
+            }
+            let q = self.job.q.load(Ordering::Acquire);
+            let cols = self.job.start.load(Ordering::Acquire)..self.job.end.load(Ordering::Acquire);
+            // SAFETY: the pointer was made from a live `&Mat` by `product` just before it posted
+            // this job, and the caller neither writes to the matrix nor returns from `product`
+            // until `finished` reaches this job (or it claimed the job itself, which failed here).
+            let a = unsafe { &*self.job.matrix.load(Ordering::Acquire) };
+            let m = a.nrows() - q;
+            let run = || {
+                let mut partial = self.partial.lock().map_err(|_| ())?;
+                partial.clear();
+                partial.resize(m, 0.0);
+                kernel(a, q, cols, &a.col_as_slice(q - 1)[q..], &mut partial);
+                Ok::<(), ()>(())
+            };
+            let ok = matches!(std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)), Ok(Ok(())));
+            self.helper_ok.store(ok, Ordering::Release);
+            self.finished.store(posted, Ordering::Release);
+        }
+    }
+
+    /// Ends the helper's loop (`helper` is its thread, which may be parked).
+    pub(crate) fn stop(&self, helper: &Thread) {
+        self.stop.store(true, Ordering::Release);
+        helper.unpark();
+    }
+
+    /// y = S v for S = A(q.., q..), v = A(q.., q − 1): columns `split..` go to the helper,
+    /// `..split` are computed here; y is overwritten.
+    pub(crate) fn product(&self, helper: &Thread, kernel: Kernel, a: &Mat<f64>, q: usize, split: usize, y: &mut [f64]) {
+        let m = a.nrows() - q;
+        let job = self.posted.load(Ordering::Relaxed) + 1;
+        self.job
+            .matrix
+            .store(std::ptr::from_ref(a).cast_mut(), Ordering::Release);
+        self.job.q.store(q, Ordering::Release);
+        self.job.start.store(split, Ordering::Release);
+        self.job.end.store(m, Ordering::Release);
+        self.posted.store(job, Ordering::Release);
+        helper.unpark();
+        let v = &a.col_as_slice(q - 1)[q..];
+        y.iter_mut().for_each(|e| *e = 0.0);
+        kernel(a, q, 0..split, v, y);
+        if self
+            .claimed
+            .compare_exchange(job - 1, job, Ordering::AcqRel, Ordering::Acquire)
+            .is_ok()
+        {
+            // The helper has not started: its half is computed here, into the same separate
+            // partial sum, so that y is bitwise the same whichever thread did the work.
+            let mut partial = vec![0.0; m];
+            kernel(a, q, split..m, v, &mut partial);
+            y.iter_mut().zip(&partial).for_each(|(e, p)| *e += p);
+            return;
+        }
+        let mut spins = 0_u32;
+        while self.finished.load(Ordering::Acquire) != job {
+            spins = spins.wrapping_add(1);
+            if spins.is_multiple_of(4096) {
+                std::thread::yield_now();
+            } else {
+                std::hint::spin_loop();
+            }
+        }
+        match self.partial.lock() {
+            Ok(partial) if self.helper_ok.load(Ordering::Acquire) => {
+                y.iter_mut().zip(partial.iter()).for_each(|(e, p)| *e += p);
+            }
+            // The helper failed (a bug): its half is computed here, so the product stays right.
+            _ => {
+                let mut partial = vec![0.0; m];
+                kernel(a, q, split..m, v, &mut partial);
+                y.iter_mut().zip(&partial).for_each(|(e, p)| *e += p);
+            }
+        }
+    }
+}
