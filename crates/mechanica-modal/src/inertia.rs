@@ -44,11 +44,15 @@ pub fn count_below(problem: &PencilProblem, shift: f64) -> Result<InertiaCount, 
 /// Whether every mode has ω² > `shift`: B − shift·A is positive definite to working precision
 /// (its Cholesky factorization succeeds with no negligible pivot). The count 0 it certifies
 /// costs a third of the LBLᵀ of [`count_below`] (n³/3 flops at Cholesky speed).
-pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> bool {
+/// `spare` is a matrix whose storage may be reused (any contents).
+pub(crate) fn all_above(problem: &PencilProblem, shift: f64, spare: Option<Mat<f64>>, par: faer::Par) -> bool {
     let (a, b) = (problem.a(), problem.b());
     // Only the lower triangle is formed and factored.
     let n = problem.dim();
-    let mut k = Mat::<f64>::zeros(n, n);
+    let mut k = match spare {
+        Some(m) if m.nrows() == n && m.ncols() == n => m,
+        _ => Mat::<f64>::zeros(n, n),
+    };
     for j in 0..n {
         let column = &mut k.col_as_slice_mut(j)[j..];
         let (b_col, a_col) = (b.col(j).subrows(j, n - j), a.col(j).subrows(j, n - j));

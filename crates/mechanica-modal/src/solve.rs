@@ -425,13 +425,15 @@ impl Finish<'_> {
         }
         timings.accuracy += clock.elapsed();
         let clock = Instant::now();
+        // The reduced eigenvectors are no longer needed: their storage takes the certificate's
+        // matrix (a fresh n×n allocation costs its page faults).
         report.inertia_check = inertia_check(
             self.problem,
             &omega_all,
-            def.first,
-            def.end,
+            (def.first, def.end),
             &report.error_bounds,
             lift,
+            def.reduced,
             self.par,
         )?;
         timings.inertia = clock.elapsed();
@@ -541,7 +543,8 @@ pub(crate) fn group_modes(modes: &mut [Mode]) -> Vec<ModeGroup> {
     groups
 }
 
-/// The Sturm check of a solve. With every mode selected it first tries the cheap certificate
+/// The Sturm check of a solve (`spare`: an unused matrix whose storage it may take). With every
+/// mode selected it first tries the cheap certificate
 /// that B − sA is positive definite for s just below the lowest computed ω² (by half its size or
 /// twice its bound): nothing was missed at the bottom of the spectrum, where stability is
 /// decided. Otherwise, or when that Cholesky fails, it places a shift in the widest gap next to
@@ -550,10 +553,10 @@ pub(crate) fn group_modes(modes: &mut [Mode]) -> Vec<ModeGroup> {
 fn inertia_check(
     problem: &PencilProblem,
     omega_all: &[f64],
-    first: usize,
-    end: usize,
+    (first, end): (usize, usize),
     bounds: &[f64],
     lift: Option<Lift<'_>>,
+    spare: Option<Mat<f64>>,
     par: Par,
 ) -> Result<Option<InertiaCheck>, ModalError> {
     // With a condensed pencil the count of B − sA mixes in the massless directions; skip it.
@@ -566,7 +569,7 @@ fn inertia_check(
         // instability, below the lowest computed ω²) with a Cholesky factorization.
         let lowest = omega_all[0];
         let shift = lowest - (0.5 * lowest.abs()).max(2.0 * bounds[0]);
-        if shift < lowest && all_above(problem, shift, par) {
+        if shift < lowest && all_above(problem, shift, spare, par) {
             return Ok(Some(InertiaCheck {
                 count: InertiaCount {
                     shift,
