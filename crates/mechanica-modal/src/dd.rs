@@ -134,21 +134,43 @@ impl Dd {
 /// Σ_j m[i, j]·x[j] in double-double, for every row i (the product M x as if computed in twice
 /// the working precision, then kept unrounded). Accumulated column by column into separate
 /// high and low parts, which vectorises; on CPUs with FMA and AVX2 the same operations run four
-/// rows per instruction (both products are exact, so results are identical).
+/// rows per instruction (both products are exact, so results are identical). From
+/// [`PARALLEL_ROWS_FROM`] rows, when faer's global parallelism allows two threads, the two
+/// halves of the rows are accumulated on two threads (each row's sum is unchanged, so the
+/// result is bitwise the same).
 pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     let n = m.nrows();
     let (mut hi, mut lo) = (vec![0.0; n], vec![0.0; n]);
+    if n >= PARALLEL_ROWS_FROM && faer::get_global_parallelism().degree() >= 2 {
+        let half = n / 2;
+        let (hi_top, hi_bottom) = hi.split_at_mut(half);
+        let (lo_top, lo_bottom) = lo.split_at_mut(half);
+        std::thread::scope(|scope| {
+            scope.spawn(|| accumulate_rows(m.subrows(half, n - half), x, hi_bottom, lo_bottom));
+            accumulate_rows(m.subrows(0, half), x, hi_top, lo_top);
+        });
+    } else {
+        accumulate_rows(m, x, &mut hi, &mut lo);
+    }
+    hi.into_iter().zip(lo).map(|(hi, lo)| Dd { hi, lo }).collect()
+}
+
+/// Orders from which [`mat_vec`] splits its rows between two threads (a thread costs tens of
+/// microseconds; the product of an order-1000 matrix takes milliseconds).
+const PARALLEL_ROWS_FROM: usize = 1000;
+
+/// hi + lo += M x with the fastest exact kernel the CPU has.
+fn accumulate_rows(m: MatRef<'_, f64>, x: &[f64], hi: &mut [f64], lo: &mut [f64]) {
     #[cfg(target_arch = "x86_64")]
     {
         if fused_available() {
             // SAFETY: the running CPU supports FMA and AVX2, checked just above; the function
             // has no other requirement.
-            unsafe { accumulate_fma(m, x, &mut hi, &mut lo) };
-            return hi.into_iter().zip(lo).map(|(hi, lo)| Dd { hi, lo }).collect();
+            unsafe { accumulate_fma(m, x, hi, lo) };
+            return;
         }
     }
-    accumulate(m, x, &mut hi, &mut lo, two_prod);
-    hi.into_iter().zip(lo).map(|(hi, lo)| Dd { hi, lo }).collect()
+    accumulate(m, x, hi, lo, two_prod);
 }
 
 /// [`accumulate`] compiled for FMA and AVX2.
@@ -347,5 +369,20 @@ mod tests {
         // Row 0: (1e12 + 1)(1 + u) − 1e12 = 1 + u + 1e12·u exactly.
         let expected = 1.0 + f64::EPSILON + 1e12 * f64::EPSILON;
         assert!((y[0].to_f64() - expected).abs() <= 2.0 * f64::EPSILON * expected);
+    }
+
+    #[test]
+    fn rows_on_two_threads_change_no_bit() {
+        let n = PARALLEL_ROWS_FROM + 37;
+        let m = faer::Mat::from_fn(n, n, |i, j| {
+            ((i * 31 + j * 17) % 97) as f64 / 7.0 - 6.0 + 1e-9 * j as f64
+        });
+        let x: Vec<f64> = (0..n).map(|j| ((j * 13) % 29) as f64 / 3.0 - 4.5).collect();
+        let split = mat_vec(m.as_ref(), &x);
+        let (mut hi, mut lo) = (vec![0.0; n], vec![0.0; n]);
+        accumulate_rows(m.as_ref(), &x, &mut hi, &mut lo);
+        for i in 0..n {
+            assert_eq!((split[i].hi, split[i].lo), (hi[i], lo[i]), "row {i}");
+        }
     }
 }
