@@ -145,10 +145,16 @@ pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
         let half = n / 2;
         let (hi_top, hi_bottom) = hi.split_at_mut(half);
         let (lo_top, lo_bottom) = lo.split_at_mut(half);
-        std::thread::scope(|scope| {
-            scope.spawn(|| accumulate_rows(m.subrows(half, n - half), x, hi_bottom, lo_bottom));
+        let bottom = move || accumulate_rows(m.subrows(half, n - half), x, hi_bottom, lo_bottom);
+        let spawned = std::thread::scope(|scope| {
+            let spawned = std::thread::Builder::new().spawn_scoped(scope, bottom).is_ok();
             accumulate_rows(m.subrows(0, half), x, hi_top, lo_top);
+            spawned
         });
+        if !spawned {
+            // No thread could be created: the bottom half here too.
+            accumulate_rows(m.subrows(half, n - half), x, &mut hi[half..], &mut lo[half..]);
+        }
     } else {
         accumulate_rows(m, x, &mut hi, &mut lo);
     }

@@ -838,7 +838,9 @@ fn solve_sparse_from(
         let mut start_count = |theta: &[f64]| {
             let omega: Vec<f64> = theta.iter().map(|t| sigma + 1.0 / t).collect();
             let tau = choose_tau(&omega);
-            pending = Some((tau, scope.spawn(move || count_at(tau))));
+            // (Should no thread be creatable, the count is done after the run instead.)
+            let counting = std::thread::Builder::new().spawn_scoped(scope, move || count_at(tau));
+            pending = counting.ok().map(|handle| (tau, handle));
         };
         let run = lanczos_run(
             &mut op,
@@ -890,9 +892,13 @@ fn solve_sparse_from(
                     let tau = choose_tau(omega);
                     if concurrent {
                         std::thread::scope(|scope| {
-                            let counting = scope.spawn(|| count_at(tau));
-                            let residuals = residuals(&mut op, false);
-                            (tau, joined(counting.join()), residuals)
+                            match std::thread::Builder::new().spawn_scoped(scope, || count_at(tau)) {
+                                Ok(counting) => {
+                                    let residuals = residuals(&mut op, false);
+                                    (tau, joined(counting.join()), residuals)
+                                }
+                                Err(_) => (tau, count_at(tau), residuals(&mut op, false)),
+                            }
                         })
                     } else {
                         (tau, count_at(tau), residuals(&mut op, false))
@@ -1063,12 +1069,13 @@ fn pair_residuals(
         let half = cols / 2;
         let work = &mut op.work;
         let (first, second) = std::thread::scope(|scope| {
-            let second = scope.spawn(|| residuals_of(&shared, half..cols, &mut Vec::new()));
+            let second =
+                std::thread::Builder::new().spawn_scoped(scope, || residuals_of(&shared, half..cols, &mut Vec::new()));
             let first = residuals_of(&shared, 0..half, work);
-            (first, second.join())
+            (first, second.ok().and_then(|s| s.join().ok()))
         });
-        // (A panic on the second thread is a bug; the pairs are then redone here.)
-        let second = second.unwrap_or_else(|_| residuals_of(&shared, half..cols, work));
+        // (No thread could be created, or it panicked, a bug: the pairs are then done here.)
+        let second = second.unwrap_or_else(|| residuals_of(&shared, half..cols, work));
         let ((mut first, first_time), (second, second_time)) = (first, second);
         first.append(second);
         // The two halves' solves ran at the same time: the stage took the longer one.

@@ -177,10 +177,15 @@ fn tridiagonalize(a: &mut Mat<f64>, par: Par) -> Tridiagonal {
     } else {
         let team = SymvTeam::new();
         std::thread::scope(|scope| {
-            let helper = scope.spawn(|| team.serve(symv_columns));
-            let helper = helper.thread().clone();
-            reduce_panels(a, &mut t, Some((&team, &helper)), par);
-            team.stop(&helper);
+            match std::thread::Builder::new().spawn_scoped(scope, || team.serve(symv_columns)) {
+                Ok(helper) => {
+                    let helper = helper.thread().clone();
+                    reduce_panels(a, &mut t, Some((&team, &helper)), par);
+                    team.stop(&helper);
+                }
+                // No thread could be created: one thread does it all.
+                Err(_) => reduce_panels(a, &mut t, None, par),
+            }
         });
     }
     t.diag[n - 1] = a[(n - 1, n - 1)];
