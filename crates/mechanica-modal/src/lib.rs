@@ -9,7 +9,8 @@
 //! - **Dense method** ([`solve`]): Cholesky A = LLᵀ, the symmetric reduction C = L⁻¹BL⁻ᵀ in
 //!   about n³ flops ([`reduce`], as LAPACK `dsygst`), the eigen-decomposition of C
 //!   ([`symmetric_eigen`]: this crate's blocked tridiagonalization, faer's tridiagonal divide
-//!   and conquer and blocked Householder application), X = L⁻ᵀY. faer's QZ (`generalized_eigen`) is not used: on this machine it loses accuracy
+//!   and conquer and blocked Householder application; values only by this crate's root-free
+//!   QL/QR), X = L⁻ᵀY. faer's QZ (`generalized_eigen`) is not used: on this machine it loses accuracy
 //!   and speed at a few hundred unknowns (see `examples/faer_facts.rs`).
 //! - **Accuracy** ([`accuracy`]): per-pair backward error, ‖XᵀAX − I‖, a bound per eigenvalue
 //!   and a Sturm check with every solve. The residuals are exact by default (5n²m flops);
