@@ -12,7 +12,8 @@ use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
 use std::thread::Thread;
 use std::time::{Duration, Instant};
 
-/// How long the helper spins for the next job before it parks.
+/// How long the helper spins for the next job before it parks (measured: 20 µs and 2 ms were
+/// no faster at n = 1000–2000, 2 ms slower at 1000).
 const SPIN: Duration = Duration::from_micros(200);
 
 /// One posted job: the columns `start..end` of S = A(q.., q..) times the reflector A(q.., q − 1).
