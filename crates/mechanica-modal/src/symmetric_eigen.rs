@@ -180,8 +180,9 @@ fn tridiagonalize(a: &mut Mat<f64>, par: Par) -> Tridiagonal {
             match std::thread::Builder::new().spawn_scoped(scope, || team.serve(symv_columns)) {
                 Ok(helper) => {
                     let helper = helper.thread().clone();
+                    // Stopped on every exit, also by unwinding: the scope joins the helper.
+                    let _stop = team.stop_on_drop(&helper);
                     reduce_panels(a, &mut t, Some((&team, &helper)), par);
-                    team.stop(&helper);
                 }
                 // No thread could be created: one thread does it all.
                 Err(_) => reduce_panels(a, &mut t, None, par),

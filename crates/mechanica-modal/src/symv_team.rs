@@ -116,6 +116,12 @@ impl SymvTeam {
         helper.unpark();
     }
 
+    /// A guard that calls [`SymvTeam::stop`] when dropped, so that a panic in the caller's
+    /// work cannot leave the helper waiting forever (and the enclosing scope joining it).
+    pub(crate) fn stop_on_drop<'a>(&'a self, helper: &'a Thread) -> StopOnDrop<'a> {
+        StopOnDrop { team: self, helper }
+    }
+
     /// y = S v for S = A(q.., q..), v = A(q.., q − 1): columns `split..` go to the helper,
     /// `..split` are computed here; y is overwritten.
     pub(crate) fn product(&self, helper: &Thread, kernel: Kernel, a: &Mat<f64>, q: usize, split: usize, y: &mut [f64]) {
@@ -164,5 +170,39 @@ impl SymvTeam {
                 y.iter_mut().zip(&partial).for_each(|(e, p)| *e += p);
             }
         }
+    }
+}
+
+/// See [`SymvTeam::stop_on_drop`].
+pub(crate) struct StopOnDrop<'a> {
+    team: &'a SymvTeam,
+    helper: &'a Thread,
+}
+
+impl Drop for StopOnDrop<'_> {
+    fn drop(&mut self) {
+        self.team.stop(self.helper);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn no_work(_: &Mat<f64>, _: usize, _: std::ops::Range<usize>, _: &[f64], _: &mut [f64]) {}
+
+    #[test]
+    fn a_panic_in_the_caller_stops_the_helper() {
+        // Without the guard the scope would wait forever for the helper; with it the panic
+        // comes back out (and this test returns).
+        let team = SymvTeam::new();
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            std::thread::scope(|scope| {
+                let helper = scope.spawn(|| team.serve(no_work)).thread().clone();
+                let _stop = team.stop_on_drop(&helper);
+                panic!("a deliberate failure in the caller's work");
+            })
+        }));
+        assert!(outcome.is_err());
     }
 }
