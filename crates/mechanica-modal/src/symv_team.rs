@@ -138,17 +138,20 @@ impl SymvTeam {
         let v = &a.col_as_slice(q - 1)[q..];
         y.iter_mut().for_each(|e| *e = 0.0);
         kernel(a, q, 0..split, v, y);
+        // The helper's half computed here, into a separate partial sum as the helper does, so
+        // that y is bitwise the same whichever thread did the work.
+        let second_half_here = |y: &mut [f64]| {
+            let mut partial = vec![0.0; m];
+            kernel(a, q, split..m, v, &mut partial);
+            y.iter_mut().zip(&partial).for_each(|(e, p)| *e += p);
+        };
         if self
             .claimed
             .compare_exchange(job - 1, job, Ordering::AcqRel, Ordering::Acquire)
             .is_ok()
         {
-            // The helper has not started: its half is computed here, into the same separate
-            // partial sum, so that y is bitwise the same whichever thread did the work.
-            let mut partial = vec![0.0; m];
-            kernel(a, q, split..m, v, &mut partial);
-            y.iter_mut().zip(&partial).for_each(|(e, p)| *e += p);
-            return;
+            // The helper has not started.
+            return second_half_here(y);
         }
         let mut spins = 0_u32;
         while self.finished.load(Ordering::Acquire) != job {
@@ -164,11 +167,7 @@ impl SymvTeam {
                 y.iter_mut().zip(partial.iter()).for_each(|(e, p)| *e += p);
             }
             // The helper failed (a bug): its half is computed here, so the product stays right.
-            _ => {
-                let mut partial = vec![0.0; m];
-                kernel(a, q, split..m, v, &mut partial);
-                y.iter_mut().zip(&partial).for_each(|(e, p)| *e += p);
-            }
+            _ => second_half_here(y),
         }
     }
 }
