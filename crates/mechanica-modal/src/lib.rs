@@ -56,6 +56,8 @@ mod supernodal_solve;
 pub mod symmetric_eigen;
 mod symv_team;
 mod tridiagonal_values;
+mod tridiagonal_vectors;
+mod values_only;
 
 pub use accuracy::{AccuracyReport, BoundKind, Residuals};
 pub use error::ModalError;

@@ -16,6 +16,8 @@
 //! bound from the reduction exceeds 1e-8·|ω²| (fewer than 8 guaranteed digits).
 
 use crate::dd::{Dd, dot, mat_vec};
+use crate::symmetric_eigen::TridiagonalForm;
+use crate::tridiagonal_vectors::{ShiftedTridiagonal, one_norm};
 use faer::linalg::solvers::Solve;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Mat, MatRef, Par, Side};
@@ -86,57 +88,112 @@ pub(crate) fn refine_pair(
     finish_pair(a, b, l, x, steps)
 }
 
+/// The correction of [`refine_pair_projected`]: an approximate inverse of C − ρI on the
+/// complement of the refined mode, C = L⁻¹BL⁻ᵀ, applied in the reduced coordinates.
+pub(crate) trait ReducedCorrection {
+    /// Σ_{j≠i} y_j (y_jᵀw)/(ω̃²_j − ρ) for the computed eigenpairs (ω̃²_j, y_j) of C.
+    fn apply(&mut self, w: Mat<f64>, rho: f64) -> Mat<f64>;
+}
+
 /// The reduced problem's spectrum C = Y diag(ω²) Yᵀ, C = L⁻¹BL⁻ᵀ, A = LLᵀ: an approximate
 /// inverse of B − ρA that costs O(n²) to apply, so refinement needs no new factorization.
 pub(crate) struct ReducedSpectrum<'a> {
-    /// Cholesky factor of A.
-    pub l: MatRef<'a, f64>,
     /// All n orthonormal eigenvectors of C.
     pub y: MatRef<'a, f64>,
     /// All n eigenvalues of C (ω², ascending).
     pub omega_sq: &'a [f64],
+    /// The mode being refined.
+    pub mode: usize,
 }
 
-/// Maximum steps of [`refine_pair_spectral`] before it gives up.
-pub const MAX_SPECTRAL_STEPS: usize = 8;
+impl ReducedCorrection for ReducedSpectrum<'_> {
+    fn apply(&mut self, w: Mat<f64>, rho: f64) -> Mat<f64> {
+        let mut c = self.y.transpose() * &w;
+        for j in 0..c.nrows() {
+            let gap = self.omega_sq[j] - rho;
+            c[(j, 0)] = if j == self.mode || gap == 0.0 {
+                0.0
+            } else {
+                c[(j, 0)] / gap
+            };
+        }
+        self.y * &c
+    }
+}
+
+/// The reduced problem in tridiagonal form C = Q T Qᵀ with one eigenvector z of T (unit): the
+/// correction of a values-only solve, which has no Y. The same operator as
+/// [`ReducedSpectrum`] evaluated as Q P (T − ρI)⁻¹ P Qᵀ with P = I − z zᵀ: the shifted
+/// tridiagonal solve is nearly singular at ρ ≈ θ, but its error lies almost entirely along z
+/// (Wilkinson, "The Algebraic Eigenvalue Problem", §5.56), which the second projection removes.
+pub(crate) struct TridiagonalCorrection<'a> {
+    /// T and Q.
+    pub form: &'a mut TridiagonalForm,
+    /// The refined mode's unit eigenvector of T.
+    pub z: &'a [f64],
+}
+
+impl ReducedCorrection for TridiagonalCorrection<'_> {
+    fn apply(&mut self, mut w: Mat<f64>, rho: f64) -> Mat<f64> {
+        let n = w.nrows();
+        self.form.apply_q_transpose(w.as_mut());
+        let u = w.col_as_slice_mut(0);
+        project_out(u, self.z);
+        let (diag, subdiag) = (self.form.diag(), self.form.subdiag());
+        let tiny = f64::EPSILON * one_norm(diag, subdiag);
+        let shrunk = ShiftedTridiagonal::new(diag, subdiag, rho, tiny).solve_in_place(u);
+        if shrunk != 1.0 {
+            // Growth beyond 1e150: no usable correction (the caller sees non-finite values).
+            u.iter_mut().for_each(|v| *v = f64::NAN);
+            return w;
+        }
+        project_out(u, self.z);
+        debug_assert_eq!(u.len(), n);
+        self.form.apply_q(w.as_mut());
+        w
+    }
+}
+
+/// u ← u − z (zᵀu) for a unit z.
+fn project_out(u: &mut [f64], z: &[f64]) {
+    let overlap: f64 = u.iter().zip(z).map(|(p, q)| p * q).sum();
+    u.iter_mut().zip(z).for_each(|(p, q)| *p -= overlap * q);
+}
+
+/// Maximum steps of [`refine_pair_projected`] before it gives up.
+pub const MAX_PROJECTED_STEPS: usize = 8;
 
 /// A correction below this many ulps of x that no longer halves has reached rounding level:
 /// the iteration stops there (the bound comes from the final residual either way).
 const STAGNATION_ULPS: f64 = 16.0;
 
-/// Refines the simple pair (ω²_i, x₀) by Rayleigh-quotient steps with a spectral correction:
-/// ρ and r = (B − ρA)x in double-double, then x ← x − Σ_{j≠i} x̃_j (x̃_jᵀ r)/(ω̃²_j − ρ) with
-/// x̃_j = L⁻ᵀy_j from the reduction. This is the Newton step of [`refine_pair`] with the bordered
-/// Jacobian replaced by its computed spectral decomposition, which has a backward error of the
-/// same order as an LBLᵀ factorization of B − ρA when the reduction is accurate; it converges
-/// linearly with the ratio of that error to the gap. None when a step above rounding level fails
-/// to halve the correction (graded problems, where the computed spectrum is too far from the
-/// exact one): the caller then falls back to [`refine_pair`].
-pub(crate) fn refine_pair_spectral(
+/// Refines the simple pair (ω²_i, x₀) by Rayleigh-quotient steps with a projected correction:
+/// ρ and r = (B − ρA)x in double-double, then x ← x − L⁻ᵀ K L⁻¹ r with K the
+/// [`ReducedCorrection`], Σ_{j≠i} y_j y_jᵀ/(ω̃²_j − ρ). This is the Newton step of
+/// [`refine_pair`] with the bordered Jacobian replaced by the reduction's computed
+/// decomposition, which has a backward error of the same order as an LBLᵀ factorization of
+/// B − ρA when the reduction is accurate; it converges linearly with the ratio of that error to
+/// the gap. None when a step above rounding level fails to halve the correction (graded
+/// problems, where the computed spectrum is too far from the exact one): the caller then falls
+/// back to [`refine_pair`].
+pub(crate) fn refine_pair_projected(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
-    spectrum: &ReducedSpectrum<'_>,
-    i: usize,
+    l: MatRef<'_, f64>,
+    correction: &mut dyn ReducedCorrection,
     x0: &[f64],
 ) -> Option<RefinedPair> {
     let n = a.nrows();
     let mut x = x0.to_vec();
     let mut previous = f64::INFINITY;
-    for step in 1..=MAX_SPECTRAL_STEPS {
+    for step in 1..=MAX_PROJECTED_STEPS {
         let axd = mat_vec(a, &x);
         let bxd = mat_vec(b, &x);
         let rq = dot(&x, &bxd).over(dot(&x, &axd));
         let mut w = Mat::from_fn(n, 1, |k, _| bxd[k].minus(rq.times(axd[k])).to_f64());
-        // x̃_jᵀ r = y_jᵀ L⁻¹ r; the correction is L⁻ᵀ Y c with c_j = y_jᵀL⁻¹r / (ω̃²_j − ρ).
-        solve_lower_triangular_in_place(spectrum.l, w.as_mut(), Par::Seq);
-        let mut c = spectrum.y.transpose() * &w;
-        let rho = rq.to_f64();
-        for j in 0..n {
-            let gap = spectrum.omega_sq[j] - rho;
-            c[(j, 0)] = if j == i || gap == 0.0 { 0.0 } else { c[(j, 0)] / gap };
-        }
-        let mut delta = spectrum.y * &c;
-        solve_upper_triangular_in_place(spectrum.l.transpose(), delta.as_mut(), Par::Seq);
+        solve_lower_triangular_in_place(l, w.as_mut(), Par::Seq);
+        let mut delta = correction.apply(w, rq.to_f64());
+        solve_upper_triangular_in_place(l.transpose(), delta.as_mut(), Par::Seq);
         let xmax = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let dmax = (0..n).fold(0.0_f64, |m, k| m.max(delta[(k, 0)].abs()));
         let at_rounding = dmax <= STAGNATION_ULPS * f64::EPSILON * xmax;
@@ -148,7 +205,7 @@ pub(crate) fn refine_pair_spectral(
             x[k] -= delta[(k, 0)];
         }
         if dmax <= 2.0 * f64::EPSILON * xmax || (at_rounding && !contracting) {
-            return finish_pair(a, b, spectrum.l, x, step);
+            return finish_pair(a, b, l, x, step);
         }
         previous = dmax;
     }
@@ -222,14 +279,15 @@ mod tests {
     #[test]
     fn spectral_and_bordered_refinement_agree_on_a_graded_chain() {
         let (a, b, l, y, omega, x) = graded();
-        let spectrum = ReducedSpectrum {
-            l: l.as_ref(),
-            y: y.as_ref(),
-            omega_sq: &omega,
-        };
         for i in 0..4 {
+            let mut spectrum = ReducedSpectrum {
+                y: y.as_ref(),
+                omega_sq: &omega,
+                mode: i,
+            };
             let x0: Vec<f64> = (0..16).map(|r| x[(r, i)]).collect();
-            let fast = refine_pair_spectral(a.as_ref(), b.as_ref(), &spectrum, i, &x0).expect("converges");
+            let fast =
+                refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut spectrum, &x0).expect("converges");
             let slow = refine_pair(a.as_ref(), b.as_ref(), l.as_ref(), &x0, omega[i]).expect("converges");
             let w = slow.omega_sq;
             assert!(
@@ -255,22 +313,22 @@ mod tests {
             .enumerate()
             .map(|(j, w)| if j == 1 { 3.0 * w } else { *w })
             .collect();
-        let spectrum = ReducedSpectrum {
-            l: l.as_ref(),
+        let mut spectrum = ReducedSpectrum {
             y: y.as_ref(),
             omega_sq: &wrong,
+            mode: 0,
         };
         // Start from a mixture of modes 0 and 1, so the wrong ω²₁ drives the correction.
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)] + 0.3 * x[(r, 1)]).collect();
-        assert!(refine_pair_spectral(a.as_ref(), b.as_ref(), &spectrum, 0, &x0).is_none());
+        assert!(refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut spectrum, &x0).is_none());
         let slow = refine_pair(a.as_ref(), b.as_ref(), l.as_ref(), &x0, omega[0]).expect("bordered Newton converges");
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)]).collect();
-        let right = ReducedSpectrum {
-            l: l.as_ref(),
+        let mut right = ReducedSpectrum {
             y: y.as_ref(),
             omega_sq: &omega,
+            mode: 0,
         };
-        let w = refine_pair_spectral(a.as_ref(), b.as_ref(), &right, 0, &x0)
+        let w = refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut right, &x0)
             .expect("converges")
             .omega_sq;
         assert!(

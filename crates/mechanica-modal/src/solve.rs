@@ -10,8 +10,8 @@
 use crate::accuracy::{self, AccuracyReport, Residuals};
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
-use crate::refine::{ReducedSpectrum, refine_pair, refine_pair_spectral};
-use crate::symmetric_eigen::symmetric_eigen_returning_input;
+use crate::refine::{ReducedSpectrum, refine_pair, refine_pair_projected};
+use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
 use std::time::{Duration, Instant};
@@ -49,6 +49,11 @@ pub const SEQUENTIAL_BELOW: usize = 192;
 
 /// Auto refinement starts when the reduction guarantees fewer than 8 digits of a mode's ω².
 pub const AUTO_REFINE_RELATIVE_BOUND: f64 = 1e-8;
+
+/// A values-only solve with [`Refinement::Auto`] forms the vectors of its poorly bounded modes
+/// one by one (inverse iteration, [`crate::values_only`]) when there are at most this many or
+/// n/16 of them; beyond that it computes all vectors, which then costs less.
+pub const FLAGGED_VECTORS_UP_TO: usize = 32;
 
 /// Options of [`solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -178,6 +183,11 @@ pub(crate) struct Definite {
     /// All n orthonormal eigenvectors Y of the reduced matrix C (when vectors were computed),
     /// for refinement without a new factorization ([`crate::refine::ReducedSpectrum`]).
     pub reduced: Option<Mat<f64>>,
+    /// Values only: C's tridiagonal form, from which [`crate::values_only`] forms the vectors
+    /// of the few modes whose a-priori bound is too weak.
+    pub form: Option<TridiagonalForm>,
+    /// Values only: the a-priori bounds of the selected modes, when already computed.
+    pub a_priori: Option<Vec<f64>>,
     /// The reduction's time (as `factor`) and the eigensolver's (as `eigen`).
     pub timings: DenseTimings,
 }
@@ -217,6 +227,8 @@ pub(crate) fn solve_definite(
             end,
             vectors: vectors.then(|| Mat::zeros(0, 0)),
             reduced: None,
+            form: None,
+            a_priori: None,
             timings: DenseTimings::default(),
         });
     }
@@ -227,27 +239,43 @@ pub(crate) fn solve_definite(
         ..DenseTimings::default()
     };
     let clock = Instant::now();
-    let (eigen, mut spent) = symmetric_eigen_returning_input(c, vectors, par)?;
+    if !vectors {
+        let (omega_sq, form) = symmetric_values_keeping_form(c, par)?;
+        let (first, end) = select(&omega_sq, selection)?;
+        timings.eigen = clock.elapsed();
+        return Ok(Definite {
+            omega_sq,
+            first,
+            end,
+            vectors: None,
+            reduced: None,
+            form: Some(form),
+            a_priori: None,
+            timings,
+        });
+    }
+    let (eigen, mut spent) = symmetric_eigen_returning_input(c, true, par)?;
     let omega_sq = eigen.values;
     let (first, end) = select(&omega_sq, selection)?;
-    let vectors = eigen.vectors.map(|y| {
-        // X = L⁻ᵀ Y(:, first..end), written into the reduced matrix's spent storage.
-        spent.truncate(n, end - first);
-        spent.copy_from(y.subcols(first, end - first));
-        back_transform(l, spent.as_mut(), par);
-        (spent, y)
-    });
-    timings.eigen = clock.elapsed();
-    let (vectors, reduced) = match vectors {
-        Some((x, y)) => (Some(x), Some(y)),
-        None => (None, None),
+    let (x, y) = match eigen.vectors {
+        Some(y) => {
+            // X = L⁻ᵀ Y(:, first..end), written into the reduced matrix's spent storage.
+            spent.truncate(n, end - first);
+            spent.copy_from(y.subcols(first, end - first));
+            back_transform(l, spent.as_mut(), par);
+            (spent, y)
+        }
+        None => return Err(ModalError::NoConvergence { n }),
     };
+    timings.eigen = clock.elapsed();
     Ok(Definite {
         omega_sq,
         first,
         end,
-        vectors,
-        reduced,
+        vectors: Some(x),
+        reduced: Some(y),
+        form: None,
+        a_priori: None,
         timings,
     })
 }
@@ -289,17 +317,25 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
             let cholesky_time = clock.elapsed();
             let mut def = solve_definite(l.as_ref(), b, options.selection, want_vectors, par)?;
             if !want_vectors && options.refinement == Refinement::Auto {
-                // Values only: decide from the a-priori bounds whether refinement is needed.
-                let pri = accuracy::a_priori_bounds(l.as_ref(), norm_a, norm_b, &def.omega_sq[def.first..def.end], par);
-                let bounds_need_vectors = def.omega_sq[def.first..def.end]
+                // Values only: the modes whose a-priori bound is too weak get their vectors
+                // (crate::values_only), unless they are so many that all vectors cost less.
+                let clock = Instant::now();
+                let selected = &def.omega_sq[def.first..def.end];
+                let bounds = accuracy::a_priori_bounds(l.as_ref(), norm_a, norm_b, selected, par);
+                def.timings.accuracy = clock.elapsed();
+                let flagged = selected
                     .iter()
-                    .zip(&pri)
-                    .any(|(w, e)| *e > AUTO_REFINE_RELATIVE_BOUND * w.abs());
-                if bounds_need_vectors {
+                    .zip(&bounds)
+                    .filter(|(w, e)| **e > AUTO_REFINE_RELATIVE_BOUND * w.abs())
+                    .count();
+                if flagged > FLAGGED_VECTORS_UP_TO.max(n / 16) {
                     let first_try = def.timings;
                     def = solve_definite(l.as_ref(), b, options.selection, true, par)?;
                     def.timings.factor += first_try.factor;
                     def.timings.eigen += first_try.eigen;
+                    def.timings.accuracy += first_try.accuracy;
+                } else {
+                    def.a_priori = Some(bounds);
                 }
             }
             def.timings.factor += cholesky_time;
@@ -356,6 +392,7 @@ impl Finish<'_> {
         let (a, b) = (self.problem.a(), self.problem.b());
         let n = self.problem.dim();
         let omega_all = def.omega_sq;
+        let mut form = def.form;
         let mut omega: Vec<f64> = omega_all[def.first..def.end].to_vec();
         let mut x = match (def.vectors, lift) {
             (Some(v), Some(f)) => Some(f(v.as_ref())),
@@ -370,22 +407,34 @@ impl Finish<'_> {
         let mut report = match (&x, &products) {
             (Some(x), Some(p)) => AccuracyReport::from_products(p, x.as_ref(), &omega, self.norm_a, self.norm_b),
             _ => {
-                let bounds = accuracy::a_priori_bounds(self.l, self.norm_a, self.norm_b, &omega, self.par);
+                let bounds = match def.a_priori {
+                    Some(bounds) => bounds,
+                    None => accuracy::a_priori_bounds(self.l, self.norm_a, self.norm_b, &omega, self.par),
+                };
                 AccuracyReport::a_priori(self.norm_a, self.norm_b, bounds)
             }
         };
-        timings.accuracy = clock.elapsed();
+        timings.accuracy += clock.elapsed();
         let clock = Instant::now();
+        if let Some(form) = form.as_mut()
+            && x.is_none()
+            && lift.is_none()
+            && self.options.refinement == Refinement::Auto
+        {
+            let pencil = crate::values_only::Pencil {
+                a,
+                b,
+                l: self.l,
+                residuals: self.options.residuals,
+                par: self.par,
+            };
+            crate::values_only::sharpen(&pencil, form, &mut report, &mut omega, &omega_all, def.first);
+        }
         // Refinement of poorly bounded simple modes (needs vectors in the original coordinates).
         if let (Some(xm), Some(products)) = (x.as_mut(), products.as_mut())
             && self.options.refinement != Refinement::Off
             && lift.is_none()
         {
-            let spectrum = def.reduced.as_ref().map(|y| ReducedSpectrum {
-                l: self.l,
-                y: y.as_ref(),
-                omega_sq: &omega_all,
-            });
             let simple = simple_modes(&omega, &report.error_bounds);
             let mut residuals: Vec<(usize, Vec<f64>)> = Vec::new();
             for i in 0..m {
@@ -395,9 +444,17 @@ impl Finish<'_> {
                     continue;
                 }
                 let col: Vec<f64> = (0..n).map(|r| xm[(r, i)]).collect();
-                let refined = spectrum
+                let refined = def
+                    .reduced
                     .as_ref()
-                    .and_then(|s| refine_pair_spectral(a, b, s, def.first + i, &col))
+                    .and_then(|y| {
+                        let mut spectrum = ReducedSpectrum {
+                            y: y.as_ref(),
+                            omega_sq: &omega_all,
+                            mode: def.first + i,
+                        };
+                        refine_pair_projected(a, b, self.l, &mut spectrum, &col)
+                    })
                     .or_else(|| refine_pair(a, b, self.l, &col, omega[i]));
                 if let Some(p) = refined {
                     for r in 0..n {
@@ -411,10 +468,12 @@ impl Finish<'_> {
                     residuals.push((i, p.residual));
                 }
             }
+            let all: Vec<usize> = (0..m).collect();
             let basis = accuracy::ModeBasis {
                 a,
                 l: self.l,
                 x: xm.as_ref(),
+                modes: &all,
             };
             accuracy::residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, &basis, self.par);
         }
@@ -433,7 +492,7 @@ impl Finish<'_> {
             (def.first, def.end),
             &report.error_bounds,
             lift,
-            def.reduced,
+            def.reduced.or_else(|| form.map(TridiagonalForm::into_storage)),
             self.par,
         )?;
         timings.inertia = clock.elapsed();
@@ -487,7 +546,7 @@ impl Finish<'_> {
 }
 
 /// Modes whose bound interval overlaps no neighbour's (refinement needs simple eigenvalues).
-fn simple_modes(omega: &[f64], bounds: &[f64]) -> Vec<bool> {
+pub(crate) fn simple_modes(omega: &[f64], bounds: &[f64]) -> Vec<bool> {
     let m = omega.len();
     (0..m)
         .map(|i| {

@@ -19,17 +19,20 @@
 use crate::ModalError;
 use crate::symv_team::SymvTeam;
 use crate::tridiagonal_values::tridiagonal_eigenvalues;
+use crate::tridiagonal_vectors::tridiagonal_eigenvectors;
 use faer::dyn_stack::StackReq;
 use faer::linalg::evd::{ComputeEigenvectors, self_adjoint_evd_scratch, tridiagonal_self_adjoint_evd};
 use faer::linalg::householder::{
     apply_block_householder_sequence_on_the_left_in_place_scratch,
-    apply_block_householder_sequence_on_the_left_in_place_with_conj, make_householder_in_place,
+    apply_block_householder_sequence_on_the_left_in_place_with_conj,
+    apply_block_householder_sequence_transpose_on_the_left_in_place_scratch,
+    apply_block_householder_sequence_transpose_on_the_left_in_place_with_conj, make_householder_in_place,
     upgrade_householder_factor,
 };
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{BlockStructure, matmul as tri_matmul};
 use faer::reborrow::{Reborrow, ReborrowMut};
-use faer::{Accum, ColMut, ColRef, Conj, Mat, Par};
+use faer::{Accum, ColMut, ColRef, Conj, Mat, MatMut, MatRef, Par};
 use std::thread::Thread;
 
 /// Columns reduced per panel before the trailing matrix is updated (LAPACK's `dsytrd` default).
@@ -78,13 +81,11 @@ pub(crate) fn symmetric_eigen_returning_input(
         };
         return Ok((eigen, c));
     }
-    let t = tridiagonalize(&mut c, par);
     if !vectors {
-        // Values only: the root-free QL/QR iteration (2.7–3.4× faster than faer's values-only
-        // tridiagonal solver, which also fails to converge on some graded matrices).
-        let values = tridiagonal_eigenvalues(&t.diag, &t.subdiag).map_err(|_| ModalError::NoConvergence { n })?;
-        return Ok((SymmetricEigen { values, vectors: None }, c));
+        let (values, form) = symmetric_values_keeping_form(c, par)?;
+        return Ok((SymmetricEigen { values, vectors: None }, form.into_storage()));
     }
+    let t = tridiagonalize(&mut c, par);
     // faer's full-EVD workspace bounds that of its tridiagonal solver and the Householder
     // application alike (it is allocated, not touched, beyond what they use).
     let mut mem = faer::dyn_stack::MemBuffer::new(StackReq::any_of(&[
@@ -136,6 +137,115 @@ pub(crate) fn symmetric_eigen_returning_input(
         },
         c,
     ))
+}
+
+/// What a values-only decomposition keeps so that a few eigenvectors can be formed afterwards
+/// (for the modes whose a-priori bound is too weak, [`crate::values_only`]): T, Q's
+/// reflectors in the reduced matrix's storage, and Q's block factor once it is needed.
+pub(crate) struct TridiagonalForm {
+    t: Tridiagonal,
+    reflectors: Mat<f64>,
+    factor: Option<Mat<f64>>,
+    par: Par,
+}
+
+/// Eigenvalues of the symmetric matrix `c` (lower triangle read), ascending, and its
+/// tridiagonal form for later eigenvectors. The values come from the root-free QL/QR iteration
+/// (2.7–3.4× faster than faer's values-only tridiagonal solver, which also fails to converge
+/// on some graded matrices).
+pub(crate) fn symmetric_values_keeping_form(
+    mut c: Mat<f64>,
+    par: Par,
+) -> Result<(Vec<f64>, TridiagonalForm), ModalError> {
+    let n = c.nrows();
+    let t = if n == 0 {
+        Tridiagonal {
+            diag: Vec::new(),
+            subdiag: Vec::new(),
+            tau: Vec::new(),
+        }
+    } else {
+        tridiagonalize(&mut c, par)
+    };
+    let values = tridiagonal_eigenvalues(&t.diag, &t.subdiag).map_err(|_| ModalError::NoConvergence { n })?;
+    let form = TridiagonalForm {
+        t,
+        reflectors: c,
+        factor: None,
+        par,
+    };
+    Ok((values, form))
+}
+
+impl TridiagonalForm {
+    /// T's diagonal.
+    pub(crate) fn diag(&self) -> &[f64] {
+        &self.t.diag
+    }
+
+    /// T's off-diagonal.
+    pub(crate) fn subdiag(&self) -> &[f64] {
+        &self.t.subdiag
+    }
+
+    /// Unit eigenvectors Y = Q Z of the reduced matrix for the ascending eigenvalues `values`
+    /// of T (Z by inverse iteration on T, [`crate::tridiagonal_vectors`]), and Z itself.
+    pub(crate) fn eigenvectors(&mut self, values: &[f64]) -> Result<(Mat<f64>, Mat<f64>), ModalError> {
+        let n = self.t.diag.len();
+        let z = tridiagonal_eigenvectors(&self.t.diag, &self.t.subdiag, values)
+            .map_err(|_| ModalError::NoConvergence { n })?;
+        let z = Mat::from_fn(n, values.len(), |i, j| z[j * n + i]);
+        let mut y = z.clone();
+        self.apply_q(y.as_mut());
+        Ok((y, z))
+    }
+
+    /// z ← Q z (T-coordinates to the reduced matrix's).
+    pub(crate) fn apply_q(&mut self, z: MatMut<'_, f64>) {
+        self.apply(z, false);
+    }
+
+    /// w ← Qᵀ w (the reduced matrix's coordinates to T's).
+    pub(crate) fn apply_q_transpose(&mut self, w: MatMut<'_, f64>) {
+        self.apply(w, true);
+    }
+
+    fn apply(&mut self, z: MatMut<'_, f64>, transpose: bool) {
+        let n = self.t.diag.len();
+        if n < 2 {
+            return;
+        }
+        let k = z.ncols();
+        let factor = self
+            .factor
+            .get_or_insert_with(|| block_factor(&self.reflectors, &self.t.tau, self.par));
+        let bs = block_size(n);
+        let mut mem = faer::dyn_stack::MemBuffer::new(StackReq::any_of(&[
+            apply_block_householder_sequence_on_the_left_in_place_scratch::<f64>(n - 1, bs, k),
+            apply_block_householder_sequence_transpose_on_the_left_in_place_scratch::<f64>(n - 1, bs, k),
+        ]));
+        let stack = faer::dyn_stack::MemStack::new(&mut mem);
+        let basis = self.reflectors.as_ref().submatrix(1, 0, n - 1, n - 1);
+        type Apply = fn(MatRef<'_, f64>, MatRef<'_, f64>, Conj, MatMut<'_, f64>, Par, &mut faer::dyn_stack::MemStack);
+        let apply: Apply = if transpose {
+            apply_block_householder_sequence_transpose_on_the_left_in_place_with_conj::<f64>
+        } else {
+            apply_block_householder_sequence_on_the_left_in_place_with_conj::<f64>
+        };
+        apply(
+            basis,
+            factor.as_ref(),
+            Conj::No,
+            z.subrows_mut(1, n - 1),
+            self.par,
+            stack,
+        );
+    }
+
+    /// The reduced matrix's storage (n×n), for reuse by the caller.
+    pub(crate) fn into_storage(self) -> Mat<f64> {
+        self.reflectors
+    }
 }
 
 /// Block size of the compact WY factors used to apply Q (faer's own choice for this order).

@@ -1,0 +1,103 @@
+//! Values-only solves that still certify every mode: the modes whose a-priori bound is too weak
+//! get their eigenvectors formed (and no others), so their bounds can be measured and, where
+//! still too weak, refined.
+//!
+//! Without vectors a dense solve can only bound an eigenvalue a priori, by an assumed backward
+//! error of n·u: n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ ([`crate::accuracy::a_priori_bounds`]), which
+//! relative to a small |ω²| is weak (the lowest modes of a long chain, stiff problems). For each
+//! mode above [`crate::solve::AUTO_REFINE_RELATIVE_BOUND`]·|ω²|:
+//!
+//! 1. its eigenvector z of the tridiagonal form T of C = L⁻¹BL⁻ᵀ is computed by inverse
+//!    iteration ([`crate::tridiagonal_vectors`], O(n) per mode), and x = L⁻ᵀQz (O(n²));
+//! 2. its backward error is measured and the bound becomes the first-order η·κ
+//!    ([`crate::BoundKind::FirstOrder`]); the measured η is usually far below n·u;
+//! 3. a mode still above the threshold (stiff and graded problems) is refined as in an
+//!    all-pairs solve ([`crate::refine`]), with the correction applied through Q and T
+//!    instead of the eigenvectors Y, which a values-only solve does not have, and gets a
+//!    residual bound ([`crate::BoundKind::Residual`]).
+//!
+//! The cost is O(n²) per flagged mode, against the n³ of the vectors that a full solve forms
+//! (before, a values-only solve with a flagged mode was solved again with all vectors).
+
+use crate::accuracy::{self, AccuracyReport, BoundKind, PairProducts, Residuals};
+use crate::reduce::back_transform;
+use crate::refine::{TridiagonalCorrection, refine_pair, refine_pair_projected};
+use crate::solve::{AUTO_REFINE_RELATIVE_BOUND, simple_modes};
+use crate::symmetric_eigen::TridiagonalForm;
+use faer::{MatRef, Par};
+
+/// The pencil and its factor, as the refinement needs them.
+pub(crate) struct Pencil<'a> {
+    pub a: MatRef<'a, f64>,
+    pub b: MatRef<'a, f64>,
+    /// Cholesky factor of A.
+    pub l: MatRef<'a, f64>,
+    /// How the flagged modes' residuals are measured (the solve's [`Residuals`] option).
+    pub residuals: Residuals,
+    pub par: Par,
+}
+
+/// Sharpens the a-priori `report` of the selected values `omega` (entries `first..` of the
+/// ascending spectrum `omega_all`, the eigenvalues of `form`'s T): measured first-order bounds
+/// for the flagged modes, refinement and residual bounds for those still flagged. `omega` is
+/// updated where refinement moved a value. When inverse iteration fails, the report keeps its
+/// a-priori bounds.
+pub(crate) fn sharpen(
+    pencil: &Pencil<'_>,
+    form: &mut TridiagonalForm,
+    report: &mut AccuracyReport,
+    omega: &mut [f64],
+    omega_all: &[f64],
+    first: usize,
+) {
+    let flagged: Vec<usize> = (0..omega.len())
+        .filter(|&i| report.error_bounds[i] > AUTO_REFINE_RELATIVE_BOUND * omega[i].abs())
+        .collect();
+    if flagged.is_empty() {
+        return;
+    }
+    let values: Vec<f64> = flagged.iter().map(|&i| omega_all[first + i]).collect();
+    let Ok((mut x, z)) = form.eigenvectors(&values) else {
+        return;
+    };
+    back_transform(pencil.l, x.as_mut(), pencil.par);
+    let (a, b) = (pencil.a, pencil.b);
+    let mut products = PairProducts::new(a, b, x.as_ref(), pencil.residuals, pencil.par);
+    for (col, &i) in flagged.iter().enumerate() {
+        let (_, bound) = products.pair_error(x.as_ref(), col, omega[i], report.norm_a, report.norm_b);
+        report.error_bounds[i] = bound;
+        report.bound_kinds[i] = BoundKind::FirstOrder;
+    }
+    if let PairProducts::Sketched { .. } = products {
+        report.residuals = Residuals::Sketched;
+    }
+    let simple = simple_modes(omega, &report.error_bounds);
+    let mut residuals: Vec<(usize, Vec<f64>)> = Vec::new();
+    for (col, &i) in flagged.iter().enumerate() {
+        if !simple[i] || report.error_bounds[i] <= AUTO_REFINE_RELATIVE_BOUND * omega[i].abs() {
+            continue;
+        }
+        let x0: Vec<f64> = x.col(col).iter().copied().collect();
+        let mut correction = TridiagonalCorrection {
+            form,
+            z: z.col_as_slice(col),
+        };
+        let refined = refine_pair_projected(a, b, pencil.l, &mut correction, &x0)
+            .or_else(|| refine_pair(a, b, pencil.l, &x0, omega[i]));
+        if let Some(p) = refined {
+            x.col_as_slice_mut(col).copy_from_slice(&p.x);
+            omega[i] = p.omega_sq;
+            products.update_column(a, b, x.as_ref(), col, pencil.par);
+            report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
+            report.refinement_steps[i] = p.steps;
+            residuals.push((i, p.residual));
+        }
+    }
+    let basis = accuracy::ModeBasis {
+        a,
+        l: pencil.l,
+        x: x.as_ref(),
+        modes: &flagged,
+    };
+    accuracy::residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
+}
