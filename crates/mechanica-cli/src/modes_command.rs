@@ -33,7 +33,8 @@ pub struct ModesArgs {
     /// Include the mode shapes (column by column, n values per mode).
     #[arg(long)]
     pub shapes: bool,
-    /// Eigenvalues only (dense solver; no shapes, a-priori bounds).
+    /// Eigenvalues only (dense solver; no shapes). Bounds are a-priori, except for modes whose
+    /// a-priori bound is weak, which --refinement auto measures and refines.
     #[arg(long, conflicts_with = "shapes")]
     pub values_only: bool,
     /// Refinement of poorly bounded low modes: auto, off or always (dense solver).

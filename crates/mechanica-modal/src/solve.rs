@@ -52,7 +52,8 @@ pub const AUTO_REFINE_RELATIVE_BOUND: f64 = 1e-8;
 
 /// A values-only solve with [`Refinement::Auto`] forms the vectors of its poorly bounded modes
 /// one by one (inverse iteration, [`crate::values_only`]) when there are at most this many or
-/// n/16 of them; beyond that it computes all vectors, which then costs less.
+/// n/4 of them; beyond that it computes all vectors, which then costs less (the clustered
+/// inverse iteration orthogonalises in O(k²n), and all vectors cost about n³ more than values).
 pub const FLAGGED_VECTORS_UP_TO: usize = 32;
 
 /// Options of [`solve`].
@@ -328,7 +329,7 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                     .zip(&bounds)
                     .filter(|(w, e)| **e > AUTO_REFINE_RELATIVE_BOUND * w.abs())
                     .count();
-                if flagged > FLAGGED_VECTORS_UP_TO.max(n / 16) {
+                if flagged > FLAGGED_VECTORS_UP_TO.max(n / 4) {
                     let first_try = def.timings;
                     def = solve_definite(l.as_ref(), b, options.selection, true, par)?;
                     def.timings.factor += first_try.factor;

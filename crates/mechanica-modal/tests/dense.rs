@@ -124,6 +124,51 @@ fn values_only_solves_measure_their_weakly_bounded_modes() {
     assert!(mult[1..mult.len() - 1].iter().all(|&m| m == 2), "{mult:?}");
 }
 
+/// Values only with more weakly bounded modes than `FLAGGED_VECTORS_UP_TO` (masses graded over
+/// six decades make ‖A⁻¹‖ large): all vectors are computed instead, and every mode agrees with
+/// the all-pairs solve within the two bounds, with measured (not assumed) bounds.
+#[test]
+fn values_only_with_many_weak_modes_computes_all_vectors() {
+    let n = 300;
+    let masses: Vec<f64> = (0..n).map(|i| 10f64.powf(-6.0 * i as f64 / (n - 1) as f64)).collect();
+    let a = Mat::from_fn(n, n, |i, j| if i == j { masses[i] } else { 0.0 });
+    let b = families::fixed_chain(n).1;
+    let q = families::random_orthogonal(n, 3);
+    let (a, b) = families::rotate(&a, &b, &q);
+    let p = pencil(&a, &b);
+    let values_only = SolveOptions {
+        vectors: false,
+        ..all_pairs()
+    };
+    let assumed = solve(
+        &p,
+        &SolveOptions {
+            refinement: Refinement::Off,
+            ..values_only
+        },
+    )
+    .expect("solve");
+    let weak = assumed
+        .modes
+        .iter()
+        .filter(|m| m.error_bound > mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * m.omega_sq.abs())
+        .count();
+    assert!(
+        weak > mechanica_modal::solve::FLAGGED_VECTORS_UP_TO.max(n / 4),
+        "{weak} weak modes"
+    );
+    let measured = solve(&p, &values_only).expect("solve");
+    let reference = solve(&p, &all_pairs()).expect("solve");
+    assert!(measured.vectors.is_none());
+    for (i, (m, r)) in measured.modes.iter().zip(&reference.modes).enumerate() {
+        assert!(
+            (m.omega_sq - r.omega_sq).abs() <= m.error_bound + r.error_bound,
+            "mode {i}"
+        );
+        assert_ne!(measured.accuracy.bound_kinds[i], BoundKind::APriori, "mode {i}");
+    }
+}
+
 #[test]
 fn free_chain_has_one_rigid_body_mode() {
     let n = 40;
