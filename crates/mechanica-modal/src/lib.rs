@@ -28,7 +28,9 @@
 //!   gap-weighted residual bound. The Newton correction is applied through the reduced
 //!   problem's computed eigen-decomposition (O(n²) per step); only when that stops contracting
 //!   is the bordered matrix factored (LBLᵀ, n³/3). Tested on graded chains with ratios up to 1e12 against
-//!   60-digit mpmath references (tools/modal_reference.py).
+//!   60-digit mpmath references (tools/modal_reference.py). A values-only solve forms the
+//!   vectors of its weakly bounded modes only, by inverse iteration on the tridiagonal form
+//!   (`values_only`), measures their bounds and refines them the same way.
 //! - **Sparse** ([`solve_sparse`] on a [`SparsePencil`] from faer `SparseColMat`s, triplets or
 //!   Matrix Market files): the k lowest modes by shift-invert block Lanczos on faer's sparse
 //!   Cholesky, certified by the inertia of B − τA ([`count_below_sparse`]), with Rayleigh–Ritz
