@@ -51,7 +51,7 @@ pub const SEQUENTIAL_BELOW: usize = 192;
 pub const AUTO_REFINE_RELATIVE_BOUND: f64 = 1e-8;
 
 /// A values-only solve with [`Refinement::Auto`] forms the vectors of its poorly bounded modes
-/// one by one (inverse iteration, [`crate::values_only`]) when there are at most this many or
+/// one by one (inverse iteration, module `values_only`) when there are at most this many or
 /// n/4 of them; beyond that it computes all vectors, which then costs less (the clustered
 /// inverse iteration orthogonalises in O(k²n), and all vectors cost about n³ more than values).
 pub const FLAGGED_VECTORS_UP_TO: usize = 32;
