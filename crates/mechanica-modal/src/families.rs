@@ -117,8 +117,8 @@ pub fn power_of_ten(e: i32) -> f64 {
     format!("1e{e}").parse().unwrap_or(f64::NAN)
 }
 
-/// Chain fixed at its left end: mass i is m_i = 10^mass_exponents[i], spring i (joining mass
-/// i − 1, or the ground for i = 0, to mass i) is k_i = 10^stiffness_exponents[i].
+/// Chain fixed at its left end: mass i is m_i = `10^mass_exponents[i]`, spring i (joining mass
+/// i − 1, or the ground for i = 0, to mass i) is k_i = `10^stiffness_exponents[i]`.
 /// Returns (A, B) with A = diag(m), B = Σ_i k_i (e_i − e_{i−1})(e_i − e_{i−1})ᵀ, assembled in
 /// the order i = 0, 1, … (tools/modal_reference.py repeats exactly these roundings).
 pub fn spring_chain(stiffness_exponents: &[i32], mass_exponents: &[i32]) -> (Mat<f64>, Mat<f64>) {

@@ -1,12 +1,12 @@
 //! Small oscillations: A δ̈ + B δ = 0 and det(λA + B) = 0 (8.84–8.92), solved with faer,
 //! with every result carrying its own accuracy report.
 //!
-//! This crate works on bare matrices; it needs no mechanism. Entry point: [`solve`] on a
+//! This crate works on bare matrices; it needs no mechanism. Entry point: [`solve()`] on a
 //! validated [`PencilProblem`]; [`count_below`] certifies how many modes lie below a shift.
 //!
 //! - **Sign convention.** det(λA + B) = 0 (8.89): an oscillatory mode has λ = −ω² < 0. Modes
 //!   are ordered by ω² = −λ ascending (unstable, rigid-body, oscillatory, infinite).
-//! - **Dense method** ([`solve`]): Cholesky A = LLᵀ, the symmetric reduction C = L⁻¹BL⁻ᵀ in
+//! - **Dense method** ([`solve()`]): Cholesky A = LLᵀ, the symmetric reduction C = L⁻¹BL⁻ᵀ in
 //!   about n³ flops ([`reduce`], as LAPACK `dsygst`), the eigen-decomposition of C
 //!   ([`symmetric_eigen`]: this crate's blocked tridiagonalization, faer's tridiagonal divide
 //!   and conquer and blocked Householder application; values only by this crate's root-free

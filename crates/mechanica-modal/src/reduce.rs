@@ -195,7 +195,7 @@ pub fn back_transform(l: MatRef<'_, f64>, y: MatMut<'_, f64>, par: Par) {
     solve_upper_triangular_in_place(l.transpose(), y, par);
 }
 
-/// The Cholesky factor L (lower, upper triangle zeroed) of A = LLᵀ exactly as [`crate::solve`]
+/// The Cholesky factor L (lower, upper triangle zeroed) of A = LLᵀ exactly as [`crate::solve()`]
 /// computes it, or None if A is not numerically positive definite (for stage benchmarks).
 pub fn cholesky_lower(a: MatRef<'_, f64>, par: Par) -> Option<Mat<f64>> {
     match cholesky(a, par) {

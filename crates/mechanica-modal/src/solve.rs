@@ -32,7 +32,7 @@ pub enum Selection {
     },
 }
 
-/// Whether to refine low modes with extended-precision residuals (see [`crate::refine`]).
+/// Whether to refine low modes with extended-precision residuals (module `refine`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Refinement {
     /// Refine every selected, simple, finite mode whose first-order error bound from the
@@ -109,7 +109,7 @@ pub struct Mode {
     /// Classification.
     pub kind: ModeKind,
     /// Bound on |ω²_computed − ω²_exact| (first-order condition bound or residual bound, see
-    /// [`AccuracyReport::bound_kind`]); 0 for infinite modes, which are exact by construction.
+    /// [`AccuracyReport::bound_kinds`]); 0 for infinite modes, which are exact by construction.
     pub error_bound: f64,
     /// Backward error η of the pair (None when values only were computed or the mode is infinite).
     pub backward_error: Option<f64>,

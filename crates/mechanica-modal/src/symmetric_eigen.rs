@@ -1,7 +1,7 @@
 //! Eigen-decomposition C = Y diag(ω²) Yᵀ of the reduced symmetric matrix C = L⁻¹BL⁻ᵀ (8.89
 //! after the reduction): a blocked Householder tridiagonalization C = Q T Qᵀ, faer's tridiagonal
 //! divide and conquer T = Z Λ Zᵀ, and faer's blocked Householder application Y = Q Z; values
-//! only: the root-free QL/QR iteration of [`crate::tridiagonal_values`] on T.
+//! only: the root-free QL/QR iteration of module `tridiagonal_values` on T.
 //!
 //! Why not faer's `self_adjoint_eigen`: faer 0.24 tridiagonalizes column by column, reading and
 //! writing the whole trailing matrix once per column (a rank-2 update fused with a
@@ -10,8 +10,8 @@
 //! computations", J. Comput. Appl. Math. 27, 1989) is used: a panel of [`PANEL`] columns is
 //! reduced with one read-only symmetric matrix-vector product per column, and the trailing
 //! matrix is updated once per panel by a symmetric rank-2·[`PANEL`] update (half the flops,
-//! as matrix products). Only the lower triangle of C is read. From order [`PARALLEL_SYMV_FROM`]
-//! half of every matrix-vector product runs on a spinning helper thread ([`crate::symv_team`]):
+//! as matrix products). Only the lower triangle of C is read. From order `PARALLEL_SYMV_FROM` (640)
+//! half of every matrix-vector product runs on a spinning helper thread (module `symv_team`):
 //! with the pool's sleeping threads, woken once per column, the reduction took 41–47 ms at
 //! n = 1000 and 0.29–0.37 s at n = 2000; with the team 34 ms and 0.21–0.24 s (OpenBLAS `dsytrd`
 //! 35 ms and 0.22–0.27 s on the same machine).
