@@ -348,7 +348,8 @@ const NORM_PROBES: usize = 12;
 const NORM_POWER: usize = 4;
 
 /// An upper bound of ‖A⁻¹‖₂ from the Cholesky factor L of A that holds with probability
-/// ≥ 1 − 1e-12: for any matrix M and r independent standard Gaussian vectors ω_i,
+/// ≥ 1 − 1e-12 over the probes (for an A that does not depend on them; see [`probe_seed`]),
+/// and never below the deterministic lower bounds 1/L_nn² and 1/min_i A_ii: for any matrix M and r independent standard Gaussian vectors ω_i,
 /// ‖M‖ ≤ α√(2/π)·max_i ‖Mω_i‖ except with probability α^(−r) (Halko, Martinsson & Tropp,
 /// "Finding structure with randomness", SIAM Review 53, 2011, Lemma 4.1, after Dixon 1983),
 /// applied to M = (L⁻ᵀL⁻¹)^q = A^(−q), whose norm is ‖A⁻¹‖^q. Cost: 2q triangular solves
@@ -359,7 +360,7 @@ pub(crate) fn a_inverse_norm_bound(l: MatRef<'_, f64>, par: Par) -> f64 {
     if n == 0 {
         return 0.0;
     }
-    let mut v = crate::sketch::gaussian(n, NORM_PROBES, 2);
+    let mut v = crate::sketch::gaussian(n, NORM_PROBES, probe_seed(l));
     // ln ‖A^(−k) ω_i‖ after k powers.
     let mut log_norms = [0.0_f64; NORM_PROBES];
     for _ in 0..NORM_POWER {
@@ -376,7 +377,28 @@ pub(crate) fn a_inverse_norm_bound(l: MatRef<'_, f64>, par: Par) -> f64 {
     }
     let alpha = 10.0_f64;
     let largest = log_norms.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    (((alpha * (2.0 / std::f64::consts::PI).sqrt()).ln() + largest) / NORM_POWER as f64).exp()
+    let probed = (((alpha * (2.0 / std::f64::consts::PI).sqrt()).ln() + largest) / NORM_POWER as f64).exp();
+    // Deterministic lower bounds of ‖A⁻¹‖₂, which no choice of probes can miss:
+    // (A⁻¹)_nn = 1/L_nn² and 1/λ_min ≥ 1/A_ii ≥ 1/Σ_k L_ik² for every i.
+    let last = l[(n - 1, n - 1)];
+    let mut diagonal_of_a = vec![0.0_f64; n];
+    for k in 0..n {
+        for (i, entry) in l.col(k).iter().enumerate().skip(k) {
+            diagonal_of_a[i] += entry * entry;
+        }
+    }
+    let smallest_diagonal = diagonal_of_a.iter().copied().fold(f64::INFINITY, f64::min);
+    probed.max(1.0 / (last * last)).max(1.0 / smallest_diagonal)
+}
+
+/// The seed of [`a_inverse_norm_bound`]'s probes, hashed (FNV-1a) from L's diagonal: the
+/// probability is over the probes for an A chosen independently of them, and with one fixed
+/// seed every A built against its probes (a small eigenvector orthogonal to all twelve)
+/// would defeat the bound.
+fn probe_seed(l: MatRef<'_, f64>) -> u64 {
+    (0..l.nrows()).fold(0xcbf2_9ce4_8422_2325_u64, |h, i| {
+        (h ^ l[(i, i)].to_bits()).wrapping_mul(0x0100_0000_01b3)
+    })
 }
 
 /// Values-only bounds n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ (a backward error of n·u assumed, not measured;
@@ -519,7 +541,7 @@ mod tests {
             };
             let exact = 1.0 / lambda[n - 1];
             let bound = a_inverse_norm_bound(l.as_ref(), Par::Seq);
-            let probes = crate::sketch::gaussian(n, NORM_PROBES, 2);
+            let probes = crate::sketch::gaussian(n, NORM_PROBES, probe_seed(l.as_ref()));
             let longest = (0..NORM_PROBES).map(|j| vector_norm(probes.col(j))).fold(0.0, f64::max);
             let worst =
                 (10.0 * (2.0 / std::f64::consts::PI).sqrt() * longest).powf(1.0 / NORM_POWER as f64) * (1.0 + 1e-9);
@@ -527,6 +549,17 @@ mod tests {
                 bound >= exact && bound <= worst * exact,
                 "{decades} decades: {bound:e} vs {exact:e}"
             );
+        }
+        // One small eigenvalue ε along a dense direction u: the diagonal of A stays near 1,
+        // so only the probes can see ‖A⁻¹‖ = 1/ε.
+        let u = q.col(0);
+        for eps in [1e-2, 1e-4, 1e-8] {
+            let a = Mat::from_fn(n, n, |i, j| if i == j { 1.0 } else { 0.0 } - (1.0 - eps) * u[i] * u[j]);
+            let Cholesky::Factor(l) = cholesky(a.as_ref(), Par::Seq) else {
+                panic!("positive definite");
+            };
+            let bound = a_inverse_norm_bound(l.as_ref(), Par::Seq);
+            assert!(bound >= 1.0 / eps && bound <= 10.0 / eps, "ε = {eps:e}: {bound:e}");
         }
     }
 }

@@ -194,6 +194,10 @@ pub(crate) fn refine_pair_projected(
         solve_lower_triangular_in_place(l, w.as_mut(), Par::Seq);
         let mut delta = correction.apply(w, rq.to_f64());
         solve_upper_triangular_in_place(l.transpose(), delta.as_mut(), Par::Seq);
+        // f64::max ignores NaN, so a failed correction is caught here, not by dmax.
+        if !(0..n).all(|k| delta[(k, 0)].is_finite()) {
+            return None;
+        }
         let xmax = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let dmax = (0..n).fold(0.0_f64, |m, k| m.max(delta[(k, 0)].abs()));
         let at_rounding = dmax <= STAGNATION_ULPS * f64::EPSILON * xmax;

@@ -645,7 +645,7 @@ fn inertia_check(
     let margin = bounds.iter().copied().fold(0.0, f64::max);
     let shift = if end < n && end > 0 {
         0.5 * (omega_all[end - 1] + omega_all[end])
-    } else if first > 0 {
+    } else if first > 0 && first < n {
         0.5 * (omega_all[first - 1] + omega_all[first])
     } else {
         // All modes selected: the widest gap, or above the top of the spectrum.

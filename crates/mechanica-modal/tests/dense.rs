@@ -343,6 +343,31 @@ fn subsets_agree_with_the_full_spectrum() {
     }
 }
 
+/// An interval above (or below) the whole spectrum selects nothing, in every mode of solve.
+#[test]
+fn empty_intervals_select_nothing() {
+    let (a, b) = families::fixed_chain(6);
+    let p = pencil(&a, &b);
+    for (lower, upper) in [(5.0, 6.0), (-2.0, -1.0)] {
+        for vectors in [false, true] {
+            for refinement in [Refinement::Auto, Refinement::Off] {
+                let sol = solve(
+                    &p,
+                    &SolveOptions {
+                        selection: Selection::Interval { lower, upper },
+                        vectors,
+                        refinement,
+                        residuals: Residuals::Exact,
+                    },
+                )
+                .expect("an empty selection is not an error");
+                assert!(sol.modes.is_empty());
+                assert!(sol.accuracy.inertia_check.is_none_or(|c| c.consistent));
+            }
+        }
+    }
+}
+
 #[test]
 fn bad_input_is_located() {
     let mut a = Mat::<f64>::identity(4, 4);
