@@ -404,12 +404,28 @@ fn probe_seed(l: MatRef<'_, f64>) -> u64 {
 /// Values-only bounds n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ (a backward error of n·u assumed, not measured;
 /// ‖A⁻¹‖₂ bounded as in [`a_inverse_norm_bound`]).
 pub(crate) fn a_priori_bounds(l: MatRef<'_, f64>, norm_a: f64, norm_b: f64, omega_sq: &[f64], par: Par) -> Vec<f64> {
-    let n = l.nrows() as f64;
-    let a_inv = a_inverse_norm_bound(l, par);
-    omega_sq
-        .iter()
-        .map(|w| n * f64::EPSILON * (norm_b + w.abs() * norm_a) * a_inv)
-        .collect()
+    let model = APrioriModel::new(l, norm_a, norm_b, par);
+    omega_sq.iter().map(|&w| model.bound(w)).collect()
+}
+
+/// The a-priori error n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ of a value whose pair was never measured.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct APrioriModel {
+    /// n·u·‖A⁻¹‖₂.
+    scale: f64,
+    norm_a: f64,
+    norm_b: f64,
+}
+
+impl APrioriModel {
+    pub(crate) fn new(l: MatRef<'_, f64>, norm_a: f64, norm_b: f64, par: Par) -> Self {
+        let scale = l.nrows() as f64 * f64::EPSILON * a_inverse_norm_bound(l, par);
+        Self { scale, norm_a, norm_b }
+    }
+
+    pub(crate) fn bound(&self, omega_sq: f64) -> f64 {
+        self.scale * (self.norm_b + omega_sq.abs() * self.norm_a)
+    }
 }
 
 /// The computed modes used to split a residual into its modal components.
@@ -422,6 +438,9 @@ pub(crate) struct ModeBasis<'a> {
     pub x: MatRef<'a, f64>,
     /// The index within the selection of each column of `x`.
     pub modes: &'a [usize],
+    /// Values only: the error model of the unselected modes' values (never measured), for the
+    /// gaps to them; None when they are as accurate as the selected ones.
+    pub unselected: Option<APrioriModel>,
 }
 
 /// Replaces the bounds of refined modes by a gap-weighted Kato–Temple bound.
@@ -501,7 +520,10 @@ pub(crate) fn residual_bounds(
         }
         for (k, &w) in omega_all.iter().enumerate() {
             if k < first || k >= first + m {
-                gap = gap.min((rho - w).abs() - others_bound);
+                let uncertainty = basis
+                    .unselected
+                    .map_or(others_bound, |model| model.bound(w).max(others_bound));
+                gap = gap.min((rho - w).abs() - uncertainty);
             }
         }
         let eps_rest = vector_norm(rest.col(col));

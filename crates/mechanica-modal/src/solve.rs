@@ -475,6 +475,7 @@ impl Finish<'_> {
                 l: self.l,
                 x: xm.as_ref(),
                 modes: &all,
+                unselected: None,
             };
             accuracy::residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, &basis, self.par);
         }

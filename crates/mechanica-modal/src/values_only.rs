@@ -93,11 +93,16 @@ pub(crate) fn sharpen(
             residuals.push((i, p.residual));
         }
     }
+    // Unselected values were never measured: the gaps to them allow for their a-priori error.
+    let subset = omega.len() < omega_all.len();
+    let unselected = (subset && !residuals.is_empty())
+        .then(|| accuracy::APrioriModel::new(pencil.l, report.norm_a, report.norm_b, pencil.par));
     let basis = accuracy::ModeBasis {
         a,
         l: pencil.l,
         x: x.as_ref(),
         modes: &flagged,
+        unselected,
     };
     accuracy::residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
 }

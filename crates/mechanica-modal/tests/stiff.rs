@@ -150,3 +150,31 @@ fn unrefined_bounds_are_honest_but_weak() {
         assert_eq!(sol.accuracy.bound_kinds[0], BoundKind::Residual, "{}", c.name);
     }
 }
+
+/// Values only on a subset (the lowest 3): the refined lowest mode's residual bound allows for
+/// the never-measured error of the unselected neighbours, and every value is within its bound
+/// of the 60-digit reference.
+#[test]
+fn values_only_subsets_are_correct_to_their_bounds() {
+    for c in cases() {
+        let p = problem(&c);
+        let options = SolveOptions {
+            selection: mechanica_modal::Selection::Lowest(3),
+            vectors: false,
+            ..SolveOptions::default()
+        };
+        let sol = solve(&p, &options).expect("solve");
+        assert_eq!(sol.modes.len(), 3);
+        for (i, (m, &w)) in sol.modes.iter().zip(&c.omega_sq).enumerate() {
+            let err = (m.omega_sq - w).abs();
+            assert!(
+                err <= m.error_bound,
+                "{} mode {i}: error {err:e} > bound {:e}",
+                c.name,
+                m.error_bound
+            );
+            assert!(m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w);
+        }
+        assert_eq!(sol.accuracy.bound_kinds[0], BoundKind::Residual, "{}", c.name);
+    }
+}
