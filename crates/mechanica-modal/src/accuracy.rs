@@ -401,14 +401,8 @@ fn probe_seed(l: MatRef<'_, f64>) -> u64 {
     })
 }
 
-/// Values-only bounds n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ (a backward error of n·u assumed, not measured;
-/// ‖A⁻¹‖₂ bounded as in [`a_inverse_norm_bound`]).
-pub(crate) fn a_priori_bounds(l: MatRef<'_, f64>, norm_a: f64, norm_b: f64, omega_sq: &[f64], par: Par) -> Vec<f64> {
-    let model = APrioriModel::new(l, norm_a, norm_b, par);
-    omega_sq.iter().map(|&w| model.bound(w)).collect()
-}
-
-/// The a-priori error n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ of a value whose pair was never measured.
+/// The a-priori (values-only) error n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ of a value whose pair was never
+/// measured: a backward error of n·u assumed, ‖A⁻¹‖₂ bounded as in [`a_inverse_norm_bound`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct APrioriModel {
     /// n·u·‖A⁻¹‖₂.
@@ -425,6 +419,11 @@ impl APrioriModel {
 
     pub(crate) fn bound(&self, omega_sq: f64) -> f64 {
         self.scale * (self.norm_b + omega_sq.abs() * self.norm_a)
+    }
+
+    /// The bounds of the values `omega_sq`.
+    pub(crate) fn bounds(&self, omega_sq: &[f64]) -> Vec<f64> {
+        omega_sq.iter().map(|&w| self.bound(w)).collect()
     }
 }
 
@@ -453,7 +452,7 @@ pub(crate) struct ModeBasis<'a> {
 /// residual bound ε = ‖r‖_{A⁻¹}, and u|ρ| is added for rounding ρ to double. Selected modes
 /// missing from the basis only enter through δ (their components stay in r_⊥), and so do
 /// unselected modes (outside `first..first + m` of `omega_all`), with the largest bound of the
-/// selection as their uncertainty.
+/// selection as their uncertainty, or (values only) their a-priori error if that is larger.
 pub(crate) fn residual_bounds(
     report: &mut AccuracyReport,
     omega_sq: &[f64],

@@ -50,6 +50,11 @@ pub const SEQUENTIAL_BELOW: usize = 192;
 /// Auto refinement starts when the reduction guarantees fewer than 8 digits of a mode's ω².
 pub const AUTO_REFINE_RELATIVE_BOUND: f64 = 1e-8;
 
+/// Whether a mode's bound guarantees fewer digits than [`AUTO_REFINE_RELATIVE_BOUND`] asks for.
+pub(crate) fn weakly_bounded(bound: f64, omega_sq: f64) -> bool {
+    bound > AUTO_REFINE_RELATIVE_BOUND * omega_sq.abs()
+}
+
 /// A values-only solve with [`Refinement::Auto`] forms the vectors of its poorly bounded modes
 /// one by one (inverse iteration, module `values_only`) when there are at most this many or
 /// n/4 of them; beyond that it computes all vectors, which then costs less (the clustered
@@ -187,8 +192,8 @@ pub(crate) struct Definite {
     /// Values only: C's tridiagonal form, from which [`crate::values_only`] forms the vectors
     /// of the few modes whose a-priori bound is too weak.
     pub form: Option<TridiagonalForm>,
-    /// Values only: the a-priori bounds of the selected modes, when already computed.
-    pub a_priori: Option<Vec<f64>>,
+    /// Values only: the a-priori error model, when already computed.
+    pub a_priori: Option<accuracy::APrioriModel>,
     /// The reduction's time (as `factor`) and the eigensolver's (as `eigen`).
     pub timings: DenseTimings,
 }
@@ -322,13 +327,9 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 // (crate::values_only), unless they are so many that all vectors cost less.
                 let clock = Instant::now();
                 let selected = &def.omega_sq[def.first..def.end];
-                let bounds = accuracy::a_priori_bounds(l.as_ref(), norm_a, norm_b, selected, par);
+                let model = accuracy::APrioriModel::new(l.as_ref(), norm_a, norm_b, par);
                 def.timings.accuracy = clock.elapsed();
-                let flagged = selected
-                    .iter()
-                    .zip(&bounds)
-                    .filter(|(w, e)| **e > AUTO_REFINE_RELATIVE_BOUND * w.abs())
-                    .count();
+                let flagged = selected.iter().filter(|&&w| weakly_bounded(model.bound(w), w)).count();
                 if flagged > FLAGGED_VECTORS_UP_TO.max(n / 4) {
                     let first_try = def.timings;
                     def = solve_definite(l.as_ref(), b, options.selection, true, par)?;
@@ -336,7 +337,7 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                     def.timings.eigen += first_try.eigen;
                     def.timings.accuracy += first_try.accuracy;
                 } else {
-                    def.a_priori = Some(bounds);
+                    def.a_priori = Some(model);
                 }
             }
             def.timings.factor += cholesky_time;
@@ -405,20 +406,21 @@ impl Finish<'_> {
         let mut products = x
             .as_ref()
             .map(|x| accuracy::PairProducts::new(a, b, x.as_ref(), self.options.residuals, self.par));
+        // Values only: the a-priori error model (computed once, here or by `solve`).
+        let mut a_priori = None;
         let mut report = match (&x, &products) {
             (Some(x), Some(p)) => AccuracyReport::from_products(p, x.as_ref(), &omega, self.norm_a, self.norm_b),
             _ => {
-                let bounds = match def.a_priori {
-                    Some(bounds) => bounds,
-                    None => accuracy::a_priori_bounds(self.l, self.norm_a, self.norm_b, &omega, self.par),
-                };
-                AccuracyReport::a_priori(self.norm_a, self.norm_b, bounds)
+                let model = def
+                    .a_priori
+                    .unwrap_or_else(|| accuracy::APrioriModel::new(self.l, self.norm_a, self.norm_b, self.par));
+                a_priori = Some(model);
+                AccuracyReport::a_priori(self.norm_a, self.norm_b, model.bounds(&omega))
             }
         };
         timings.accuracy += clock.elapsed();
         let clock = Instant::now();
-        if let Some(form) = form.as_mut()
-            && x.is_none()
+        if let (Some(form), Some(model)) = (form.as_mut(), a_priori)
             && lift.is_none()
             && self.options.refinement == Refinement::Auto
         {
@@ -429,7 +431,7 @@ impl Finish<'_> {
                 residuals: self.options.residuals,
                 par: self.par,
             };
-            crate::values_only::sharpen(&pencil, form, &mut report, &mut omega, &omega_all, def.first);
+            crate::values_only::sharpen(&pencil, model, form, &mut report, &mut omega, &omega_all, def.first);
         }
         // Refinement of poorly bounded simple modes (needs vectors in the original coordinates).
         if let (Some(xm), Some(products)) = (x.as_mut(), products.as_mut())
@@ -439,7 +441,7 @@ impl Finish<'_> {
             let simple = simple_modes(&omega, &report.error_bounds);
             let mut residuals: Vec<(usize, Vec<f64>)> = Vec::new();
             for i in 0..m {
-                let poor = report.error_bounds[i] > AUTO_REFINE_RELATIVE_BOUND * omega[i].abs();
+                let poor = weakly_bounded(report.error_bounds[i], omega[i]);
                 let wanted = self.options.refinement == Refinement::Always || poor;
                 if !(wanted && simple[i]) {
                     continue;

@@ -3,7 +3,7 @@
 //! still too weak, refined.
 //!
 //! Without vectors a dense solve can only bound an eigenvalue a priori, by an assumed backward
-//! error of n·u: n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ ([`crate::accuracy::a_priori_bounds`]), which
+//! error of n·u: n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ (`accuracy::APrioriModel`), which
 //! relative to a small |ω²| is weak (the lowest modes of a long chain, stiff problems). For each
 //! mode above [`crate::solve::AUTO_REFINE_RELATIVE_BOUND`]·|ω²|:
 //!
@@ -22,7 +22,7 @@
 use crate::accuracy::{self, AccuracyReport, BoundKind, PairProducts, Residuals};
 use crate::reduce::back_transform;
 use crate::refine::{TridiagonalCorrection, refine_pair, refine_pair_projected};
-use crate::solve::{AUTO_REFINE_RELATIVE_BOUND, simple_modes};
+use crate::solve::{simple_modes, weakly_bounded};
 use crate::symmetric_eigen::TridiagonalForm;
 use faer::{MatRef, Par};
 
@@ -37,13 +37,14 @@ pub(crate) struct Pencil<'a> {
     pub par: Par,
 }
 
-/// Sharpens the a-priori `report` of the selected values `omega` (entries `first..` of the
+/// Sharpens the a-priori `report` (from the model `a_priori`) of the selected values `omega` (entries `first..` of the
 /// ascending spectrum `omega_all`, the eigenvalues of `form`'s T): measured first-order bounds
 /// for the flagged modes, refinement and residual bounds for those still flagged. `omega` is
 /// updated where refinement moved a value. When inverse iteration fails, the report keeps its
 /// a-priori bounds.
 pub(crate) fn sharpen(
     pencil: &Pencil<'_>,
+    a_priori: accuracy::APrioriModel,
     form: &mut TridiagonalForm,
     report: &mut AccuracyReport,
     omega: &mut [f64],
@@ -51,7 +52,7 @@ pub(crate) fn sharpen(
     first: usize,
 ) {
     let flagged: Vec<usize> = (0..omega.len())
-        .filter(|&i| report.error_bounds[i] > AUTO_REFINE_RELATIVE_BOUND * omega[i].abs())
+        .filter(|&i| weakly_bounded(report.error_bounds[i], omega[i]))
         .collect();
     if flagged.is_empty() {
         return;
@@ -74,7 +75,7 @@ pub(crate) fn sharpen(
     let simple = simple_modes(omega, &report.error_bounds);
     let mut residuals: Vec<(usize, Vec<f64>)> = Vec::new();
     for (col, &i) in flagged.iter().enumerate() {
-        if !simple[i] || report.error_bounds[i] <= AUTO_REFINE_RELATIVE_BOUND * omega[i].abs() {
+        if !simple[i] || !weakly_bounded(report.error_bounds[i], omega[i]) {
             continue;
         }
         let x0: Vec<f64> = x.col(col).iter().copied().collect();
@@ -94,15 +95,12 @@ pub(crate) fn sharpen(
         }
     }
     // Unselected values were never measured: the gaps to them allow for their a-priori error.
-    let subset = omega.len() < omega_all.len();
-    let unselected = (subset && !residuals.is_empty())
-        .then(|| accuracy::APrioriModel::new(pencil.l, report.norm_a, report.norm_b, pencil.par));
     let basis = accuracy::ModeBasis {
         a,
         l: pencil.l,
         x: x.as_ref(),
         modes: &flagged,
-        unselected,
+        unselected: Some(a_priori),
     };
     accuracy::residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
 }
