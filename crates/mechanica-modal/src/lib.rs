@@ -57,6 +57,7 @@ pub mod sparse_pencil;
 mod supernodal_solve;
 pub mod symmetric_eigen;
 mod symv_team;
+mod tridiagonal_divide;
 mod tridiagonal_values;
 mod tridiagonal_vectors;
 mod values_only;

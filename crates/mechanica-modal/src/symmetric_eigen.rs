@@ -1,6 +1,7 @@
 //! Eigen-decomposition C = Y diag(ω²) Yᵀ of the reduced symmetric matrix C = L⁻¹BL⁻ᵀ (8.89
-//! after the reduction): a blocked Householder tridiagonalization C = Q T Qᵀ, faer's tridiagonal
-//! divide and conquer T = Z Λ Zᵀ, and faer's blocked Householder application Y = Q Z; values
+//! after the reduction): a blocked Householder tridiagonalization C = Q T Qᵀ, the tridiagonal
+//! divide and conquer T = Z Λ Zᵀ of module `tridiagonal_divide` (faer's as fallback), and faer's
+//! blocked Householder application Y = Q Z; values
 //! only: the root-free QL/QR iteration of module `tridiagonal_values` on T.
 //!
 //! Why not faer's `self_adjoint_eigen`: faer 0.24 tridiagonalizes column by column, reading and
@@ -18,6 +19,7 @@
 
 use crate::ModalError;
 use crate::symv_team::SymvTeam;
+use crate::tridiagonal_divide::tridiagonal_divide_and_conquer;
 use crate::tridiagonal_values::tridiagonal_eigenvalues;
 use crate::tridiagonal_vectors::tridiagonal_eigenvectors;
 use faer::dyn_stack::StackReq;
@@ -86,39 +88,14 @@ pub(crate) fn symmetric_eigen_returning_input(
         return Ok((SymmetricEigen { values, vectors: None }, form.into_storage()));
     }
     let t = tridiagonalize(&mut c, par);
-    // faer's full-EVD workspace bounds that of its tridiagonal solver and the Householder
-    // application alike (it is allocated, not touched, beyond what they use).
-    let mut mem = faer::dyn_stack::MemBuffer::new(StackReq::any_of(&[
-        self_adjoint_evd_scratch::<f64>(n, ComputeEigenvectors::Yes, par, Default::default()),
-        apply_block_householder_sequence_on_the_left_in_place_scratch::<f64>(n, block_size(n), n),
-    ]));
-    let stack = faer::dyn_stack::MemStack::new(&mut mem);
-    let mut values = vec![0.0; n];
-    let mut z = Mat::<f64>::zeros(n, n);
-    let mut solve_t = |diag: &[f64], subdiag: &[f64], z: &mut Mat<f64>, stack: &mut faer::dyn_stack::MemStack| {
-        tridiagonal_self_adjoint_evd(
-            ColRef::from_slice(diag).as_diagonal(),
-            ColRef::from_slice(subdiag).as_diagonal(),
-            ColMut::from_slice_mut(&mut values).as_diagonal_mut(),
-            Some(z.as_mut()),
-            par,
-            stack,
-            Default::default(),
-        )
-        .is_ok()
+    let (values, mut z) = match tridiagonal_divide_and_conquer(&t.diag, &t.subdiag, par) {
+        Some(pairs) => pairs,
+        None => faer_tridiagonal_eigen(&t, par)?,
     };
-    if !solve_t(&t.diag, &t.subdiag, &mut z, stack) {
-        // faer's QR iteration (divide and conquer's leaves, n ≤ 128) fails on some tridiagonals
-        // graded from tiny at the top to huge at the bottom, and not on the same matrix turned
-        // upside down: T = P T' P with P the reversal, so T's eigenvectors are those of T'
-        // with their rows reversed.
-        let reversed = |v: &[f64]| v.iter().rev().copied().collect::<Vec<f64>>();
-        let mut z_reversed = Mat::<f64>::zeros(n, n);
-        if !solve_t(&reversed(&t.diag), &reversed(&t.subdiag), &mut z_reversed, stack) {
-            return Err(ModalError::NoConvergence { n });
-        }
-        z = Mat::from_fn(n, n, |i, j| z_reversed[(n - 1 - i, j)]);
-    }
+    let mut mem = faer::dyn_stack::MemBuffer::new(
+        apply_block_householder_sequence_on_the_left_in_place_scratch::<f64>(n, block_size(n), n),
+    );
+    let stack = faer::dyn_stack::MemStack::new(&mut mem);
     if n > 1 {
         let factor = block_factor(&c, &t.tau, par);
         apply_block_householder_sequence_on_the_left_in_place_with_conj(
@@ -137,6 +114,45 @@ pub(crate) fn symmetric_eigen_returning_input(
         },
         c,
     ))
+}
+
+/// T = Z Λ Zᵀ by faer's divide and conquer: the fallback when the own one
+/// ([`tridiagonal_divide_and_conquer`]) declines (a leaf's QL iteration did not converge).
+fn faer_tridiagonal_eigen(t: &Tridiagonal, par: Par) -> Result<(Vec<f64>, Mat<f64>), ModalError> {
+    let n = t.diag.len();
+    let mut mem = faer::dyn_stack::MemBuffer::new(self_adjoint_evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::Yes,
+        par,
+        Default::default(),
+    ));
+    let stack = faer::dyn_stack::MemStack::new(&mut mem);
+    let solve = |diag: &[f64], subdiag: &[f64], stack: &mut faer::dyn_stack::MemStack| {
+        let mut values = vec![0.0; n];
+        let mut z = Mat::<f64>::zeros(n, n);
+        tridiagonal_self_adjoint_evd(
+            ColRef::from_slice(diag).as_diagonal(),
+            ColRef::from_slice(subdiag).as_diagonal(),
+            ColMut::from_slice_mut(&mut values).as_diagonal_mut(),
+            Some(z.as_mut()),
+            par,
+            stack,
+            Default::default(),
+        )
+        .ok()
+        .map(|_| (values, z))
+    };
+    if let Some(pairs) = solve(&t.diag, &t.subdiag, stack) {
+        return Ok(pairs);
+    }
+    // faer's QR iteration (divide and conquer's leaves, n ≤ 128) fails on some tridiagonals
+    // graded from tiny at the top to huge at the bottom, and not on the same matrix turned
+    // upside down: T = P T' P with P the reversal, so T's eigenvectors are those of T' with
+    // their rows reversed.
+    let reversed = |v: &[f64]| v.iter().rev().copied().collect::<Vec<f64>>();
+    let (values, z_reversed) =
+        solve(&reversed(&t.diag), &reversed(&t.subdiag), stack).ok_or(ModalError::NoConvergence { n })?;
+    Ok((values, Mat::from_fn(n, n, |i, j| z_reversed[(n - 1 - i, j)])))
 }
 
 /// What a values-only decomposition keeps so that a few eigenvectors can be formed afterwards
