@@ -379,29 +379,40 @@ fn secular_root(
         poles[position[m + 1]]
     };
     let half_gap = 0.5 * (upper - lower);
-    // Origin at the lower pole unless f(midpoint) < 0 puts the root in the upper half.
+    // f at the midpoint, with the origin at the lower pole.
     let mut origin = lower;
-    let mut origin_is_lower = true;
     shift_poles(poles, lower, shifted);
     let mut tau = half_gap;
     let mut sums = evaluate(shifted, z_sq, 0.0, tau, delta);
     let mut f = 1.0 / rho + sums.below + sums.above;
-    let (mut low, mut high);
-    if f >= 0.0 || last {
-        (low, high) = (0.0, half_gap);
-        if last && f < 0.0 {
-            (low, high) = (half_gap, 2.0 * half_gap);
+    let (mut low, mut high) = (0.0, half_gap);
+    if last && f < 0.0 {
+        (low, high) = (half_gap, 2.0 * half_gap);
+    }
+    if !last {
+        if f < 0.0 {
+            // The root is in the upper half: the origin moves to the upper pole (the sums at
+            // the midpoint are the same).
+            origin = upper;
+            shift_poles(poles, upper, shifted);
+            tau = -half_gap;
+            (low, high) = (-half_gap, 0.0);
         }
-    } else {
-        origin = upper;
-        origin_is_lower = false;
-        shift_poles(poles, upper, shifted);
-        tau = -half_gap;
-        (low, high) = (-half_gap, 0.0);
-        sums = evaluate(shifted, z_sq, lower - upper, tau, delta);
+        // First guess (as `dlaed4`): the two poles beside the root exact, the other terms
+        // frozen at their midpoint value.
+        let (a, b) = (shifted[position[m]], shifted[position[m + 1]]);
+        let (s_low, s_high) = (z_sq[position[m]], z_sq[position[m + 1]]);
+        let others = f - s_low / (a - tau) - s_high / (b - tau);
+        let guess = two_pole_root(others, a, b, s_low, s_high);
+        tau = if guess > low && guess < high {
+            guess
+        } else {
+            0.5 * (low + high)
+        };
+        sums = evaluate(shifted, z_sq, a, tau, delta);
         f = 1.0 / rho + sums.below + sums.above;
     }
-    let below_limit = if origin_is_lower { 0.0 } else { lower - upper };
+    let below_limit = shifted[position[m]];
     for step in 0..MAX_SECULAR_STEPS {
         let slope = sums.below_slope + sums.above_slope;
         let rounding = EPS * (8.0 * (sums.above - sums.below) + 2.0 / rho + 3.0 * tau.abs() * slope);
@@ -424,18 +435,7 @@ fn secular_root(
         } else {
             let b = delta[position[m + 1]];
             let c = f - a * sums.below_slope - b * sums.above_slope;
-            let quad_a = (a + b) * f - a * b * slope;
-            let quad_b = a * b * f;
-            if c == 0.0 {
-                quad_b / quad_a
-            } else {
-                let root = (quad_a * quad_a - 4.0 * quad_b * c).abs().sqrt();
-                if quad_a <= 0.0 {
-                    (quad_a - root) / (2.0 * c)
-                } else {
-                    2.0 * quad_b / (quad_a + root)
-                }
-            }
+            two_pole_root(c, a, b, a * a * sums.below_slope, b * b * sums.above_slope)
         };
         if f * eta >= 0.0 {
             // The model stepped away from the root: a Newton step instead.
@@ -453,6 +453,23 @@ fn secular_root(
         f = 1.0 / rho + sums.below + sums.above;
     }
     origin + tau
+}
+
+/// The root η in (a, b) of c + s/(a − η) + S/(b − η) = 0 (s, S ≥ 0, a < 0 < b or a < b),
+/// i.e. of c η² − (c(a + b) + s + S) η + c ab + s b + S a = 0, in the cancellation-free form of
+/// `dlaed4`.
+fn two_pole_root(c: f64, a: f64, b: f64, s: f64, big_s: f64) -> f64 {
+    let linear = c * (a + b) + s + big_s;
+    let constant = c * a * b + s * b + big_s * a;
+    if c == 0.0 {
+        return constant / linear;
+    }
+    let root = (linear * linear - 4.0 * constant * c).abs().sqrt();
+    if linear <= 0.0 {
+        (linear - root) / (2.0 * c)
+    } else {
+        2.0 * constant / (linear + root)
+    }
 }
 
 /// shifted_i = d_i − origin.
