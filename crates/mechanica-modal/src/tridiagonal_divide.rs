@@ -142,7 +142,8 @@ fn solve_node(d: &mut [f64], e: &mut [f64], nodes: Node<'_>, order: &mut [usize]
     merge(d, beta, n1, Node { u, work, secular }, order, par)
 }
 
-/// Runs two closures, on two threads when `par` allows it.
+/// Runs two closures, on two threads of Rayon's global pool when `par` allows more than one
+/// (the pool, not `par`'s count, decides how many run at once).
 fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send, par: Par) -> (A, B) {
     match par {
         Par::Rayon(threads) if threads.get() > 1 => rayon::join(a, b),
