@@ -8,8 +8,8 @@
 //!   are ordered by ω² = −λ ascending (unstable, rigid-body, oscillatory, infinite).
 //! - **Dense method** ([`solve()`]): Cholesky A = LLᵀ, the symmetric reduction C = L⁻¹BL⁻ᵀ in
 //!   about n³ flops ([`reduce`], as LAPACK `dsygst`), the eigen-decomposition of C
-//!   ([`symmetric_eigen`]: this crate's blocked tridiagonalization, faer's tridiagonal divide
-//!   and conquer and blocked Householder application; values only by this crate's root-free
+//!   ([`symmetric_eigen`]: this crate's blocked tridiagonalization and tridiagonal divide and
+//!   conquer, faer's blocked Householder application; values only by this crate's root-free
 //!   QL/QR), X = L⁻ᵀY. faer's QZ (`generalized_eigen`) is not used: on this machine it loses accuracy
 //!   and speed at a few hundred unknowns (see `examples/faer_facts.rs`).
 //! - **Accuracy** ([`accuracy`]): per-pair backward error, ‖XᵀAX − I‖, a bound per eigenvalue

@@ -753,7 +753,7 @@ mod tests {
         let n = 70;
         let c = Mat::from_fn(n, n, |i, j| if i == j { (n - i) as f64 } else { 0.0 });
         let e = symmetric_eigen(c.clone(), true, Par::Seq).expect("converges");
-        // T is already diagonal; faer's divide and conquer still rounds (within n·u·‖C‖).
+        // T is already diagonal; the divide and conquer still rounds (within n·u·‖C‖).
         let tol = 4.0 * n as f64 * f64::EPSILON;
         for (k, v) in e.values.iter().enumerate() {
             assert!((v - (k + 1) as f64).abs() <= tol * n as f64, "{v} vs {}", k + 1);
