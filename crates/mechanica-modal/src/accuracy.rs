@@ -17,6 +17,7 @@ use crate::sketch::Sketch;
 use crate::solve::InertiaCheck;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Mat, MatRef, Par};
+use std::ops::Range;
 
 /// Where a mode's error bound comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -442,6 +443,19 @@ pub(crate) struct ModeBasis<'a> {
     pub unselected: Option<APrioriModel>,
 }
 
+/// The residual of a refined mode, with the cluster of modes refined together as one block
+/// ([`crate::refine::refine_cluster_projected`]; a simple mode is a cluster of one).
+pub(crate) struct RefinedResidual {
+    /// The mode's index within the selection.
+    pub mode: usize,
+    /// The selection indices of the modes refined together with it (contains `mode`).
+    pub cluster: Range<usize>,
+    /// max |x_kᵀAx_l| over distinct refined vectors of the cluster (0 for a single mode).
+    pub orthogonality: f64,
+    /// (B − ω²A)x from double-double, rounded.
+    pub residual: Vec<f64>,
+}
+
 /// Replaces the bounds of refined modes by a gap-weighted Kato–Temple bound.
 ///
 /// The residual r = (B − ρA)x of a refined, A-normalised x is split along the computed modes,
@@ -453,12 +467,20 @@ pub(crate) struct ModeBasis<'a> {
 /// missing from the basis only enter through δ (their components stay in r_⊥), and so do
 /// unselected modes (outside `first..first + m` of `omega_all`), with the largest bound of the
 /// selection as their uncertainty, or (values only) their a-priori error if that is larger.
+///
+/// A cluster G of p modes refined as one block gets one bound for all its members, the same
+/// sums taken over the block: ε² = Σ_{k∈G} ‖r_k‖²_{A⁻¹} (the Frobenius norm of the block
+/// residual, which bounds its 2-norm: p eigenvalues lie within it of the Ritz values, Kahan's
+/// theorem; Parlett, "The Symmetric Eigenvalue Problem", Thm 11.5.1), Σ_{j∉G} Σ_{k∈G} c_{jk}²/δ_j
+/// with δ_j the gap from mode j to the nearest member, and ‖R_⊥‖²_F/δ: the quadratic residual
+/// bound of a Ritz block separated by δ from the rest of the spectrum (Mathias, SIMAX 19, 1998).
+/// p·γ·|ρ| is added for the block's A-orthogonality defect γ.
 pub(crate) fn residual_bounds(
     report: &mut AccuracyReport,
     omega_sq: &[f64],
     omega_all: &[f64],
     first: usize,
-    residuals: &[(usize, Vec<f64>)],
+    residuals: &[RefinedResidual],
     basis: &ModeBasis<'_>,
     par: Par,
 ) {
@@ -475,7 +497,7 @@ pub(crate) fn residual_bounds(
         })
         .collect();
     // All refined residuals at once: C = Xᵀ R, and R_⊥ = L⁻¹(R − A X C) in the A⁻¹-norm.
-    let r = Mat::from_fn(n, k, |row, col| residuals[col].1[row]);
+    let r = Mat::from_fn(n, k, |row, col| residuals[col].residual[row]);
     let mut c = Mat::<f64>::zeros(basis.x.ncols(), k);
     faer::linalg::matmul::matmul(
         c.as_mut(),
@@ -490,28 +512,37 @@ pub(crate) fn residual_bounds(
     for (col, &mode) in basis.modes.iter().enumerate() {
         column_of[mode] = Some(col);
     }
+    let mut residual_of = vec![None; m];
+    for (col, refined) in residuals.iter().enumerate() {
+        residual_of[refined.mode] = Some(col);
+    }
     faer::linalg::matmul::matmul(xc.as_mut(), faer::Accum::Replace, basis.x, c.as_ref(), 1.0, par);
     let mut rest = r;
     faer::linalg::matmul::matmul(rest.as_mut(), faer::Accum::Add, basis.a, xc.as_ref(), -1.0, par);
     solve_lower_triangular_in_place(basis.l, rest.as_mut(), par);
-    for (col, (i, _)) in residuals.iter().enumerate() {
-        let i = *i;
-        let Some(eps) = report.residual_norms_a_inv[i] else {
+    for refined in residuals {
+        let i = refined.mode;
+        let group = refined.cluster.clone();
+        // The block's residual columns; a member without one leaves the linear bound.
+        let Some(columns) = group
+            .clone()
+            .map(|g| residual_of[g].zip(report.residual_norms_a_inv[g]))
+            .collect::<Option<Vec<(usize, f64)>>>()
+        else {
             continue;
         };
+        let eps = columns.iter().map(|(_, e)| e * e).sum::<f64>().sqrt();
         let rho = omega_sq[i];
+        let distance = |w: f64| group.clone().map(|g| (omega_sq[g] - w).abs()).fold(f64::INFINITY, f64::min);
         let mut gap = f64::INFINITY;
         let mut weighted = 0.0;
         let mut usable = true;
-        for j in 0..m {
-            if j == i {
-                continue;
-            }
-            let d = (rho - omega_sq[j]).abs() - linear[j];
+        for j in (0..m).filter(|j| !group.contains(j)) {
+            let d = distance(omega_sq[j]) - linear[j];
             gap = gap.min(d);
             if let Some(basis_col) = column_of[j] {
                 if d > 0.0 {
-                    weighted += c[(basis_col, col)] * c[(basis_col, col)] / d;
+                    weighted += columns.iter().map(|&(col, _)| c[(basis_col, col)].powi(2)).sum::<f64>() / d;
                 } else {
                     usable = false;
                 }
@@ -522,10 +553,14 @@ pub(crate) fn residual_bounds(
                 let uncertainty = basis
                     .unselected
                     .map_or(others_bound, |model| model.bound(w).max(others_bound));
-                gap = gap.min((rho - w).abs() - uncertainty);
+                gap = gap.min(distance(w) - uncertainty);
             }
         }
-        let eps_rest = vector_norm(rest.col(col));
+        let eps_rest = columns
+            .iter()
+            .map(|&(col, _)| vector_norm(rest.col(col)).powi(2))
+            .sum::<f64>()
+            .sqrt();
         let mut bound = eps;
         if gap > eps {
             bound = bound.min(eps * eps / gap);
@@ -533,7 +568,8 @@ pub(crate) fn residual_bounds(
                 bound = bound.min(weighted + eps_rest * eps_rest / gap);
             }
         }
-        report.error_bounds[i] = bound + f64::EPSILON * rho.abs();
+        let defect = group.len() as f64 * refined.orthogonality * rho.abs();
+        report.error_bounds[i] = bound + defect + f64::EPSILON * rho.abs();
         report.bound_kinds[i] = BoundKind::Residual;
     }
 }

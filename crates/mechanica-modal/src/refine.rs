@@ -1,6 +1,6 @@
-//! Refinement of one simple eigenpair of det(λA + B) = 0 with extended-precision residuals,
-//! for stiff and graded problems where the Cholesky reduction is accurate only relative to the
-//! largest eigenvalue.
+//! Refinement of one simple eigenpair, or of one cluster of nearly equal eigenvalues, of
+//! det(λA + B) = 0 with extended-precision residuals, for stiff and graded problems where the
+//! Cholesky reduction is accurate only relative to the largest eigenvalue.
 //!
 //! Method (Dongarra, Moler & Wilkinson, "Improving the accuracy of computed eigenvalues and
 //! eigenvectors", SIAM J. Numer. Anal. 20, 1983, adapted to the symmetric pencil): Newton's
@@ -13,7 +13,10 @@
 //! (n+1)³/3 factorization plus a few O(n²) double-double residuals per refined mode.
 //!
 //! It is chosen by [`crate::Refinement::Auto`] for every selected simple mode whose first-order
-//! bound from the reduction exceeds 1e-8·|ω²| (fewer than 8 guaranteed digits).
+//! bound from the reduction exceeds 1e-8·|ω²| (fewer than 8 guaranteed digits). Modes whose
+//! bound intervals overlap (a repeated frequency of a symmetric structure, or eigenvalues too
+//! close to tell apart) are refined together as one block by [`refine_cluster_projected`]: the
+//! block's invariant subspace is well defined where its single vectors are not.
 
 use crate::dd::{Dd, dot, mat_vec};
 use crate::symmetric_eigen::TridiagonalForm;
@@ -21,6 +24,7 @@ use crate::tridiagonal_vectors::{ShiftedTridiagonal, one_norm};
 use faer::linalg::solvers::Solve;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Mat, MatRef, Par, Side};
+use std::ops::Range;
 
 /// Maximum Newton steps per pair.
 pub const MAX_STEPS: usize = 12;
@@ -38,6 +42,25 @@ pub(crate) struct RefinedPair {
     pub residual: Vec<f64>,
     /// Newton steps taken.
     pub steps: usize,
+}
+
+/// The modes of one cluster refined together ([`refine_cluster_projected`]).
+#[derive(Debug, Clone)]
+pub(crate) struct RefinedCluster {
+    /// The refined pairs, ascending ω², each A-normalised.
+    pub pairs: Vec<RefinedPair>,
+    /// max_{k≠l} |x_kᵀAx_l| of the refined vectors, in double-double (0 for a single mode).
+    pub orthogonality: f64,
+}
+
+impl RefinedCluster {
+    /// A cluster of one pair.
+    pub(crate) fn single(pair: RefinedPair) -> Self {
+        Self {
+            pairs: vec![pair],
+            orthogonality: 0.0,
+        }
+    }
 }
 
 /// Refines (ω₀², x₀), with `l` the Cholesky factor of A (for the A⁻¹-norm of the residual); None if the bordered matrix is singular to working precision (the
@@ -88,10 +111,11 @@ pub(crate) fn refine_pair(
     finish_pair(a, b, l, x, steps)
 }
 
-/// The correction of [`refine_pair_projected`]: an approximate inverse of C − ρI on the
-/// complement of the refined mode, C = L⁻¹BL⁻ᵀ, applied in the reduced coordinates.
+/// The correction of [`refine_cluster_projected`]: an approximate inverse of C − ρI on the
+/// complement of the refined modes, C = L⁻¹BL⁻ᵀ, applied in the reduced coordinates.
 pub(crate) trait ReducedCorrection {
-    /// Σ_{j≠i} y_j (y_jᵀw)/(ω̃²_j − ρ) for the computed eigenpairs (ω̃²_j, y_j) of C.
+    /// Σ_{j∉G} y_j (y_jᵀw)/(ω̃²_j − ρ) for the computed eigenpairs (ω̃²_j, y_j) of C outside the
+    /// refined modes G, for every column of `w`.
     fn apply(&mut self, w: Mat<f64>, rho: f64) -> Mat<f64>;
 }
 
@@ -102,8 +126,8 @@ pub(crate) struct ReducedSpectrum<'a> {
     pub y: MatRef<'a, f64>,
     /// All n eigenvalues of C (ω², ascending).
     pub omega_sq: &'a [f64],
-    /// The mode being refined.
-    pub mode: usize,
+    /// The modes being refined (indices into `omega_sq`).
+    pub modes: Range<usize>,
 }
 
 impl ReducedCorrection for ReducedSpectrum<'_> {
@@ -111,51 +135,56 @@ impl ReducedCorrection for ReducedSpectrum<'_> {
         let mut c = self.y.transpose() * &w;
         for j in 0..c.nrows() {
             let gap = self.omega_sq[j] - rho;
-            c[(j, 0)] = if j == self.mode || gap == 0.0 {
-                0.0
-            } else {
-                c[(j, 0)] / gap
-            };
+            let excluded = self.modes.contains(&j) || gap == 0.0;
+            for k in 0..c.ncols() {
+                c[(j, k)] = if excluded { 0.0 } else { c[(j, k)] / gap };
+            }
         }
         self.y * &c
     }
 }
 
-/// The reduced problem in tridiagonal form C = Q T Qᵀ with one eigenvector z of T (unit): the
-/// correction of a values-only solve, which has no Y. The same operator as
-/// [`ReducedSpectrum`] evaluated as Q P (T − ρI)⁻¹ P Qᵀ with P = I − z zᵀ: the shifted
-/// tridiagonal solve is nearly singular at ρ ≈ θ, but its error lies almost entirely along z
-/// (Wilkinson, "The Algebraic Eigenvalue Problem", §5.56), which the second projection removes.
+/// The reduced problem in tridiagonal form C = Q T Qᵀ with the refined modes' orthonormal
+/// eigenvectors Z of T: the correction of a values-only solve, which has no Y. The same
+/// operator as [`ReducedSpectrum`] evaluated as Q P (T − ρI)⁻¹ P Qᵀ with P = I − Z Zᵀ: the
+/// shifted tridiagonal solve is nearly singular at ρ ≈ θ, but its error lies almost entirely in
+/// span Z (Wilkinson, "The Algebraic Eigenvalue Problem", §5.56), which the second projection
+/// removes.
 pub(crate) struct TridiagonalCorrection<'a> {
     /// T and Q.
     pub form: &'a mut TridiagonalForm,
-    /// The refined mode's unit eigenvector of T.
-    pub z: &'a [f64],
+    /// The refined modes' orthonormal eigenvectors of T, one column each.
+    pub z: MatRef<'a, f64>,
 }
 
 impl ReducedCorrection for TridiagonalCorrection<'_> {
     fn apply(&mut self, mut w: Mat<f64>, rho: f64) -> Mat<f64> {
         self.form.apply_q_transpose(w.as_mut());
-        let u = w.col_as_slice_mut(0);
-        project_out(u, self.z);
         let (diag, subdiag) = (self.form.diag(), self.form.subdiag());
         let tiny = f64::EPSILON * one_norm(diag, subdiag);
-        let shrunk = ShiftedTridiagonal::new(diag, subdiag, rho, tiny).solve_in_place(u);
-        if shrunk != 1.0 {
-            // Growth beyond 1e150: no usable correction (the caller sees non-finite values).
-            u.iter_mut().for_each(|v| *v = f64::NAN);
-            return w;
+        let shifted = ShiftedTridiagonal::new(diag, subdiag, rho, tiny);
+        for k in 0..w.ncols() {
+            let u = w.col_as_slice_mut(k);
+            project_out(u, self.z);
+            if shifted.solve_in_place(u) != 1.0 {
+                // Growth beyond 1e150: no usable correction (the caller sees non-finite values).
+                u.iter_mut().for_each(|v| *v = f64::NAN);
+                return w;
+            }
+            project_out(u, self.z);
         }
-        project_out(u, self.z);
         self.form.apply_q(w.as_mut());
         w
     }
 }
 
-/// u ← u − z (zᵀu) for a unit z.
-fn project_out(u: &mut [f64], z: &[f64]) {
-    let overlap: f64 = u.iter().zip(z).map(|(p, q)| p * q).sum();
-    u.iter_mut().zip(z).for_each(|(p, q)| *p -= overlap * q);
+/// u ← u − Σ_k z_k (z_kᵀu) for orthonormal columns z_k.
+fn project_out(u: &mut [f64], z: MatRef<'_, f64>) {
+    for k in 0..z.ncols() {
+        let zk = z.col(k);
+        let overlap: f64 = u.iter().zip(zk.iter()).map(|(p, q)| p * q).sum();
+        u.iter_mut().zip(zk.iter()).for_each(|(p, q)| *p -= overlap * q);
+    }
 }
 
 /// Maximum steps of [`refine_pair_projected`] before it gives up.
@@ -165,15 +194,8 @@ pub const MAX_PROJECTED_STEPS: usize = 8;
 /// the iteration stops there (the bound comes from the final residual either way).
 const STAGNATION_ULPS: f64 = 16.0;
 
-/// Refines the simple pair (ω²_i, x₀) by Rayleigh-quotient steps with a projected correction:
-/// ρ and r = (B − ρA)x in double-double, then x ← x − L⁻ᵀ K L⁻¹ r with K the
-/// [`ReducedCorrection`], Σ_{j≠i} y_j y_jᵀ/(ω̃²_j − ρ). This is the Newton step of
-/// [`refine_pair`] with the bordered Jacobian replaced by the reduction's computed
-/// decomposition, which has a backward error of the same order as an LBLᵀ factorization of
-/// B − ρA when the reduction is accurate; it converges linearly with the ratio of that error to
-/// the gap. None when a step above rounding level fails to halve the correction (graded
-/// problems, where the computed spectrum is too far from the exact one): the caller then falls
-/// back to [`refine_pair`].
+/// Refines the simple pair (ω²_i, x₀): [`refine_cluster_projected`] for one mode.
+#[cfg(test)]
 pub(crate) fn refine_pair_projected(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
@@ -181,37 +203,160 @@ pub(crate) fn refine_pair_projected(
     correction: &mut dyn ReducedCorrection,
     x0: &[f64],
 ) -> Option<RefinedPair> {
-    let n = a.nrows();
-    let mut x = x0.to_vec();
+    let x0 = MatRef::from_column_major_slice(x0, x0.len(), 1);
+    refine_cluster_projected(a, b, l, correction, x0).and_then(|c| c.pairs.into_iter().next())
+}
+
+/// Refines a cluster G of p modes with nearly equal ω² (p = 1: a simple pair), starting from
+/// their computed vectors X₀ (n × p, A-orthonormal to working precision), by block
+/// Rayleigh-quotient steps with a projected correction: the p × p Rayleigh-quotient matrix
+/// M = (XᵀAX)⁻¹XᵀBX and R = BX − AXM in double-double, ρ = trace M / p, then
+/// X ← X − L⁻ᵀ K L⁻¹ R with K the [`ReducedCorrection`], Σ_{j∉G} y_j y_jᵀ/(ω̃²_j − ρ).
+///
+/// For p = 1 this is the Newton step of [`refine_pair`] with the bordered Jacobian replaced by
+/// the reduction's computed decomposition, which has a backward error of the same order as an
+/// LBLᵀ factorization of B − ρA when the reduction is accurate. For p > 1 it is the block
+/// (subspace) form of that step, which needs no single vector of the cluster to be well
+/// defined: X converges to the invariant subspace, and a final Rayleigh–Ritz step on (XᵀBX,
+/// XᵀAX) gives the A-orthonormal pairs. It converges linearly with the ratio of the cluster's
+/// spread and the decomposition's error to the gap to the other modes. None when a step above
+/// rounding level fails to halve the correction (graded problems where the computed spectrum is
+/// too far from the exact one, or a cluster that is not separated from the rest): for p = 1 the
+/// caller then falls back to [`refine_pair`].
+pub(crate) fn refine_cluster_projected(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    l: MatRef<'_, f64>,
+    correction: &mut dyn ReducedCorrection,
+    x0: MatRef<'_, f64>,
+) -> Option<RefinedCluster> {
+    let (n, p) = (x0.nrows(), x0.ncols());
+    if p == 0 {
+        return None;
+    }
+    let mut x = x0.to_owned();
     let mut previous = f64::INFINITY;
     for step in 1..=MAX_PROJECTED_STEPS {
-        let axd = mat_vec(a, &x);
-        let bxd = mat_vec(b, &x);
-        let rq = dot(&x, &bxd).over(dot(&x, &axd));
-        let mut w = Mat::from_fn(n, 1, |k, _| bxd[k].minus(rq.times(axd[k])).to_f64());
+        let ax: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(a, x.col_as_slice(k))).collect();
+        let bx: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(b, x.col_as_slice(k))).collect();
+        let m = rayleigh_quotient_matrix(&x, &ax, &bx)?;
+        let rho = (0..p).fold(Dd::of(0.0), |t, k| t.plus(m[k][k])).to_f64() / p as f64;
+        let mut w = Mat::from_fn(n, p, |i, k| {
+            (0..p)
+                .fold(bx[k][i], |r, j| r.minus(m[j][k].times(ax[j][i])))
+                .to_f64()
+        });
         solve_lower_triangular_in_place(l, w.as_mut(), Par::Seq);
-        let mut delta = correction.apply(w, rq.to_f64());
+        let mut delta = correction.apply(w, rho);
         solve_upper_triangular_in_place(l.transpose(), delta.as_mut(), Par::Seq);
         // f64::max ignores NaN, so a failed correction is caught here, not by dmax.
-        if !(0..n).all(|k| delta[(k, 0)].is_finite()) {
+        if !delta.col_iter().all(|c| c.iter().all(|v| v.is_finite())) {
             return None;
         }
-        let xmax = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        let dmax = (0..n).fold(0.0_f64, |m, k| m.max(delta[(k, 0)].abs()));
+        let xmax = x.col_iter().flat_map(|c| c.iter()).fold(0.0_f64, |m, v| m.max(v.abs()));
+        let dmax = delta
+            .col_iter()
+            .flat_map(|c| c.iter())
+            .fold(0.0_f64, |m, v| m.max(v.abs()));
         let at_rounding = dmax <= STAGNATION_ULPS * f64::EPSILON * xmax;
         let contracting = dmax <= 0.5 * previous;
         if !dmax.is_finite() || !(contracting || at_rounding) {
             return None;
         }
-        for k in 0..n {
-            x[k] -= delta[(k, 0)];
+        for k in 0..p {
+            for (xi, di) in x.col_as_slice_mut(k).iter_mut().zip(delta.col_as_slice(k)) {
+                *xi -= di;
+            }
         }
         if dmax <= 2.0 * f64::EPSILON * xmax || (at_rounding && !contracting) {
-            return finish_pair(a, b, l, x, step);
+            return finish_cluster(a, b, l, x, step);
         }
         previous = dmax;
     }
     None
+}
+
+/// M = (XᵀAX)⁻¹ XᵀBX in double-double from the double-double products AX and BX (one vector
+/// per column), by Gaussian elimination on the Gram matrix XᵀAX (symmetric positive definite
+/// and close to I for an A-orthonormal X, so no pivoting); None if a pivot is not positive.
+fn rayleigh_quotient_matrix(x: &Mat<f64>, ax: &[Vec<Dd>], bx: &[Vec<Dd>]) -> Option<Vec<Vec<Dd>>> {
+    let p = ax.len();
+    let mut gram: Vec<Vec<Dd>> = (0..p)
+        .map(|k| (0..p).map(|j| dot(x.col_as_slice(k), &ax[j])).collect())
+        .collect();
+    let mut m: Vec<Vec<Dd>> = (0..p)
+        .map(|k| (0..p).map(|j| dot(x.col_as_slice(k), &bx[j])).collect())
+        .collect();
+    for k in 0..p {
+        let pivot = gram[k][k];
+        if !(pivot.hi > 0.0) {
+            return None;
+        }
+        for i in k + 1..p {
+            let factor = gram[i][k].over(pivot);
+            for j in k..p {
+                gram[i][j] = gram[i][j].minus(factor.times(gram[k][j]));
+            }
+            for j in 0..p {
+                m[i][j] = m[i][j].minus(factor.times(m[k][j]));
+            }
+        }
+    }
+    for k in (0..p).rev() {
+        for j in 0..p {
+            let mut v = m[k][j];
+            for i in k + 1..p {
+                v = v.minus(gram[k][i].times(m[i][j]));
+            }
+            m[k][j] = v.over(gram[k][k]);
+        }
+    }
+    Some(m)
+}
+
+/// Rayleigh–Ritz on the converged cluster (p > 1): the A-orthonormal Ritz vectors of
+/// (XᵀBX, XᵀAX) in ascending order, each finished by [`finish_pair`], and their mutual
+/// A-orthogonality in double-double.
+fn finish_cluster(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    l: MatRef<'_, f64>,
+    x: Mat<f64>,
+    steps: usize,
+) -> Option<RefinedCluster> {
+    let p = x.ncols();
+    if p == 1 {
+        return finish_pair(a, b, l, x.col_as_slice(0).to_vec(), steps).map(RefinedCluster::single);
+    }
+    let ax: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(a, x.col_as_slice(k))).collect();
+    let bx: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(b, x.col_as_slice(k))).collect();
+    let symmetric = |products: &[Vec<Dd>], i: usize, j: usize| {
+        let upper = dot(x.col_as_slice(i), &products[j]).to_f64();
+        let lower = dot(x.col_as_slice(j), &products[i]).to_f64();
+        0.5 * (upper + lower)
+    };
+    let gram = Mat::from_fn(p, p, |i, j| symmetric(&ax, i, j));
+    let projected = Mat::from_fn(p, p, |i, j| symmetric(&bx, i, j));
+    let factor = gram.llt(Side::Lower).ok()?;
+    let lg = factor.L();
+    let mut c = projected;
+    solve_lower_triangular_in_place(lg, c.as_mut(), Par::Seq);
+    solve_lower_triangular_in_place(lg, c.as_mut().transpose_mut(), Par::Seq);
+    let eigen = c.self_adjoint_eigen(Side::Lower).ok()?;
+    let mut v = eigen.U().to_owned();
+    solve_upper_triangular_in_place(lg.transpose(), v.as_mut(), Par::Seq);
+    let rotated = &x * &v;
+    let pairs: Vec<RefinedPair> = (0..p)
+        .map(|k| finish_pair(a, b, l, rotated.col_as_slice(k).to_vec(), steps))
+        .collect::<Option<_>>()?;
+    let mut orthogonality = 0.0_f64;
+    for k in 0..p {
+        let axk = mat_vec(a, &pairs[k].x);
+        for j in 0..k {
+            orthogonality = orthogonality.max(dot(&pairs[j].x, &axk).to_f64().abs());
+        }
+    }
+    Some(RefinedCluster { pairs, orthogonality })
 }
 
 /// A-normalises x, then its double-double Rayleigh quotient, residual and A⁻¹-norm residual.
@@ -285,7 +430,7 @@ mod tests {
             let mut spectrum = ReducedSpectrum {
                 y: y.as_ref(),
                 omega_sq: &omega,
-                mode: i,
+                modes: i..i + 1,
             };
             let x0: Vec<f64> = (0..16).map(|r| x[(r, i)]).collect();
             let fast =
@@ -320,7 +465,7 @@ mod tests {
             let x0: Vec<f64> = x.col(i).iter().copied().collect();
             let mut correction = TridiagonalCorrection {
                 form: &mut form,
-                z: z.col_as_slice(i),
+                z: z.subcols(i, 1),
             };
             let fast = refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut correction, &x0)
                 .expect("the tridiagonal correction converges");
@@ -347,7 +492,7 @@ mod tests {
         let mut spectrum = ReducedSpectrum {
             y: y.as_ref(),
             omega_sq: &wrong,
-            mode: 0,
+            modes: 0..1,
         };
         // Start from a mixture of modes 0 and 1, so the wrong ω²₁ drives the correction.
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)] + 0.3 * x[(r, 1)]).collect();
@@ -357,7 +502,7 @@ mod tests {
         let mut right = ReducedSpectrum {
             y: y.as_ref(),
             omega_sq: &omega,
-            mode: 0,
+            modes: 0..1,
         };
         let w = refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut right, &x0)
             .expect("converges")

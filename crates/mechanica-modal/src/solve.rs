@@ -7,13 +7,14 @@
 //! (8.90). Internally and in every ordering the solver uses ω² = −λ, ascending: unstable modes
 //! (ω² < 0) first, then rigid-body modes, then oscillatory modes, then infinite ones.
 
-use crate::accuracy::{self, AccuracyReport, Residuals};
+use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
-use crate::refine::{ReducedSpectrum, refine_pair, refine_pair_projected};
+use crate::refine::{ReducedSpectrum, RefinedCluster, refine_cluster_projected, refine_pair};
 use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
+use std::ops::Range;
 use std::time::{Duration, Instant};
 
 /// Which eigenpairs to return.
@@ -438,15 +439,14 @@ impl Finish<'_> {
             && self.options.refinement != Refinement::Off
             && lift.is_none()
         {
-            let simple = simple_modes(&omega, &report.error_bounds);
-            let mut residuals: Vec<(usize, Vec<f64>)> = Vec::new();
-            for i in 0..m {
-                let poor = weakly_bounded(report.error_bounds[i], omega[i]);
-                let wanted = self.options.refinement == Refinement::Always || poor;
-                if !(wanted && simple[i]) {
+            let mut residuals: Vec<RefinedResidual> = Vec::new();
+            for g in clusters(&omega, &report.error_bounds) {
+                let wanted = self.options.refinement == Refinement::Always
+                    || g.clone().any(|i| weakly_bounded(report.error_bounds[i], omega[i]));
+                if !wanted || !refinable(&g, &omega, &report.error_bounds, &omega_all, def.first) {
                     continue;
                 }
-                let col: Vec<f64> = (0..n).map(|r| xm[(r, i)]).collect();
+                let x0 = xm.as_ref().subcols(g.start, g.len()).to_owned();
                 let refined = def
                     .reduced
                     .as_ref()
@@ -454,21 +454,30 @@ impl Finish<'_> {
                         let mut spectrum = ReducedSpectrum {
                             y: y.as_ref(),
                             omega_sq: &omega_all,
-                            mode: def.first + i,
+                            modes: def.first + g.start..def.first + g.end,
                         };
-                        refine_pair_projected(a, b, self.l, &mut spectrum, &col)
+                        refine_cluster_projected(a, b, self.l, &mut spectrum, x0.as_ref())
                     })
-                    .or_else(|| refine_pair(a, b, self.l, &col, omega[i]));
-                if let Some(p) = refined {
-                    for r in 0..n {
-                        xm[(r, i)] = p.x[r];
-                    }
+                    .or_else(|| {
+                        // The bordered Newton step needs a simple eigenvalue.
+                        let single = g.len() == 1;
+                        let pair = single.then(|| refine_pair(a, b, self.l, x0.col_as_slice(0), omega[g.start]));
+                        pair.flatten().map(RefinedCluster::single)
+                    });
+                let Some(cluster) = refined else { continue };
+                for (i, p) in g.clone().zip(cluster.pairs) {
+                    xm.col_as_slice_mut(i).copy_from_slice(&p.x);
                     omega[i] = p.omega_sq;
                     products.update_column(a, b, xm.as_ref(), i, self.par);
                     report.set_pair_error(products, xm.as_ref(), i, omega[i]);
                     report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
                     report.refinement_steps[i] = p.steps;
-                    residuals.push((i, p.residual));
+                    residuals.push(RefinedResidual {
+                        mode: i,
+                        cluster: g.clone(),
+                        orthogonality: cluster.orthogonality,
+                        residual: p.residual,
+                    });
                 }
             }
             let all: Vec<usize> = (0..m).collect();
@@ -549,15 +558,44 @@ impl Finish<'_> {
     }
 }
 
-/// Modes whose bound interval overlaps no neighbour's (refinement needs simple eigenvalues).
-pub(crate) fn simple_modes(omega: &[f64], bounds: &[f64]) -> Vec<bool> {
-    let m = omega.len();
-    (0..m)
-        .map(|i| {
-            let close = |j: usize| (omega[i] - omega[j]).abs() <= 2.0 * (bounds[i] + bounds[j]);
-            !((i > 0 && close(i - 1)) || (i + 1 < m && close(i + 1)))
-        })
-        .collect()
+/// The largest cluster of nearly equal ω² that refinement treats as one block; larger ones
+/// keep the bounds of the reduction (a block step costs 4p double-double matrix-vector
+/// products).
+pub const MAX_REFINED_CLUSTER: usize = 16;
+
+/// Whether the bound intervals of two modes overlap (with a factor 2 of margin): refinement
+/// cannot tell them apart, so it treats them as one cluster.
+fn overlapping(omega_i: f64, bound_i: f64, omega_j: f64, bound_j: f64) -> bool {
+    (omega_i - omega_j).abs() <= 2.0 * (bound_i + bound_j)
+}
+
+/// The selected modes split into clusters: maximal runs of consecutive modes whose bound
+/// intervals overlap, chained (a simple mode is a cluster of one). Refinement treats each
+/// cluster as one block ([`crate::refine::refine_cluster_projected`]).
+pub(crate) fn clusters(omega: &[f64], bounds: &[f64]) -> Vec<Range<usize>> {
+    let mut out: Vec<Range<usize>> = Vec::new();
+    for i in 0..omega.len() {
+        match out.last_mut() {
+            Some(g) if overlapping(omega[i - 1], bounds[i - 1], omega[i], bounds[i]) => g.end = i + 1,
+            _ => out.push(i..i + 1),
+        }
+    }
+    out
+}
+
+/// Whether the cluster `g` of the selection (entries `first..` of the ascending spectrum
+/// `omega_all`) can be refined: at most [`MAX_REFINED_CLUSTER`] modes, and not cut by the
+/// selection (an unselected mode within its bounds would be a missing member of the block,
+/// which makes the correction singular).
+pub(crate) fn refinable(g: &Range<usize>, omega: &[f64], bounds: &[f64], omega_all: &[f64], first: usize) -> bool {
+    let cut_below = g.start == 0
+        && first > 0
+        && overlapping(omega[0], bounds[0], omega_all[first - 1], bounds[0]);
+    let last = g.end - 1;
+    let cut_above = g.end == omega.len()
+        && first + omega.len() < omega_all.len()
+        && overlapping(omega[last], bounds[last], omega_all[first + omega.len()], bounds[last]);
+    g.len() <= MAX_REFINED_CLUSTER && !cut_below && !cut_above
 }
 
 /// Zero when |ω²| is within its error bound; otherwise oscillatory or unstable by its sign.

@@ -12,17 +12,18 @@
 //! 2. its backward error is measured and the bound becomes the first-order η·κ
 //!    ([`crate::BoundKind::FirstOrder`]); the measured η is usually far below n·u;
 //! 3. a mode still above the threshold (stiff and graded problems) is refined as in an
-//!    all-pairs solve ([`crate::refine`]), with the correction applied through Q and T
-//!    instead of the eigenvectors Y, which a values-only solve does not have, and gets a
-//!    residual bound ([`crate::BoundKind::Residual`]).
+//!    all-pairs solve ([`crate::refine`]; a cluster of nearly equal values as one block), with
+//!    the correction applied through Q and T instead of the eigenvectors Y, which a
+//!    values-only solve does not have, and gets a residual bound
+//!    ([`crate::BoundKind::Residual`]).
 //!
 //! The cost is O(n²) per flagged mode, against the n³ of the vectors that a full solve forms
 //! (before, a values-only solve with a flagged mode was solved again with all vectors).
 
-use crate::accuracy::{self, AccuracyReport, BoundKind, PairProducts, Residuals};
+use crate::accuracy::{self, AccuracyReport, BoundKind, PairProducts, RefinedResidual, Residuals};
 use crate::reduce::back_transform;
-use crate::refine::{TridiagonalCorrection, refine_pair, refine_pair_projected};
-use crate::solve::{simple_modes, weakly_bounded};
+use crate::refine::{RefinedCluster, TridiagonalCorrection, refine_cluster_projected, refine_pair};
+use crate::solve::{clusters, refinable, weakly_bounded};
 use crate::symmetric_eigen::TridiagonalForm;
 use faer::{MatRef, Par};
 
@@ -72,26 +73,42 @@ pub(crate) fn sharpen(
     if let PairProducts::Sketched { .. } = products {
         report.residuals = Residuals::Sketched;
     }
-    let simple = simple_modes(omega, &report.error_bounds);
-    let mut residuals: Vec<(usize, Vec<f64>)> = Vec::new();
-    for (col, &i) in flagged.iter().enumerate() {
-        if !simple[i] || !weakly_bounded(report.error_bounds[i], omega[i]) {
+    let mut residuals: Vec<RefinedResidual> = Vec::new();
+    for g in clusters(omega, &report.error_bounds) {
+        // A block needs the vectors of all its members: consecutive flagged columns.
+        let Some(col) = flagged.iter().position(|&i| i == g.start) else {
+            continue;
+        };
+        let all_flagged = flagged.get(col + g.len() - 1) == Some(&(g.end - 1));
+        let weak = g.clone().any(|i| weakly_bounded(report.error_bounds[i], omega[i]));
+        if !(all_flagged && weak && refinable(&g, omega, &report.error_bounds, omega_all, first)) {
             continue;
         }
-        let x0: Vec<f64> = x.col(col).iter().copied().collect();
+        let x0 = x.as_ref().subcols(col, g.len()).to_owned();
         let mut correction = TridiagonalCorrection {
             form,
-            z: z.col_as_slice(col),
+            z: z.as_ref().subcols(col, g.len()),
         };
-        let refined = refine_pair_projected(a, b, pencil.l, &mut correction, &x0)
-            .or_else(|| refine_pair(a, b, pencil.l, &x0, omega[i]));
-        if let Some(p) = refined {
-            x.col_as_slice_mut(col).copy_from_slice(&p.x);
+        let refined = refine_cluster_projected(a, b, pencil.l, &mut correction, x0.as_ref()).or_else(|| {
+            // The bordered Newton step needs a simple eigenvalue.
+            let single = g.len() == 1;
+            let pair = single.then(|| refine_pair(a, b, pencil.l, x0.col_as_slice(0), omega[g.start]));
+            pair.flatten().map(RefinedCluster::single)
+        });
+        let Some(cluster) = refined else { continue };
+        for (k, p) in cluster.pairs.into_iter().enumerate() {
+            let i = g.start + k;
+            x.col_as_slice_mut(col + k).copy_from_slice(&p.x);
             omega[i] = p.omega_sq;
-            products.update_column(a, b, x.as_ref(), col, pencil.par);
+            products.update_column(a, b, x.as_ref(), col + k, pencil.par);
             report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
             report.refinement_steps[i] = p.steps;
-            residuals.push((i, p.residual));
+            residuals.push(RefinedResidual {
+                mode: i,
+                cluster: g.clone(),
+                orthogonality: cluster.orthogonality,
+                residual: p.residual,
+            });
         }
     }
     // Unselected values were never measured: the gaps to them allow for their a-priori error.
