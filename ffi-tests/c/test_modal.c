@@ -511,11 +511,69 @@ static void dense_blocked_path(void) {
     mech_modal_result_destroy(measured);
 }
 
+/* A symmetric stiff structure: two uncoupled copies of the chain graded over 1e12 in stiffness
+ * (spring i, from the ground or mass i − 1 to mass i, k_i = 10^round(12 i/23), unit masses),
+ * interleaved (copy c's coordinate i is 2i + c). Every eigenvalue is double; the lowest two
+ * references are the 60-digit mpmath values of tools/modal_reference.txt. The copies are refined
+ * as one block: both values within their bounds, bounds that certify 8 digits or more, one group
+ * of multiplicity 2; with refinement off the same pair's bound is honest but weak. */
+#define NG 24
+static void repeated_stiff_pair(void) {
+    static double a[4 * NG * NG], b[4 * NG * NG];
+    double k[NG + 1];
+    for (int i = 0; i < NG; ++i) {
+        k[i] = pow(10.0, round(12.0 * i / (NG - 1)));
+    }
+    k[NG] = 0.0;
+    const int n = 2 * NG;
+    for (int c = 0; c < 2; ++c) {
+        for (int i = 0; i < NG; ++i) {
+            int r = 2 * i + c;
+            a[r + n * r] = 1.0;
+            b[r + n * r] = k[i] + k[i + 1];
+            if (i + 1 < NG) {
+                b[r + n * (r + 2)] = -k[i + 1];
+                b[(r + 2) + n * r] = -k[i + 1];
+            }
+        }
+    }
+    const double reference[2] = {3.491050226983499243542598e-2, 4.24397184079628978523204};
+    for (int vectors = 0; vectors < 2; ++vectors) {
+        mech_modal_options_t o = default_options();
+        o.vectors = vectors;
+        mech_modal_result_t *r = NULL;
+        CHECK_STATUS(mech_modal_solve(n, a, b, &o, &r), MECH_STATUS_OK);
+        static mech_modal_mode_t m[2 * NG];
+        CHECK_STATUS(mech_modal_result_modes(r, m, n), MECH_STATUS_OK);
+        for (int i = 0; i < 4; ++i) {
+            double w = reference[i / 2];
+            CHECK_NEAR(m[i].omega_sq, w, m[i].error_bound);
+            CHECK(m[i].error_bound <= 1e-8 * w);
+            CHECK(m[i].multiplicity == 2);
+        }
+        CHECK(m[0].group == m[1].group && m[2].group == m[3].group && m[1].group != m[2].group);
+        mech_modal_accuracy_t acc;
+        CHECK_STATUS(mech_modal_result_accuracy(r, &acc), MECH_STATUS_OK);
+        CHECK(acc.refined_modes >= 4);
+        mech_modal_result_destroy(r);
+    }
+    mech_modal_options_t off = default_options();
+    off.refinement = MECH_MODAL_REFINEMENT_OFF;
+    mech_modal_result_t *plain = NULL;
+    CHECK_STATUS(mech_modal_solve(n, a, b, &off, &plain), MECH_STATUS_OK);
+    mech_modal_mode_t low[2 * NG];
+    CHECK_STATUS(mech_modal_result_modes(plain, low, n), MECH_STATUS_OK);
+    CHECK_NEAR(low[0].omega_sq, reference[0], low[0].error_bound);
+    CHECK(low[0].error_bound > 1e-8 * reference[0]);
+    mech_modal_result_destroy(plain);
+}
+
 int main(void) {
     all_pairs();
     dense_blocked_path();
     sparse_lowest();
     sketched_report();
+    repeated_stiff_pair();
     free_response();
     subsets_and_values_only();
     massless_coordinate();

@@ -533,7 +533,12 @@ pub(crate) fn residual_bounds(
         };
         let eps = columns.iter().map(|(_, e)| e * e).sum::<f64>().sqrt();
         let rho = omega_sq[i];
-        let distance = |w: f64| group.clone().map(|g| (omega_sq[g] - w).abs()).fold(f64::INFINITY, f64::min);
+        let distance = |w: f64| {
+            group
+                .clone()
+                .map(|g| (omega_sq[g] - w).abs())
+                .fold(f64::INFINITY, f64::min)
+        };
         let mut gap = f64::INFINITY;
         let mut weighted = 0.0;
         let mut usable = true;

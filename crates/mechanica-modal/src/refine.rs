@@ -149,12 +149,33 @@ impl ReducedCorrection for ReducedSpectrum<'_> {
 /// operator as [`ReducedSpectrum`] evaluated as Q P (T − ρI)⁻¹ P Qᵀ with P = I − Z Zᵀ: the
 /// shifted tridiagonal solve is nearly singular at ρ ≈ θ, but its error lies almost entirely in
 /// span Z (Wilkinson, "The Algebraic Eigenvalue Problem", §5.56), which the second projection
-/// removes.
+/// removes. That needs span Z to be T's invariant subspace to working precision, which inverse
+/// iteration does not give a cluster (its single vectors are ill determined, and orthogonalising
+/// them loses digits): at the first application Z takes two steps of subspace inverse iteration
+/// Z ← orth((T − ρI)⁻¹Z) at the cluster's ρ, which damp every other direction by the ratio of
+/// the cluster's spread to its gap.
 pub(crate) struct TridiagonalCorrection<'a> {
     /// T and Q.
     pub form: &'a mut TridiagonalForm,
     /// The refined modes' orthonormal eigenvectors of T, one column each.
-    pub z: MatRef<'a, f64>,
+    pub z: Mat<f64>,
+    /// Whether `z` has had its subspace inverse iteration.
+    pub purified: bool,
+}
+
+impl TridiagonalCorrection<'_> {
+    /// Two steps of Z ← orth((T − ρI)⁻¹Z); false if a solve or the orthonormalisation fails.
+    fn purify(&mut self, shifted: &ShiftedTridiagonal) -> bool {
+        for _ in 0..2 {
+            for k in 0..self.z.ncols() {
+                shifted.solve_in_place(self.z.col_as_slice_mut(k));
+            }
+            if !orthonormalize(&mut self.z) {
+                return false;
+            }
+        }
+        true
+    }
 }
 
 impl ReducedCorrection for TridiagonalCorrection<'_> {
@@ -163,19 +184,49 @@ impl ReducedCorrection for TridiagonalCorrection<'_> {
         let (diag, subdiag) = (self.form.diag(), self.form.subdiag());
         let tiny = f64::EPSILON * one_norm(diag, subdiag);
         let shifted = ShiftedTridiagonal::new(diag, subdiag, rho, tiny);
+        if !self.purified {
+            self.purified = true;
+            if !self.purify(&shifted) {
+                w.col_iter_mut().for_each(|c| c.iter_mut().for_each(|v| *v = f64::NAN));
+                return w;
+            }
+        }
         for k in 0..w.ncols() {
             let u = w.col_as_slice_mut(k);
-            project_out(u, self.z);
+            project_out(u, self.z.as_ref());
             if shifted.solve_in_place(u) != 1.0 {
                 // Growth beyond 1e150: no usable correction (the caller sees non-finite values).
                 u.iter_mut().for_each(|v| *v = f64::NAN);
                 return w;
             }
-            project_out(u, self.z);
+            project_out(u, self.z.as_ref());
         }
         self.form.apply_q(w.as_mut());
         w
     }
+}
+
+/// Orthonormalises the columns of `z` in place by modified Gram–Schmidt applied twice; false
+/// if a column is not finite or falls to zero.
+fn orthonormalize(z: &mut Mat<f64>) -> bool {
+    for k in 0..z.ncols() {
+        for _ in 0..2 {
+            for j in 0..k {
+                let overlap: f64 = (0..z.nrows()).map(|i| z[(i, j)] * z[(i, k)]).sum();
+                for i in 0..z.nrows() {
+                    let zij = z[(i, j)];
+                    z[(i, k)] -= overlap * zij;
+                }
+            }
+        }
+        let column = z.col_as_slice_mut(k);
+        let norm = column.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(norm.is_finite() && norm > 0.0) {
+            return false;
+        }
+        column.iter_mut().for_each(|v| *v /= norm);
+    }
+    true
 }
 
 /// u ← u − Σ_k z_k (z_kᵀu) for orthonormal columns z_k.
@@ -242,9 +293,7 @@ pub(crate) fn refine_cluster_projected(
         let m = rayleigh_quotient_matrix(&x, &ax, &bx)?;
         let rho = (0..p).fold(Dd::of(0.0), |t, k| t.plus(m[k][k])).to_f64() / p as f64;
         let mut w = Mat::from_fn(n, p, |i, k| {
-            (0..p)
-                .fold(bx[k][i], |r, j| r.minus(m[j][k].times(ax[j][i])))
-                .to_f64()
+            (0..p).fold(bx[k][i], |r, j| r.minus(m[j][k].times(ax[j][i]))).to_f64()
         });
         solve_lower_triangular_in_place(l, w.as_mut(), Par::Seq);
         let mut delta = correction.apply(w, rho);
@@ -465,7 +514,8 @@ mod tests {
             let x0: Vec<f64> = x.col(i).iter().copied().collect();
             let mut correction = TridiagonalCorrection {
                 form: &mut form,
-                z: z.subcols(i, 1),
+                z: z.subcols(i, 1).to_owned(),
+                purified: false,
             };
             let fast = refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut correction, &x0)
                 .expect("the tridiagonal correction converges");

@@ -588,9 +588,7 @@ pub(crate) fn clusters(omega: &[f64], bounds: &[f64]) -> Vec<Range<usize>> {
 /// selection (an unselected mode within its bounds would be a missing member of the block,
 /// which makes the correction singular).
 pub(crate) fn refinable(g: &Range<usize>, omega: &[f64], bounds: &[f64], omega_all: &[f64], first: usize) -> bool {
-    let cut_below = g.start == 0
-        && first > 0
-        && overlapping(omega[0], bounds[0], omega_all[first - 1], bounds[0]);
+    let cut_below = g.start == 0 && first > 0 && overlapping(omega[0], bounds[0], omega_all[first - 1], bounds[0]);
     let last = g.end - 1;
     let cut_above = g.end == omega.len()
         && first + omega.len() < omega_all.len()

@@ -87,7 +87,8 @@ pub(crate) fn sharpen(
         let x0 = x.as_ref().subcols(col, g.len()).to_owned();
         let mut correction = TridiagonalCorrection {
             form,
-            z: z.as_ref().subcols(col, g.len()),
+            z: z.as_ref().subcols(col, g.len()).to_owned(),
+            purified: false,
         };
         let refined = refine_cluster_projected(a, b, pencil.l, &mut correction, x0.as_ref()).or_else(|| {
             // The bordered Newton step needs a simple eigenvalue.

@@ -120,20 +120,22 @@ fn refined_modes_are_correct_to_their_bounds() {
     }
 }
 
+/// All pairs without refinement: the reduction's own accuracy.
+fn unrefined(p: &PencilProblem) -> mechanica_modal::ModalSolution {
+    let options = SolveOptions {
+        refinement: Refinement::Off,
+        ..SolveOptions::default()
+    };
+    solve(p, &options).expect("solve")
+}
+
 /// Without refinement the reduction loses digits of the lowest mode on the 1e12 chain, and its
 /// first-order bound says so honestly: the bound still contains the error.
 #[test]
 fn unrefined_bounds_are_honest_but_weak() {
     let c = &cases()[0];
     let p = problem(c);
-    let sol = solve(
-        &p,
-        &SolveOptions {
-            refinement: Refinement::Off,
-            ..SolveOptions::default()
-        },
-    )
-    .expect("solve");
+    let sol = unrefined(&p);
     let low = &sol.modes[0];
     assert_eq!(sol.accuracy.bound_kinds[0], BoundKind::FirstOrder);
     assert!((low.omega_sq - c.omega_sq[0]).abs() <= low.error_bound);
@@ -176,5 +178,165 @@ fn values_only_subsets_are_correct_to_their_bounds() {
             assert!(m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w);
         }
         assert_eq!(sol.accuracy.bound_kinds[0], BoundKind::Residual, "{}", c.name);
+    }
+}
+
+/// Two uncoupled copies of a chain, interleaved (copy c's coordinate i is 2i + c; a
+/// permutation, so the pencil is stored exactly), the second copy's masses scaled by `scale`:
+/// its ω² are those of the chain divided by `scale`.
+fn doubled(c: &Case, scale: f64) -> PencilProblem {
+    let (a, b) = families::spring_chain(&c.stiffness, &c.mass);
+    let n = a.nrows();
+    let copy = |m: &mechanica_modal::faer::Mat<f64>, s: f64| {
+        mechanica_modal::faer::Mat::from_fn(2 * n, 2 * n, |i, j| {
+            if i % 2 != j % 2 {
+                0.0
+            } else if i % 2 == 0 {
+                m[(i / 2, j / 2)]
+            } else {
+                s * m[(i / 2, j / 2)]
+            }
+        })
+    };
+    PencilProblem::new(copy(&a, scale).as_ref(), copy(&b, 1.0).as_ref()).expect("valid doubled chain")
+}
+
+/// A symmetric stiff structure: every eigenvalue of the graded chains doubled. The copies of a
+/// repeated eigenvalue are refined together as one block, so the lowest pairs reach full
+/// relative accuracy with a bound that says so, as a simple mode does; each group has
+/// multiplicity 2 and an A-orthonormal basis. Without refinement the same pair keeps only the
+/// reduction's accuracy (its bound honest but weak).
+#[test]
+fn repeated_stiff_modes_are_refined_as_one_block() {
+    for c in cases() {
+        let p = doubled(&c, 1.0);
+        let n = p.dim() as f64;
+        for options in auto_options() {
+            let sol = solve(&p, &options).expect("solve");
+            assert_eq!(sol.groups.len(), c.omega_sq.len(), "{} {options:?}", c.name);
+            assert!(sol.groups.iter().all(|g| g.multiplicity == 2), "{} {options:?}", c.name);
+            for (i, m) in sol.modes.iter().enumerate() {
+                let w = c.omega_sq[i / 2];
+                let err = (m.omega_sq - w).abs();
+                assert!(
+                    err <= m.error_bound,
+                    "{} {options:?} mode {i}: error {err:e} > bound {:e}",
+                    c.name,
+                    m.error_bound
+                );
+                assert!(
+                    m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w,
+                    "{} {options:?} mode {i}: bound {:e} relative",
+                    c.name,
+                    m.error_bound / w
+                );
+            }
+            for i in 0..2 {
+                assert_eq!(
+                    sol.accuracy.bound_kinds[i],
+                    BoundKind::Residual,
+                    "{} {options:?}",
+                    c.name
+                );
+                let certified = if options.vectors {
+                    sol.modes[i].error_bound
+                } else {
+                    (sol.modes[i].omega_sq - c.omega_sq[0]).abs()
+                };
+                assert!(
+                    certified <= 8.0 * n * U * c.omega_sq[0],
+                    "{} {options:?}: {certified:e}",
+                    c.name
+                );
+            }
+            if let Some(x) = &sol.vectors {
+                // The refined pair's basis is A-orthonormal.
+                let xg = x.as_ref().subcols(0, 2);
+                let gram = xg.transpose() * p.a() * xg;
+                for (i, j) in [(0, 0), (0, 1), (1, 1)] {
+                    let target = if i == j { 1.0 } else { 0.0 };
+                    assert!(
+                        (gram[(i, j)] - target).abs() <= 10.0 * n * U,
+                        "{}: gram {:e}",
+                        c.name,
+                        gram[(i, j)]
+                    );
+                }
+            }
+            assert!(sol.accuracy.inertia_check.expect("check").consistent);
+        }
+        let plain = unrefined(&p);
+        let low = &plain.modes[0];
+        assert!((low.omega_sq - c.omega_sq[0]).abs() <= low.error_bound, "{}", c.name);
+        if c.name.starts_with("graded_stiffness_n24") {
+            assert!(
+                low.error_bound > 1e-8 * c.omega_sq[0],
+                "the plain reduction is not relative-accurate here"
+            );
+        }
+    }
+}
+
+/// Two copies whose masses differ by 2⁻⁴⁰ (exactly representable): every eigenvalue splits by
+/// 9.1e-13 relative, far inside the reduction's bounds, so each pair starts as one cluster.
+/// The block refinement resolves it: both values match their references (the chain's ω² and
+/// ω²/(1 + 2⁻⁴⁰)) within their bounds, and with all vectors the bounds are tight enough that
+/// the two come back as separate groups (values only, the bounds are weaker, see
+/// `refined_modes_are_correct_to_their_bounds`, and may keep them in one group).
+#[test]
+fn a_cluster_of_two_close_stiff_modes_is_resolved() {
+    let c = &cases()[0];
+    let scale = 1.0 + 2f64.powi(-40);
+    let p = doubled(c, scale);
+    for options in auto_options() {
+        let sol = solve(&p, &options).expect("solve");
+        let lower = c.omega_sq[0] / scale;
+        let upper = c.omega_sq[0];
+        for (m, w) in sol.modes.iter().zip([lower, upper]) {
+            // The reference ω²/(1 + 2⁻⁴⁰) is itself rounded: allow u·w for it.
+            let err = (m.omega_sq - w).abs();
+            assert!(
+                err <= m.error_bound + U * w,
+                "{options:?}: error {err:e} > bound {:e}",
+                m.error_bound
+            );
+            assert!(
+                !options.vectors || m.error_bound <= 1e-3 * (upper - lower),
+                "{options:?}: bound {:e}",
+                m.error_bound
+            );
+        }
+        assert!(
+            !options.vectors || sol.modes[0].group != sol.modes[1].group,
+            "{options:?}"
+        );
+    }
+}
+
+/// A selection that cuts a repeated stiff eigenvalue (the lowest 1 of a doubled pair) cannot
+/// refine it as a block (its other copy is not selected): it keeps the reduction's honest bound.
+/// The lowest 2 take the whole pair and are refined.
+#[test]
+fn a_selection_that_cuts_a_cluster_keeps_honest_bounds() {
+    let c = &cases()[0];
+    let p = doubled(c, 1.0);
+    let w = c.omega_sq[0];
+    for (count, refined) in [(1, false), (2, true), (3, true)] {
+        let options = SolveOptions {
+            selection: mechanica_modal::Selection::Lowest(count),
+            ..SolveOptions::default()
+        };
+        let sol = solve(&p, &options).expect("solve");
+        assert_eq!(sol.modes.len(), count);
+        let low = &sol.modes[0];
+        assert!((low.omega_sq - w).abs() <= low.error_bound, "lowest {count}");
+        let kind = sol.accuracy.bound_kinds[0];
+        assert_eq!(kind == BoundKind::Residual, refined, "lowest {count}: {kind:?}");
+        assert_eq!(
+            low.error_bound <= 1e-8 * w,
+            refined,
+            "lowest {count}: {:e}",
+            low.error_bound / w
+        );
     }
 }
