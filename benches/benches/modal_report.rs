@@ -320,19 +320,36 @@ fn graded_cases() -> Vec<Case> {
         } else if let Some(rest) = line.strip_prefix("omega_sq ") {
             let exact: Vec<f64> = rest.split_whitespace().filter_map(|w| w.parse().ok()).collect();
             let (a, b) = families::spring_chain(&k, &m);
-            let n = a.nrows();
             let scale = exact.iter().copied().fold(0.0, f64::max);
-            cases.push(Case {
-                label: name.clone(),
-                n,
-                sparse: Some((to_triplets(a.as_ref()), to_triplets(b.as_ref()))),
-                dense: Some((a, b)),
-                exact,
-                scale,
-            });
+            // The same chain twice, interleaved (a symmetric structure): every ω² is double.
+            let (a2, b2) = (interleaved_copies(&a), interleaved_copies(&b));
+            let doubled: Vec<f64> = exact.iter().flat_map(|&w| [w, w]).collect();
+            for (label, a, b, exact) in [
+                (name.clone(), a, b, exact),
+                (format!("{name} doubled"), a2, b2, doubled),
+            ] {
+                cases.push(Case {
+                    label,
+                    n: a.nrows(),
+                    sparse: Some((to_triplets(a.as_ref()), to_triplets(b.as_ref()))),
+                    dense: Some((a, b)),
+                    exact,
+                    scale,
+                });
+            }
         }
     }
     cases
+}
+
+/// Two uncoupled copies of `m`, interleaved: copy c's coordinate i is 2i + c.
+fn interleaved_copies(m: &Mat<f64>) -> Mat<f64> {
+    let n = m.nrows();
+    Mat::from_fn(
+        2 * n,
+        2 * n,
+        |i, j| if i % 2 == j % 2 { m[(i / 2, j / 2)] } else { 0.0 },
+    )
 }
 
 fn grid_case(side: usize) -> Case {
@@ -771,7 +788,7 @@ fn main() {
         ];
         report(
             "graded",
-            "Graded stiff chains (mpmath references)",
+            "Graded stiff chains, single and doubled (mpmath references)",
             &graded_cases(),
             &methods,
         );

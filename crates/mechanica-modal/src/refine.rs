@@ -338,7 +338,7 @@ fn rayleigh_quotient_matrix(x: &Mat<f64>, ax: &[Vec<Dd>], bx: &[Vec<Dd>]) -> Opt
         .collect();
     for k in 0..p {
         let pivot = gram[k][k];
-        if !(pivot.hi > 0.0) {
+        if pivot.hi.is_nan() || pivot.hi <= 0.0 {
             return None;
         }
         for i in k + 1..p {
