@@ -408,24 +408,47 @@ fn probe_seed(l: MatRef<'_, f64>) -> u64 {
 pub(crate) struct APrioriModel {
     /// n·u·‖A⁻¹‖₂.
     scale: f64,
+    /// The order n.
+    order: usize,
     norm_a: f64,
     norm_b: f64,
 }
 
 impl APrioriModel {
     pub(crate) fn new(l: MatRef<'_, f64>, norm_a: f64, norm_b: f64, par: Par) -> Self {
-        let scale = l.nrows() as f64 * f64::EPSILON * a_inverse_norm_bound(l, par);
-        Self { scale, norm_a, norm_b }
+        let order = l.nrows();
+        let scale = order as f64 * f64::EPSILON * a_inverse_norm_bound(l, par);
+        Self {
+            scale,
+            order,
+            norm_a,
+            norm_b,
+        }
     }
 
     pub(crate) fn bound(&self, omega_sq: f64) -> f64 {
         self.scale * (self.norm_b + omega_sq.abs() * self.norm_a)
     }
 
+    /// [`data_resolution`] without the mode shape: ‖x‖₂² ≤ ‖A⁻¹‖₂ for an A-normalised x.
+    pub(crate) fn data_resolution(&self, omega_sq: f64) -> f64 {
+        self.bound(omega_sq) / self.order.max(1) as f64
+    }
+
     /// The bounds of the values `omega_sq`.
     pub(crate) fn bounds(&self, omega_sq: &[f64]) -> Vec<f64> {
         omega_sq.iter().map(|&w| self.bound(w)).collect()
     }
+}
+
+/// The change of ω² that rounding A and B entrywise can cause for an A-normalised mode shape x:
+/// |xᵀδBx| + |ω²|·|xᵀδAx| ≤ u(‖B‖_F + |ω²|‖A‖_F)‖x‖₂² for |δA| ≤ u|A|, |δB| ≤ u|B| (u taken as
+/// f64::EPSILON, one rounding of each entry with margin). Below it neither the sign nor the
+/// size of ω² is determined by the data: a rigid-body mode of a stiffness matrix that is
+/// singular only up to rounding (an assembled or rotated one) has a computed ω² of that order,
+/// of either sign, however tight its error bound for the stored matrices.
+pub fn data_resolution(omega_sq: f64, norm_a: f64, norm_b: f64, shape_norm_sq: f64) -> f64 {
+    f64::EPSILON * (norm_b + omega_sq.abs() * norm_a) * shape_norm_sq
 }
 
 /// The computed modes used to split a residual into its modal components.

@@ -1240,11 +1240,16 @@ fn finish(
         bounds[c] = omega_bound + rounding[c];
     }
     let take = k.min(cols);
+    let resolution = |c: usize| {
+        let shape = &refined.vectors[n * c..n * (c + 1)];
+        let shape_norm_sq = shape.iter().map(|v| v * v).sum::<f64>();
+        crate::accuracy::data_resolution(omega_sq[c], norm_a, norm_b, shape_norm_sq)
+    };
     let mut modes: Vec<Mode> = (0..cols)
         .map(|c| Mode {
             lambda: -omega_sq[c],
             omega_sq: omega_sq[c],
-            kind: classify(omega_sq[c], bounds[c]),
+            kind: classify(omega_sq[c], bounds[c].max(resolution(c))),
             error_bound: bounds[c],
             backward_error: Some(eta[c]),
             group: 0,

@@ -509,6 +509,17 @@ impl Finish<'_> {
             self.par,
         )?;
         timings.inertia = clock.elapsed();
+        // What the data resolve: the zero classification allows for the rounding of A and B.
+        let resolution: Vec<f64> = (0..m)
+            .map(|i| match (&x, &a_priori) {
+                (Some(x), _) => {
+                    let shape_norm_sq = x.col(i).iter().map(|v| v * v).sum::<f64>();
+                    accuracy::data_resolution(omega[i], self.norm_a, self.norm_b, shape_norm_sq)
+                }
+                (None, Some(model)) => model.data_resolution(omega[i]),
+                (None, None) => 0.0,
+            })
+            .collect();
         if !self.options.vectors {
             x = None;
             report.backward_errors.iter_mut().for_each(|e| *e = None);
@@ -520,7 +531,7 @@ impl Finish<'_> {
                 Mode {
                     lambda: -omega[i],
                     omega_sq: omega[i],
-                    kind: classify(omega[i], bound),
+                    kind: classify(omega[i], bound.max(resolution[i])),
                     error_bound: bound,
                     backward_error: report.backward_errors.get(i).copied().flatten(),
                     group: 0,
@@ -596,7 +607,9 @@ pub(crate) fn refinable(g: &Range<usize>, omega: &[f64], bounds: &[f64], omega_a
     g.len() <= MAX_REFINED_CLUSTER && !cut_below && !cut_above
 }
 
-/// Zero when |ω²| is within its error bound; otherwise oscillatory or unstable by its sign.
+/// Zero when |ω²| is within `bound`; otherwise oscillatory or unstable by its sign. The solvers
+/// pass the larger of the mode's error bound and its [`crate::accuracy::data_resolution`]: a mode
+/// is zero when the computation cannot tell it from zero, or the data cannot.
 pub fn classify(omega_sq: f64, bound: f64) -> ModeKind {
     if omega_sq.is_infinite() {
         ModeKind::Infinite
@@ -611,14 +624,15 @@ pub fn classify(omega_sq: f64, bound: f64) -> ModeKind {
     }
 }
 
-/// Groups consecutive modes whose ω² differ by at most the sum of their bounds, and stores
-/// each mode's group index.
+/// Groups consecutive modes whose ω² differ by at most the sum of their bounds, or that are
+/// both zero (the rigid-body modes form one group), and stores each mode's group index.
 pub(crate) fn group_modes(modes: &mut [Mode]) -> Vec<ModeGroup> {
     let mut groups: Vec<ModeGroup> = Vec::new();
     for i in 0..modes.len() {
         let joins = i > 0 && {
             let (p, q) = (&modes[i - 1], &modes[i]);
             (p.omega_sq.is_infinite() && q.omega_sq.is_infinite())
+                || (p.kind == ModeKind::Zero && q.kind == ModeKind::Zero)
                 || (q.omega_sq - p.omega_sq).abs() <= p.error_bound + q.error_bound
         };
         if joins && let Some(g) = groups.last_mut() {

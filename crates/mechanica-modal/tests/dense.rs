@@ -573,3 +573,44 @@ fn sketched_residuals_bound_the_exact_ones() {
         assert!(sketched.accuracy.inertia_check.expect("check").consistent);
     }
 }
+
+/// Six uncoupled free chains (each with one rigid-body mode), turned by a random rotation: the
+/// rotated stiffness is singular only up to rounding, so the six zero eigenvalues of the stored
+/// pencil are of order u·‖B‖, of either sign, and refinement bounds them far more tightly than
+/// that. They are still rigid-body modes to the precision of the data: classified zero (not
+/// unstable with a growth rate of 1e-8), and one group of multiplicity six, in every mode of
+/// solve. The ring (one rigid-body mode, every other frequency double) likewise.
+#[test]
+fn rigid_body_modes_of_a_rounded_stiffness_are_zero() {
+    let copies = 6;
+    let (a1, b1) = families::free_chain(10);
+    let n1 = a1.nrows();
+    let n = copies * n1;
+    let copied = |m: &Mat<f64>| {
+        Mat::from_fn(n, n, |i, j| {
+            if i % copies == j % copies { m[(i / copies, j / copies)] } else { 0.0 }
+        })
+    };
+    let (a, b) = families::rotate(&copied(&a1), &copied(&b1), &families::random_orthogonal(n, 5));
+    let (ar, br) = families::ring(12);
+    let (ar, br) = families::rotate(&ar, &br, &families::random_orthogonal(12, 3));
+    for (p, zeros) in [(pencil(&a, &b), copies), (pencil(&ar, &br), 1)] {
+        for vectors in [true, false] {
+            let options = SolveOptions {
+                vectors,
+                ..all_pairs()
+            };
+            let sol = solve(&p, &options).expect("solve");
+            let kinds: Vec<ModeKind> = sol.modes.iter().map(|m| m.kind).collect();
+            assert!(kinds[..zeros].iter().all(|k| *k == ModeKind::Zero), "{kinds:?}");
+            assert!(
+                kinds[zeros..].iter().all(|k| matches!(k, ModeKind::Oscillatory { .. })),
+                "{kinds:?}"
+            );
+            assert_eq!(sol.groups[0].multiplicity, zeros, "vectors {vectors}");
+            for m in &sol.modes[..zeros] {
+                assert!(m.omega_sq.abs() <= 1e-13, "{:e}", m.omega_sq);
+            }
+        }
+    }
+}
