@@ -426,19 +426,20 @@ static void sketched_report(void) {
  * with a dense u, A' = HAH and B' = HBH: a congruence by an orthogonal matrix, so the closed
  * form ω²_k = 4 sin²(kπ/(2(n+1))) still holds while A' and B' are full. */
 #define ND 700
-static void reflect(double *m, const double *u, double uu) {
+/* M ← HMH for the order-n (n ≤ ND) column-major symmetric M, H = I − 2uuᵀ/uu. */
+static void reflect(double *m, const double *u, double uu, int n) {
     static double mu[ND];
     double umu = 0.0;
-    for (int i = 0; i < ND; ++i) {
+    for (int i = 0; i < n; ++i) {
         double s = 0.0;
-        for (int j = 0; j < ND; ++j) s += m[i + ND * j] * u[j];
+        for (int j = 0; j < n; ++j) s += m[i + n * j] * u[j];
         mu[i] = s;
         umu += u[i] * s;
     }
     /* HMH = M − 2(Mu)uᵀ/uu − 2u(Mu)ᵀ/uu + 4(uᵀMu) uuᵀ/uu² for symmetric M. */
-    for (int j = 0; j < ND; ++j) {
-        for (int i = 0; i < ND; ++i) {
-            m[i + ND * j] += -2.0 * (mu[i] * u[j] + u[i] * mu[j]) / uu + 4.0 * umu * u[i] * u[j] / (uu * uu);
+    for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i) {
+            m[i + n * j] += -2.0 * (mu[i] * u[j] + u[i] * mu[j]) / uu + 4.0 * umu * u[i] * u[j] / (uu * uu);
         }
     }
 }
@@ -458,8 +459,8 @@ static void dense_blocked_path(void) {
             b[i + ND * j] = sqrt(mi * mj) * t;
         }
     }
-    reflect(a, u, uu);
-    reflect(b, u, uu);
+    reflect(a, u, uu, ND);
+    reflect(b, u, uu, ND);
     /* Rounding of the reflection leaves the matrices symmetric to a few ulps; make them exact. */
     for (int j = 0; j < ND; ++j) {
         for (int i = j + 1; i < ND; ++i) {
@@ -568,12 +569,55 @@ static void repeated_stiff_pair(void) {
     mech_modal_result_destroy(plain);
 }
 
+/* Three uncoupled free chains of unit masses and springs (each with one rigid-body mode),
+ * reflected by a dense Householder matrix: the stored stiffness is singular only up to
+ * rounding, so the three zero eigenvalues come out of order u·‖B‖ and of either sign. They are
+ * rigid-body modes to the data's precision: MECH_MODAL_KIND_ZERO, one group of multiplicity 3,
+ * with vectors and values only; every other mode is oscillatory. */
+#define NF 8
+static void rigid_body_modes(void) {
+    const int n = 3 * NF;
+    static double a[9 * NF * NF], b[9 * NF * NF], u[3 * NF];
+    double uu = 0.0;
+    for (int i = 0; i < n; ++i) {
+        u[i] = 1.0 + 0.3 * cos(1.3 * i);
+        uu += u[i] * u[i];
+        a[i + n * i] = 1.0;
+    }
+    for (int c = 0; c < 3; ++c) {
+        for (int i = 0; i + 1 < NF; ++i) {
+            int r = 3 * i + c, s = r + 3; /* spring between masses i and i + 1 of copy c */
+            b[r + n * r] += 1.0;
+            b[s + n * s] += 1.0;
+            b[r + n * s] -= 1.0;
+            b[s + n * r] -= 1.0;
+        }
+    }
+    reflect(a, u, uu, n);
+    reflect(b, u, uu, n);
+    for (int vectors = 0; vectors < 2; ++vectors) {
+        mech_modal_options_t o = default_options();
+        o.vectors = vectors;
+        mech_modal_result_t *r = NULL;
+        CHECK_STATUS(mech_modal_solve(n, a, b, &o, &r), MECH_STATUS_OK);
+        static mech_modal_mode_t m[3 * NF];
+        CHECK_STATUS(mech_modal_result_modes(r, m, n), MECH_STATUS_OK);
+        for (int i = 0; i < n; ++i) {
+            CHECK(m[i].kind == (i < 3 ? MECH_MODAL_KIND_ZERO : MECH_MODAL_KIND_OSCILLATORY));
+        }
+        CHECK(m[0].multiplicity == 3 && m[2].group == m[0].group && m[3].group != m[0].group);
+        CHECK(fabs(m[0].omega_sq) <= 1e-13 && m[0].rate == 0.0);
+        mech_modal_result_destroy(r);
+    }
+}
+
 int main(void) {
     all_pairs();
     dense_blocked_path();
     sparse_lowest();
     sketched_report();
     repeated_stiff_pair();
+    rigid_body_modes();
     free_response();
     subsets_and_values_only();
     massless_coordinate();
