@@ -1247,6 +1247,84 @@ typedef struct mech_modal_sparse_report_t {
 } mech_modal_sparse_report_t;
 #endif
 
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Options of mech_modal_sparse_solve. Zero fields take the defaults, so a zero-initialised
+ * struct with `count` set is the default solve of mech_modal_sparse_lowest.
+ */
+typedef struct mech_modal_sparse_options_t {
+    /**
+     * Number of lowest modes wanted (1 ≤ count ≤ n).
+     */
+    size_t count;
+    /**
+     * Each wanted pair converges until its Ritz residual ‖K⁻¹Ax − θx‖_A ≤ tolerance·θ
+     * (in (0, 1)); 0: 1e-12.
+     */
+    double tolerance;
+    /**
+     * Block size of the block Lanczos iteration (an eigenvalue of up to this multiplicity is
+     * seen in one run); 0: 2.
+     */
+    size_t block_size;
+    /**
+     * Lanczos runs allowed (the first plus deflated reruns for modes the inertia count shows
+     * missing); 0: the default (6). When exhausted: MECH_STATUS_NOT_CONVERGED.
+     */
+    size_t max_runs;
+    /**
+     * 1: `shift` is the factorization shift σ (below the lowest mode); 0: automatic.
+     */
+    int32_t shift_given;
+    /**
+     * σ (rad²/s²) when `shift_given` is 1.
+     */
+    double shift;
+} mech_modal_sparse_options_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * What a sparse solve did beyond mech_modal_sparse_report_t (a separate struct, so that the
+ * report's layout never changes).
+ */
+typedef struct mech_modal_sparse_details_t {
+    /**
+     * Lanczos runs (1, plus one per deflated rerun for missed copies of a repeated eigenvalue).
+     */
+    size_t lanczos_runs;
+    /**
+     * Thick restarts over all runs.
+     */
+    size_t restarts;
+    /**
+     * Shifts tried until B − σA was positive definite.
+     */
+    size_t shift_attempts;
+    /**
+     * Multiplicity of the count-th mode's eigenvalue: larger than the copies returned when
+     * `count` cuts through a repeated eigenvalue (every copy lies below the certified shift).
+     */
+    size_t kth_group_multiplicity;
+    /**
+     * Wall time of the factorization of B − σA (s).
+     */
+    double factor_seconds;
+    /**
+     * Wall time of the Lanczos runs (s).
+     */
+    double lanczos_seconds;
+    /**
+     * Wall time of Rayleigh–Ritz and the residual bounds (s).
+     */
+    double refine_seconds;
+    /**
+     * Wall time of the inertia count (s; partly overlapped with Lanczos on a second thread).
+     */
+    double inertia_seconds;
+} mech_modal_sparse_details_t;
+#endif
+
 /**
  * Success.
  */
@@ -3252,6 +3330,35 @@ mech_status_t mech_modal_sparse_lowest(size_t n,
                                        double *error_bound_out,
                                        double *vectors_out,
                                        struct mech_modal_sparse_report_t *report_out);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * The `options->count` lowest modes of det(λA + B) = 0 for sparse A and B in compressed sparse
+ * columns, as mech_modal_sparse_lowest, with options (tolerance, block size, runs, shift) and
+ * the full record of each mode: `modes_out` (count) receives λ, ω², the rate, the error bound,
+ * the backward error, the MECH_MODAL_KIND_* classification (zero when |ω²| is within its
+ * bound or within what the rounding of A and B can change), the group index and the group's
+ * multiplicity. `vectors_out` (n × count, column-major, may be NULL), `report_out` and
+ * `details_out` (may be NULL) as named. Errors as mech_modal_sparse_lowest, plus
+ * INVALID_ARGUMENT for a tolerance outside [0, 1) or shift_given ∉ {0, 1}, NON_FINITE for a
+ * non-finite tolerance or given shift; nothing is written on error.
+ *
+ * # Safety
+ * As mech_modal_sparse_lowest; `options` must point to a readable struct.
+ */
+mech_status_t mech_modal_sparse_solve(size_t n,
+                                      const size_t *a_col_ptr,
+                                      const size_t *a_row_idx,
+                                      const double *a_values,
+                                      const size_t *b_col_ptr,
+                                      const size_t *b_row_idx,
+                                      const double *b_values,
+                                      const struct mech_modal_sparse_options_t *options,
+                                      struct mech_modal_mode_t *modes_out,
+                                      double *vectors_out,
+                                      struct mech_modal_sparse_report_t *report_out,
+                                      struct mech_modal_sparse_details_t *details_out);
 #endif
 
 #ifdef __cplusplus

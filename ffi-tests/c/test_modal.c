@@ -1,6 +1,7 @@
 /* C test of the modal entry points: det(λA + B) = 0 on a fixed–fixed unit spring chain
  * (closed form ω²_k = 4 sin²(kπ/(2(n+1)))), a massless coordinate, and every error path. */
 #include "check.h"
+#include <string.h>
 
 #define N 6
 
@@ -343,6 +344,76 @@ static void sparse_lowest(void) {
     CHECK(rep.orthogonality_error < 1e-12);
     CHECK(rep.factor_nnz > 0 && rep.operator_applications > 0);
     CHECK_STATUS(mech_modal_sparse_lowest(GN, acp, arow, aval, bcp, brow, bval, 2, w, NULL, NULL, NULL), MECH_STATUS_OK);
+
+    /* mech_modal_sparse_solve: the same modes with their full records. A zero-initialised
+     * options struct with count set is the default solve. */
+    mech_modal_sparse_options_t so;
+    memset(&so, 0, sizeof so);
+    so.count = 4;
+    mech_modal_mode_t md[4];
+    mech_modal_sparse_report_t rep2;
+    mech_modal_sparse_details_t det;
+    CHECK_STATUS(mech_modal_sparse_solve(GN, acp, arow, aval, bcp, brow, bval, &so, md, NULL, &rep2, &det), MECH_STATUS_OK);
+    for (int k = 0; k < 4; ++k) {
+        CHECK(md[k].omega_sq == w[k] && md[k].error_bound == e[k]);
+        CHECK(md[k].kind == MECH_MODAL_KIND_OSCILLATORY && fabs(md[k].rate * md[k].rate - w[k]) <= 1e-15 * w[k]);
+        CHECK(md[k].lambda == -w[k] && md[k].backward_error >= 0.0 && md[k].backward_error <= rep2.max_backward_error);
+    }
+    CHECK(md[1].group == md[2].group && md[1].multiplicity == 2 && md[0].multiplicity == 1 && md[3].group != md[2].group);
+    CHECK(det.lanczos_runs >= 1 && det.kth_group_multiplicity == 1 && det.shift_attempts >= 1);
+    CHECK(det.factor_seconds > 0.0 && det.lanczos_seconds > 0.0 && det.refine_seconds >= 0.0);
+    CHECK(rep2.inertia_consistent == 1);
+    /* count = 2 cuts the double eigenvalue: two modes come back, the details give its whole
+     * multiplicity. A looser tolerance still gives bounds that hold. */
+    so.count = 2;
+    so.tolerance = 1e-8;
+    so.block_size = 3;
+    CHECK_STATUS(mech_modal_sparse_solve(GN, acp, arow, aval, bcp, brow, bval, &so, md, x, NULL, &det), MECH_STATUS_OK);
+    CHECK(det.kth_group_multiplicity == 2);
+    for (int k = 0; k < 2; ++k) CHECK_NEAR(md[k].omega_sq, exact[k], md[k].error_bound + 4.0 * 2.2e-16 * exact[k]);
+    /* B − cA with c the double eigenvalue: the lowest mode becomes unstable (growth rate
+     * √(c − 2s1)), the double one zero to the rounding of the shifted diagonal (one group of
+     * two), the next oscillatory. An explicit σ below the spectrum is used as given. */
+    double c = s1 + s2;
+    for (size_t k = 0; k < nb; ++k) {
+        if (bval[k] == 4.0) bval[k] = 4.0 - c;
+    }
+    so.count = 4;
+    so.tolerance = 0.0;
+    so.block_size = 0;
+    so.shift_given = 1;
+    so.shift = -1.0;
+    CHECK_STATUS(mech_modal_sparse_solve(GN, acp, arow, aval, bcp, brow, bval, &so, md, NULL, &rep2, NULL), MECH_STATUS_OK);
+    CHECK(rep2.shift == -1.0);
+    CHECK(md[0].kind == MECH_MODAL_KIND_UNSTABLE);
+    CHECK_NEAR(md[0].rate, sqrt(c - 2.0 * s1), 1e-12);
+    CHECK(md[1].kind == MECH_MODAL_KIND_ZERO && md[2].kind == MECH_MODAL_KIND_ZERO);
+    CHECK(md[1].group == md[2].group && md[1].multiplicity == 2 && md[1].rate == 0.0);
+    CHECK(md[3].kind == MECH_MODAL_KIND_OSCILLATORY);
+    for (size_t k = 0; k < nb; ++k) {
+        if (bval[k] == 4.0 - c) bval[k] = 4.0;
+    }
+    /* Bad options: nothing written. */
+    mech_modal_mode_t untouched[4];
+    FILL_SENTINEL(untouched, sizeof untouched);
+    so.shift_given = 0;
+    so.tolerance = NAN;
+    CHECK_STATUS(mech_modal_sparse_solve(GN, acp, arow, aval, bcp, brow, bval, &so, untouched, NULL, NULL, NULL),
+                 MECH_STATUS_NON_FINITE);
+    so.tolerance = 1.5;
+    CHECK_STATUS(mech_modal_sparse_solve(GN, acp, arow, aval, bcp, brow, bval, &so, untouched, NULL, NULL, NULL),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    so.tolerance = 0.0;
+    so.shift_given = 2;
+    CHECK_STATUS(mech_modal_sparse_solve(GN, acp, arow, aval, bcp, brow, bval, &so, untouched, NULL, NULL, NULL),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    so.shift_given = 0;
+    CHECK_STATUS(mech_modal_sparse_solve(GN, acp, arow, aval, bcp, brow, bval, NULL, untouched, NULL, NULL, NULL),
+                 MECH_STATUS_NULL_POINTER);
+    so.count = GN + 1;
+    CHECK_STATUS(mech_modal_sparse_solve(GN, acp, arow, aval, bcp, brow, bval, &so, untouched, NULL, NULL, NULL),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(untouched, sizeof untouched));
 
     /* Errors: nothing written. */
     double ws[4];

@@ -86,6 +86,9 @@ pub enum ModalError {
     /// A shift for the inertia count was not finite.
     #[error("shift {0} is not finite")]
     BadShift(f64),
+    /// A convergence tolerance outside (0, 1) (or not finite).
+    #[error("tolerance {0} must be finite and in (0, 1)")]
+    BadTolerance(f64),
     /// A vector argument has the wrong length.
     #[error("{what} has length {len}, expected {expected}")]
     BadLength {

@@ -716,6 +716,9 @@ fn solve_sparse_from(
     {
         return Err(ModalError::BadShift(s));
     }
+    if !(options.tolerance > 0.0 && options.tolerance < 1.0) {
+        return Err(ModalError::BadTolerance(options.tolerance));
+    }
     let (a, b) = (pencil.a(), pencil.b());
     let norm_a = frobenius(a);
     let norm_b = frobenius(b);

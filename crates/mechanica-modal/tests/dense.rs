@@ -588,7 +588,11 @@ fn rigid_body_modes_of_a_rounded_stiffness_are_zero() {
     let n = copies * n1;
     let copied = |m: &Mat<f64>| {
         Mat::from_fn(n, n, |i, j| {
-            if i % copies == j % copies { m[(i / copies, j / copies)] } else { 0.0 }
+            if i % copies == j % copies {
+                m[(i / copies, j / copies)]
+            } else {
+                0.0
+            }
         })
     };
     let (a, b) = families::rotate(&copied(&a1), &copied(&b1), &families::random_orthogonal(n, 5));
@@ -596,10 +600,7 @@ fn rigid_body_modes_of_a_rounded_stiffness_are_zero() {
     let (ar, br) = families::rotate(&ar, &br, &families::random_orthogonal(12, 3));
     for (p, zeros) in [(pencil(&a, &b), copies), (pencil(&ar, &br), 1)] {
         for vectors in [true, false] {
-            let options = SolveOptions {
-                vectors,
-                ..all_pairs()
-            };
+            let options = SolveOptions { vectors, ..all_pairs() };
             let sol = solve(&p, &options).expect("solve");
             let kinds: Vec<ModeKind> = sol.modes.iter().map(|m| m.kind).collect();
             assert!(kinds[..zeros].iter().all(|k| *k == ModeKind::Zero), "{kinds:?}");

@@ -208,3 +208,27 @@ fn faer_sparse_matrices_are_accepted() {
         assert!((m.omega_sq - w).abs() <= m.error_bound);
     }
 }
+
+/// A tolerance that is not a finite number in (0, 1) is refused before any work.
+#[test]
+fn bad_tolerances_are_refused() {
+    let (a, b) = families::grid_laplacian(25, 25);
+    let p = SparsePencil::from_triplets(625, &a, &b).expect("valid pencil");
+    for tolerance in [f64::NAN, f64::INFINITY, 0.0, -1e-12, 1.0, 2.0] {
+        let options = SparseOptions { tolerance, ..lowest(3) };
+        assert!(
+            matches!(solve_sparse(&p, &options), Err(ModalError::BadTolerance(t)) if t.to_bits() == tolerance.to_bits()),
+            "{tolerance}"
+        );
+    }
+    assert!(
+        solve_sparse(
+            &p,
+            &SparseOptions {
+                tolerance: 1e-8,
+                ..lowest(3)
+            }
+        )
+        .is_ok()
+    );
+}

@@ -7,8 +7,8 @@ use super::validate::*;
 use mechanica_modal::faer::MatRef;
 use mechanica_modal::faer::sparse::Triplet;
 use mechanica_modal::{
-    FreeResponse, Method, ModalError, ModalSolution, ModeKind, PencilProblem, Refinement, Residuals, Selection,
-    SolveOptions, SparseOptions, SparsePencil, count_below, solve, solve_sparse,
+    FreeResponse, Method, ModalError, ModalSolution, Mode, ModeGroup, ModeKind, PencilProblem, Refinement, Residuals,
+    Selection, SolveOptions, SparseModalSolution, SparseOptions, SparsePencil, count_below, solve, solve_sparse,
 };
 
 impl From<ModalError> for FfiError {
@@ -29,6 +29,7 @@ impl From<ModalError> for FfiError {
             }
             ModalError::NotSymmetric { .. }
             | ModalError::BadInterval { .. }
+            | ModalError::BadTolerance(_)
             | ModalError::TooManyModes { .. }
             | ModalError::IncompleteSolution { .. }
             | ModalError::ResponseOverflow { .. } => MECH_STATUS_INVALID_ARGUMENT,
@@ -380,6 +381,26 @@ pub unsafe extern "C" fn mech_modal_result_eigenvalues(
     })
 }
 
+/// The C record of a mode, with its group's multiplicity from `groups`.
+fn mode_to_c(m: &Mode, groups: &[ModeGroup]) -> mech_modal_mode_t {
+    let (kind, rate) = match m.kind {
+        ModeKind::Oscillatory { omega } => (MECH_MODAL_KIND_OSCILLATORY, omega),
+        ModeKind::Zero => (MECH_MODAL_KIND_ZERO, 0.0),
+        ModeKind::Unstable { growth_rate } => (MECH_MODAL_KIND_UNSTABLE, growth_rate),
+        ModeKind::Infinite => (MECH_MODAL_KIND_INFINITE, f64::INFINITY),
+    };
+    mech_modal_mode_t {
+        lambda: m.lambda,
+        omega_sq: m.omega_sq,
+        rate,
+        error_bound: m.error_bound,
+        backward_error: m.backward_error.unwrap_or(-1.0),
+        kind,
+        group: m.group,
+        multiplicity: groups.get(m.group).map_or(1, |g| g.multiplicity),
+    }
+}
+
 /// Copies the scalar data of every mode into `modes` (capacity ≥ number of modes).
 ///
 /// # Safety
@@ -396,28 +417,7 @@ pub unsafe extern "C" fn mech_modal_result_modes(
         let s = &r.solution;
         check_capacity(capacity, s.modes.len(), "modes")?;
         let out = OutSlice::new(modes, s.modes.len(), "modes")?;
-        let values: Vec<mech_modal_mode_t> = s
-            .modes
-            .iter()
-            .map(|m| {
-                let (kind, rate) = match m.kind {
-                    ModeKind::Oscillatory { omega } => (MECH_MODAL_KIND_OSCILLATORY, omega),
-                    ModeKind::Zero => (MECH_MODAL_KIND_ZERO, 0.0),
-                    ModeKind::Unstable { growth_rate } => (MECH_MODAL_KIND_UNSTABLE, growth_rate),
-                    ModeKind::Infinite => (MECH_MODAL_KIND_INFINITE, f64::INFINITY),
-                };
-                mech_modal_mode_t {
-                    lambda: m.lambda,
-                    omega_sq: m.omega_sq,
-                    rate,
-                    error_bound: m.error_bound,
-                    backward_error: m.backward_error.unwrap_or(-1.0),
-                    kind,
-                    group: m.group,
-                    multiplicity: s.groups.get(m.group).map_or(1, |g| g.multiplicity),
-                }
-            })
-            .collect();
+        let values: Vec<mech_modal_mode_t> = s.modes.iter().map(|m| mode_to_c(m, &s.groups)).collect();
         // SAFETY: checked for the number of modes.
         unsafe { out.write(&values) };
         Ok(())
@@ -755,45 +755,26 @@ pub unsafe extern "C" fn mech_modal_sparse_lowest(
         } else {
             Some(Out::new(report_out, "report_out")?)
         };
-        // SAFETY: caller's contract.
-        let (a, b) = unsafe {
-            (
-                read_csc(n, a_col_ptr, a_row_idx, a_values, "a")?,
-                read_csc(n, b_col_ptr, b_row_idx, b_values, "b")?,
-            )
+        let a = CscInput {
+            col_ptr: a_col_ptr,
+            row_idx: a_row_idx,
+            values: a_values,
         };
-        let pencil = SparsePencil::from_triplets(n, &a, &b)?;
-        let sol = solve_sparse(
-            &pencil,
-            &SparseOptions {
-                count,
-                ..SparseOptions::default()
-            },
-        )?;
+        let b = CscInput {
+            col_ptr: b_col_ptr,
+            row_idx: b_row_idx,
+            values: b_values,
+        };
+        let options = SparseOptions {
+            count,
+            ..SparseOptions::default()
+        };
+        // SAFETY: caller's contract.
+        let sol = unsafe { solve_csc(n, a, b, &options) }?;
         let omega: Vec<f64> = sol.modes.iter().map(|m| m.omega_sq).collect();
         let bounds: Vec<f64> = sol.modes.iter().map(|m| m.error_bound).collect();
-        let mut shapes = Vec::with_capacity(len);
-        for j in 0..sol.vectors.ncols() {
-            shapes.extend((0..n).map(|i| sol.vectors[(i, j)]));
-        }
-        if omega.len() != count || shapes.len() != len {
-            return Err(FfiError::new(
-                MECH_STATUS_NOT_CONVERGED,
-                "fewer modes than requested were found",
-            ));
-        }
-        let r = &sol.report;
-        let report = mech_modal_sparse_report_t {
-            shift: r.shift,
-            max_backward_error: r.max_backward_error,
-            orthogonality_error: r.orthogonality_error,
-            inertia_shift: r.inertia.map_or(0.0, |c| c.count.shift),
-            inertia_below: r.inertia.map_or(0, |c| c.count.below),
-            computed_below: r.computed_below,
-            inertia_consistent: i32::from(r.consistent),
-            operator_applications: r.operator_applications,
-            factor_nnz: r.factor_nnz,
-        };
+        let shapes = shapes_of(&sol, n, count)?;
+        let report = sparse_report(&sol);
         // SAFETY: checked writable for the sizes above (caller's contract).
         unsafe {
             w_out.write(&omega);
@@ -805,6 +786,244 @@ pub unsafe extern "C" fn mech_modal_sparse_lowest(
             }
             if let Some(o) = r_out {
                 o.write(report);
+            }
+        }
+        Ok(())
+    })
+}
+
+/// One caller CSC matrix (0-based, both triangles; see [`read_csc`]).
+#[derive(Clone, Copy)]
+struct CscInput {
+    col_ptr: *const usize,
+    row_idx: *const usize,
+    values: *const f64,
+}
+
+/// Reads both CSC matrices and runs the sparse solver.
+///
+/// # Safety
+/// As [`read_csc`] for each matrix.
+unsafe fn solve_csc(
+    n: usize,
+    a: CscInput,
+    b: CscInput,
+    options: &SparseOptions,
+) -> Result<SparseModalSolution, FfiError> {
+    // SAFETY: caller's contract.
+    let (a, b) = unsafe {
+        (
+            read_csc(n, a.col_ptr, a.row_idx, a.values, "a")?,
+            read_csc(n, b.col_ptr, b.row_idx, b.values, "b")?,
+        )
+    };
+    let pencil = SparsePencil::from_triplets(n, &a, &b)?;
+    Ok(solve_sparse(&pencil, options)?)
+}
+
+/// The n × count mode shapes, column-major; an error if fewer than `count` came back.
+fn shapes_of(sol: &SparseModalSolution, n: usize, count: usize) -> Result<Vec<f64>, FfiError> {
+    let mut shapes = Vec::with_capacity(n * count);
+    for j in 0..sol.vectors.ncols() {
+        shapes.extend((0..n).map(|i| sol.vectors[(i, j)]));
+    }
+    if sol.modes.len() != count || shapes.len() != n * count {
+        return Err(FfiError::new(
+            MECH_STATUS_NOT_CONVERGED,
+            "fewer modes than requested were found",
+        ));
+    }
+    Ok(shapes)
+}
+
+/// The C summary of a sparse solve.
+fn sparse_report(sol: &SparseModalSolution) -> mech_modal_sparse_report_t {
+    let r = &sol.report;
+    mech_modal_sparse_report_t {
+        shift: r.shift,
+        max_backward_error: r.max_backward_error,
+        orthogonality_error: r.orthogonality_error,
+        inertia_shift: r.inertia.map_or(0.0, |c| c.count.shift),
+        inertia_below: r.inertia.map_or(0, |c| c.count.below),
+        computed_below: r.computed_below,
+        inertia_consistent: i32::from(r.consistent),
+        operator_applications: r.operator_applications,
+        factor_nnz: r.factor_nnz,
+    }
+}
+
+/// Options of mech_modal_sparse_solve. Zero fields take the defaults, so a zero-initialised
+/// struct with `count` set is the default solve of mech_modal_sparse_lowest.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_modal_sparse_options_t {
+    /// Number of lowest modes wanted (1 ≤ count ≤ n).
+    pub count: usize,
+    /// Each wanted pair converges until its Ritz residual ‖K⁻¹Ax − θx‖_A ≤ tolerance·θ
+    /// (in (0, 1)); 0: 1e-12.
+    pub tolerance: f64,
+    /// Block size of the block Lanczos iteration (an eigenvalue of up to this multiplicity is
+    /// seen in one run); 0: 2.
+    pub block_size: usize,
+    /// Lanczos runs allowed (the first plus deflated reruns for modes the inertia count shows
+    /// missing); 0: the default (6). When exhausted: MECH_STATUS_NOT_CONVERGED.
+    pub max_runs: usize,
+    /// 1: `shift` is the factorization shift σ (below the lowest mode); 0: automatic.
+    pub shift_given: i32,
+    /// σ (rad²/s²) when `shift_given` is 1.
+    pub shift: f64,
+}
+
+/// What a sparse solve did beyond mech_modal_sparse_report_t (a separate struct, so that the
+/// report's layout never changes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_modal_sparse_details_t {
+    /// Lanczos runs (1, plus one per deflated rerun for missed copies of a repeated eigenvalue).
+    pub lanczos_runs: usize,
+    /// Thick restarts over all runs.
+    pub restarts: usize,
+    /// Shifts tried until B − σA was positive definite.
+    pub shift_attempts: usize,
+    /// Multiplicity of the count-th mode's eigenvalue: larger than the copies returned when
+    /// `count` cuts through a repeated eigenvalue (every copy lies below the certified shift).
+    pub kth_group_multiplicity: usize,
+    /// Wall time of the factorization of B − σA (s).
+    pub factor_seconds: f64,
+    /// Wall time of the Lanczos runs (s).
+    pub lanczos_seconds: f64,
+    /// Wall time of Rayleigh–Ritz and the residual bounds (s).
+    pub refine_seconds: f64,
+    /// Wall time of the inertia count (s; partly overlapped with Lanczos on a second thread).
+    pub inertia_seconds: f64,
+}
+
+/// [`SparseOptions`] from the C options: zero fields take the defaults; a non-finite or
+/// out-of-range tolerance or shift, or a `shift_given` other than 0 and 1, is refused.
+fn sparse_options(o: &mech_modal_sparse_options_t) -> Result<SparseOptions, FfiError> {
+    let defaults = SparseOptions::default();
+    if !o.tolerance.is_finite() || (o.shift_given == 1 && !o.shift.is_finite()) {
+        return Err(FfiError::new(
+            MECH_STATUS_NON_FINITE,
+            "tolerance or shift is not finite",
+        ));
+    }
+    let shift = match o.shift_given {
+        0 => None,
+        1 => Some(o.shift),
+        other => {
+            return Err(FfiError::new(
+                MECH_STATUS_INVALID_ARGUMENT,
+                format!("shift_given is {other}, expected 0 or 1"),
+            ));
+        }
+    };
+    let nonzero = |value: usize, default: usize| if value == 0 { default } else { value };
+    Ok(SparseOptions {
+        count: o.count,
+        shift,
+        tolerance: if o.tolerance == 0.0 {
+            defaults.tolerance
+        } else {
+            o.tolerance
+        },
+        block_size: nonzero(o.block_size, defaults.block_size),
+        max_runs: nonzero(o.max_runs, defaults.max_runs),
+        ..defaults
+    })
+}
+
+/// The `options->count` lowest modes of det(λA + B) = 0 for sparse A and B in compressed sparse
+/// columns, as mech_modal_sparse_lowest, with options (tolerance, block size, runs, shift) and
+/// the full record of each mode: `modes_out` (count) receives λ, ω², the rate, the error bound,
+/// the backward error, the MECH_MODAL_KIND_* classification (zero when |ω²| is within its
+/// bound or within what the rounding of A and B can change), the group index and the group's
+/// multiplicity. `vectors_out` (n × count, column-major, may be NULL), `report_out` and
+/// `details_out` (may be NULL) as named. Errors as mech_modal_sparse_lowest, plus
+/// INVALID_ARGUMENT for a tolerance outside [0, 1) or shift_given ∉ {0, 1}, NON_FINITE for a
+/// non-finite tolerance or given shift; nothing is written on error.
+///
+/// # Safety
+/// As mech_modal_sparse_lowest; `options` must point to a readable struct.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn mech_modal_sparse_solve(
+    n: usize,
+    a_col_ptr: *const usize,
+    a_row_idx: *const usize,
+    a_values: *const f64,
+    b_col_ptr: *const usize,
+    b_row_idx: *const usize,
+    b_values: *const f64,
+    options: *const mech_modal_sparse_options_t,
+    modes_out: *mut mech_modal_mode_t,
+    vectors_out: *mut f64,
+    report_out: *mut mech_modal_sparse_report_t,
+    details_out: *mut mech_modal_sparse_details_t,
+) -> mech_status_t {
+    boundary(|| {
+        if n == 0 {
+            return Err(FfiError::new(MECH_STATUS_BAD_DIMENSION, "n: dimension is 0"));
+        }
+        // SAFETY: caller's contract.
+        let c_options = unsafe { read(options, "options") }?;
+        let options = sparse_options(&c_options)?;
+        let count = options.count;
+        let m_out = OutSlice::new(modes_out, count, "modes_out")?;
+        let len = n
+            .checked_mul(count)
+            .ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n·count overflows"))?;
+        let x_out = if vectors_out.is_null() {
+            None
+        } else {
+            Some(OutSlice::new(vectors_out, len, "vectors_out")?)
+        };
+        let r_out = if report_out.is_null() {
+            None
+        } else {
+            Some(Out::new(report_out, "report_out")?)
+        };
+        let d_out = if details_out.is_null() {
+            None
+        } else {
+            Some(Out::new(details_out, "details_out")?)
+        };
+        let a = CscInput {
+            col_ptr: a_col_ptr,
+            row_idx: a_row_idx,
+            values: a_values,
+        };
+        let b = CscInput {
+            col_ptr: b_col_ptr,
+            row_idx: b_row_idx,
+            values: b_values,
+        };
+        // SAFETY: caller's contract.
+        let sol = unsafe { solve_csc(n, a, b, &options) }?;
+        let shapes = shapes_of(&sol, n, count)?;
+        let modes: Vec<mech_modal_mode_t> = sol.modes.iter().map(|m| mode_to_c(m, &sol.groups)).collect();
+        let r = &sol.report;
+        let details = mech_modal_sparse_details_t {
+            lanczos_runs: r.lanczos_runs,
+            restarts: r.restarts,
+            shift_attempts: r.shift_attempts,
+            kth_group_multiplicity: r.kth_group_multiplicity,
+            factor_seconds: r.timings.factor.as_secs_f64(),
+            lanczos_seconds: r.timings.lanczos.as_secs_f64(),
+            refine_seconds: r.timings.refine.as_secs_f64(),
+            inertia_seconds: r.timings.inertia.as_secs_f64(),
+        };
+        // SAFETY: checked writable for the sizes above (caller's contract).
+        unsafe {
+            m_out.write(&modes);
+            if let Some(x) = x_out {
+                x.write(&shapes);
+            }
+            if let Some(o) = r_out {
+                o.write(sparse_report(&sol));
+            }
+            if let Some(o) = d_out {
+                o.write(details);
             }
         }
         Ok(())
