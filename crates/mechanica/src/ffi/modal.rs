@@ -737,34 +737,11 @@ pub unsafe extern "C" fn mech_modal_sparse_lowest(
             return Err(FfiError::new(MECH_STATUS_BAD_DIMENSION, "n: dimension is 0"));
         }
         let w_out = OutSlice::new(omega_sq_out, count, "omega_sq_out")?;
-        let e_out = if error_bound_out.is_null() {
-            None
-        } else {
-            Some(OutSlice::new(error_bound_out, count, "error_bound_out")?)
-        };
-        let len = n
-            .checked_mul(count)
-            .ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n·count overflows"))?;
-        let x_out = if vectors_out.is_null() {
-            None
-        } else {
-            Some(OutSlice::new(vectors_out, len, "vectors_out")?)
-        };
-        let r_out = if report_out.is_null() {
-            None
-        } else {
-            Some(Out::new(report_out, "report_out")?)
-        };
-        let a = CscInput {
-            col_ptr: a_col_ptr,
-            row_idx: a_row_idx,
-            values: a_values,
-        };
-        let b = CscInput {
-            col_ptr: b_col_ptr,
-            row_idx: b_row_idx,
-            values: b_values,
-        };
+        let e_out = OutSlice::optional(error_bound_out, count, "error_bound_out")?;
+        let x_out = OutSlice::optional(vectors_out, shapes_len(n, count)?, "vectors_out")?;
+        let r_out = Out::optional(report_out, "report_out")?;
+        let a = CscInput::new(a_col_ptr, a_row_idx, a_values);
+        let b = CscInput::new(b_col_ptr, b_row_idx, b_values);
         let options = SparseOptions {
             count,
             ..SparseOptions::default()
@@ -800,6 +777,22 @@ struct CscInput {
     values: *const f64,
 }
 
+impl CscInput {
+    fn new(col_ptr: *const usize, row_idx: *const usize, values: *const f64) -> Self {
+        Self {
+            col_ptr,
+            row_idx,
+            values,
+        }
+    }
+}
+
+/// n·count, the length of the mode shapes' buffer.
+fn shapes_len(n: usize, count: usize) -> Result<usize, FfiError> {
+    n.checked_mul(count)
+        .ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n·count overflows"))
+}
+
 /// Reads both CSC matrices and runs the sparse solver.
 ///
 /// # Safety
@@ -823,7 +816,7 @@ unsafe fn solve_csc(
 
 /// The n × count mode shapes, column-major; an error if fewer than `count` came back.
 fn shapes_of(sol: &SparseModalSolution, n: usize, count: usize) -> Result<Vec<f64>, FfiError> {
-    let mut shapes = Vec::with_capacity(n * count);
+    let mut shapes = Vec::with_capacity(sol.vectors.nrows() * sol.vectors.ncols());
     for j in 0..sol.vectors.ncols() {
         shapes.extend((0..n).map(|i| sol.vectors[(i, j)]));
     }
@@ -970,34 +963,11 @@ pub unsafe extern "C" fn mech_modal_sparse_solve(
         let options = sparse_options(&c_options)?;
         let count = options.count;
         let m_out = OutSlice::new(modes_out, count, "modes_out")?;
-        let len = n
-            .checked_mul(count)
-            .ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, "n·count overflows"))?;
-        let x_out = if vectors_out.is_null() {
-            None
-        } else {
-            Some(OutSlice::new(vectors_out, len, "vectors_out")?)
-        };
-        let r_out = if report_out.is_null() {
-            None
-        } else {
-            Some(Out::new(report_out, "report_out")?)
-        };
-        let d_out = if details_out.is_null() {
-            None
-        } else {
-            Some(Out::new(details_out, "details_out")?)
-        };
-        let a = CscInput {
-            col_ptr: a_col_ptr,
-            row_idx: a_row_idx,
-            values: a_values,
-        };
-        let b = CscInput {
-            col_ptr: b_col_ptr,
-            row_idx: b_row_idx,
-            values: b_values,
-        };
+        let x_out = OutSlice::optional(vectors_out, shapes_len(n, count)?, "vectors_out")?;
+        let r_out = Out::optional(report_out, "report_out")?;
+        let d_out = Out::optional(details_out, "details_out")?;
+        let a = CscInput::new(a_col_ptr, a_row_idx, a_values);
+        let b = CscInput::new(b_col_ptr, b_row_idx, b_values);
         // SAFETY: caller's contract.
         let sol = unsafe { solve_csc(n, a, b, &options) }?;
         let shapes = shapes_of(&sol, n, count)?;

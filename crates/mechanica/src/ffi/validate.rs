@@ -57,6 +57,15 @@ impl<T> Out<T> {
             .ok_or_else(|| FfiError::new(MECH_STATUS_NULL_POINTER, what))
     }
 
+    /// Checks an optional output pointer: None for NULL.
+    pub fn optional(ptr: *mut T, what: &str) -> Result<Option<Self>, FfiError> {
+        if ptr.is_null() {
+            Ok(None)
+        } else {
+            Self::new(ptr, what).map(Some)
+        }
+    }
+
     /// Writes the result.
     ///
     /// # Safety
@@ -86,6 +95,15 @@ impl<T: Copy> OutSlice<T> {
         byte_length::<T>(len, what)?;
         let ptr = NonNull::new(ptr).ok_or_else(|| FfiError::new(MECH_STATUS_NULL_POINTER, what))?;
         Ok(Self { ptr, len })
+    }
+
+    /// Checks an optional output array: None for NULL.
+    pub fn optional(ptr: *mut T, len: usize, what: &str) -> Result<Option<Self>, FfiError> {
+        if ptr.is_null() {
+            Ok(None)
+        } else {
+            Self::new(ptr, len, what).map(Some)
+        }
     }
 
     /// Copies `values` (exactly `len` of them) into the array.
