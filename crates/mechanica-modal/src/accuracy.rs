@@ -430,7 +430,7 @@ impl APrioriModel {
         self.scale * (self.norm_b + omega_sq.abs() * self.norm_a)
     }
 
-    /// [`data_resolution`] without the mode shape: ‖x‖₂² ≤ ‖A⁻¹‖₂ for an A-normalised x.
+    /// [`normwise_resolution`] without the mode shape: ‖x‖₂² ≤ ‖A⁻¹‖₂ for an A-normalised x.
     pub(crate) fn data_resolution(&self, omega_sq: f64) -> f64 {
         self.bound(omega_sq) / self.order.max(1) as f64
     }
@@ -442,13 +442,49 @@ impl APrioriModel {
 }
 
 /// The change of ω² that rounding A and B entrywise can cause for an A-normalised mode shape x:
-/// |xᵀδBx| + |ω²|·|xᵀδAx| ≤ u(‖B‖_F + |ω²|‖A‖_F)‖x‖₂² for |δA| ≤ u|A|, |δB| ≤ u|B| (u taken as
-/// f64::EPSILON, one rounding of each entry with margin). Below it neither the sign nor the
-/// size of ω² is determined by the data: a rigid-body mode of a stiffness matrix that is
+/// |xᵀδBx| + |ω²|·|xᵀδAx| ≤ u(|x|ᵀ|B||x| + |ω²|·|x|ᵀ|A||x|) for |δA| ≤ u|A|, |δB| ≤ u|B| (u
+/// taken as f64::EPSILON, one rounding of each entry with margin). Below it neither the sign
+/// nor the size of ω² is determined by the data: a rigid-body mode of a stiffness matrix that is
 /// singular only up to rounding (an assembled or rotated one) has a computed ω² of that order,
-/// of either sign, however tight its error bound for the stored matrices.
-pub fn data_resolution(omega_sq: f64, norm_a: f64, norm_b: f64, shape_norm_sq: f64) -> f64 {
+/// of either sign, however tight its error bound for the stored matrices. Componentwise, so a
+/// soft spring beside stiff ones, or a small negative stiffness on a decoupled coordinate,
+/// stays resolved. O(n²); [`normwise_resolution`] bounds it from above in O(n).
+pub fn data_resolution(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: &[f64], omega_sq: f64) -> f64 {
+    f64::EPSILON * (abs_quadratic(b, x) + omega_sq.abs() * abs_quadratic(a, x))
+}
+
+/// An upper bound of [`data_resolution`] from norms: |x|ᵀ|M||x| ≤ ‖M‖_F‖x‖₂².
+pub fn normwise_resolution(omega_sq: f64, norm_a: f64, norm_b: f64, shape_norm_sq: f64) -> f64 {
     f64::EPSILON * (norm_b + omega_sq.abs() * norm_a) * shape_norm_sq
+}
+
+/// |x|ᵀ|M||x| of a dense M.
+fn abs_quadratic(m: MatRef<'_, f64>, x: &[f64]) -> f64 {
+    (0..m.ncols())
+        .map(|j| {
+            let column: f64 = m.col(j).iter().zip(x).map(|(mij, xi)| (mij * xi).abs()).sum();
+            column * x[j].abs()
+        })
+        .sum()
+}
+
+/// The resolution the zero classification compares |ω²| with: [`data_resolution`] where
+/// |ω²| is within the cheap [`normwise_resolution`] (only there can it decide), the normwise
+/// value elsewhere.
+pub(crate) fn zero_resolution(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    x: &[f64],
+    omega_sq: f64,
+    (norm_a, norm_b): (f64, f64),
+) -> f64 {
+    let shape_norm_sq = x.iter().map(|v| v * v).sum::<f64>();
+    let normwise = normwise_resolution(omega_sq, norm_a, norm_b, shape_norm_sq);
+    if omega_sq.abs() <= normwise {
+        data_resolution(a, b, x, omega_sq)
+    } else {
+        normwise
+    }
 }
 
 /// The computed modes used to split a residual into its modal components.
@@ -497,7 +533,8 @@ pub(crate) struct RefinedResidual {
 /// theorem; Parlett, "The Symmetric Eigenvalue Problem", Thm 11.5.1), Σ_{j∉G} Σ_{k∈G} c_{jk}²/δ_j
 /// with δ_j the gap from mode j to the nearest member, and ‖R_⊥‖²_F/δ: the quadratic residual
 /// bound of a Ritz block separated by δ from the rest of the spectrum (Mathias, SIMAX 19, 1998).
-/// p·γ·|ρ| is added for the block's A-orthogonality defect γ.
+/// p·γ·s and u·s are added for the block's A-orthogonality defect γ and the rounding, with s
+/// the largest |ω²| of the block.
 pub(crate) fn residual_bounds(
     report: &mut AccuracyReport,
     omega_sq: &[f64],
@@ -555,7 +592,6 @@ pub(crate) fn residual_bounds(
             continue;
         };
         let eps = columns.iter().map(|(_, e)| e * e).sum::<f64>().sqrt();
-        let rho = omega_sq[i];
         let distance = |w: f64| {
             group
                 .clone()
@@ -596,8 +632,13 @@ pub(crate) fn residual_bounds(
                 bound = bound.min(weighted + eps_rest * eps_rest / gap);
             }
         }
-        let defect = group.len() as f64 * refined.orthogonality * rho.abs();
-        report.error_bounds[i] = bound + defect + f64::EPSILON * rho.abs();
+        // Rounding and the block's A-orthogonality defect at the cluster's largest |ω²|: the
+        // Rayleigh–Ritz step in double leaves a mixing of order u between members, which moves a
+        // member's Rayleigh quotient by up to u² times the cluster's spread (found in review: a
+        // zero mode chained to soft ones had ω² = 5e-37 against a bound of 1.7e-40 with |ρ_i|).
+        let scale = group.clone().map(|g| omega_sq[g].abs()).fold(0.0, f64::max);
+        let defect = group.len() as f64 * refined.orthogonality * scale;
+        report.error_bounds[i] = bound + defect + f64::EPSILON * scale;
         report.bound_kinds[i] = BoundKind::Residual;
     }
 }

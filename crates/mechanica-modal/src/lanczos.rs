@@ -1037,13 +1037,15 @@ fn rayleigh_ritz(
 }
 
 /// What the bounds of the refined pairs need: each Rayleigh quotient and its rounding, θ, the
-/// first-order θ bound δ and the backward error η.
+/// first-order θ bound δ and the backward error η; and what the classification needs, the
+/// data resolution of each ω² ([`crate::accuracy::data_resolution`]).
 struct PairResiduals {
     omega_sq: Vec<f64>,
     theta: Vec<f64>,
     delta: Vec<f64>,
     eta: Vec<f64>,
     rounding: Vec<f64>,
+    resolution: Vec<f64>,
 }
 
 /// The residuals of every refined pair: Rayleigh quotients and residuals in double-double, the
@@ -1112,6 +1114,7 @@ impl PairResiduals {
         self.delta.extend(other.delta);
         self.eta.extend(other.eta);
         self.rounding.extend(other.rounding);
+        self.resolution.extend(other.resolution);
     }
 }
 
@@ -1137,6 +1140,7 @@ fn residuals_of(
     let mut delta = vec![0.0; cols];
     let mut eta = vec![0.0; cols];
     let mut rounding = vec![0.0; cols];
+    let mut resolution = vec![0.0; cols];
     let mut omega_sq = refined.omega_sq[range.clone()].to_vec();
     // Residuals s = Ax − θKx of every pair, solved with K in one block.
     let mut residuals = vec![0.0; n * cols];
@@ -1167,8 +1171,9 @@ fn residuals_of(
         eta[c] = dot(&r, &r).sqrt() / ((norm_b + w.abs() * norm_a) * xn).max(f64::MIN_POSITIVE);
         let xax = xax.to_f64().max(f64::MIN_POSITIVE);
         // Rounding of the double-double quotient and its final rounding to double.
-        rounding[c] = 2.0 * f64::EPSILON * w.abs()
-            + max_row * f64::EPSILON * f64::EPSILON * (abs_quadratic(b, x) + w.abs() * abs_quadratic(a, x)) / xax;
+        let componentwise = (abs_quadratic(b, x) + w.abs() * abs_quadratic(a, x)) / xax;
+        rounding[c] = 2.0 * f64::EPSILON * w.abs() + max_row * f64::EPSILON * f64::EPSILON * componentwise;
+        resolution[c] = f64::EPSILON * componentwise;
     }
     let mut solved = residuals.clone();
     let clock = Instant::now();
@@ -1185,6 +1190,7 @@ fn residuals_of(
         delta,
         eta,
         rounding,
+        resolution,
     };
     (residuals, solve_time)
 }
@@ -1210,6 +1216,7 @@ fn finish(
         delta,
         eta,
         rounding,
+        resolution,
     } = residuals;
     // Clusters of θ whose δ-intervals overlap; Kato–Temple with the gap to other clusters and to
     // θ(τ) (no eigenvalue with ω² < τ is unaccounted for when the inertia check passed).
@@ -1243,16 +1250,11 @@ fn finish(
         bounds[c] = omega_bound + rounding[c];
     }
     let take = k.min(cols);
-    let resolution = |c: usize| {
-        let shape = &refined.vectors[n * c..n * (c + 1)];
-        let shape_norm_sq = shape.iter().map(|v| v * v).sum::<f64>();
-        crate::accuracy::data_resolution(omega_sq[c], norm_a, norm_b, shape_norm_sq)
-    };
     let mut modes: Vec<Mode> = (0..cols)
         .map(|c| Mode {
             lambda: -omega_sq[c],
             omega_sq: omega_sq[c],
-            kind: classify(omega_sq[c], bounds[c].max(resolution(c))),
+            kind: classify(omega_sq[c], bounds[c].max(resolution[c])),
             error_bound: bounds[c],
             backward_error: Some(eta[c]),
             group: 0,

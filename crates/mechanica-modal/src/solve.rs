@@ -421,6 +421,8 @@ impl Finish<'_> {
         };
         timings.accuracy += clock.elapsed();
         let clock = Instant::now();
+        // Values only: the data resolution of the modes whose vectors were formed.
+        let mut measured_resolution: Vec<(usize, f64)> = Vec::new();
         if let (Some(form), Some(model)) = (form.as_mut(), a_priori)
             && lift.is_none()
             && self.options.refinement == Refinement::Auto
@@ -432,7 +434,8 @@ impl Finish<'_> {
                 residuals: self.options.residuals,
                 par: self.par,
             };
-            crate::values_only::sharpen(&pencil, model, form, &mut report, &mut omega, &omega_all, def.first);
+            measured_resolution =
+                crate::values_only::sharpen(&pencil, model, form, &mut report, &mut omega, &omega_all, def.first);
         }
         // Refinement of poorly bounded simple modes (needs vectors in the original coordinates).
         if let (Some(xm), Some(products)) = (x.as_mut(), products.as_mut())
@@ -510,16 +513,19 @@ impl Finish<'_> {
         )?;
         timings.inertia = clock.elapsed();
         // What the data resolve: the zero classification allows for the rounding of A and B.
-        let resolution: Vec<f64> = (0..m)
+        let mut resolution: Vec<f64> = (0..m)
             .map(|i| match (&x, &a_priori) {
                 (Some(x), _) => {
-                    let shape_norm_sq = x.col(i).iter().map(|v| v * v).sum::<f64>();
-                    accuracy::data_resolution(omega[i], self.norm_a, self.norm_b, shape_norm_sq)
+                    let shape: Vec<f64> = x.col(i).iter().copied().collect();
+                    accuracy::zero_resolution(a, b, &shape, omega[i], (self.norm_a, self.norm_b))
                 }
                 (None, Some(model)) => model.data_resolution(omega[i]),
                 (None, None) => 0.0,
             })
             .collect();
+        for (i, value) in measured_resolution {
+            resolution[i] = value;
+        }
         if !self.options.vectors {
             x = None;
             report.backward_errors.iter_mut().for_each(|e| *e = None);
@@ -660,9 +666,10 @@ pub(crate) fn group_modes(modes: &mut [Mode]) -> Vec<ModeGroup> {
 /// mode selected it first tries the cheap certificate
 /// that B − sA is positive definite for s just below the lowest computed ω² (by half its size or
 /// twice its bound): nothing was missed at the bottom of the spectrum, where stability is
-/// decided. Otherwise, or when that Cholesky fails, it places a shift in the widest gap next to
-/// the selection (or of the whole spectrum) and compares the LBLᵀ inertia count with the number
-/// of computed ω² below it.
+/// decided. Otherwise, or when that Cholesky fails, it places a shift in the first real gap
+/// (wider than twice the largest bound) at or beyond the selection's edge, so never inside a
+/// cluster the selection cut, or in the widest gap of the whole spectrum, and compares the LBLᵀ
+/// inertia count with the number of computed ω² below it.
 fn inertia_check(
     problem: &PencilProblem,
     omega_all: &[f64],
@@ -696,10 +703,14 @@ fn inertia_check(
         }
     }
     let margin = bounds.iter().copied().fold(0.0, f64::max);
+    // A gap between i − 1 and i that is real (wider than the bounds), so that the shift does
+    // not fall inside a cluster the selection cut (its count would split the cluster).
+    let real_gap = |i: &usize| omega_all[*i] - omega_all[*i - 1] > 2.0 * margin;
+    let midpoint = |i: usize| 0.5 * (omega_all[i - 1] + omega_all[i]);
     let shift = if end < n && end > 0 {
-        0.5 * (omega_all[end - 1] + omega_all[end])
+        midpoint((end..n).find(real_gap).unwrap_or(end))
     } else if first > 0 && first < n {
-        0.5 * (omega_all[first - 1] + omega_all[first])
+        midpoint((1..=first).rev().find(real_gap).unwrap_or(first))
     } else {
         // All modes selected: the widest gap, or above the top of the spectrum.
         let widest =

@@ -615,3 +615,82 @@ fn rigid_body_modes_of_a_rounded_stiffness_are_zero() {
         }
     }
 }
+
+/// Diagonal pencils: ω² = b_i/a_i exactly. The zero classification follows the data
+/// componentwise: a small negative stiffness on a decoupled coordinate beside stiff ones is an
+/// instability (growth rate 1e-3), not a rigid-body mode; a soft but exactly stored spring is
+/// oscillatory; an exact zero is zero. Values only and with vectors agree.
+#[test]
+fn resolved_small_modes_are_not_called_zero() {
+    let diagonal = |d: &[f64]| Mat::from_fn(d.len(), d.len(), |i, j| if i == j { d[i] } else { 0.0 });
+    let cases: [(&[f64], &[f64]); 3] = [
+        (&[1.0, 1.0, 1.0], &[-1e-6, 1e10, 2e10]),
+        (&[1e6, 1.0], &[1e-3, 1e8]),
+        (&[1.0, 1.0, 1e-3, 1.0], &[0.0, 1e-15, 1e-16, 1.0]),
+    ];
+    for (masses, stiffnesses) in cases {
+        let p = pencil(&diagonal(masses), &diagonal(stiffnesses));
+        let mut exact: Vec<f64> = masses.iter().zip(stiffnesses).map(|(m, k)| k / m).collect();
+        exact.sort_by(f64::total_cmp);
+        for vectors in [true, false] {
+            let options = SolveOptions { vectors, ..all_pairs() };
+            let sol = solve(&p, &options).expect("solve");
+            for (m, &w) in sol.modes.iter().zip(&exact) {
+                assert!(
+                    (m.omega_sq - w).abs() <= m.error_bound + U * w.abs(),
+                    "{w:e}: {:e}",
+                    m.omega_sq
+                );
+                let expected = if w == 0.0 {
+                    ModeKind::Zero
+                } else if w < 0.0 {
+                    ModeKind::Unstable {
+                        growth_rate: (-m.omega_sq).sqrt(),
+                    }
+                } else {
+                    ModeKind::Oscillatory {
+                        omega: m.omega_sq.sqrt(),
+                    }
+                };
+                assert_eq!(m.kind, expected, "ω² = {w:e}, vectors {vectors}");
+            }
+        }
+    }
+}
+
+/// Two free chains (two rigid-body modes) beside a chain of six soft springs of 1e-10, stored
+/// exactly: the soft modes (ω² from 6e-12) are oscillatory, and the zero group has multiplicity
+/// two, the nullity of B.
+#[test]
+fn soft_springs_do_not_join_the_rigid_body_group() {
+    let (af, bf) = families::free_chain(10);
+    let (asoft, bsoft) = families::spring_chain(&[-10; 6], &[0; 6]);
+    let blocks = [(&af, &bf), (&af, &bf), (&asoft, &bsoft)];
+    let n: usize = blocks.iter().map(|(a, _)| a.nrows()).sum();
+    let mut a = Mat::<f64>::zeros(n, n);
+    let mut b = Mat::<f64>::zeros(n, n);
+    let mut offset = 0;
+    for (ak, bk) in blocks {
+        let m = ak.nrows();
+        for j in 0..m {
+            for i in 0..m {
+                a[(offset + i, offset + j)] = ak[(i, j)];
+                b[(offset + i, offset + j)] = bk[(i, j)];
+            }
+        }
+        offset += m;
+    }
+    for vectors in [true, false] {
+        let options = SolveOptions { vectors, ..all_pairs() };
+        let sol = solve(&pencil(&a, &b), &options).expect("solve");
+        assert_eq!(sol.groups[0].multiplicity, 2, "vectors {vectors}");
+        assert!(sol.modes[..2].iter().all(|m| m.kind == ModeKind::Zero));
+        assert!(
+            sol.modes[2..8]
+                .iter()
+                .all(|m| matches!(m.kind, ModeKind::Oscillatory { .. })),
+            "vectors {vectors}: {:?}",
+            &sol.modes[2..8]
+        );
+    }
+}

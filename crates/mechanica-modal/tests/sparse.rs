@@ -232,3 +232,35 @@ fn bad_tolerances_are_refused() {
         .is_ok()
     );
 }
+
+/// A unit mass on a soft spring (1e-3) beside a stiff chain (springs of 1e11): its mode,
+/// ω² = 1e-3, is oscillatory, although a normwise estimate of what rounding the data could
+/// change (u·‖B‖_F·‖x‖² ≈ 3e-3 here) would call it zero.
+#[test]
+fn a_soft_mode_beside_stiff_springs_is_oscillatory() {
+    let n = 2000;
+    let a: Vec<Triplet<usize, usize, f64>> = (0..n).map(|i| Triplet::new(i, i, 1.0)).collect();
+    let mut b = Vec::new();
+    for i in 0..n - 1 {
+        // Stiff chain on 0..n−1, grounded at 0 and free at n − 2.
+        b.push(Triplet::new(i, i, if i + 2 < n { 2e11 } else { 1e11 }));
+        if i + 2 < n {
+            b.push(Triplet::new(i, i + 1, -1e11));
+            b.push(Triplet::new(i + 1, i, -1e11));
+        }
+    }
+    b.push(Triplet::new(n - 1, n - 1, 1e-3));
+    let p = SparsePencil::from_triplets(n, &a, &b).expect("valid pencil");
+    let sol = solve_sparse(&p, &lowest(3)).expect("solve");
+    let low = &sol.modes[0];
+    assert!(
+        (low.omega_sq - 1e-3).abs() <= low.error_bound + 1e-18,
+        "{:e}",
+        low.omega_sq
+    );
+    assert!(
+        matches!(low.kind, mechanica_modal::ModeKind::Oscillatory { .. }),
+        "{:?}",
+        low.kind
+    );
+}

@@ -315,7 +315,7 @@ fn a_cluster_of_two_close_stiff_modes_is_resolved() {
 
 /// A selection that cuts a repeated stiff eigenvalue (the lowest 1 of a doubled pair) cannot
 /// refine it as a block (its other copy is not selected): it keeps the reduction's honest bound.
-/// The lowest 2 take the whole pair and are refined.
+/// The lowest 2 take the whole pair and are refined. The Sturm check agrees in every case.
 #[test]
 fn a_selection_that_cuts_a_cluster_keeps_honest_bounds() {
     let c = &cases()[0];
@@ -338,5 +338,53 @@ fn a_selection_that_cuts_a_cluster_keeps_honest_bounds() {
             "lowest {count}: {:e}",
             low.error_bound / w
         );
+        // The Sturm shift is placed in a real gap, not between the two copies the cut split.
+        let check = sol.accuracy.inertia_check.expect("check");
+        assert!(check.consistent, "lowest {count}: {check:?}");
+    }
+}
+
+/// A cluster that chains three exact zero modes (three free chains) to six soft ones (a fixed
+/// chain with springs of 1e-6), beside a 1e12-graded chain, permuted (i → 7i mod 44, exact):
+/// the block refinement's bounds hold at ω² = 0 too, where a bound scaled by each member's own
+/// |ω²| would vanish (found in review: ω² = 5e-37 against a bound of 1.7e-40).
+#[test]
+fn a_zero_cluster_chained_to_soft_modes_keeps_valid_bounds() {
+    let (af, bf) = families::free_chain(10);
+    let (asoft, bsoft) = families::fixed_chain(6);
+    let c = families::power_of_ten(-6);
+    let bsoft = mechanica_modal::faer::Mat::from_fn(6, 6, |i, j| c * bsoft[(i, j)]);
+    let (ag, bg) = families::spring_chain(&families::graded_exponents(8, 12), &[0; 8]);
+    let blocks = [(&af, &bf), (&af, &bf), (&af, &bf), (&asoft, &bsoft), (&ag, &bg)];
+    let n = 44;
+    let place = |i: usize| (7 * i) % n;
+    let mut a = mechanica_modal::faer::Mat::<f64>::zeros(n, n);
+    let mut b = mechanica_modal::faer::Mat::<f64>::zeros(n, n);
+    let mut offset = 0;
+    for (ak, bk) in blocks {
+        let m = ak.nrows();
+        for j in 0..m {
+            for i in 0..m {
+                a[(place(offset + i), place(offset + j))] = ak[(i, j)];
+                b[(place(offset + i), place(offset + j))] = bk[(i, j)];
+            }
+        }
+        offset += m;
+    }
+    assert_eq!(offset, n);
+    let p = PencilProblem::new(a.as_ref(), b.as_ref()).expect("valid pencil");
+    let soft: Vec<f64> = families::fixed_chain_omega_sq(6).iter().map(|w| c * w).collect();
+    let exact: Vec<f64> = [0.0, 0.0, 0.0].iter().chain(&soft).copied().collect();
+    for options in auto_options() {
+        let sol = solve(&p, &options).expect("solve");
+        for (i, (m, &w)) in sol.modes.iter().zip(&exact).enumerate() {
+            let err = (m.omega_sq - w).abs();
+            assert!(
+                err <= m.error_bound + 4.0 * U * w,
+                "{options:?} mode {i}: error {err:e} > bound {:e}",
+                m.error_bound
+            );
+        }
+        assert_eq!(sol.groups[0].multiplicity, 3, "{options:?}");
     }
 }
