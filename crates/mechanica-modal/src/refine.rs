@@ -325,6 +325,26 @@ pub(crate) fn refine_cluster_projected(
     None
 }
 
+/// [`refine_cluster_projected`] through `correction` when there is one, and for a single mode
+/// the bordered Newton step of [`refine_pair`] where that declines (the bordered step needs a
+/// simple eigenvalue, so a larger cluster has no fallback).
+pub(crate) fn refine_cluster(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    l: MatRef<'_, f64>,
+    correction: Option<&mut dyn ReducedCorrection>,
+    x0: MatRef<'_, f64>,
+    omega0: f64,
+) -> Option<RefinedCluster> {
+    correction
+        .and_then(|c| refine_cluster_projected(a, b, l, c, x0))
+        .or_else(|| {
+            let single = x0.ncols() == 1;
+            let pair = single.then(|| refine_pair(a, b, l, &x0.col(0).iter().copied().collect::<Vec<_>>(), omega0));
+            pair.flatten().map(RefinedCluster::single)
+        })
+}
+
 /// M = (XᵀAX)⁻¹ XᵀBX in double-double from the double-double products AX and BX (one vector
 /// per column), by Gaussian elimination on the Gram matrix XᵀAX (symmetric positive definite
 /// and close to I for an A-orthonormal X, so no pivoting); None if a pivot is not positive.

@@ -10,7 +10,7 @@
 use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
-use crate::refine::{ReducedSpectrum, RefinedCluster, refine_cluster_projected, refine_pair};
+use crate::refine::{ReducedCorrection, ReducedSpectrum, refine_cluster};
 use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
@@ -450,23 +450,13 @@ impl Finish<'_> {
                     continue;
                 }
                 let x0 = xm.as_ref().subcols(g.start, g.len()).to_owned();
-                let refined = def
-                    .reduced
-                    .as_ref()
-                    .and_then(|y| {
-                        let mut spectrum = ReducedSpectrum {
-                            y: y.as_ref(),
-                            omega_sq: &omega_all,
-                            modes: def.first + g.start..def.first + g.end,
-                        };
-                        refine_cluster_projected(a, b, self.l, &mut spectrum, x0.as_ref())
-                    })
-                    .or_else(|| {
-                        // The bordered Newton step needs a simple eigenvalue.
-                        let single = g.len() == 1;
-                        let pair = single.then(|| refine_pair(a, b, self.l, x0.col_as_slice(0), omega[g.start]));
-                        pair.flatten().map(RefinedCluster::single)
-                    });
+                let mut spectrum = def.reduced.as_ref().map(|y| ReducedSpectrum {
+                    y: y.as_ref(),
+                    omega_sq: &omega_all,
+                    modes: def.first + g.start..def.first + g.end,
+                });
+                let correction = spectrum.as_mut().map(|s| s as &mut dyn ReducedCorrection);
+                let refined = refine_cluster(a, b, self.l, correction, x0.as_ref(), omega[g.start]);
                 let Some(cluster) = refined else { continue };
                 for (i, p) in g.clone().zip(cluster.pairs) {
                     xm.col_as_slice_mut(i).copy_from_slice(&p.x);
@@ -516,8 +506,7 @@ impl Finish<'_> {
         let mut resolution: Vec<f64> = (0..m)
             .map(|i| match (&x, &a_priori) {
                 (Some(x), _) => {
-                    let shape: Vec<f64> = x.col(i).iter().copied().collect();
-                    accuracy::zero_resolution(a, b, &shape, omega[i], (self.norm_a, self.norm_b))
+                    accuracy::zero_resolution(a, b, x.col_as_slice(i), omega[i], (self.norm_a, self.norm_b))
                 }
                 (None, Some(model)) => model.data_resolution(omega[i]),
                 (None, None) => 0.0,

@@ -22,7 +22,7 @@
 
 use crate::accuracy::{self, AccuracyReport, BoundKind, PairProducts, RefinedResidual, Residuals};
 use crate::reduce::back_transform;
-use crate::refine::{RefinedCluster, TridiagonalCorrection, refine_cluster_projected, refine_pair};
+use crate::refine::{TridiagonalCorrection, refine_cluster};
 use crate::solve::{clusters, refinable, weakly_bounded};
 use crate::symmetric_eigen::TridiagonalForm;
 use faer::{MatRef, Par};
@@ -98,12 +98,7 @@ pub(crate) fn sharpen(
             z: z.as_ref().subcols(col, g.len()).to_owned(),
             purified: false,
         };
-        let refined = refine_cluster_projected(a, b, pencil.l, &mut correction, x0.as_ref()).or_else(|| {
-            // The bordered Newton step needs a simple eigenvalue.
-            let single = g.len() == 1;
-            let pair = single.then(|| refine_pair(a, b, pencil.l, x0.col_as_slice(0), omega[g.start]));
-            pair.flatten().map(RefinedCluster::single)
-        });
+        let refined = refine_cluster(a, b, pencil.l, Some(&mut correction), x0.as_ref(), omega[g.start]);
         let Some(cluster) = refined else { continue };
         for (k, p) in cluster.pairs.into_iter().enumerate() {
             let i = g.start + k;
