@@ -18,6 +18,13 @@ pub fn rotated_fixed_chain(n: usize) -> (Mat<f64>, Mat<f64>) {
     families::rotate(&a, &b, &families::random_orthogonal(n, 42))
 }
 
+/// [`families::lumped_chain`] with masses 1 + i/n and seed 42: the lumped-mass counterpart of
+/// [`rotated_fixed_chain`] (same ω², A diagonal, B dense).
+pub fn lumped_fixed_chain(n: usize) -> (Mat<f64>, Mat<f64>) {
+    let d: Vec<f64> = (0..n).map(|i| 1.0 + i as f64 / n as f64).collect();
+    families::lumped_chain(&d, 42)
+}
+
 /// Column-major copy with leading dimension nrows (the layout LAPACK takes).
 pub fn to_col_major(m: MatRef<'_, f64>) -> Vec<f64> {
     let (r, c) = (m.nrows(), m.ncols());

@@ -583,6 +583,54 @@ static void dense_blocked_path(void) {
     mech_modal_result_destroy(measured);
 }
 
+/* Lumped masses over twelve decades with a dense stiffness, every entry exact in binary: H the
+ * Sylvester–Hadamard matrix of order 64, a_ii = 4^k_i (k_i from −10 to 10), B = D^½ (HᵀTH/64) D^½
+ * (integers times powers of two). D^−½ B D^−½ = (H/8)ᵀ T (H/8) is orthogonally similar to the
+ * fixed chain's T, so ω² is the closed form; A is diagonal, so the solve scales instead of
+ * factoring. Every ω² within its bound plus the closed form's own 4u, backward errors and the
+ * A-orthogonality within 10·n·u, the Sturm check consistent, the lowest bound under 1e-8·ω². */
+#define NL 64
+static int lumped_power(int i) { return -10 + (20 * i) / (NL - 1); }
+
+static void lumped_masses(void) {
+    static double a[NL * NL], b[NL * NL], t[NL * NL], th[NL * NL];
+    const double u_round = 2.220446049250313e-16, pi = 3.14159265358979323846;
+    for (int j = 0; j < NL; ++j)
+        for (int i = 0; i < NL; ++i) t[i + NL * j] = (i == j) ? 2.0 : ((i - j == 1 || j - i == 1) ? -1.0 : 0.0);
+    /* th = T H, then b = Hᵀ th, all integer arithmetic. */
+    for (int j = 0; j < NL; ++j)
+        for (int i = 0; i < NL; ++i) {
+            double sum = 0.0;
+            for (int k = 0; k < NL; ++k) sum += t[i + NL * k] * ((__builtin_popcount(k & j) % 2) ? -1.0 : 1.0);
+            th[i + NL * j] = sum;
+        }
+    for (int j = 0; j < NL; ++j)
+        for (int i = 0; i < NL; ++i) {
+            double sum = 0.0;
+            for (int k = 0; k < NL; ++k) sum += ((__builtin_popcount(k & i) % 2) ? -1.0 : 1.0) * th[k + NL * j];
+            b[i + NL * j] = ldexp(sum / NL, lumped_power(i) + lumped_power(j));
+            a[i + NL * j] = (i == j) ? ldexp(1.0, 2 * lumped_power(i)) : 0.0;
+        }
+    mech_modal_options_t o = default_options();
+    mech_modal_result_t *r = NULL;
+    CHECK_STATUS(mech_modal_solve(NL, a, b, &o, &r), MECH_STATUS_OK);
+    static mech_modal_mode_t modes[NL];
+    CHECK_STATUS(mech_modal_result_modes(r, modes, NL), MECH_STATUS_OK);
+    for (int k = 0; k < NL; ++k) {
+        double s = sin((k + 1) * pi / (2.0 * (NL + 1)));
+        double w2 = 4.0 * s * s;
+        CHECK_NEAR(modes[k].omega_sq, w2, modes[k].error_bound + 4.0 * u_round * w2);
+        CHECK(modes[k].kind == MECH_MODAL_KIND_OSCILLATORY);
+        CHECK(modes[k].backward_error >= 0.0 && modes[k].backward_error <= 10.0 * NL * u_round);
+    }
+    CHECK(modes[0].error_bound <= 1e-8 * modes[0].omega_sq);
+    mech_modal_accuracy_t acc;
+    CHECK_STATUS(mech_modal_result_accuracy(r, &acc), MECH_STATUS_OK);
+    CHECK(acc.orthogonality_error >= 0.0 && acc.orthogonality_error <= 10.0 * NL * u_round);
+    CHECK(acc.inertia_checked == 1 && acc.inertia_consistent == 1);
+    mech_modal_result_destroy(r);
+}
+
 /* A symmetric stiff structure: two uncoupled copies of the chain graded over 1e12 in stiffness
  * (spring i, from the ground or mass i − 1 to mass i, k_i = 10^round(12 i/23), unit masses),
  * interleaved (copy c's coordinate i is 2i + c). Every eigenvalue is double; the lowest two
@@ -685,6 +733,7 @@ static void rigid_body_modes(void) {
 int main(void) {
     all_pairs();
     dense_blocked_path();
+    lumped_masses();
     sparse_lowest();
     sketched_report();
     repeated_stiff_pair();

@@ -112,6 +112,22 @@ pub fn rotate(a: &Mat<f64>, b: &Mat<f64>, q: &Mat<f64>) -> (Mat<f64>, Mat<f64>) 
     (sym(q.transpose() * a * q), sym(q.transpose() * b * q))
 }
 
+/// Lumped masses with a dense stiffness: A = D = diag(`masses`) and B = D^½ Qᵀ T Q D^½ with T the
+/// fixed–fixed unit chain ([`fixed_chain`]) and Q = [`random_orthogonal`]`(n, seed)`. With
+/// z = Q D^½ x, B x = ω² A x becomes T z = ω² z, so ω² = [`fixed_chain_omega_sq`] up to the
+/// rounding of the products (about u·n in ω², absolute), while A stays diagonal.
+pub fn lumped_chain(masses: &[f64], seed: u64) -> (Mat<f64>, Mat<f64>) {
+    let n = masses.len();
+    let a = Mat::from_fn(n, n, |i, j| if i == j { masses[i] } else { 0.0 });
+    let (_, t) = fixed_chain(n);
+    let q = random_orthogonal(n, seed);
+    let similar = q.transpose() * &t * &q;
+    let b = Mat::from_fn(n, n, |i, j| {
+        (masses[i] * masses[j]).sqrt() * 0.5 * (similar[(i, j)] + similar[(j, i)])
+    });
+    (a, b)
+}
+
 /// 10^e as the correctly rounded double (the same value Python's `float(f"1e{e}")` gives).
 pub fn power_of_ten(e: i32) -> f64 {
     format!("1e{e}").parse().unwrap_or(f64::NAN)

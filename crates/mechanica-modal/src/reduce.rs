@@ -4,6 +4,13 @@
 //! The reduction follows the blocked algorithm of LAPACK `dsygst` (itype 1, lower), one block
 //! column per step: it costs about n³ flops by updating only the lower triangle of the trailing
 //! block with a symmetric rank-2k update, instead of the 2n³ of two full triangular solves.
+//!
+//! A diagonal A (lumped masses, the usual mass matrix of finite-element and spring–mass models)
+//! is recognised: L = diag(√a_ii), C_ij = b_ij/(l_i l_j) and x_i = y_i/l_i cost O(n²) instead
+//! of the n³/3 + n³ + n³ flops of factor, reduction and back-transformation, and each entry of C
+//! carries a relative error of a few u (no growth with the mass ratio). LAPACK's `dsygvd`
+//! (SciPy's `eigh(B, A)`) does the dense work whatever A is. The test is exact (every
+//! off-diagonal entry of the symmetrised A is zero); a nearly diagonal A takes the dense path.
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{BlockStructure, matmul as tri_matmul};
@@ -43,7 +50,12 @@ pub(crate) fn cholesky(a: MatRef<'_, f64>, par: Par) -> Cholesky {
 
 /// [`cholesky`] of a matrix the caller no longer needs (factored in place, no copy).
 pub(crate) fn cholesky_owned(mut l: Mat<f64>, par: Par) -> Cholesky {
-    if let Err(pivot) = factor_in_place(l.as_mut(), par) {
+    let factored = if is_diagonal(l.as_ref()) {
+        factor_diagonal_in_place(l.as_mut())
+    } else {
+        factor_in_place(l.as_mut(), par)
+    };
+    if let Err(pivot) = factored {
         return Cholesky::Failed { pivot };
     }
     let n = l.nrows();
@@ -53,6 +65,30 @@ pub(crate) fn cholesky_owned(mut l: Mat<f64>, par: Par) -> Cholesky {
         }
     }
     Cholesky::Factor(l)
+}
+
+/// Whether the strict lower triangle of `m` is zero (an exact test: early exit at the first
+/// nonzero, so a dense matrix costs a few reads).
+pub(crate) fn is_diagonal(m: MatRef<'_, f64>) -> bool {
+    (0..m.ncols()).all(|j| (j + 1..m.nrows()).all(|i| m[(i, j)] == 0.0))
+}
+
+/// [`factor_in_place`] of a diagonal A: l_ii = √a_ii, with the same pivot test (a pivot that is
+/// not positive, NaN, or ≤ n·u·max_j a_jj fails).
+fn factor_diagonal_in_place(mut l: MatMut<'_, f64>) -> Result<(), usize> {
+    let n = l.nrows();
+    let max_diag = (0..n).map(|i| l[(i, i)]).fold(0.0_f64, f64::max);
+    let tolerance = n as f64 * f64::EPSILON * max_diag;
+    if let Some(pivot) = (0..n).find(|&i| {
+        let pivot = l[(i, i)];
+        pivot.is_nan() || pivot <= tolerance
+    }) {
+        return Err(pivot);
+    }
+    for i in 0..n {
+        l[(i, i)] = l[(i, i)].sqrt();
+    }
+    Ok(())
 }
 
 /// Factors the lower triangle of `l` in place (the strict upper triangle is neither read nor
@@ -120,8 +156,24 @@ fn factor_recursive(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
 /// valid (the upper triangle is unspecified).
 pub fn reduce(l: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Mat<f64> {
     let mut c = b.to_owned();
-    reduce_in_place(l, c.as_mut(), par);
+    if is_diagonal(l) {
+        scale_lower_in_place(l, c.as_mut());
+    } else {
+        reduce_in_place(l, c.as_mut(), par);
+    }
     c
+}
+
+/// C = L⁻¹ B L⁻ᵀ for a diagonal L: c_ij = b_ij/(l_i l_j) on the lower triangle.
+fn scale_lower_in_place(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>) {
+    let n = c.nrows();
+    let inverse: Vec<f64> = (0..n).map(|i| l[(i, i)].recip()).collect();
+    for j in 0..n {
+        let column = &mut c.rb_mut().col_mut(j);
+        for i in j..n {
+            column[i] *= inverse[i] * inverse[j];
+        }
+    }
 }
 
 /// Copies the strict lower triangle of `c` onto its upper triangle.
@@ -190,8 +242,20 @@ pub fn reduce_two_solves(l: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Ma
     c
 }
 
-/// X = L⁻ᵀ Y in place (back-transformation of eigenvectors of C to those of the pencil).
-pub fn back_transform(l: MatRef<'_, f64>, y: MatMut<'_, f64>, par: Par) {
+/// X = L⁻ᵀ Y in place (back-transformation of eigenvectors of C to those of the pencil); a
+/// diagonal L divides each row.
+pub fn back_transform(l: MatRef<'_, f64>, mut y: MatMut<'_, f64>, par: Par) {
+    if is_diagonal(l) {
+        let inverse: Vec<f64> = (0..l.nrows()).map(|i| l[(i, i)].recip()).collect();
+        for j in 0..y.ncols() {
+            y.rb_mut()
+                .col_mut(j)
+                .iter_mut()
+                .zip(&inverse)
+                .for_each(|(e, s)| *e *= s);
+        }
+        return;
+    }
     solve_upper_triangular_in_place(l.transpose(), y, par);
 }
 
@@ -281,6 +345,64 @@ mod tests {
             match cholesky(b.as_ref(), Par::rayon(2)) {
                 Cholesky::Failed { pivot } => assert!(pivot <= bad, "n = {n}: pivot {pivot} after {bad}"),
                 Cholesky::Factor(_) => panic!("n = {n}: an indefinite matrix factored"),
+            }
+        }
+    }
+
+    #[test]
+    fn diagonal_mass_reduction_matches_the_dense_one() {
+        // A diagonal over twelve decades: L, C and X = L⁻ᵀY from the scaling path agree with
+        // the triangular solves of the general path to a few u (entrywise, relative for L).
+        let n = 200;
+        let a = Mat::from_fn(n, n, |i, j| {
+            if i == j {
+                10f64.powf(-6.0 + 12.0 * i as f64 / (n - 1) as f64)
+            } else {
+                0.0
+            }
+        });
+        let b = spd(n, 6);
+        let Cholesky::Factor(l) = cholesky(a.as_ref(), Par::Seq) else {
+            panic!("positive diagonal must factor")
+        };
+        assert!(is_diagonal(l.as_ref()));
+        for i in 0..n {
+            assert!((l[(i, i)] - a[(i, i)].sqrt()).abs() <= 2.0 * f64::EPSILON * l[(i, i)]);
+        }
+        let c = reduce(l.as_ref(), b.as_ref(), Par::Seq);
+        let r = reduce_two_solves(l.as_ref(), b.as_ref(), Par::Seq);
+        for j in 0..n {
+            for i in j..n {
+                assert!(
+                    (c[(i, j)] - r[(i, j)]).abs() <= 8.0 * f64::EPSILON * r[(i, j)].abs(),
+                    "({i},{j})"
+                );
+            }
+        }
+        let mut x = b.clone();
+        back_transform(l.as_ref(), x.as_mut(), Par::Seq);
+        let mut reference = b.clone();
+        solve_upper_triangular_in_place(l.transpose(), reference.as_mut(), Par::Seq);
+        for j in 0..n {
+            for i in 0..n {
+                assert!((x[(i, j)] - reference[(i, j)]).abs() <= 4.0 * f64::EPSILON * reference[(i, j)].abs());
+            }
+        }
+    }
+
+    #[test]
+    fn diagonal_mass_names_its_failing_pivot() {
+        // Zero, negative and negligible (≤ n·u·max a_jj) diagonal entries fail at their index.
+        let n = 50;
+        for (bad, value) in [(0, 0.0), (17, -1.0), (49, 1e-20)] {
+            let a = Mat::from_fn(n, n, |i, j| match (i == j, i == bad) {
+                (true, true) => value,
+                (true, false) => 1.0 + i as f64,
+                _ => 0.0,
+            });
+            match cholesky(a.as_ref(), Par::Seq) {
+                Cholesky::Failed { pivot } => assert_eq!(pivot, bad),
+                Cholesky::Factor(_) => panic!("a_{bad}{bad} = {value} factored"),
             }
         }
     }

@@ -71,6 +71,54 @@ fn rotated_chain_keeps_its_spectrum() {
     check_against(&pencil(&ar, &br), &families::fixed_chain_omega_sq(n));
 }
 
+/// Lumped masses graded over twelve decades with a dense stiffness, all stored exactly: with H
+/// the Sylvester–Hadamard matrix of order 128 and d_i = 4^k_i (k_i from −10 to 10), A = D and
+/// B = D^½ (HᵀTH/128) D^½ are exact in binary (integers times powers of two), and
+/// D^−½ B D^−½ = (H/√128)ᵀ T (H/√128) is an orthogonal similarity of the fixed chain's T, so ω²
+/// are the chain's closed form. A stays diagonal, so the solve takes the diagonal-scaling
+/// reduction. Every ω² lies within its bound of the closed form (plus the closed form's own
+/// 4u rounding), the lowest ten are certified to 1e-8 relative, η and XᵀAX − I meet 10·n·u and
+/// the Sturm check agrees.
+#[test]
+fn lumped_masses_over_twelve_decades_keep_the_chain_spectrum() {
+    let n = 128;
+    let hadamard = Mat::from_fn(n, n, |i: usize, j: usize| {
+        if (i & j).count_ones().is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        }
+    });
+    let (_, t) = families::fixed_chain(n);
+    let similar = hadamard.transpose() * &t * &hadamard;
+    let power = |i: usize| -10 + (20 * i / (n - 1)) as i32;
+    let a = Mat::from_fn(n, n, |i, j| if i == j { 4f64.powi(power(i)) } else { 0.0 });
+    let b = Mat::from_fn(n, n, |i, j| 2f64.powi(power(i) + power(j)) * similar[(i, j)] / n as f64);
+    assert!((0..n).all(|j| (0..n).any(|i| i != j && b[(i, j)] != 0.0)), "B is dense");
+    let exact = families::fixed_chain_omega_sq(n);
+    let p = pencil(&a, &b);
+    let sol = solve(&p, &all_pairs()).expect("solve");
+    assert_eq!(sol.modes.len(), n);
+    for (k, (m, &w)) in sol.modes.iter().zip(&exact).enumerate() {
+        let error = (m.omega_sq - w).abs();
+        assert!(
+            error <= m.error_bound + 4.0 * U * w,
+            "mode {k}: error {error:e}, bound {:e}",
+            m.error_bound
+        );
+        if k < 10 {
+            assert!(
+                m.error_bound <= 1e-8 * w,
+                "mode {k}: bound {:e} for ω² = {w:e}",
+                m.error_bound
+            );
+        }
+    }
+    assert!(sol.accuracy.max_backward_error.expect("vectors") <= 10.0 * n as f64 * U);
+    assert!(sol.accuracy.orthogonality_error.expect("vectors") <= 10.0 * n as f64 * U);
+    assert!(sol.accuracy.inertia_check.expect("sturm check").consistent);
+}
+
 /// Glued Wilkinson W21+ stiffness (eigenvalue pairs equal to 1e-14, blocks glued by 1e-10 into
 /// clusters of six), rotated by a random orthogonal matrix: the divide and conquer's deflation
 /// by rotation and its close secular roots, through the public solver. Backward errors and
