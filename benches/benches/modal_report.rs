@@ -3,7 +3,7 @@
 //! threads) and nalgebra as peers in the same run.
 //!
 //! Run: `cargo bench -p mechanica-benches --bench modal_report [-- FAMILY...]` with FAMILY among
-//! `fixed free ring rotated graded grid stages` (default: all; `stages-small` = the stages at
+//! `fixed free ring rotated lumped graded grid stages` (default: all; `stages-small` = the stages at
 //! n = 1000 and 2000 only; `rotated-plain` = mechanica all pairs with `Refinement::Off` against
 //! dsygvd on the rotated chain, only when named). Writes
 //! `target/reports/modal-<family>.csv`, `modal-<family>.svg` (max relative error of the lowest
@@ -42,8 +42,8 @@ use mechanica::modal::{
     count_below, families, solve, solve_sparse,
 };
 use mechanica_benches::modal::{
-    from_col_major, from_nalgebra, from_triplets, max_backward_error, max_eigenvalue_error, nalgebra_all_pairs,
-    rotated_fixed_chain, to_col_major, to_nalgebra, to_triplets,
+    from_col_major, from_nalgebra, from_triplets, lumped_fixed_chain, max_backward_error, max_eigenvalue_error,
+    nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra, to_triplets,
 };
 use mechanica_benches::{Series, lapack, median_seconds, plot_error_vs_time, write_csv};
 use std::time::Duration;
@@ -365,6 +365,20 @@ fn grid_case(side: usize) -> Case {
         sparse: Some((ta, tb)),
         exact,
         scale: 8.0,
+    }
+}
+
+fn lumped_case(n: usize) -> Case {
+    let (a, b) = lumped_fixed_chain(n);
+    let exact = families::fixed_chain_omega_sq(n);
+    let scale = exact.iter().copied().fold(0.0, f64::max);
+    Case {
+        label: format!("lumped fixed chain n={n}"),
+        n,
+        dense: Some((a, b)),
+        sparse: None,
+        exact,
+        scale,
     }
 }
 
@@ -763,6 +777,17 @@ fn main() {
         ];
         let rows = report("rotated", "Rotated fixed chain (dense)", &cases, &methods);
         dense_summary(&rows);
+    }
+    if wanted("lumped") {
+        // Diagonal masses, dense stiffness: mechanica scales instead of factoring, dsygvd does not.
+        let cases: Vec<Case> = [200, 1000, 2000].into_iter().map(lumped_case).collect();
+        let methods = [MechAll, MechSketched, MechValues, MechLowest, LapackAll, LapackValues];
+        report(
+            "lumped",
+            "Lumped masses, rotated stiffness (A diagonal, B dense)",
+            &cases,
+            &methods,
+        );
     }
     if args.iter().any(|a| a == "rotated-plain") {
         // Like-for-like with dsygvd: all pairs without the auto refinement of the low modes.
