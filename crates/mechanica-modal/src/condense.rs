@@ -5,6 +5,12 @@
 //! w = −B₀₀⁻¹B₀₁z and (B₁₁ − B₁₀B₀₀⁻¹B₀₁) z = ω² A₁ z: a definite pencil of order n − r, plus r
 //! infinite eigenvalues (λ = −∞) with eigenvectors Q₀ (the Fix–Heiberger reduction, SIAM J.
 //! Numer. Anal. 9, 1972, in its simplest form). B₀₀ singular makes det(λA + B) ≡ 0.
+//!
+//! A diagonal A (lumped masses with massless coordinates, e.g. the rotations of a lumped beam
+//! model) needs no eigen-decomposition: Q is the permutation that sorts its diagonal, so QᵀBQ is
+//! a reordering of B and the lift Q₁z + Q₀w a scatter of rows. That replaces the O(n³) eigen-
+//! decomposition of A and the 4n³ flops of QᵀBQ by O(n²), and the condensed pencil's A₁ is
+//! diagonal again (the reduction then scales, module `reduce`).
 
 use crate::solve::{Finish, Method, ModalSolution, SolveOptions, solve_definite};
 use crate::symmetric_eigen::symmetric_eigen;
@@ -23,9 +29,7 @@ pub(crate) fn solve_semidefinite(
     let (a, b) = (problem.a(), problem.b());
     let n = problem.dim();
     let clock = std::time::Instant::now();
-    let eig = symmetric_eigen(a.to_owned(), true, par)?;
-    let values = eig.values;
-    let q = eig.vectors.ok_or(ModalError::NoConvergence { n })?;
+    let (values, q) = mass_eigen(a, par)?;
     let amax = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let tolerance = 2.0 * n as f64 * f64::EPSILON * amax;
     if values[0] < -tolerance {
@@ -36,9 +40,7 @@ pub(crate) fn solve_semidefinite(
         });
     }
     let r = values.partition_point(|&v| v <= tolerance).max(1);
-    let q0 = q.subcols(0, r);
-    let q1 = q.subcols(r, n - r);
-    let bq = q.transpose() * b * &q;
+    let bq = q.congruence(b);
     let b00 = bq.as_ref().submatrix(0, 0, r, r).to_owned();
     let b10 = bq.as_ref().submatrix(r, 0, n - r, r).to_owned();
     let b11 = bq.as_ref().submatrix(r, r, n - r, n - r).to_owned();
@@ -66,8 +68,9 @@ pub(crate) fn solve_semidefinite(
     let condensation = clock.elapsed();
     let mut def = solve_definite(l1.as_ref(), s.as_ref(), options.selection, want_vectors, par)?;
     def.timings.factor += condensation;
-    let infinite: Vec<Vec<f64>> = (0..r).map(|c| (0..n).map(|i| q0[(i, c)]).collect()).collect();
-    let lift = |z: MatRef<'_, f64>| -> Mat<f64> { q1 * z - q0 * (&g * z) };
+    let infinite: Vec<Vec<f64>> = (0..r).map(|c| q.column(c)).collect();
+    // x = Q₁z + Q₀w with w = −G z.
+    let lift = |z: MatRef<'_, f64>| -> Mat<f64> { q.combine(z, (&g * z).as_ref(), r) };
     let finish = Finish {
         problem,
         l: l1.as_ref(),
@@ -77,4 +80,70 @@ pub(crate) fn solve_semidefinite(
         par,
     };
     finish.run(def, infinite, Some(&lift), Method::CondensedReduction { massless: r })
+}
+
+/// The eigenvectors Q of the mass matrix: a dense orthogonal matrix, or, for a diagonal A, the
+/// permutation that sorts the diagonal (column c of Q is the unit vector e_order[c]).
+enum MassBasis {
+    Dense(Mat<f64>),
+    Permutation(Vec<usize>),
+}
+
+/// Eigenvalues of A ascending and their eigenvectors; a diagonal A is sorted, not decomposed.
+fn mass_eigen(a: MatRef<'_, f64>, par: Par) -> Result<(Vec<f64>, MassBasis), ModalError> {
+    let n = a.nrows();
+    if crate::reduce::is_diagonal(a) {
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&i, &j| a[(i, i)].total_cmp(&a[(j, j)]));
+        let values = order.iter().map(|&i| a[(i, i)]).collect();
+        return Ok((values, MassBasis::Permutation(order)));
+    }
+    let eig = symmetric_eigen(a.to_owned(), true, par)?;
+    let q = eig.vectors.ok_or(ModalError::NoConvergence { n })?;
+    Ok((eig.values, MassBasis::Dense(q)))
+}
+
+impl MassBasis {
+    /// QᵀBQ (a reordering of B for a permutation).
+    fn congruence(&self, b: MatRef<'_, f64>) -> Mat<f64> {
+        match self {
+            Self::Dense(q) => q.transpose() * b * q,
+            Self::Permutation(order) => Mat::from_fn(b.nrows(), b.ncols(), |i, j| b[(order[i], order[j])]),
+        }
+    }
+
+    /// Column c of Q.
+    fn column(&self, c: usize) -> Vec<f64> {
+        match self {
+            Self::Dense(q) => q.col(c).iter().copied().collect(),
+            Self::Permutation(order) => {
+                let mut e = vec![0.0; order.len()];
+                e[order[c]] = 1.0;
+                e
+            }
+        }
+    }
+
+    /// Q₁ z − Q₀ y, with Q₀ the first `r` columns of Q and Q₁ the others (the lift of condensed
+    /// mode shapes z, with y = G z the massless coordinates' response).
+    fn combine(&self, z: MatRef<'_, f64>, y: MatRef<'_, f64>, r: usize) -> Mat<f64> {
+        match self {
+            Self::Dense(q) => {
+                let n = q.nrows();
+                q.as_ref().subcols(r, n - r) * z - q.as_ref().subcols(0, r) * y
+            }
+            Self::Permutation(order) => {
+                let mut x = Mat::<f64>::zeros(order.len(), z.ncols());
+                for j in 0..z.ncols() {
+                    for (i, &row) in order[r..].iter().enumerate() {
+                        x[(row, j)] = z[(i, j)];
+                    }
+                    for (i, &row) in order[..r].iter().enumerate() {
+                        x[(row, j)] = -y[(i, j)];
+                    }
+                }
+                x
+            }
+        }
+    }
 }

@@ -343,6 +343,70 @@ fn massless_coordinate_is_condensed_and_reported_infinite() {
     assert!((x[(1, 2)].abs() - 1.0).abs() <= 10.0 * U);
 }
 
+/// Unit springs between two walls through 2m + 1 nodes, of which the even ones (including both
+/// ends) are massless and the odd ones carry unit masses; the coordinates are shuffled so that
+/// the massless ones are scattered. Condensing each massless node puts two unit springs in series
+/// (½), so the m finite modes are those of a fixed–fixed chain of unit masses and springs ½:
+/// ω² = 2 sin²(kπ/(2(m + 1))); the m + 1 infinite modes are the massless unit vectors; a
+/// massless node of a finite mode sits at the mean of its neighbours. A is diagonal, so the
+/// massless directions come from sorting its diagonal, not from an eigen-decomposition.
+#[test]
+fn scattered_massless_nodes_of_a_lumped_chain_are_condensed() {
+    let m = 150;
+    let n = 2 * m + 1;
+    // Node i of the chain is coordinate place[i] (a fixed pseudo-random permutation).
+    let mut place: Vec<usize> = (0..n).collect();
+    let mut s = 7_u64;
+    for i in (1..n).rev() {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        place.swap(i, (s >> 33) as usize % (i + 1));
+    }
+    let (_, t) = families::fixed_chain(n);
+    let a = Mat::from_fn(n, n, |i, j| {
+        if i == j && place.iter().position(|&p| p == i).unwrap_or(0) % 2 == 1 {
+            1.0
+        } else {
+            0.0
+        }
+    });
+    let node = |c: usize| place.iter().position(|&p| p == c).unwrap_or(0);
+    let b = Mat::from_fn(n, n, |i, j| t[(node(i), node(j))]);
+    let sol = solve(&pencil(&a, &b), &all_pairs()).expect("solve");
+    assert_eq!(sol.method, Method::CondensedReduction { massless: m + 1 });
+    assert_eq!(sol.modes.len(), n);
+    let x = sol.vectors.expect("vectors");
+    for k in 0..m {
+        let s = ((k + 1) as f64 * std::f64::consts::PI / (2.0 * (m + 1) as f64)).sin();
+        let exact = 2.0 * s * s;
+        let mode = &sol.modes[k];
+        assert!(
+            (mode.omega_sq - exact).abs() <= mode.error_bound + 4.0 * U * exact,
+            "mode {k}"
+        );
+        assert!(matches!(mode.kind, ModeKind::Oscillatory { .. }));
+        // Every massless interior node at the mean of its two massed neighbours; the end nodes
+        // at half their one neighbour (the wall is fixed).
+        for i in (0..n).step_by(2) {
+            let left = if i == 0 { 0.0 } else { x[(place[i - 1], k)] };
+            let right = if i == n - 1 { 0.0 } else { x[(place[i + 1], k)] };
+            assert!(
+                (x[(place[i], k)] - 0.5 * (left + right)).abs() <= 100.0 * U,
+                "mode {k} node {i}"
+            );
+        }
+    }
+    for k in m..n {
+        assert_eq!(sol.modes[k].kind, ModeKind::Infinite);
+        // A massless unit vector.
+        let column: Vec<f64> = (0..n).map(|i| x[(i, k)].abs()).collect();
+        let top = column.iter().copied().fold(0.0, f64::max);
+        let at = column.iter().position(|&v| v == top).unwrap_or(0);
+        assert_eq!(node(at) % 2, 0, "infinite mode {k} is not massless");
+        assert!((top - 1.0).abs() <= 10.0 * U && column.iter().filter(|&&v| v != 0.0).count() == 1);
+    }
+    assert!(sol.accuracy.max_backward_error.expect("vectors") <= 10.0 * n as f64 * U);
+}
+
 #[test]
 fn indefinite_mass_names_the_pivot() {
     let a = Mat::from_fn(3, 3, |i, j| if i == j { [1.0, -2.0, 1.0][i] } else { 0.0 });
