@@ -141,6 +141,24 @@ static void massless_coordinate(void) {
     mech_modal_accuracy_t acc;
     CHECK_STATUS(mech_modal_result_accuracy(r, &acc), MECH_STATUS_OK);
     CHECK(acc.massless == 1);
+    /* The condensed solve is certified too: the count of B − sA, less B₀₀'s negative
+     * eigenvalues (none here), matches the computed modes below s. */
+    CHECK(acc.inertia_checked == 1 && acc.inertia_consistent == 1);
+    CHECK(acc.inertia_below == acc.computed_below);
+    mech_modal_result_destroy(r);
+
+    /* The massless node held by a negative ground spring (−3): B₀₀ = −1, condensed stiffness
+     * [[3, 1], [1, 3]], ω² = 2 and 4; B − sA has one more negative eigenvalue than there are
+     * modes below s, which the check allows for (Haynsworth inertia additivity). */
+    double bn[9] = {2, -1, 0, -1, -1, -1, 0, -1, 2};
+    CHECK_STATUS(mech_modal_solve(3, a, bn, &o, &r), MECH_STATUS_OK);
+    CHECK_STATUS(mech_modal_result_modes(r, modes, 3), MECH_STATUS_OK);
+    CHECK_NEAR(modes[0].omega_sq, 2.0, modes[0].error_bound);
+    CHECK_NEAR(modes[1].omega_sq, 4.0, modes[1].error_bound);
+    CHECK(modes[2].kind == MECH_MODAL_KIND_INFINITE);
+    CHECK_STATUS(mech_modal_result_accuracy(r, &acc), MECH_STATUS_OK);
+    CHECK(acc.inertia_checked == 1 && acc.inertia_consistent == 1);
+    CHECK(acc.inertia_below == acc.computed_below);
     mech_modal_result_destroy(r);
 }
 

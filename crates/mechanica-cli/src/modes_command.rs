@@ -308,7 +308,7 @@ pub fn run(args: &ModesArgs) -> Result<Report, String> {
                 Some(match check {
                     Some(c) if c.consistent => "consistent".into(),
                     Some(_) => "INCONSISTENT".into(),
-                    None => "not run (condensed pencil)".into(),
+                    None => "not run (no finite mode)".into(),
                 }),
             )],
         ));

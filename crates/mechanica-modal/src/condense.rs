@@ -78,6 +78,7 @@ pub(crate) fn solve_semidefinite(
         norm_b,
         options,
         par,
+        condensed_stiffness_negatives: Some(d.iter().filter(|&&v| v < 0.0).count()),
     };
     finish.run(def, infinite, Some(&lift), Method::CondensedReduction { massless: r })
 }

@@ -349,6 +349,7 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 norm_b,
                 options,
                 par,
+                condensed_stiffness_negatives: None,
             };
             finish.run(def, Vec::new(), None, Method::CholeskyReduction)
         }
@@ -379,6 +380,10 @@ pub(crate) struct Finish<'a> {
     pub norm_b: f64,
     pub options: &'a SolveOptions,
     pub par: Par,
+    /// For a condensed pencil: the number of negative eigenvalues of the stiffness block B₀₀ of
+    /// the massless directions, by which the inertia of B − sA exceeds the count of modes
+    /// below s (Haynsworth: In(B − sA) = In(B₀₀) + In(S − sA₁), S the condensed stiffness).
+    pub condensed_stiffness_negatives: Option<usize>,
 }
 
 impl Finish<'_> {
@@ -497,7 +502,7 @@ impl Finish<'_> {
             &omega_all,
             (def.first, def.end),
             &report.error_bounds,
-            lift,
+            self.condensed_stiffness_negatives,
             def.reduced.or_else(|| form.map(TridiagonalForm::into_storage)),
             self.par,
         )?;
@@ -664,16 +669,17 @@ fn inertia_check(
     omega_all: &[f64],
     (first, end): (usize, usize),
     bounds: &[f64],
-    lift: Option<Lift<'_>>,
+    condensed_stiffness_negatives: Option<usize>,
     spare: Option<Mat<f64>>,
     par: Par,
 ) -> Result<Option<InertiaCheck>, ModalError> {
-    // With a condensed pencil the count of B − sA mixes in the massless directions; skip it.
-    if lift.is_some() || omega_all.is_empty() {
+    if omega_all.is_empty() {
         return Ok(None);
     }
     let n = omega_all.len();
-    if first == 0 && end == n && !bounds.is_empty() {
+    // A condensed pencil: the count of the full B − sA includes B₀₀'s negative eigenvalues.
+    let offset = condensed_stiffness_negatives.unwrap_or(0);
+    if first == 0 && end == n && !bounds.is_empty() && offset == 0 {
         // Every mode selected: certify the bottom of the spectrum (no mode, and so no
         // instability, below the lowest computed ω²) with a Cholesky factorization.
         let lowest = omega_all[0];
@@ -684,7 +690,7 @@ fn inertia_check(
                     shift,
                     below: 0,
                     zero: 0,
-                    above: n,
+                    above: problem.dim(),
                 },
                 computed_below: 0,
                 consistent: true,
@@ -709,19 +715,29 @@ fn inertia_check(
             _ => omega_all[n - 1] + omega_all[n - 1].abs().max(1.0),
         }
     };
-    let count = count_below(problem, shift)?;
+    let raw = count_below(problem, shift)?;
+    // In modes: B₀₀'s negative eigenvalues leave `below`; its positive ones are the infinite
+    // modes, above every shift, as `above` already counts them.
+    let count = InertiaCount {
+        below: raw.below.saturating_sub(offset),
+        above: raw.above + offset.min(raw.below),
+        ..raw
+    };
     let expected = omega_all.partition_point(|&w| w < shift);
     Ok(Some(InertiaCheck {
         count,
         computed_below: expected,
-        consistent: count.below == expected && count.zero == 0,
+        consistent: raw.below == expected + offset && raw.zero == 0,
     }))
 }
 
 /// The Sturm check attached to a solve: no mode below the shift was missed or invented.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InertiaCheck {
-    /// The inertia of B − sA at the chosen shift.
+    /// The inertia of B − sA at the chosen shift, in modes: for a condensed pencil (semidefinite
+    /// A) the negative eigenvalues of the massless directions' stiffness B₀₀ are taken out of
+    /// `below` (Haynsworth: In(B − sA) = In(B₀₀) + In(S − sA₁)), and the infinite modes are
+    /// `above`.
     pub count: InertiaCount,
     /// How many computed ω² lie below the shift.
     pub computed_below: usize,

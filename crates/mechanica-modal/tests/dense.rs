@@ -341,6 +341,7 @@ fn massless_coordinate_is_condensed_and_reported_infinite() {
     assert!(sol.accuracy.max_backward_error.expect("vectors") <= 30.0 * U);
     // The infinite mode is the massless direction e₂.
     assert!((x[(1, 2)].abs() - 1.0).abs() <= 10.0 * U);
+    assert!(sol.accuracy.inertia_check.expect("certified").consistent);
 }
 
 /// Unit springs between two walls through 2m + 1 nodes, of which the even ones (including both
@@ -405,6 +406,38 @@ fn scattered_massless_nodes_of_a_lumped_chain_are_condensed() {
         assert!((top - 1.0).abs() <= 10.0 * U && column.iter().filter(|&&v| v != 0.0).count() == 1);
     }
     assert!(sol.accuracy.max_backward_error.expect("vectors") <= 10.0 * n as f64 * U);
+    let check = sol
+        .accuracy
+        .inertia_check
+        .expect("the condensed solve is certified too");
+    assert!(check.consistent, "{check:?}");
+    assert_eq!(check.count.below + check.count.zero + check.count.above, n);
+}
+
+/// A massless middle node held by a negative spring to the ground (−3) between unit springs:
+/// B = [[2, −1, 0], [−1, −1, −1], [0, −1, 2]], A = diag(1, 0, 1). B₀₀ = −1 is nonsingular, so
+/// condensing gives S = [[3, 1], [1, 3]], ω² = 2 and 4, plus one infinite mode. The Sturm count
+/// of the full B − sA includes B₀₀'s negative eigenvalue (Haynsworth inertia additivity); the
+/// check subtracts it and agrees with the condensed spectrum at every shift it may pick, and an
+/// independent count at s = 3 (between the modes) on B − sA itself has two negative pivots.
+#[test]
+fn condensed_sturm_check_allows_for_negative_stiffness_of_massless_coordinates() {
+    let a = Mat::from_fn(3, 3, |i, j| if i == j && i != 1 { 1.0 } else { 0.0 });
+    let b = Mat::from_fn(3, 3, |i, j| {
+        [[2.0, -1.0, 0.0], [-1.0, -1.0, -1.0], [0.0, -1.0, 2.0]][i][j]
+    });
+    let p = pencil(&a, &b);
+    let sol = solve(&p, &all_pairs()).expect("solve");
+    assert_eq!(sol.method, Method::CondensedReduction { massless: 1 });
+    assert!((sol.modes[0].omega_sq - 2.0).abs() <= sol.modes[0].error_bound);
+    assert!((sol.modes[1].omega_sq - 4.0).abs() <= sol.modes[1].error_bound);
+    assert_eq!(sol.modes[2].kind, ModeKind::Infinite);
+    let check = sol.accuracy.inertia_check.expect("certified");
+    assert!(check.consistent, "{check:?}");
+    assert_eq!(check.count.below, check.computed_below);
+    assert_eq!(check.count.below + check.count.zero + check.count.above, 3);
+    // The raw count at s = 3: one mode below plus B₀₀'s negative eigenvalue.
+    assert_eq!(count_below(&p, 3.0).expect("count").below, 2);
 }
 
 #[test]
