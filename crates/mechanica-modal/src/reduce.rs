@@ -164,14 +164,16 @@ pub fn reduce(l: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Mat<f64> {
     c
 }
 
-/// C = L⁻¹ B L⁻ᵀ for a diagonal L: c_ij = b_ij/(l_i l_j) on the lower triangle.
+/// C = L⁻¹ B L⁻ᵀ for a diagonal L: c_ij = (b_ij/l_i)/l_j on the lower triangle, scaled one
+/// factor at a time so that tiny masses with a tiny stiffness (1/(l_i l_j) beyond the range of
+/// f64 while C is not) do not overflow.
 fn scale_lower_in_place(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>) {
     let n = c.nrows();
     let inverse: Vec<f64> = (0..n).map(|i| l[(i, i)].recip()).collect();
     for j in 0..n {
         let column = &mut c.rb_mut().col_mut(j);
         for i in j..n {
-            column[i] *= inverse[i] * inverse[j];
+            column[i] = column[i] * inverse[i] * inverse[j];
         }
     }
 }
@@ -386,6 +388,30 @@ mod tests {
         for j in 0..n {
             for i in 0..n {
                 assert!((x[(i, j)] - reference[(i, j)]).abs() <= 4.0 * f64::EPSILON * reference[(i, j)].abs());
+            }
+        }
+    }
+
+    #[test]
+    fn diagonal_scaling_does_not_overflow_where_c_is_representable() {
+        // A = 2⁻¹⁰³⁰ I (subnormal, exact) and B = 2⁻¹⁰³⁰ T: C = T exactly, though 1/(l_i l_j)
+        // = 2¹⁰³⁰ is beyond f64.
+        let n = 6;
+        let tiny = 2f64.powi(-1030);
+        let a = Mat::from_fn(n, n, |i, j| if i == j { tiny } else { 0.0 });
+        let t = Mat::from_fn(n, n, |i, j| match i.abs_diff(j) {
+            0 => 2.0,
+            1 => -1.0,
+            _ => 0.0,
+        });
+        let b = Mat::from_fn(n, n, |i, j| tiny * t[(i, j)]);
+        let Cholesky::Factor(l) = cholesky(a.as_ref(), Par::Seq) else {
+            panic!("a positive diagonal factors")
+        };
+        let c = reduce(l.as_ref(), b.as_ref(), Par::Seq);
+        for j in 0..n {
+            for i in j..n {
+                assert_eq!(c[(i, j)], t[(i, j)], "({i},{j})");
             }
         }
     }
