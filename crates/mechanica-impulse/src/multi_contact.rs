@@ -330,7 +330,7 @@ const DRIFT_LIMIT: f64 = 1e6;
 
 fn check_no_drift(w: &[f64], rows: usize, p: &[f64], speed: f64) -> Result<(), ImpulseError> {
     let effect = (0..rows).map(|r| p[r].abs() * w[r + rows * r]).fold(0.0_f64, f64::max);
-    if !(effect <= DRIFT_LIMIT * speed) {
+    if effect.is_nan() || effect > DRIFT_LIMIT * speed {
         return Err(ImpulseError::Singular {
             what: "simultaneous impact: the impulses drift along the null space of the Delassus matrix (redundant contacts); their velocity effect over the approach speed is",
             value: if speed > 0.0 { effect / speed } else { f64::INFINITY },
