@@ -369,25 +369,21 @@ fn grid_case(side: usize) -> Case {
 }
 
 fn lumped_case(n: usize) -> Case {
-    let (a, b) = lumped_fixed_chain(n);
-    let exact = families::fixed_chain_omega_sq(n);
-    let scale = exact.iter().copied().fold(0.0, f64::max);
-    Case {
-        label: format!("lumped fixed chain n={n}"),
-        n,
-        dense: Some((a, b)),
-        sparse: None,
-        exact,
-        scale,
-    }
+    dense_fixed_chain_case("lumped", lumped_fixed_chain(n))
 }
 
 fn rotated_case(n: usize) -> Case {
-    let (a, b) = rotated_fixed_chain(n);
+    dense_fixed_chain_case("rotated", rotated_fixed_chain(n))
+}
+
+/// A dense pencil with the fixed chain's closed-form spectrum (rotated or lumped), labelled
+/// "`kind` fixed chain n=…".
+fn dense_fixed_chain_case(kind: &str, (a, b): (Mat<f64>, Mat<f64>)) -> Case {
+    let n = a.nrows();
     let exact = families::fixed_chain_omega_sq(n);
     let scale = exact.iter().copied().fold(0.0, f64::max);
     Case {
-        label: format!("rotated fixed chain n={n}"),
+        label: format!("{kind} fixed chain n={n}"),
         n,
         dense: Some((a, b)),
         sparse: None,
