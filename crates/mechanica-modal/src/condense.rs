@@ -12,6 +12,7 @@
 //! decomposition of A and the 4n³ flops of QᵀBQ by O(n²), and the condensed pencil's A₁ is
 //! diagonal again (the reduction then scales, module `reduce`).
 
+use crate::refine::ReducedCorrection;
 use crate::solve::{Finish, Method, ModalSolution, SolveOptions, solve_definite};
 use crate::symmetric_eigen::symmetric_eigen;
 use crate::{ModalError, PencilProblem};
@@ -53,14 +54,14 @@ pub(crate) fn solve_semidefinite(
         return Err(ModalError::SingularPencil { nullity: r, pivot: p });
     }
     // G = B₀₀⁻¹ B₀₁ = V diag(1/d) Vᵀ B₁₀ᵀ.
-    let v = e00.U();
+    let v = e00.U().to_owned();
     let mut t = v.transpose() * b10.transpose();
     for i in 0..r {
         for j in 0..n - r {
             t[(i, j)] /= d[i];
         }
     }
-    let g = v * &t;
+    let g = &v * &t;
     let s_raw = &b11 - &b10 * &g;
     let s = Mat::from_fn(n - r, n - r, |i, j| 0.5 * (s_raw[(i, j)] + s_raw[(j, i)]));
     let l1 = Mat::from_fn(n - r, n - r, |i, j| if i == j { values[r + i].sqrt() } else { 0.0 });
@@ -69,18 +70,159 @@ pub(crate) fn solve_semidefinite(
     let mut def = solve_definite(l1.as_ref(), s.as_ref(), options.selection, want_vectors, par)?;
     def.timings.factor += condensation;
     let infinite: Vec<Vec<f64>> = (0..r).map(|c| q.column(c)).collect();
+    let negatives = d.iter().filter(|&&v| v < 0.0).count();
+    let condensed = Condensation::new(&q, &values, r, Blocks { b10, v, d, g }, l1);
     // x = Q₁z + Q₀w with w = −G z.
-    let lift = |z: MatRef<'_, f64>| -> Mat<f64> { q.combine(z, (&g * z).as_ref(), r) };
+    let lift = |z: MatRef<'_, f64>| -> Mat<f64> { q.combine(z, (&condensed.g * z).as_ref(), r) };
     let finish = Finish {
         problem,
-        l: l1.as_ref(),
+        l: condensed.l1.as_ref(),
         norm_a,
         norm_b,
         options,
         par,
-        condensed_stiffness_negatives: Some(d.iter().filter(|&&v| v < 0.0).count()),
+        condensed_stiffness_negatives: Some(negatives),
+        condensation: condensed.refinable.then_some(&condensed),
     };
     finish.run(def, infinite, Some(&lift), Method::CondensedReduction { massless: r })
+}
+
+/// The static condensation of the pencil (B, A) as refinement needs it: the exact identity
+/// (S − ρA₁)z = r₁ − B₁₀B₀₀⁻¹r₀ for any x = Q[w; z] and its residual r = (B − ρA)x, with
+/// S = B₁₁ − B₁₀B₀₀⁻¹B₀₁ the condensed stiffness. A residual measured in double-double on the
+/// stored A and B thus becomes the residual of the condensed definite pencil (S, A₁), whose
+/// residual bounds ([`crate::accuracy::residual_bounds`]) then hold for the stored data, however
+/// much the condensation's own rounding (stiff springs to massless nodes: the subtraction in S
+/// loses u·‖B₁₀‖‖B₀₀⁻¹‖‖B₀₁‖) changed S.
+pub(crate) struct Condensation {
+    /// The massless coordinates first, then the others (MassBasis::Permutation).
+    order: Vec<usize>,
+    /// Number r of massless coordinates.
+    massless: usize,
+    /// B₁₀: rows of the coordinates with mass, columns of the massless ones.
+    b10: Mat<f64>,
+    /// B₀₀ = V diag(d) Vᵀ.
+    v: Mat<f64>,
+    d: Vec<f64>,
+    /// G = B₀₀⁻¹B₀₁ (w = −G z on the condensed modes).
+    g: Mat<f64>,
+    /// L₁ = diag(√a₁), the Cholesky factor of the condensed mass matrix.
+    pub(crate) l1: Mat<f64>,
+    /// A₁ = L₁².
+    pub(crate) a1: Mat<f64>,
+    /// 4r·u·(κ(B₀₀) + 2)·‖B₁₀‖_F·‖B₀₀⁻¹‖₂: the rounding of B₁₀B₀₀⁻¹r₀ per unit ‖r₀‖.
+    rounding: f64,
+    /// Refinement is offered only when A is diagonal and its massless entries are exactly zero,
+    /// so that the condensed pencil is the stored one, not a perturbation of it.
+    pub(crate) refinable: bool,
+}
+
+/// The blocks of QᵀBQ a condensation keeps: B₁₀, B₀₀ = V diag(d) Vᵀ and G = B₀₀⁻¹B₀₁.
+struct Blocks {
+    b10: Mat<f64>,
+    v: Mat<f64>,
+    d: Vec<f64>,
+    g: Mat<f64>,
+}
+
+impl Condensation {
+    fn new(q: &MassBasis, values: &[f64], r: usize, blocks: Blocks, l1: Mat<f64>) -> Self {
+        let Blocks { b10, v, d, g } = blocks;
+        let order = match q {
+            MassBasis::Permutation(order) => order.clone(),
+            MassBasis::Dense(_) => Vec::new(),
+        };
+        let refinable = !order.is_empty() && values[..r].iter().all(|&a| a == 0.0);
+        let dmin = d.iter().fold(f64::INFINITY, |m, v| m.min(v.abs()));
+        let dmax = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let rounding =
+            4.0 * r as f64 * f64::EPSILON * (dmax / dmin + 2.0) * crate::accuracy::frobenius_norm(b10.as_ref()) / dmin;
+        let a1 = Mat::from_fn(l1.nrows(), l1.ncols(), |i, j| if i == j { values[r + i] } else { 0.0 });
+        Self {
+            order,
+            massless: r,
+            b10,
+            v,
+            d,
+            g,
+            l1,
+            a1,
+            rounding,
+            refinable,
+        }
+    }
+
+    /// The residual s = r₁ − B₁₀B₀₀⁻¹r₀ of the condensed pencil, t = B₀₀⁻¹r₀, and ‖r₀‖, for a
+    /// residual r of the full pencil in the original coordinates.
+    pub(crate) fn condensed_residual(&self, r: &[f64]) -> (Vec<f64>, Vec<f64>, f64) {
+        let (massless, massed) = self.order.split_at(self.massless);
+        let r0: Vec<f64> = massless.iter().map(|&i| r[i]).collect();
+        let vt_r0: Vec<f64> = (0..self.massless)
+            .map(|k| (0..self.massless).map(|i| self.v[(i, k)] * r0[i]).sum::<f64>() / self.d[k])
+            .collect();
+        let t: Vec<f64> = (0..self.massless)
+            .map(|i| (0..self.massless).map(|k| self.v[(i, k)] * vt_r0[k]).sum())
+            .collect();
+        let s = massed
+            .iter()
+            .enumerate()
+            .map(|(row, &i)| r[i] - (0..self.massless).map(|k| self.b10[(row, k)] * t[k]).sum::<f64>())
+            .collect();
+        let r0_norm = r0.iter().map(|v| v * v).sum::<f64>().sqrt();
+        (s, t, r0_norm)
+    }
+
+    /// ‖L₁⁻¹s‖ for the condensed residual s of [`Self::condensed_residual`], plus the rounding
+    /// allowance of s (a bound of ‖L₁⁻¹‖ times [`Self::rounding`]·‖r₀‖).
+    pub(crate) fn inverse_mass_norm(&self, s: &[f64], r0_norm: f64) -> f64 {
+        let scaled = s
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (v / self.l1[(i, i)]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let lmin = (0..self.l1.nrows()).fold(f64::INFINITY, |m, i| m.min(self.l1[(i, i)]));
+        scaled + self.rounding * r0_norm / lmin
+    }
+
+    /// The correction δX ≈ (B − ρA)⁻¹R by block elimination: δz = L₁⁻ᵀ K L₁⁻¹ s with K the
+    /// reduced correction of the condensed pencil, δw = B₀₀⁻¹r₀ − G δz, scattered back.
+    pub(crate) fn correction(&self, r: &Mat<f64>, rho: f64, reduced: &mut dyn ReducedCorrection) -> Mat<f64> {
+        let (n, p) = (r.nrows(), r.ncols());
+        let (massless, massed) = self.order.split_at(self.massless);
+        let mut scaled = Mat::<f64>::zeros(massed.len(), p);
+        let mut t = Mat::<f64>::zeros(massless.len(), p);
+        for k in 0..p {
+            let (s, tk, _) = self.condensed_residual(r.col_as_slice(k));
+            for (i, v) in s.iter().enumerate() {
+                scaled[(i, k)] = v / self.l1[(i, i)];
+            }
+            t.col_as_slice_mut(k).copy_from_slice(&tk);
+        }
+        let mut dz = reduced.apply(scaled, rho);
+        for k in 0..p {
+            for i in 0..massed.len() {
+                dz[(i, k)] /= self.l1[(i, i)];
+            }
+        }
+        let dw = &t - &self.g * &dz;
+        let mut dx = Mat::<f64>::zeros(n, p);
+        for k in 0..p {
+            for (i, &row) in massed.iter().enumerate() {
+                dx[(row, k)] = dz[(i, k)];
+            }
+            for (i, &row) in massless.iter().enumerate() {
+                dx[(row, k)] = dw[(i, k)];
+            }
+        }
+        dx
+    }
+
+    /// The rows of X at the coordinates with mass: the condensed mode shapes Z.
+    pub(crate) fn massed_rows(&self, x: MatRef<'_, f64>) -> Mat<f64> {
+        let massed = &self.order[self.massless..];
+        Mat::from_fn(massed.len(), x.ncols(), |i, k| x[(massed[i], k)])
+    }
 }
 
 /// The eigenvectors Q of the mass matrix: a dense orthogonal matrix, or, for a diagonal A, the

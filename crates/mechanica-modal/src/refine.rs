@@ -18,6 +18,7 @@
 //! close to tell apart) are refined together as one block by [`refine_cluster_projected`]: the
 //! block's invariant subspace is well defined where its single vectors are not.
 
+use crate::condense::Condensation;
 use crate::dd::{Dd, dot, mat_vec};
 use crate::symmetric_eigen::TridiagonalForm;
 use crate::tridiagonal_vectors::{ShiftedTridiagonal, one_norm};
@@ -36,9 +37,11 @@ pub(crate) struct RefinedPair {
     pub x: Vec<f64>,
     /// ω² (the double-double Rayleigh quotient, rounded).
     pub omega_sq: f64,
-    /// ‖(B − ω²A)x‖_{A⁻¹} / ‖x‖_A from the double-double residual.
+    /// ‖(B − ω²A)x‖_{A⁻¹} / ‖x‖_A from the double-double residual; for a condensed pencil
+    /// ‖s‖_{A₁⁻¹} / ‖x‖_A of its residual s (plus the rounding allowance of s).
     pub residual_a_inv: f64,
-    /// The residual (B − ω²A)x from double-double, rounded to double.
+    /// The residual (B − ω²A)x from double-double, rounded to double; for a condensed pencil
+    /// the residual s of (S, A₁) (`Condensation::condensed_residual`), of order n − r.
     pub residual: Vec<f64>,
     /// Newton steps taken.
     pub steps: usize,
@@ -63,12 +66,54 @@ impl RefinedCluster {
     }
 }
 
+/// The definite pencil in which refinement corrects a mode and measures its residual.
+#[derive(Clone, Copy)]
+pub(crate) enum Metric<'a> {
+    /// A = LLᵀ positive definite (L lower): corrections L⁻ᵀKL⁻¹r, residuals in the A⁻¹-norm.
+    Cholesky(MatRef<'a, f64>),
+    /// A diagonal with exactly massless coordinates, condensed statically: corrections and
+    /// residuals of the condensed pencil (S, A₁) (module `condense`).
+    Condensed(&'a Condensation),
+}
+
+impl Metric<'_> {
+    /// δX ≈ (B − ρA)⁻¹R with K, the reduced correction, applied on the definite pencil.
+    fn correction(&self, r: Mat<f64>, rho: f64, reduced: &mut dyn ReducedCorrection) -> Mat<f64> {
+        match self {
+            Self::Cholesky(l) => {
+                let mut w = r;
+                solve_lower_triangular_in_place(*l, w.as_mut(), Par::Seq);
+                let mut delta = reduced.apply(w, rho);
+                solve_upper_triangular_in_place(l.transpose(), delta.as_mut(), Par::Seq);
+                delta
+            }
+            Self::Condensed(c) => c.correction(&r, rho, reduced),
+        }
+    }
+
+    /// The definite pencil's residual for a residual r of (B, A), and its inverse-mass norm.
+    fn definite_residual(&self, r: Vec<f64>) -> (Vec<f64>, f64) {
+        match self {
+            Self::Cholesky(l) => {
+                let mut y = Mat::from_fn(r.len(), 1, |i, _| r[i]);
+                solve_lower_triangular_in_place(*l, y.as_mut(), Par::Seq);
+                (r, y.norm_l2())
+            }
+            Self::Condensed(c) => {
+                let (s, _, r0_norm) = c.condensed_residual(&r);
+                let norm = c.inverse_mass_norm(&s, r0_norm);
+                (s, norm)
+            }
+        }
+    }
+}
+
 /// Refines (ω₀², x₀), with `l` the Cholesky factor of A (for the A⁻¹-norm of the residual); None if the bordered matrix is singular to working precision (the
 /// eigenvalue is not simple) or A is not positive definite.
 pub(crate) fn refine_pair(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
-    l: MatRef<'_, f64>,
+    metric: Metric<'_>,
     x0: &[f64],
     omega0: f64,
 ) -> Option<RefinedPair> {
@@ -108,7 +153,7 @@ pub(crate) fn refine_pair(
             break;
         }
     }
-    finish_pair(a, b, l, x, steps)
+    finish_pair(a, b, metric, x, steps)
 }
 
 /// The correction of [`refine_cluster_projected`]: an approximate inverse of C − ρI on the
@@ -250,12 +295,12 @@ const STAGNATION_ULPS: f64 = 16.0;
 pub(crate) fn refine_pair_projected(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
-    l: MatRef<'_, f64>,
+    metric: Metric<'_>,
     correction: &mut dyn ReducedCorrection,
     x0: &[f64],
 ) -> Option<RefinedPair> {
     let x0 = MatRef::from_column_major_slice(x0, x0.len(), 1);
-    refine_cluster_projected(a, b, l, correction, x0).and_then(|c| c.pairs.into_iter().next())
+    refine_cluster_projected(a, b, metric, correction, x0).and_then(|c| c.pairs.into_iter().next())
 }
 
 /// Refines a cluster G of p modes with nearly equal ω² (p = 1: a simple pair), starting from
@@ -277,7 +322,7 @@ pub(crate) fn refine_pair_projected(
 pub(crate) fn refine_cluster_projected(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
-    l: MatRef<'_, f64>,
+    metric: Metric<'_>,
     correction: &mut dyn ReducedCorrection,
     x0: MatRef<'_, f64>,
 ) -> Option<RefinedCluster> {
@@ -292,12 +337,10 @@ pub(crate) fn refine_cluster_projected(
         let bx: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(b, x.col_as_slice(k))).collect();
         let m = rayleigh_quotient_matrix(&x, &ax, &bx)?;
         let rho = (0..p).fold(Dd::of(0.0), |t, k| t.plus(m[k][k])).to_f64() / p as f64;
-        let mut w = Mat::from_fn(n, p, |i, k| {
+        let w = Mat::from_fn(n, p, |i, k| {
             (0..p).fold(bx[k][i], |r, j| r.minus(m[j][k].times(ax[j][i]))).to_f64()
         });
-        solve_lower_triangular_in_place(l, w.as_mut(), Par::Seq);
-        let mut delta = correction.apply(w, rho);
-        solve_upper_triangular_in_place(l.transpose(), delta.as_mut(), Par::Seq);
+        let delta = metric.correction(w, rho, correction);
         // f64::max ignores NaN, so a failed correction is caught here, not by dmax.
         if !delta.col_iter().all(|c| c.iter().all(|v| v.is_finite())) {
             return None;
@@ -318,7 +361,7 @@ pub(crate) fn refine_cluster_projected(
             }
         }
         if dmax <= 2.0 * f64::EPSILON * xmax || (at_rounding && !contracting) {
-            return finish_cluster(a, b, l, x, step);
+            return finish_cluster(a, b, metric, x, step);
         }
         previous = dmax;
     }
@@ -331,16 +374,17 @@ pub(crate) fn refine_cluster_projected(
 pub(crate) fn refine_cluster(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
-    l: MatRef<'_, f64>,
+    metric: Metric<'_>,
     correction: Option<&mut dyn ReducedCorrection>,
     x0: MatRef<'_, f64>,
     omega0: f64,
 ) -> Option<RefinedCluster> {
     correction
-        .and_then(|c| refine_cluster_projected(a, b, l, c, x0))
+        .and_then(|c| refine_cluster_projected(a, b, metric, c, x0))
         .or_else(|| {
             let single = x0.ncols() == 1;
-            let pair = single.then(|| refine_pair(a, b, l, &x0.col(0).iter().copied().collect::<Vec<_>>(), omega0));
+            let pair =
+                single.then(|| refine_pair(a, b, metric, &x0.col(0).iter().copied().collect::<Vec<_>>(), omega0));
             pair.flatten().map(RefinedCluster::single)
         })
 }
@@ -389,13 +433,13 @@ fn rayleigh_quotient_matrix(x: &Mat<f64>, ax: &[Vec<Dd>], bx: &[Vec<Dd>]) -> Opt
 fn finish_cluster(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
-    l: MatRef<'_, f64>,
+    metric: Metric<'_>,
     x: Mat<f64>,
     steps: usize,
 ) -> Option<RefinedCluster> {
     let p = x.ncols();
     if p == 1 {
-        return finish_pair(a, b, l, x.col_as_slice(0).to_vec(), steps).map(RefinedCluster::single);
+        return finish_pair(a, b, metric, x.col_as_slice(0).to_vec(), steps).map(RefinedCluster::single);
     }
     let ax: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(a, x.col_as_slice(k))).collect();
     let bx: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(b, x.col_as_slice(k))).collect();
@@ -416,7 +460,7 @@ fn finish_cluster(
     solve_upper_triangular_in_place(lg.transpose(), v.as_mut(), Par::Seq);
     let rotated = &x * &v;
     let pairs: Vec<RefinedPair> = (0..p)
-        .map(|k| finish_pair(a, b, l, rotated.col_as_slice(k).to_vec(), steps))
+        .map(|k| finish_pair(a, b, metric, rotated.col_as_slice(k).to_vec(), steps))
         .collect::<Option<_>>()?;
     let mut orthogonality = 0.0_f64;
     for k in 0..p {
@@ -432,7 +476,7 @@ fn finish_cluster(
 fn finish_pair(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
-    l: MatRef<'_, f64>,
+    metric: Metric<'_>,
     mut x: Vec<f64>,
     steps: usize,
 ) -> Option<RefinedPair> {
@@ -449,9 +493,8 @@ fn finish_pair(
     let xax = dot(&x, &axd);
     let rq = dot(&x, &bxd).over(xax);
     let r: Vec<f64> = (0..n).map(|i| bxd[i].minus(rq.times(axd[i])).to_f64()).collect();
-    let mut y = Mat::from_fn(n, 1, |i, _| r[i]);
-    solve_lower_triangular_in_place(l, y.as_mut(), Par::Seq);
-    let residual_a_inv = y.norm_l2() / xax.to_f64().sqrt();
+    let (r, norm) = metric.definite_residual(r);
+    let residual_a_inv = norm / xax.to_f64().sqrt();
     let omega_sq = rq.to_f64();
     if !omega_sq.is_finite() || !residual_a_inv.is_finite() {
         return None;
@@ -502,9 +545,10 @@ mod tests {
                 modes: i..i + 1,
             };
             let x0: Vec<f64> = (0..16).map(|r| x[(r, i)]).collect();
-            let fast =
-                refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut spectrum, &x0).expect("converges");
-            let slow = refine_pair(a.as_ref(), b.as_ref(), l.as_ref(), &x0, omega[i]).expect("converges");
+            let fast = refine_pair_projected(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &mut spectrum, &x0)
+                .expect("converges");
+            let slow =
+                refine_pair(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &x0, omega[i]).expect("converges");
             let w = slow.omega_sq;
             assert!(
                 (fast.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
@@ -537,9 +581,16 @@ mod tests {
                 z: z.subcols(i, 1).to_owned(),
                 purified: false,
             };
-            let fast = refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut correction, &x0)
-                .expect("the tridiagonal correction converges");
-            let slow = refine_pair(a.as_ref(), b.as_ref(), l.as_ref(), &x0, values[i]).expect("converges");
+            let fast = refine_pair_projected(
+                a.as_ref(),
+                b.as_ref(),
+                Metric::Cholesky(l.as_ref()),
+                &mut correction,
+                &x0,
+            )
+            .expect("the tridiagonal correction converges");
+            let slow =
+                refine_pair(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &x0, values[i]).expect("converges");
             let w = slow.omega_sq;
             assert!(
                 (fast.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
@@ -566,15 +617,18 @@ mod tests {
         };
         // Start from a mixture of modes 0 and 1, so the wrong ω²₁ drives the correction.
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)] + 0.3 * x[(r, 1)]).collect();
-        assert!(refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut spectrum, &x0).is_none());
-        let slow = refine_pair(a.as_ref(), b.as_ref(), l.as_ref(), &x0, omega[0]).expect("bordered Newton converges");
+        assert!(
+            refine_pair_projected(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &mut spectrum, &x0).is_none()
+        );
+        let slow = refine_pair(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &x0, omega[0])
+            .expect("bordered Newton converges");
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)]).collect();
         let mut right = ReducedSpectrum {
             y: y.as_ref(),
             omega_sq: &omega,
             modes: 0..1,
         };
-        let w = refine_pair_projected(a.as_ref(), b.as_ref(), l.as_ref(), &mut right, &x0)
+        let w = refine_pair_projected(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &mut right, &x0)
             .expect("converges")
             .omega_sq;
         assert!(

@@ -8,9 +8,10 @@
 //! (ω² < 0) first, then rigid-body modes, then oscillatory modes, then infinite ones.
 
 use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
+use crate::condense::Condensation;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
-use crate::refine::{ReducedCorrection, ReducedSpectrum, refine_cluster};
+use crate::refine::{Metric, ReducedCorrection, ReducedSpectrum, refine_cluster};
 use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
@@ -350,6 +351,7 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 options,
                 par,
                 condensed_stiffness_negatives: None,
+                condensation: None,
             };
             finish.run(def, Vec::new(), None, Method::CholeskyReduction)
         }
@@ -384,6 +386,9 @@ pub(crate) struct Finish<'a> {
     /// the massless directions, by which the inertia of B − sA exceeds the count of modes
     /// below s (Haynsworth: In(B − sA) = In(B₀₀) + In(S − sA₁), S the condensed stiffness).
     pub condensed_stiffness_negatives: Option<usize>,
+    /// For a condensed pencil whose condensation is exact (diagonal A): what refinement needs
+    /// to correct its modes and bound them in the condensed pencil.
+    pub condensation: Option<&'a Condensation>,
 }
 
 impl Finish<'_> {
@@ -442,10 +447,16 @@ impl Finish<'_> {
             measured_resolution =
                 crate::values_only::sharpen(&pencil, model, form, &mut report, &mut omega, &omega_all, def.first);
         }
-        // Refinement of poorly bounded simple modes (needs vectors in the original coordinates).
-        if let (Some(xm), Some(products)) = (x.as_mut(), products.as_mut())
+        // Refinement of poorly bounded modes (needs vectors in the original coordinates). A
+        // condensed pencil is refined when its condensation is exact (diagonal A), in the metric
+        // of the condensed pencil.
+        let metric = match (lift.is_none(), self.condensation) {
+            (true, _) => Some(Metric::Cholesky(self.l)),
+            (false, Some(c)) => Some(Metric::Condensed(c)),
+            (false, None) => None,
+        };
+        if let (Some(xm), Some(products), Some(metric)) = (x.as_mut(), products.as_mut(), metric)
             && self.options.refinement != Refinement::Off
-            && lift.is_none()
         {
             let mut residuals: Vec<RefinedResidual> = Vec::new();
             for g in clusters(&omega, &report.error_bounds) {
@@ -461,7 +472,7 @@ impl Finish<'_> {
                     modes: def.first + g.start..def.first + g.end,
                 });
                 let correction = spectrum.as_mut().map(|s| s as &mut dyn ReducedCorrection);
-                let refined = refine_cluster(a, b, self.l, correction, x0.as_ref(), omega[g.start]);
+                let refined = refine_cluster(a, b, metric, correction, x0.as_ref(), omega[g.start]);
                 let Some(cluster) = refined else { continue };
                 for (i, p) in g.clone().zip(cluster.pairs) {
                     xm.col_as_slice_mut(i).copy_from_slice(&p.x);
@@ -479,12 +490,27 @@ impl Finish<'_> {
                 }
             }
             let all: Vec<usize> = (0..m).collect();
-            let basis = accuracy::ModeBasis {
-                a,
-                l: self.l,
-                x: xm.as_ref(),
-                modes: &all,
-                unselected: None,
+            // The bounds hold in the definite pencil the residuals belong to: (B, A) itself, or
+            // the condensed (S, A₁) with the modes' rows at the coordinates with mass.
+            let condensed = self
+                .condensation
+                .filter(|_| !residuals.is_empty())
+                .map(|c| (c, c.massed_rows(xm.as_ref())));
+            let basis = match &condensed {
+                Some((c, z)) => accuracy::ModeBasis {
+                    a: c.a1.as_ref(),
+                    l: self.l,
+                    x: z.as_ref(),
+                    modes: &all,
+                    unselected: None,
+                },
+                None => accuracy::ModeBasis {
+                    a,
+                    l: self.l,
+                    x: xm.as_ref(),
+                    modes: &all,
+                    unselected: None,
+                },
             };
             accuracy::residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, &basis, self.par);
         }

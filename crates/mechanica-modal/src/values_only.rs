@@ -22,7 +22,7 @@
 
 use crate::accuracy::{self, AccuracyReport, BoundKind, PairProducts, RefinedResidual, Residuals};
 use crate::reduce::back_transform;
-use crate::refine::{TridiagonalCorrection, refine_cluster};
+use crate::refine::{Metric, TridiagonalCorrection, refine_cluster};
 use crate::solve::{clusters, refinable, weakly_bounded};
 use crate::symmetric_eigen::TridiagonalForm;
 use faer::{MatRef, Par};
@@ -98,7 +98,14 @@ pub(crate) fn sharpen(
             z: z.as_ref().subcols(col, g.len()).to_owned(),
             purified: false,
         };
-        let refined = refine_cluster(a, b, pencil.l, Some(&mut correction), x0.as_ref(), omega[g.start]);
+        let refined = refine_cluster(
+            a,
+            b,
+            Metric::Cholesky(pencil.l),
+            Some(&mut correction),
+            x0.as_ref(),
+            omega[g.start],
+        );
         let Some(cluster) = refined else { continue };
         for (k, p) in cluster.pairs.into_iter().enumerate() {
             let i = g.start + k;

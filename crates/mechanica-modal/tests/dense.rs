@@ -420,6 +420,106 @@ fn scattered_massless_nodes_of_a_lumped_chain_are_condensed() {
 /// of the full B − sA includes B₀₀'s negative eigenvalue (Haynsworth inertia additivity); the
 /// check subtracts it and agrees with the condensed spectrum at every shift it may pick, and an
 /// independent count at s = 3 (between the modes) on B − sA itself has two negative pivots.
+/// `copies` decoupled fixed chains of `masses` unit masses, each pair of neighbours (and each
+/// end and its wall) joined by a stiff spring k₁ and a soft spring k₂ = 1 in series through a
+/// massless node: A = diag(0, 1, 0, 1, …, 0) per chain. The condensed chain has springs
+/// k = k₁k₂/(k₁ + k₂), so ω²_j = 4k sin²(jπ/(2(masses + 1))), each `copies` times.
+fn series_spring_chains(masses: usize, k1: f64, copies: usize) -> (Mat<f64>, Mat<f64>) {
+    let k2 = 1.0;
+    let size = 2 * masses + 1;
+    let n = copies * size;
+    let mut a = Mat::<f64>::zeros(n, n);
+    let mut b = Mat::<f64>::zeros(n, n);
+    for c in 0..copies {
+        let o = c * size;
+        for segment in 0..=masses {
+            let node = o + 2 * segment;
+            b[(node, node)] += k1 + k2;
+            if segment > 0 {
+                b[(node - 1, node - 1)] += k1;
+                b[(node - 1, node)] -= k1;
+                b[(node, node - 1)] -= k1;
+            }
+            if segment < masses {
+                b[(node + 1, node + 1)] += k2;
+                b[(node + 1, node)] -= k2;
+                b[(node, node + 1)] -= k2;
+                a[(node + 1, node + 1)] = 1.0;
+            }
+        }
+    }
+    (a, b)
+}
+
+#[test]
+fn stiff_springs_to_massless_nodes_keep_every_digit_of_the_low_modes() {
+    // k₁ = 1e12: the condensed stiffness k₁ − k₁²/(k₁ + 1) cancels 12 digits, so the condensed
+    // pencil alone carries errors of u·k₁ ≈ 1e-4 in its entries (a power of two would round
+    // exactly and hide this). Refinement measures residuals on the stored A and B in
+    // double-double and must recover every digit.
+    let (masses, k1) = (60, 1e12);
+    let spring = k1 / (k1 + 1.0);
+    let omega_exact = |j: usize| {
+        let s = (j as f64 * std::f64::consts::PI / (2.0 * (masses + 1) as f64)).sin();
+        4.0 * spring * s * s
+    };
+    for copies in [1, 2] {
+        let (a, b) = series_spring_chains(masses, k1, copies);
+        let p = pencil(&a, &b);
+        let unrefined = solve(
+            &p,
+            &SolveOptions {
+                refinement: Refinement::Off,
+                ..SolveOptions::default()
+            },
+        )
+        .expect("solve");
+        let sol = solve(&p, &all_pairs()).expect("solve");
+        assert_eq!(
+            sol.method,
+            Method::CondensedReduction {
+                massless: copies * (masses + 1)
+            }
+        );
+        for k in 0..10 * copies {
+            // The closed form in f64 carries a few roundings of its own (k and 4k sin²).
+            let exact = omega_exact(1 + k / copies);
+            let (raw, mode) = (&unrefined.modes[k], &sol.modes[k]);
+            // The case is hard: the unrefined lowest modes are wrong well beyond 1e-9, and say so.
+            if k < copies {
+                assert!((raw.omega_sq - exact).abs() > 1e-9 * exact, "mode {k} is not hard");
+            }
+            assert!(
+                (raw.omega_sq - exact).abs() <= raw.error_bound + 8.0 * U * exact,
+                "mode {k}"
+            );
+            assert!(
+                (mode.omega_sq - exact).abs() <= mode.error_bound + 8.0 * U * exact,
+                "mode {k}: {:e} vs bound {:e}",
+                (mode.omega_sq - exact).abs(),
+                mode.error_bound
+            );
+            // Single modes: every digit. A repeated pair is refined inside the cluster formed
+            // from the unrefined bounds (relative 1e0 here, so it spans the lowest ten modes),
+            // whose Rayleigh–Ritz defect term is p·δ·max ω² over that cluster: a weaker claim.
+            let claim = if copies == 1 { 1e-13 } else { 1e-11 };
+            assert!(
+                mode.error_bound <= claim * exact,
+                "copies {copies} mode {k}: bound {:e}",
+                mode.error_bound / exact
+            );
+            assert_eq!(sol.accuracy.bound_kinds[k], BoundKind::Residual, "mode {k}");
+            assert!(sol.accuracy.refinement_steps[k] > 0, "mode {k}");
+        }
+        if copies == 2 {
+            let lowest = &sol.groups[0];
+            assert_eq!((lowest.first, lowest.multiplicity), (0, 2), "{:?}", sol.groups);
+        }
+        let check = sol.accuracy.inertia_check.expect("certified");
+        assert!(check.consistent, "{check:?}");
+    }
+}
+
 #[test]
 fn condensed_sturm_check_allows_for_negative_stiffness_of_massless_coordinates() {
     let a = Mat::from_fn(3, 3, |i, j| if i == j && i != 1 { 1.0 } else { 0.0 });
