@@ -649,6 +649,58 @@ static void lumped_masses(void) {
     mech_modal_result_destroy(r);
 }
 
+/* Stiff series springs through massless nodes: NS unit masses, each pair of neighbours (and
+ * each end and its wall) joined by k1 = 1e12 and k2 = 1 in series through a massless node, so
+ * A = diag(0, 1, 0, …, 1, 0) and the condensed chain has springs k = k1 k2 / (k1 + k2):
+ * ω²_j = 4 k sin²(jπ/(2(NS + 1))). The condensation cancels 12 digits; the lowest modes must
+ * still be right to their bounds, and those bounds certify 13 digits (refinement measures
+ * residuals of the stored A and B). With refinement off the lowest bound is honest but weak. */
+#define NSERIES 40
+static void stiff_massless_series(void) {
+    const int n = 2 * NSERIES + 1;
+    static double a[(2 * NSERIES + 1) * (2 * NSERIES + 1)], b[(2 * NSERIES + 1) * (2 * NSERIES + 1)];
+    const double k1 = 1e12, k2 = 1.0, u_round = 2.220446049250313e-16, pi = 3.14159265358979323846;
+    memset(a, 0, sizeof a);
+    memset(b, 0, sizeof b);
+    for (int s = 0; s <= NSERIES; ++s) {
+        int node = 2 * s;
+        b[node + n * node] += k1 + k2;
+        if (s > 0) {
+            b[(node - 1) + n * (node - 1)] += k1;
+            b[(node - 1) + n * node] -= k1;
+            b[node + n * (node - 1)] -= k1;
+        }
+        if (s < NSERIES) {
+            b[(node + 1) + n * (node + 1)] += k2;
+            b[(node + 1) + n * node] -= k2;
+            b[node + n * (node + 1)] -= k2;
+            a[(node + 1) + n * (node + 1)] = 1.0;
+        }
+    }
+    const double spring = k1 * k2 / (k1 + k2);
+    static mech_modal_mode_t modes[2 * NSERIES + 1];
+    for (int refine = 0; refine < 2; ++refine) {
+        mech_modal_options_t o = default_options();
+        if (!refine) o.refinement = MECH_MODAL_REFINEMENT_OFF;
+        mech_modal_result_t *r = NULL;
+        CHECK_STATUS(mech_modal_solve(n, a, b, &o, &r), MECH_STATUS_OK);
+        CHECK_STATUS(mech_modal_result_modes(r, modes, n), MECH_STATUS_OK);
+        for (int k = 0; k < 5; ++k) {
+            double s = sin((k + 1) * pi / (2.0 * (NSERIES + 1)));
+            double w2 = 4.0 * spring * s * s;
+            CHECK_NEAR(modes[k].omega_sq, w2, modes[k].error_bound + 8.0 * u_round * w2);
+            CHECK(modes[k].kind == MECH_MODAL_KIND_OSCILLATORY);
+            if (refine) CHECK(modes[k].error_bound <= 1e-13 * w2);
+        }
+        if (!refine) CHECK(modes[0].error_bound > 1e-6 * modes[0].omega_sq);
+        CHECK(modes[n - 1].kind == MECH_MODAL_KIND_INFINITE);
+        mech_modal_accuracy_t acc;
+        CHECK_STATUS(mech_modal_result_accuracy(r, &acc), MECH_STATUS_OK);
+        CHECK(acc.inertia_checked == 1 && acc.inertia_consistent == 1);
+        mech_modal_result_destroy(r);
+    }
+}
+
 /* A symmetric stiff structure: two uncoupled copies of the chain graded over 1e12 in stiffness
  * (spring i, from the ground or mass i − 1 to mass i, k_i = 10^round(12 i/23), unit masses),
  * interleaved (copy c's coordinate i is 2i + c). Every eigenvalue is double; the lowest two
@@ -759,6 +811,7 @@ int main(void) {
     free_response();
     subsets_and_values_only();
     massless_coordinate();
+    stiff_massless_series();
     error_paths();
     return CHECK_DONE();
 }
