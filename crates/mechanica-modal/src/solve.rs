@@ -489,6 +489,7 @@ impl Finish<'_> {
                     });
                 }
             }
+            split_refined_clusters(&mut residuals, &omega, &report.residual_norms_a_inv);
             let all: Vec<usize> = (0..m).collect();
             // The bounds hold in the definite pencil the residuals belong to: (B, A) itself, or
             // the condensed (S, A₁) with the modes' rows at the coordinates with mass.
@@ -618,6 +619,42 @@ pub(crate) fn clusters(omega: &[f64], bounds: &[f64]) -> Vec<Range<usize>> {
         }
     }
     out
+}
+
+/// Narrows the clusters of refined modes to what their refined residuals can tell apart.
+/// Clusters are formed from the reduction's bounds, which on stiff problems are wide enough to
+/// chain modes that are far apart (the lowest ten of a 1e12 chain); the block's bound then
+/// carries its Rayleigh–Ritz defect at the block's largest ω². After refinement each member's
+/// residual places an eigenvalue within e_i = ‖r_i‖_{A⁻¹} of ω²_i, so the clusters of the
+/// intervals ω²_i ± e_i ([`clusters`]) are separated from one another: each keeps the block's
+/// A-orthogonality defect (a maximum over more pairs) and its members' residuals, and a member
+/// alone keeps none (its ω² is its own Rayleigh quotient, not a mixture).
+fn split_refined_clusters(residuals: &mut [RefinedResidual], omega: &[f64], residual_norms: &[Option<f64>]) {
+    let mut start = 0;
+    while start < residuals.len() {
+        let block = residuals[start].cluster.clone();
+        let members = residuals[start..].iter().take_while(|r| r.cluster == block).count();
+        let complete = members == block.len();
+        let sharp: Option<Vec<f64>> = block
+            .clone()
+            .map(|i| residual_norms[i].map(|e| e + f64::EPSILON * omega[i].abs()))
+            .collect();
+        if let (true, Some(sharp)) = (complete && block.len() > 1, sharp) {
+            for sub in clusters(&omega[block.clone()], &sharp) {
+                let sub = block.start + sub.start..block.start + sub.end;
+                for record in residuals[start..start + members]
+                    .iter_mut()
+                    .filter(|r| sub.contains(&r.mode))
+                {
+                    record.cluster = sub.clone();
+                    if sub.len() == 1 {
+                        record.orthogonality = 0.0;
+                    }
+                }
+            }
+        }
+        start += members;
+    }
 }
 
 /// Whether the cluster `g` of the selection (entries `first..` of the ascending spectrum
@@ -769,4 +806,36 @@ pub struct InertiaCheck {
     pub computed_below: usize,
     /// Whether the two counts agree (and s is not numerically an eigenvalue).
     pub consistent: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(mode: usize, cluster: Range<usize>) -> RefinedResidual {
+        RefinedResidual {
+            mode,
+            cluster,
+            orthogonality: 1e-15,
+            residual: Vec::new(),
+        }
+    }
+
+    /// A block of four refined together: modes 0 and 1 are a pair within their refined
+    /// residuals, 2 and 3 stand apart; a block with a member lacking its residual norm, and a
+    /// block cut short (a member not refined), keep their clusters.
+    #[test]
+    fn refined_blocks_split_where_their_residuals_separate_the_modes() {
+        let omega = [1.0, 1.0 + 2e-15, 2.0, 3.0, 5.0, 5.5, 7.0, 7.5];
+        let mut norms = vec![Some(1e-15); omega.len()];
+        norms[5] = None;
+        let mut residuals: Vec<RefinedResidual> = (0..4).map(|i| record(i, 0..4)).collect();
+        residuals.extend((4..6).map(|i| record(i, 4..6)));
+        residuals.push(record(6, 6..8));
+        split_refined_clusters(&mut residuals, &omega, &norms);
+        let clusters: Vec<Range<usize>> = residuals.iter().map(|r| r.cluster.clone()).collect();
+        assert_eq!(clusters, vec![0..2, 0..2, 2..3, 3..4, 4..6, 4..6, 6..8]);
+        let orthogonality: Vec<f64> = residuals.iter().map(|r| r.orthogonality).collect();
+        assert_eq!(orthogonality, vec![1e-15, 1e-15, 0.0, 0.0, 1e-15, 1e-15, 1e-15]);
+    }
 }
