@@ -17,6 +17,10 @@
 //! bound intervals overlap (a repeated frequency of a symmetric structure, or eigenvalues too
 //! close to tell apart) are refined together as one block by [`refine_cluster_projected`]: the
 //! block's invariant subspace is well defined where its single vectors are not.
+//!
+//! A condensed pencil (massless coordinates of a diagonal A, module `condense`) is refined the
+//! same way in the original coordinates; its residuals are mapped exactly to residuals of the
+//! condensed pencil (S, A₁) and its corrections go through the condensed spectrum ([`Metric`]).
 
 use crate::condense::Condensation;
 use crate::dd::{Dd, dot, mat_vec};
@@ -108,8 +112,10 @@ impl Metric<'_> {
     }
 }
 
-/// Refines (ω₀², x₀), with `l` the Cholesky factor of A (for the A⁻¹-norm of the residual); None if the bordered matrix is singular to working precision (the
-/// eigenvalue is not simple) or A is not positive definite.
+/// Refines (ω₀², x₀) by Newton steps on the bordered matrix [B − ω₀²A, −Ax₀; −(Ax₀)ᵀ, 0]
+/// (nonsingular for a simple finite eigenvalue, also when A is singular), with the final
+/// residual measured in `metric`; None if the bordered matrix is singular to working precision
+/// (the eigenvalue is not simple) or xᵀAx is not positive.
 pub(crate) fn refine_pair(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
