@@ -226,6 +226,36 @@ impl PairProducts {
         }
     }
 
+    /// Recomputes the columns `cols` after those x_i changed: one product with A and one with B
+    /// over all of them (a product per column would cost a fork of the threads each).
+    pub(crate) fn update_columns(
+        &mut self,
+        a: MatRef<'_, f64>,
+        b: MatRef<'_, f64>,
+        x: MatRef<'_, f64>,
+        cols: &[usize],
+        par: Par,
+    ) {
+        match self {
+            Self::Exact { ax, bx } => {
+                let changed = Mat::from_fn(x.nrows(), cols.len(), |i, k| x[(i, cols[k])]);
+                let mut a_changed = Mat::<f64>::zeros(x.nrows(), cols.len());
+                let mut b_changed = Mat::<f64>::zeros(x.nrows(), cols.len());
+                mass_product(a_changed.as_mut(), a, changed.as_ref(), par);
+                faer::linalg::matmul::matmul(b_changed.as_mut(), faer::Accum::Replace, b, changed.as_ref(), 1.0, par);
+                for (k, &c) in cols.iter().enumerate() {
+                    ax.col_mut(c).copy_from(a_changed.col(k));
+                    bx.col_mut(c).copy_from(b_changed.col(k));
+                }
+            }
+            Self::Sketched { .. } => {
+                for &c in cols {
+                    self.update_column(a, b, x, c, par);
+                }
+            }
+        }
+    }
+
     /// Backward error η_i and first-order bound η_i·κ_i of the pair (ω²_i, x_i). Sketched, the
     /// residual is its probabilistic upper bound and x_iᵀAx_i ≥ 1 − ‖XᵀAX − I‖_F.
     pub(crate) fn pair_error(

@@ -141,7 +141,9 @@ impl Dd {
 pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     let n = m.nrows();
     let (mut hi, mut lo) = (vec![0.0; n], vec![0.0; n]);
-    if n >= PARALLEL_ROWS_FROM && faer::get_global_parallelism().degree() >= 2 {
+    // Inside a pool thread (refinement runs clusters in parallel) the other threads are busy.
+    let nested = rayon::current_thread_index().is_some();
+    if n >= PARALLEL_ROWS_FROM && !nested && faer::get_global_parallelism().degree() >= 2 {
         let half = n / 2;
         let (hi_top, hi_bottom) = hi.split_at_mut(half);
         let (lo_top, lo_bottom) = lo.split_at_mut(half);

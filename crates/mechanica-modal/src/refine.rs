@@ -26,9 +26,10 @@ use crate::condense::Condensation;
 use crate::dd::{Dd, dot, mat_vec};
 use crate::symmetric_eigen::TridiagonalForm;
 use crate::tridiagonal_vectors::{ShiftedTridiagonal, one_norm};
+use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
-use faer::{Mat, MatRef, Par, Side};
+use faer::{Accum, Mat, MatRef, Par, Side};
 use std::ops::Range;
 
 /// Maximum Newton steps per pair.
@@ -183,7 +184,17 @@ pub(crate) struct ReducedSpectrum<'a> {
 
 impl ReducedCorrection for ReducedSpectrum<'_> {
     fn apply(&mut self, w: Mat<f64>, rho: f64) -> Mat<f64> {
-        let mut c = self.y.transpose() * &w;
+        // Sequential: refinement runs clusters on the threads (a fork per product would cost more
+        // than these O(n²) products).
+        let mut c = Mat::<f64>::zeros(self.y.ncols(), w.ncols());
+        matmul(
+            c.as_mut(),
+            Accum::Replace,
+            self.y.transpose(),
+            w.as_ref(),
+            1.0,
+            Par::Seq,
+        );
         for j in 0..c.nrows() {
             let gap = self.omega_sq[j] - rho;
             let excluded = self.modes.contains(&j) || gap == 0.0;
@@ -191,7 +202,9 @@ impl ReducedCorrection for ReducedSpectrum<'_> {
                 c[(j, k)] = if excluded { 0.0 } else { c[(j, k)] / gap };
             }
         }
-        self.y * &c
+        let mut out = Mat::<f64>::zeros(self.y.nrows(), w.ncols());
+        matmul(out.as_mut(), Accum::Replace, self.y, c.as_ref(), 1.0, Par::Seq);
+        out
     }
 }
 

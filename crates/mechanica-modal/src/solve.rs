@@ -11,10 +11,11 @@ use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::condense::Condensation;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
-use crate::refine::{Metric, ReducedCorrection, ReducedSpectrum, refine_cluster};
+use crate::refine::{Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, refine_cluster};
 use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
+use rayon::prelude::*;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
@@ -458,29 +459,41 @@ impl Finish<'_> {
         if let (Some(xm), Some(products), Some(metric)) = (x.as_mut(), products.as_mut(), metric)
             && self.options.refinement != Refinement::Off
         {
-            let mut residuals: Vec<RefinedResidual> = Vec::new();
-            for g in clusters(&omega, &report.error_bounds) {
-                let wanted = self.options.refinement == Refinement::Always
-                    || g.clone().any(|i| weakly_bounded(report.error_bounds[i], omega[i]));
-                if !wanted || !refinable(&g, &omega, &report.error_bounds, &omega_all, def.first) {
-                    continue;
-                }
-                let x0 = xm.as_ref().subcols(g.start, g.len()).to_owned();
+            let jobs: Vec<Range<usize>> = clusters(&omega, &report.error_bounds)
+                .into_iter()
+                .filter(|g| {
+                    let wanted = self.options.refinement == Refinement::Always
+                        || g.clone().any(|i| weakly_bounded(report.error_bounds[i], omega[i]));
+                    wanted && refinable(g, &omega, &report.error_bounds, &omega_all, def.first)
+                })
+                .collect();
+            // Clusters are independent: each is refined from its own columns of X, sequentially
+            // inside, and the clusters are shared among the threads.
+            let start = xm.as_ref();
+            let refine_one = |g: &Range<usize>| {
+                let x0 = start.subcols(g.start, g.len()).to_owned();
                 let mut spectrum = def.reduced.as_ref().map(|y| ReducedSpectrum {
                     y: y.as_ref(),
                     omega_sq: &omega_all,
                     modes: def.first + g.start..def.first + g.end,
                 });
                 let correction = spectrum.as_mut().map(|s| s as &mut dyn ReducedCorrection);
-                let refined = refine_cluster(a, b, metric, correction, x0.as_ref(), omega[g.start]);
-                let Some(cluster) = refined else { continue };
+                refine_cluster(a, b, metric, correction, x0.as_ref(), omega[g.start])
+            };
+            let refined: Vec<Option<RefinedCluster>> = match self.par {
+                Par::Seq => jobs.iter().map(refine_one).collect(),
+                _ => jobs.par_iter().map(refine_one).collect(),
+            };
+            let mut residuals: Vec<RefinedResidual> = Vec::new();
+            let mut changed: Vec<usize> = Vec::new();
+            for (g, cluster) in jobs.iter().zip(refined) {
+                let Some(cluster) = cluster else { continue };
                 for (i, p) in g.clone().zip(cluster.pairs) {
                     xm.col_as_slice_mut(i).copy_from_slice(&p.x);
                     omega[i] = p.omega_sq;
-                    products.update_column(a, b, xm.as_ref(), i, self.par);
-                    report.set_pair_error(products, xm.as_ref(), i, omega[i]);
                     report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
                     report.refinement_steps[i] = p.steps;
+                    changed.push(i);
                     residuals.push(RefinedResidual {
                         mode: i,
                         cluster: g.clone(),
@@ -488,6 +501,10 @@ impl Finish<'_> {
                         residual: p.residual,
                     });
                 }
+            }
+            products.update_columns(a, b, xm.as_ref(), &changed, self.par);
+            for &i in &changed {
+                report.set_pair_error(products, xm.as_ref(), i, omega[i]);
             }
             split_refined_clusters(&mut residuals, &omega, &report.residual_norms_a_inv);
             let all: Vec<usize> = (0..m).collect();
