@@ -11,7 +11,7 @@ use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::condense::Condensation;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
-use crate::refine::{Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, refine_cluster};
+use crate::refine::{Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, refine_cluster, refine_simple_modes};
 use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
@@ -480,10 +480,30 @@ impl Finish<'_> {
                 let correction = spectrum.as_mut().map(|s| s as &mut dyn ReducedCorrection);
                 refine_cluster(a, b, metric, correction, x0.as_ref(), omega[g.start])
             };
-            let refined: Vec<Option<RefinedCluster>> = match self.par {
-                Par::Seq => jobs.iter().map(refine_one).collect(),
-                _ => jobs.par_iter().map(refine_one).collect(),
+            // Simple modes of a definite pencil are refined as one batch whose corrections are
+            // block products ([`refine_simple_modes`]); a mode whose batch step fails, and
+            // every cluster, takes its own path.
+            let mut batched: Vec<Option<Option<RefinedCluster>>> = vec![None; jobs.len()];
+            if let (Metric::Cholesky(l), Some(y)) = (metric, def.reduced.as_ref()) {
+                let singles: Vec<usize> = (0..jobs.len()).filter(|&j| jobs[j].len() == 1).collect();
+                if !singles.is_empty() {
+                    let x0 = Mat::from_fn(n, singles.len(), |i, c| start[(i, jobs[singles[c]].start)]);
+                    let modes: Vec<usize> = singles.iter().map(|&j| def.first + jobs[j].start).collect();
+                    let pairs = refine_simple_modes(a, b, l, (y.as_ref(), &omega_all), &modes, x0.as_ref(), self.par);
+                    for (&j, pair) in singles.iter().zip(pairs) {
+                        batched[j] = pair.map(|p| Some(RefinedCluster::single(p)));
+                    }
+                }
+            }
+            let remaining: Vec<usize> = (0..jobs.len()).filter(|&j| batched[j].is_none()).collect();
+            let rest: Vec<Option<RefinedCluster>> = match self.par {
+                Par::Seq => remaining.iter().map(|&j| refine_one(&jobs[j])).collect(),
+                _ => remaining.par_iter().map(|&j| refine_one(&jobs[j])).collect(),
             };
+            for (&j, cluster) in remaining.iter().zip(rest) {
+                batched[j] = Some(cluster);
+            }
+            let refined = batched.into_iter().map(Option::flatten);
             let mut residuals: Vec<RefinedResidual> = Vec::new();
             let mut changed: Vec<usize> = Vec::new();
             for (g, cluster) in jobs.iter().zip(refined) {
