@@ -197,7 +197,31 @@ fn accumulate(
     lo: &mut [f64],
     two_prod: impl Fn(f64, f64) -> (f64, f64),
 ) {
-    for (j, &xj) in x.iter().enumerate() {
+    // Four contiguous columns per pass over hi and lo: each row takes the four updates in
+    // column order with hi and lo held in registers (the same operations in the same order as
+    // one column at a time, so the same bits, with a quarter of the loads and stores of hi, lo).
+    let mut j = 0;
+    while j + 4 <= x.len() {
+        let cols = [m.col(j), m.col(j + 1), m.col(j + 2), m.col(j + 3)].map(|c| c.try_as_col_major());
+        let [Some(c0), Some(c1), Some(c2), Some(c3)] = cols else {
+            break;
+        };
+        let (c0, c1, c2, c3) = (c0.as_slice(), c1.as_slice(), c2.as_slice(), c3.as_slice());
+        let (x0, x1, x2, x3) = (x[j], x[j + 1], x[j + 2], x[j + 3]);
+        for (i, (h, l)) in hi.iter_mut().zip(lo.iter_mut()).enumerate() {
+            let (mut sh, mut sl) = (*h, *l);
+            for (mij, xj) in [(c0[i], x0), (c1[i], x1), (c2[i], x2), (c3[i], x3)] {
+                let (p, e) = two_prod(mij, xj);
+                let (s, e2) = two_sum(sh, p);
+                sh = s;
+                sl += e + e2;
+            }
+            *h = sh;
+            *l = sl;
+        }
+        j += 4;
+    }
+    for (j, &xj) in x.iter().enumerate().skip(j) {
         let col = m.col(j);
         match col.try_as_col_major() {
             Some(c) => {
@@ -377,6 +401,24 @@ mod tests {
         // Row 0: (1e12 + 1)(1 + u) − 1e12 = 1 + u + 1e12·u exactly.
         let expected = 1.0 + f64::EPSILON + 1e12 * f64::EPSILON;
         assert!((y[0].to_f64() - expected).abs() <= 2.0 * f64::EPSILON * expected);
+    }
+
+    /// Four columns per pass (and the leftover columns one at a time) give the bits of one
+    /// column at a time: the same operations per row, in the same order.
+    #[test]
+    fn four_columns_per_pass_change_no_bit() {
+        let (n, k) = (29, 11);
+        let m = faer::Mat::from_fn(n, k, |i, j| {
+            ((i * 31 + j * 17) % 97) as f64 / 7.0 - 6.0 + 1e-9 * (i * j) as f64
+        });
+        let x: Vec<f64> = (0..k).map(|j| ((j * 13) % 29) as f64 / 3.0 - 4.5).collect();
+        let (mut hi, mut lo) = (vec![0.0; n], vec![0.0; n]);
+        accumulate(m.as_ref(), &x, &mut hi, &mut lo, two_prod);
+        let (mut hi1, mut lo1) = (vec![0.0; n], vec![0.0; n]);
+        for j in 0..k {
+            accumulate(m.as_ref().subcols(j, 1), &x[j..j + 1], &mut hi1, &mut lo1, two_prod);
+        }
+        assert_eq!((hi, lo), (hi1, lo1));
     }
 
     #[test]
