@@ -23,7 +23,7 @@
 //! condensed pencil (S, A₁) and its corrections go through the condensed spectrum ([`Metric`]).
 
 use crate::condense::Condensation;
-use crate::dd::{Dd, dot, mat_vec};
+use crate::dd::{Dd, Operand, dot, mat_vec};
 use crate::symmetric_eigen::TridiagonalForm;
 use crate::tridiagonal_vectors::{ShiftedTridiagonal, one_norm};
 use faer::linalg::matmul::matmul;
@@ -119,16 +119,16 @@ impl Metric<'_> {
 /// residual measured in `metric`; None if the bordered matrix is singular to working precision
 /// (the eigenvalue is not simple) or xᵀAx is not positive.
 pub(crate) fn refine_pair(
-    a: MatRef<'_, f64>,
+    a: Operand<'_>,
     b: MatRef<'_, f64>,
     metric: Metric<'_>,
     x0: &[f64],
     omega0: f64,
 ) -> Option<RefinedPair> {
-    let n = a.nrows();
-    let ax0: Vec<f64> = mat_vec(a, x0).iter().map(|v| v.to_f64()).collect();
+    let n = a.matrix().nrows();
+    let ax0: Vec<f64> = a.product(x0).iter().map(|v| v.to_f64()).collect();
     let border = Mat::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
-        (true, true) => b[(i, j)] - omega0 * a[(i, j)],
+        (true, true) => b[(i, j)] - omega0 * a.matrix()[(i, j)],
         (true, false) => -ax0[i],
         (false, true) => -ax0[j],
         (false, false) => 0.0,
@@ -139,7 +139,7 @@ pub(crate) fn refine_pair(
     let mut steps = 0;
     for _ in 0..MAX_STEPS {
         let bx = mat_vec(b, &x);
-        let axd = mat_vec(a, &x);
+        let axd = a.product(&x);
         let mut rhs = Mat::<f64>::zeros(n + 1, 1);
         for i in 0..n {
             rhs[(i, 0)] = -(bx[i].minus(omega.times(axd[i]))).to_f64();
@@ -313,7 +313,7 @@ const STAGNATION_ULPS: f64 = 16.0;
 /// Refines the simple pair (ω²_i, x₀): [`refine_cluster_projected`] for one mode.
 #[cfg(test)]
 pub(crate) fn refine_pair_projected(
-    a: MatRef<'_, f64>,
+    a: Operand<'_>,
     b: MatRef<'_, f64>,
     metric: Metric<'_>,
     correction: &mut dyn ReducedCorrection,
@@ -340,7 +340,7 @@ pub(crate) fn refine_pair_projected(
 /// too far from the exact one, or a cluster that is not separated from the rest): for p = 1 the
 /// caller then falls back to [`refine_pair`].
 pub(crate) fn refine_cluster_projected(
-    a: MatRef<'_, f64>,
+    a: Operand<'_>,
     b: MatRef<'_, f64>,
     metric: Metric<'_>,
     correction: &mut dyn ReducedCorrection,
@@ -353,7 +353,7 @@ pub(crate) fn refine_cluster_projected(
     let mut x = x0.to_owned();
     let mut previous = f64::INFINITY;
     for step in 1..=MAX_PROJECTED_STEPS {
-        let ax: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(a, x.col_as_slice(k))).collect();
+        let ax: Vec<Vec<Dd>> = (0..p).map(|k| a.product(x.col_as_slice(k))).collect();
         let bx: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(b, x.col_as_slice(k))).collect();
         let m = rayleigh_quotient_matrix(&x, &ax, &bx)?;
         let rho = (0..p).fold(Dd::of(0.0), |t, k| t.plus(m[k][k])).to_f64() / p as f64;
@@ -399,7 +399,7 @@ pub(crate) fn refine_cluster_projected(
 /// cluster of one). `reduced` is Y and all n eigenvalues of C; `modes[c]` is the index in
 /// that spectrum of column c of `x0`.
 pub(crate) fn refine_simple_modes(
-    a: MatRef<'_, f64>,
+    a: Operand<'_>,
     b: MatRef<'_, f64>,
     l: MatRef<'_, f64>,
     reduced: (MatRef<'_, f64>, &[f64]),
@@ -426,7 +426,7 @@ pub(crate) fn refine_simple_modes(
         // Residual r = Bx − ρAx in double-double, ρ = xᵀBx / xᵀAx, per active mode.
         let residual_of = |&c: &usize| {
             let xc = x.col_as_slice(c);
-            let (ax, bx) = (mat_vec(a, xc), mat_vec(b, xc));
+            let (ax, bx) = (a.product(xc), mat_vec(b, xc));
             let rho = dot(xc, &bx).over(dot(xc, &ax));
             let r: Vec<f64> = (0..n).map(|i| bx[i].minus(rho.times(ax[i])).to_f64()).collect();
             (rho.to_f64(), r)
@@ -496,7 +496,7 @@ pub(crate) fn refine_simple_modes(
 /// the bordered Newton step of [`refine_pair`] where that declines (the bordered step needs a
 /// simple eigenvalue, so a larger cluster has no fallback).
 pub(crate) fn refine_cluster(
-    a: MatRef<'_, f64>,
+    a: Operand<'_>,
     b: MatRef<'_, f64>,
     metric: Metric<'_>,
     correction: Option<&mut dyn ReducedCorrection>,
@@ -555,7 +555,7 @@ fn rayleigh_quotient_matrix(x: &Mat<f64>, ax: &[Vec<Dd>], bx: &[Vec<Dd>]) -> Opt
 /// (XᵀBX, XᵀAX) in ascending order, each finished by [`finish_pair`], and their mutual
 /// A-orthogonality in double-double.
 fn finish_cluster(
-    a: MatRef<'_, f64>,
+    a: Operand<'_>,
     b: MatRef<'_, f64>,
     metric: Metric<'_>,
     x: Mat<f64>,
@@ -565,7 +565,7 @@ fn finish_cluster(
     if p == 1 {
         return finish_pair(a, b, metric, x.col_as_slice(0).to_vec(), steps).map(RefinedCluster::single);
     }
-    let ax: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(a, x.col_as_slice(k))).collect();
+    let ax: Vec<Vec<Dd>> = (0..p).map(|k| a.product(x.col_as_slice(k))).collect();
     let bx: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(b, x.col_as_slice(k))).collect();
     let symmetric = |products: &[Vec<Dd>], i: usize, j: usize| {
         let upper = dot(x.col_as_slice(i), &products[j]).to_f64();
@@ -588,7 +588,7 @@ fn finish_cluster(
         .collect::<Option<_>>()?;
     let mut orthogonality = 0.0_f64;
     for k in 0..p {
-        let axk = mat_vec(a, &pairs[k].x);
+        let axk = a.product(&pairs[k].x);
         for j in 0..k {
             orthogonality = orthogonality.max(dot(&pairs[j].x, &axk).to_f64().abs());
         }
@@ -598,21 +598,21 @@ fn finish_cluster(
 
 /// A-normalises x, then its double-double Rayleigh quotient, residual and A⁻¹-norm residual.
 fn finish_pair(
-    a: MatRef<'_, f64>,
+    a: Operand<'_>,
     b: MatRef<'_, f64>,
     metric: Metric<'_>,
     mut x: Vec<f64>,
     steps: usize,
 ) -> Option<RefinedPair> {
-    let n = a.nrows();
-    let axd = mat_vec(a, &x);
+    let n = a.matrix().nrows();
+    let axd = a.product(&x);
     let xax = dot(&x, &axd);
     if xax.hi.is_nan() || xax.hi <= 0.0 {
         return None;
     }
     let scale = 1.0 / xax.hi.sqrt();
     x.iter_mut().for_each(|v| *v *= scale);
-    let axd = mat_vec(a, &x);
+    let axd = a.product(&x);
     let bxd = mat_vec(b, &x);
     let xax = dot(&x, &axd);
     let rq = dot(&x, &bxd).over(xax);
@@ -669,10 +669,22 @@ mod tests {
                 modes: i..i + 1,
             };
             let x0: Vec<f64> = (0..16).map(|r| x[(r, i)]).collect();
-            let fast = refine_pair_projected(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &mut spectrum, &x0)
-                .expect("converges");
-            let slow =
-                refine_pair(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &x0, omega[i]).expect("converges");
+            let fast = refine_pair_projected(
+                Operand::new(a.as_ref()),
+                b.as_ref(),
+                Metric::Cholesky(l.as_ref()),
+                &mut spectrum,
+                &x0,
+            )
+            .expect("converges");
+            let slow = refine_pair(
+                Operand::new(a.as_ref()),
+                b.as_ref(),
+                Metric::Cholesky(l.as_ref()),
+                &x0,
+                omega[i],
+            )
+            .expect("converges");
             let w = slow.omega_sq;
             assert!(
                 (fast.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
@@ -696,7 +708,7 @@ mod tests {
         let x0 = Mat::from_fn(16, modes.len(), |r, c| x[(r, modes[c])]);
         for par in [Par::Seq, Par::rayon(2)] {
             let batch = refine_simple_modes(
-                a.as_ref(),
+                Operand::new(a.as_ref()),
                 b.as_ref(),
                 l.as_ref(),
                 (y.as_ref(), &omega),
@@ -707,8 +719,14 @@ mod tests {
             for (c, &i) in modes.iter().enumerate() {
                 let fast = batch[c].as_ref().expect("the batch step converges");
                 let start: Vec<f64> = x0.col(c).iter().copied().collect();
-                let slow = refine_pair(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &start, omega[i])
-                    .expect("converges");
+                let slow = refine_pair(
+                    Operand::new(a.as_ref()),
+                    b.as_ref(),
+                    Metric::Cholesky(l.as_ref()),
+                    &start,
+                    omega[i],
+                )
+                .expect("converges");
                 let w = slow.omega_sq;
                 assert!(
                     (fast.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
@@ -740,15 +758,21 @@ mod tests {
                 purified: false,
             };
             let fast = refine_pair_projected(
-                a.as_ref(),
+                Operand::new(a.as_ref()),
                 b.as_ref(),
                 Metric::Cholesky(l.as_ref()),
                 &mut correction,
                 &x0,
             )
             .expect("the tridiagonal correction converges");
-            let slow =
-                refine_pair(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &x0, values[i]).expect("converges");
+            let slow = refine_pair(
+                Operand::new(a.as_ref()),
+                b.as_ref(),
+                Metric::Cholesky(l.as_ref()),
+                &x0,
+                values[i],
+            )
+            .expect("converges");
             let w = slow.omega_sq;
             assert!(
                 (fast.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
@@ -776,19 +800,38 @@ mod tests {
         // Start from a mixture of modes 0 and 1, so the wrong ω²₁ drives the correction.
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)] + 0.3 * x[(r, 1)]).collect();
         assert!(
-            refine_pair_projected(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &mut spectrum, &x0).is_none()
+            refine_pair_projected(
+                Operand::new(a.as_ref()),
+                b.as_ref(),
+                Metric::Cholesky(l.as_ref()),
+                &mut spectrum,
+                &x0
+            )
+            .is_none()
         );
-        let slow = refine_pair(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &x0, omega[0])
-            .expect("bordered Newton converges");
+        let slow = refine_pair(
+            Operand::new(a.as_ref()),
+            b.as_ref(),
+            Metric::Cholesky(l.as_ref()),
+            &x0,
+            omega[0],
+        )
+        .expect("bordered Newton converges");
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)]).collect();
         let mut right = ReducedSpectrum {
             y: y.as_ref(),
             omega_sq: &omega,
             modes: 0..1,
         };
-        let w = refine_pair_projected(a.as_ref(), b.as_ref(), Metric::Cholesky(l.as_ref()), &mut right, &x0)
-            .expect("converges")
-            .omega_sq;
+        let w = refine_pair_projected(
+            Operand::new(a.as_ref()),
+            b.as_ref(),
+            Metric::Cholesky(l.as_ref()),
+            &mut right,
+            &x0,
+        )
+        .expect("converges")
+        .omega_sq;
         assert!(
             (slow.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
             "{} vs {w}",

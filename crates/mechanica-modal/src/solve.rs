@@ -9,6 +9,7 @@
 
 use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::condense::Condensation;
+use crate::dd::Operand;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
 use crate::refine::{Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, refine_cluster, refine_simple_modes};
@@ -467,6 +468,7 @@ impl Finish<'_> {
                     wanted && refinable(g, &omega, &report.error_bounds, &omega_all, def.first)
                 })
                 .collect();
+            let mass = Operand::new(a);
             // Clusters are independent: each is refined from its own columns of X, sequentially
             // inside, and the clusters are shared among the threads.
             let start = xm.as_ref();
@@ -478,7 +480,7 @@ impl Finish<'_> {
                     modes: def.first + g.start..def.first + g.end,
                 });
                 let correction = spectrum.as_mut().map(|s| s as &mut dyn ReducedCorrection);
-                refine_cluster(a, b, metric, correction, x0.as_ref(), omega[g.start])
+                refine_cluster(mass, b, metric, correction, x0.as_ref(), omega[g.start])
             };
             // Simple modes of a definite pencil are refined as one batch whose corrections are
             // block products ([`refine_simple_modes`]); a mode whose batch step fails, and
@@ -489,7 +491,8 @@ impl Finish<'_> {
                 if !singles.is_empty() {
                     let x0 = Mat::from_fn(n, singles.len(), |i, c| start[(i, jobs[singles[c]].start)]);
                     let modes: Vec<usize> = singles.iter().map(|&j| def.first + jobs[j].start).collect();
-                    let pairs = refine_simple_modes(a, b, l, (y.as_ref(), &omega_all), &modes, x0.as_ref(), self.par);
+                    let pairs =
+                        refine_simple_modes(mass, b, l, (y.as_ref(), &omega_all), &modes, x0.as_ref(), self.par);
                     for (&j, pair) in singles.iter().zip(pairs) {
                         batched[j] = pair.map(|p| Some(RefinedCluster::single(p)));
                     }

@@ -82,6 +82,7 @@ pub(crate) fn sharpen(
     let separable: Vec<f64> = (0..omega.len())
         .map(|i| report.error_bounds[i].max(a_priori.bound(omega[i])))
         .collect();
+    let mass = crate::dd::Operand::new(a);
     for g in clusters(omega, &separable) {
         // A block needs the vectors of all its members: consecutive flagged columns.
         let Some(col) = flagged.iter().position(|&i| i == g.start) else {
@@ -99,7 +100,7 @@ pub(crate) fn sharpen(
             purified: false,
         };
         let refined = refine_cluster(
-            a,
+            mass,
             b,
             Metric::Cholesky(pencil.l),
             Some(&mut correction),
