@@ -108,8 +108,6 @@ pub(crate) struct Condensation {
     g: Mat<f64>,
     /// L₁ = diag(√a₁), the Cholesky factor of the condensed mass matrix.
     pub(crate) l1: Mat<f64>,
-    /// A₁ = L₁².
-    pub(crate) a1: Mat<f64>,
     /// 4r·u·(κ(B₀₀) + 2)·‖B₁₀‖_F·‖B₀₀⁻¹‖₂: the rounding of B₁₀B₀₀⁻¹r₀ per unit ‖r₀‖.
     rounding: f64,
     /// Refinement is offered only when A is diagonal and its massless entries are exactly zero,
@@ -137,7 +135,6 @@ impl Condensation {
         let dmax = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let rounding =
             4.0 * r as f64 * f64::EPSILON * (dmax / dmin + 2.0) * crate::accuracy::frobenius_norm(b10.as_ref()) / dmin;
-        let a1 = Mat::from_fn(l1.nrows(), l1.ncols(), |i, j| if i == j { values[r + i] } else { 0.0 });
         Self {
             order,
             massless: r,
@@ -146,7 +143,6 @@ impl Condensation {
             d,
             g,
             l1,
-            a1,
             rounding,
             refinable,
         }
@@ -216,6 +212,16 @@ impl Condensation {
             }
         }
         dx
+    }
+
+    /// A₁ = L₁L₁ᵀ, the condensed mass matrix (diagonal).
+    pub(crate) fn condensed_mass(&self) -> Mat<f64> {
+        let m = self.l1.nrows();
+        Mat::from_fn(
+            m,
+            m,
+            |i, j| if i == j { self.l1[(i, i)] * self.l1[(i, i)] } else { 0.0 },
+        )
     }
 
     /// The rows of X at the coordinates with mass: the condensed mode shapes Z.

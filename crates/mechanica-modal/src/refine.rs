@@ -659,6 +659,18 @@ mod tests {
 
     /// The spectral correction and the bordered LBLᵀ Newton step converge to the same pair: both
     /// Rayleigh quotients agree to a few ulps, and the residuals are of the same size.
+    /// The bordered LBLᵀ Newton step from (ω₀², x₀), the reference the other steps must meet.
+    fn bordered(a: &Mat<f64>, b: &Mat<f64>, l: &Mat<f64>, x0: &[f64], omega0: f64) -> RefinedPair {
+        refine_pair(
+            Operand::new(a.as_ref()),
+            b.as_ref(),
+            Metric::Cholesky(l.as_ref()),
+            x0,
+            omega0,
+        )
+        .expect("the bordered Newton step converges")
+    }
+
     #[test]
     fn spectral_and_bordered_refinement_agree_on_a_graded_chain() {
         let (a, b, l, y, omega, x) = graded();
@@ -677,14 +689,7 @@ mod tests {
                 &x0,
             )
             .expect("converges");
-            let slow = refine_pair(
-                Operand::new(a.as_ref()),
-                b.as_ref(),
-                Metric::Cholesky(l.as_ref()),
-                &x0,
-                omega[i],
-            )
-            .expect("converges");
+            let slow = bordered(&a, &b, &l, &x0, omega[i]);
             let w = slow.omega_sq;
             assert!(
                 (fast.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
@@ -719,14 +724,7 @@ mod tests {
             for (c, &i) in modes.iter().enumerate() {
                 let fast = batch[c].as_ref().expect("the batch step converges");
                 let start: Vec<f64> = x0.col(c).iter().copied().collect();
-                let slow = refine_pair(
-                    Operand::new(a.as_ref()),
-                    b.as_ref(),
-                    Metric::Cholesky(l.as_ref()),
-                    &start,
-                    omega[i],
-                )
-                .expect("converges");
+                let slow = bordered(&a, &b, &l, &start, omega[i]);
                 let w = slow.omega_sq;
                 assert!(
                     (fast.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
@@ -765,14 +763,7 @@ mod tests {
                 &x0,
             )
             .expect("the tridiagonal correction converges");
-            let slow = refine_pair(
-                Operand::new(a.as_ref()),
-                b.as_ref(),
-                Metric::Cholesky(l.as_ref()),
-                &x0,
-                values[i],
-            )
-            .expect("converges");
+            let slow = bordered(&a, &b, &l, &x0, values[i]);
             let w = slow.omega_sq;
             assert!(
                 (fast.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
@@ -809,14 +800,7 @@ mod tests {
             )
             .is_none()
         );
-        let slow = refine_pair(
-            Operand::new(a.as_ref()),
-            b.as_ref(),
-            Metric::Cholesky(l.as_ref()),
-            &x0,
-            omega[0],
-        )
-        .expect("bordered Newton converges");
+        let slow = bordered(&a, &b, &l, &x0, omega[0]);
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)]).collect();
         let mut right = ReducedSpectrum {
             y: y.as_ref(),

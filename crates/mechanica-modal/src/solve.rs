@@ -488,28 +488,28 @@ impl Finish<'_> {
             // Simple modes of a definite pencil are refined as one batch whose corrections are
             // block products ([`refine_simple_modes`]); a mode whose batch step fails, and
             // every cluster, takes its own path.
-            let mut batched: Vec<Option<Option<RefinedCluster>>> = vec![None; jobs.len()];
+            let mut refined: Vec<Option<RefinedCluster>> = vec![None; jobs.len()];
+            let mut pending: Vec<usize> = (0..jobs.len()).collect();
             if let (Metric::Cholesky(l), Some(y)) = (metric, def.reduced.as_ref()) {
-                let singles: Vec<usize> = (0..jobs.len()).filter(|&j| jobs[j].len() == 1).collect();
+                let singles: Vec<usize> = pending.iter().copied().filter(|&j| jobs[j].len() == 1).collect();
                 if !singles.is_empty() {
                     let x0 = Mat::from_fn(n, singles.len(), |i, c| start[(i, jobs[singles[c]].start)]);
                     let modes: Vec<usize> = singles.iter().map(|&j| def.first + jobs[j].start).collect();
                     let pairs =
                         refine_simple_modes(mass, b, l, (y.as_ref(), &omega_all), &modes, x0.as_ref(), self.par);
                     for (&j, pair) in singles.iter().zip(pairs) {
-                        batched[j] = pair.map(|p| Some(RefinedCluster::single(p)));
+                        refined[j] = pair.map(RefinedCluster::single);
                     }
+                    pending.retain(|&j| refined[j].is_none());
                 }
             }
-            let remaining: Vec<usize> = (0..jobs.len()).filter(|&j| batched[j].is_none()).collect();
             let rest: Vec<Option<RefinedCluster>> = match self.par {
-                Par::Seq => remaining.iter().map(|&j| refine_one(&jobs[j])).collect(),
-                _ => remaining.par_iter().map(|&j| refine_one(&jobs[j])).collect(),
+                Par::Seq => pending.iter().map(|&j| refine_one(&jobs[j])).collect(),
+                _ => pending.par_iter().map(|&j| refine_one(&jobs[j])).collect(),
             };
-            for (&j, cluster) in remaining.iter().zip(rest) {
-                batched[j] = Some(cluster);
+            for (&j, cluster) in pending.iter().zip(rest) {
+                refined[j] = cluster;
             }
-            let refined = batched.into_iter().map(Option::flatten);
             let mut residuals: Vec<RefinedResidual> = Vec::new();
             let mut changed: Vec<usize> = Vec::new();
             for (g, cluster) in jobs.iter().zip(refined) {
@@ -538,23 +538,17 @@ impl Finish<'_> {
             // the condensed (S, A₁) with the modes' rows at the coordinates with mass.
             let condensed = self
                 .condensation
-                .filter(|_| !residuals.is_empty())
-                .map(|c| (c, c.massed_rows(xm.as_ref())));
-            let basis = match &condensed {
-                Some((c, z)) => accuracy::ModeBasis {
-                    a: c.a1.as_ref(),
-                    l: self.l,
-                    x: z.as_ref(),
-                    modes: &all,
-                    unselected: None,
-                },
-                None => accuracy::ModeBasis {
-                    a,
-                    l: self.l,
-                    x: xm.as_ref(),
-                    modes: &all,
-                    unselected: None,
-                },
+                .map(|c| (c.condensed_mass(), c.massed_rows(xm.as_ref())));
+            let (basis_a, basis_x) = match &condensed {
+                Some((a1, z)) => (a1.as_ref(), z.as_ref()),
+                None => (a, xm.as_ref()),
+            };
+            let basis = accuracy::ModeBasis {
+                a: basis_a,
+                l: self.l,
+                x: basis_x,
+                modes: &all,
+                unselected: None,
             };
             accuracy::residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, &basis, self.par);
         }
