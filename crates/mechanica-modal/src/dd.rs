@@ -163,22 +163,45 @@ pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     hi.into_iter().zip(lo).map(|(hi, lo)| Dd { hi, lo }).collect()
 }
 
-/// A matrix for double-double products, with whether it is diagonal found once: a lumped
-/// mass matrix then costs n exact products (TwoProd) per vector instead of n² double-double
-/// operations, in every refinement step.
-#[derive(Clone, Copy)]
+/// A matrix for double-double products, with its structure found once: a diagonal matrix
+/// (lumped masses) costs n exact products (TwoProd) per vector, and a matrix with few nonzeros
+/// (a banded or assembled stiffness stored densely) costs one double-double operation per
+/// nonzero, instead of n² in every refinement step. The products are those of [`mat_vec`]
+/// with its zero terms left out: a zero term adds an exact zero to both parts, so the values
+/// are the same.
+#[derive(Clone)]
 pub(crate) struct Operand<'a> {
     matrix: MatRef<'a, f64>,
-    diagonal: bool,
+    structure: Structure,
 }
 
+/// How [`Operand::product`] forms its products.
+#[derive(Clone)]
+enum Structure {
+    Dense,
+    Diagonal,
+    /// The nonzero entries by columns.
+    Sparse(faer::sparse::SparseColMat<usize, f64>),
+}
+
+/// An operand with at most n²/`SPARSE_FRACTION` nonzeros is stored by columns: the sparse
+/// product touches scattered accumulators one term at a time, where the dense kernel runs four
+/// rows per instruction, so it wins only well below full density.
+const SPARSE_FRACTION: usize = 16;
+
 impl<'a> Operand<'a> {
-    /// Wraps `matrix` (one scan of its off-diagonal entries, stopping at the first nonzero).
+    /// Wraps `matrix`: one scan of its entries, stopping once it holds more nonzeros than a
+    /// sparse operand may (a dense matrix costs n²/16 reads).
     pub(crate) fn new(matrix: MatRef<'a, f64>) -> Self {
-        Self {
-            matrix,
-            diagonal: crate::reduce::is_diagonal(matrix),
-        }
+        let structure = if crate::reduce::is_diagonal(matrix) && crate::reduce::is_diagonal(matrix.transpose()) {
+            Structure::Diagonal
+        } else {
+            match nonzeros_by_columns(matrix, matrix.nrows() * matrix.ncols() / SPARSE_FRACTION) {
+                Some(sparse) => Structure::Sparse(sparse),
+                None => Structure::Dense,
+            }
+        };
+        Self { matrix, structure }
     }
 
     /// The matrix itself.
@@ -186,21 +209,42 @@ impl<'a> Operand<'a> {
         self.matrix
     }
 
-    /// M x in double-double, exactly as [`mat_vec`] (a diagonal entry's product is exact in
-    /// double-double, so both give the same value).
+    /// M x in double-double, with the values of [`mat_vec`].
     pub(crate) fn product(&self, x: &[f64]) -> Vec<Dd> {
-        if self.diagonal {
-            x.iter()
+        match &self.structure {
+            Structure::Diagonal => x
+                .iter()
                 .enumerate()
                 .map(|(i, &v)| {
                     let (hi, lo) = two_prod(self.matrix[(i, i)], v);
                     Dd { hi, lo }
                 })
-                .collect()
-        } else {
-            mat_vec(self.matrix, x)
+                .collect(),
+            Structure::Sparse(m) => sparse_mat_vec(m.as_ref(), x),
+            Structure::Dense => mat_vec(self.matrix, x),
         }
     }
+}
+
+/// The nonzero entries of `m` by columns (rows ascending), or None past `limit` nonzeros.
+fn nonzeros_by_columns(m: MatRef<'_, f64>, limit: usize) -> Option<faer::sparse::SparseColMat<usize, f64>> {
+    let mut column_starts = Vec::with_capacity(m.ncols() + 1);
+    let (mut rows, mut values) = (Vec::new(), Vec::new());
+    column_starts.push(0);
+    for j in 0..m.ncols() {
+        for (i, &v) in m.col(j).iter().enumerate() {
+            if v != 0.0 {
+                if rows.len() == limit {
+                    return None;
+                }
+                rows.push(i);
+                values.push(v);
+            }
+        }
+        column_starts.push(rows.len());
+    }
+    let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(m.nrows(), m.ncols(), column_starts, None, rows);
+    Some(faer::sparse::SparseColMat::new(symbolic, values))
 }
 
 /// Orders from which [`mat_vec`] splits its rows between two threads (a thread costs tens of
@@ -468,13 +512,47 @@ mod tests {
         let n = 13;
         let mut m = faer::Mat::from_fn(n, n, |i, j| if i == j { 1.0 / (i as f64 + 3.0) } else { 0.0 });
         let x: Vec<f64> = (0..n).map(|j| ((j * 13) % 29) as f64 / 3.0 - 4.5).collect();
-        let fast = Operand::new(m.as_ref()).product(&x);
+        let operand = Operand::new(m.as_ref());
+        assert!(matches!(operand.structure, Structure::Diagonal));
+        let fast = operand.product(&x);
         let dense = mat_vec(m.as_ref(), &x);
         assert!(fast.iter().zip(&dense).all(|(f, d)| (f.hi, f.lo) == (d.hi, d.lo)));
-        m[(n - 1, 0)] = 0.5;
-        let fast = Operand::new(m.as_ref()).product(&x);
-        let dense = mat_vec(m.as_ref(), &x);
-        assert!(fast.iter().zip(&dense).all(|(f, d)| (f.hi, f.lo) == (d.hi, d.lo)));
+        // One entry off the diagonal, below or above it: not diagonal.
+        for (i, j) in [(n - 1, 0), (0, n - 1)] {
+            let mut off = m.clone();
+            off[(i, j)] = 0.5;
+            let operand = Operand::new(off.as_ref());
+            assert!(!matches!(operand.structure, Structure::Diagonal), "({i}, {j})");
+            let fast = operand.product(&x);
+            let dense = mat_vec(off.as_ref(), &x);
+            assert!(fast.iter().zip(&dense).all(|(f, d)| (f.hi, f.lo) == (d.hi, d.lo)));
+        }
+        m[(1, 0)] = 1.0;
+        assert!(!matches!(Operand::new(m.as_ref()).structure, Structure::Diagonal));
+    }
+
+    /// A banded matrix stored densely is taken for sparse, and its products have the values of
+    /// the dense kernel (the zero terms it skips add exact zeros), also on a row whose terms
+    /// cancel to a tiny sum; a dense matrix stays dense.
+    #[test]
+    fn sparse_operands_give_the_dense_products() {
+        let n = 200;
+        let band = faer::Mat::from_fn(n, n, |i, j| match i.abs_diff(j) {
+            0 => 1e12 * (1.0 + i as f64 / 7.0),
+            1 => -1e12 * (1.0 + i.min(j) as f64 / 7.0) + 0.25,
+            3 => 1.0 / (1.0 + (i + j) as f64),
+            _ => 0.0,
+        });
+        let x: Vec<f64> = (0..n).map(|j| 1.0 + ((j * 13) % 29) as f64 * f64::EPSILON).collect();
+        let operand = Operand::new(band.as_ref());
+        assert!(matches!(operand.structure, Structure::Sparse(_)));
+        let fast = operand.product(&x);
+        let dense = mat_vec(band.as_ref(), &x);
+        for (i, (f, d)) in fast.iter().zip(&dense).enumerate() {
+            assert!(f.hi == d.hi && f.lo == d.lo, "row {i}: {f:?} against {d:?}");
+        }
+        let full = faer::Mat::from_fn(n, n, |i, j| 1.0 / (1.0 + i as f64 + j as f64));
+        assert!(matches!(Operand::new(full.as_ref()).structure, Structure::Dense));
     }
 
     #[test]

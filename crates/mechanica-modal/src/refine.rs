@@ -23,7 +23,8 @@
 //! condensed pencil (S, A₁) and its corrections go through the condensed spectrum ([`Metric`]).
 
 use crate::condense::Condensation;
-use crate::dd::{Dd, Operand, dot, mat_vec};
+use crate::dd::{Dd, Operand, dot};
+use crate::reduce::LowerFactor;
 use crate::symmetric_eigen::TridiagonalForm;
 use crate::tridiagonal_vectors::{ShiftedTridiagonal, one_norm};
 use faer::linalg::matmul::matmul;
@@ -76,7 +77,7 @@ impl RefinedCluster {
 #[derive(Clone, Copy)]
 pub(crate) enum Metric<'a> {
     /// A = LLᵀ positive definite (L lower): corrections L⁻ᵀKL⁻¹r, residuals in the A⁻¹-norm.
-    Cholesky(MatRef<'a, f64>),
+    Cholesky(LowerFactor<'a>),
     /// A diagonal with exactly massless coordinates, condensed statically: corrections and
     /// residuals of the condensed pencil (S, A₁) (module `condense`).
     Condensed(&'a Condensation),
@@ -88,9 +89,9 @@ impl Metric<'_> {
         match self {
             Self::Cholesky(l) => {
                 let mut w = r;
-                solve_lower_triangular_in_place(*l, w.as_mut(), Par::Seq);
+                l.solve(w.as_mut(), Par::Seq);
                 let mut delta = reduced.apply(w, rho);
-                solve_upper_triangular_in_place(l.transpose(), delta.as_mut(), Par::Seq);
+                l.solve_transposed(delta.as_mut(), Par::Seq);
                 delta
             }
             Self::Condensed(c) => c.correction(&r, rho, reduced),
@@ -102,7 +103,7 @@ impl Metric<'_> {
         match self {
             Self::Cholesky(l) => {
                 let mut y = Mat::from_fn(r.len(), 1, |i, _| r[i]);
-                solve_lower_triangular_in_place(*l, y.as_mut(), Par::Seq);
+                l.solve(y.as_mut(), Par::Seq);
                 (r, y.norm_l2())
             }
             Self::Condensed(c) => {
@@ -119,8 +120,8 @@ impl Metric<'_> {
 /// residual measured in `metric`; None if the bordered matrix is singular to working precision
 /// (the eigenvalue is not simple) or xᵀAx is not positive.
 pub(crate) fn refine_pair(
-    a: Operand<'_>,
-    b: MatRef<'_, f64>,
+    a: &Operand<'_>,
+    b: &Operand<'_>,
     metric: Metric<'_>,
     x0: &[f64],
     omega0: f64,
@@ -128,7 +129,7 @@ pub(crate) fn refine_pair(
     let n = a.matrix().nrows();
     let ax0: Vec<f64> = a.product(x0).iter().map(|v| v.to_f64()).collect();
     let border = Mat::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
-        (true, true) => b[(i, j)] - omega0 * a.matrix()[(i, j)],
+        (true, true) => b.matrix()[(i, j)] - omega0 * a.matrix()[(i, j)],
         (true, false) => -ax0[i],
         (false, true) => -ax0[j],
         (false, false) => 0.0,
@@ -138,7 +139,7 @@ pub(crate) fn refine_pair(
     let mut omega = Dd::of(omega0);
     let mut steps = 0;
     for _ in 0..MAX_STEPS {
-        let bx = mat_vec(b, &x);
+        let bx = b.product(&x);
         let axd = a.product(&x);
         let mut rhs = Mat::<f64>::zeros(n + 1, 1);
         for i in 0..n {
@@ -313,8 +314,8 @@ const STAGNATION_ULPS: f64 = 16.0;
 /// Refines the simple pair (ω²_i, x₀): [`refine_cluster_projected`] for one mode.
 #[cfg(test)]
 pub(crate) fn refine_pair_projected(
-    a: Operand<'_>,
-    b: MatRef<'_, f64>,
+    a: &Operand<'_>,
+    b: &Operand<'_>,
     metric: Metric<'_>,
     correction: &mut dyn ReducedCorrection,
     x0: &[f64],
@@ -340,8 +341,8 @@ pub(crate) fn refine_pair_projected(
 /// too far from the exact one, or a cluster that is not separated from the rest): for p = 1 the
 /// caller then falls back to [`refine_pair`].
 pub(crate) fn refine_cluster_projected(
-    a: Operand<'_>,
-    b: MatRef<'_, f64>,
+    a: &Operand<'_>,
+    b: &Operand<'_>,
     metric: Metric<'_>,
     correction: &mut dyn ReducedCorrection,
     x0: MatRef<'_, f64>,
@@ -354,7 +355,7 @@ pub(crate) fn refine_cluster_projected(
     let mut previous = f64::INFINITY;
     for step in 1..=MAX_PROJECTED_STEPS {
         let ax: Vec<Vec<Dd>> = (0..p).map(|k| a.product(x.col_as_slice(k))).collect();
-        let bx: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(b, x.col_as_slice(k))).collect();
+        let bx: Vec<Vec<Dd>> = (0..p).map(|k| b.product(x.col_as_slice(k))).collect();
         let m = rayleigh_quotient_matrix(&x, &ax, &bx)?;
         let rho = (0..p).fold(Dd::of(0.0), |t, k| t.plus(m[k][k])).to_f64() / p as f64;
         let w = Mat::from_fn(n, p, |i, k| {
@@ -399,9 +400,9 @@ pub(crate) fn refine_cluster_projected(
 /// cluster of one). `reduced` is Y and all n eigenvalues of C; `modes[c]` is the index in
 /// that spectrum of column c of `x0`.
 pub(crate) fn refine_simple_modes(
-    a: Operand<'_>,
-    b: MatRef<'_, f64>,
-    l: MatRef<'_, f64>,
+    a: &Operand<'_>,
+    b: &Operand<'_>,
+    l: LowerFactor<'_>,
     reduced: (MatRef<'_, f64>, &[f64]),
     modes: &[usize],
     x0: MatRef<'_, f64>,
@@ -426,7 +427,7 @@ pub(crate) fn refine_simple_modes(
         // Residual r = Bx − ρAx in double-double, ρ = xᵀBx / xᵀAx, per active mode.
         let residual_of = |&c: &usize| {
             let xc = x.col_as_slice(c);
-            let (ax, bx) = (a.product(xc), mat_vec(b, xc));
+            let (ax, bx) = (a.product(xc), b.product(xc));
             let rho = dot(xc, &bx).over(dot(xc, &ax));
             let r: Vec<f64> = (0..n).map(|i| bx[i].minus(rho.times(ax[i])).to_f64()).collect();
             (rho.to_f64(), r)
@@ -436,7 +437,7 @@ pub(crate) fn refine_simple_modes(
             _ => active.par_iter().map(residual_of).collect(),
         };
         let mut w = Mat::from_fn(n, active.len(), |i, c| residuals[c].1[i]);
-        solve_lower_triangular_in_place(l, w.as_mut(), par);
+        l.solve(w.as_mut(), par);
         let mut coefficients = Mat::<f64>::zeros(y.ncols(), active.len());
         matmul(
             coefficients.as_mut(),
@@ -457,7 +458,7 @@ pub(crate) fn refine_simple_modes(
         }
         let mut delta = Mat::<f64>::zeros(n, active.len());
         matmul(delta.as_mut(), Accum::Replace, y, coefficients.as_ref(), 1.0, par);
-        solve_upper_triangular_in_place(l.transpose(), delta.as_mut(), par);
+        l.solve_transposed(delta.as_mut(), par);
         for (c, &mode) in active.iter().enumerate() {
             let d = delta.col_as_slice(c);
             if !d.iter().all(|v| v.is_finite()) {
@@ -496,8 +497,8 @@ pub(crate) fn refine_simple_modes(
 /// the bordered Newton step of [`refine_pair`] where that declines (the bordered step needs a
 /// simple eigenvalue, so a larger cluster has no fallback).
 pub(crate) fn refine_cluster(
-    a: Operand<'_>,
-    b: MatRef<'_, f64>,
+    a: &Operand<'_>,
+    b: &Operand<'_>,
     metric: Metric<'_>,
     correction: Option<&mut dyn ReducedCorrection>,
     x0: MatRef<'_, f64>,
@@ -555,8 +556,8 @@ fn rayleigh_quotient_matrix(x: &Mat<f64>, ax: &[Vec<Dd>], bx: &[Vec<Dd>]) -> Opt
 /// (XᵀBX, XᵀAX) in ascending order, each finished by [`finish_pair`], and their mutual
 /// A-orthogonality in double-double.
 fn finish_cluster(
-    a: Operand<'_>,
-    b: MatRef<'_, f64>,
+    a: &Operand<'_>,
+    b: &Operand<'_>,
     metric: Metric<'_>,
     x: Mat<f64>,
     steps: usize,
@@ -566,7 +567,7 @@ fn finish_cluster(
         return finish_pair(a, b, metric, x.col_as_slice(0).to_vec(), steps).map(RefinedCluster::single);
     }
     let ax: Vec<Vec<Dd>> = (0..p).map(|k| a.product(x.col_as_slice(k))).collect();
-    let bx: Vec<Vec<Dd>> = (0..p).map(|k| mat_vec(b, x.col_as_slice(k))).collect();
+    let bx: Vec<Vec<Dd>> = (0..p).map(|k| b.product(x.col_as_slice(k))).collect();
     let symmetric = |products: &[Vec<Dd>], i: usize, j: usize| {
         let upper = dot(x.col_as_slice(i), &products[j]).to_f64();
         let lower = dot(x.col_as_slice(j), &products[i]).to_f64();
@@ -598,8 +599,8 @@ fn finish_cluster(
 
 /// A-normalises x, then its double-double Rayleigh quotient, residual and A⁻¹-norm residual.
 fn finish_pair(
-    a: Operand<'_>,
-    b: MatRef<'_, f64>,
+    a: &Operand<'_>,
+    b: &Operand<'_>,
     metric: Metric<'_>,
     mut x: Vec<f64>,
     steps: usize,
@@ -613,7 +614,7 @@ fn finish_pair(
     let scale = 1.0 / xax.hi.sqrt();
     x.iter_mut().for_each(|v| *v *= scale);
     let axd = a.product(&x);
-    let bxd = mat_vec(b, &x);
+    let bxd = b.product(&x);
     let xax = dot(&x, &axd);
     let rq = dot(&x, &bxd).over(xax);
     let r: Vec<f64> = (0..n).map(|i| bxd[i].minus(rq.times(axd[i])).to_f64()).collect();
@@ -662,9 +663,9 @@ mod tests {
     /// The bordered LBLᵀ Newton step from (ω₀², x₀), the reference the other steps must meet.
     fn bordered(a: &Mat<f64>, b: &Mat<f64>, l: &Mat<f64>, x0: &[f64], omega0: f64) -> RefinedPair {
         refine_pair(
-            Operand::new(a.as_ref()),
-            b.as_ref(),
-            Metric::Cholesky(l.as_ref()),
+            &Operand::new(a.as_ref()),
+            &Operand::new(b.as_ref()),
+            Metric::Cholesky(LowerFactor::new(l.as_ref())),
             x0,
             omega0,
         )
@@ -682,9 +683,9 @@ mod tests {
             };
             let x0: Vec<f64> = (0..16).map(|r| x[(r, i)]).collect();
             let fast = refine_pair_projected(
-                Operand::new(a.as_ref()),
-                b.as_ref(),
-                Metric::Cholesky(l.as_ref()),
+                &Operand::new(a.as_ref()),
+                &Operand::new(b.as_ref()),
+                Metric::Cholesky(LowerFactor::new(l.as_ref())),
                 &mut spectrum,
                 &x0,
             )
@@ -713,9 +714,9 @@ mod tests {
         let x0 = Mat::from_fn(16, modes.len(), |r, c| x[(r, modes[c])]);
         for par in [Par::Seq, Par::rayon(2)] {
             let batch = refine_simple_modes(
-                Operand::new(a.as_ref()),
-                b.as_ref(),
-                l.as_ref(),
+                &Operand::new(a.as_ref()),
+                &Operand::new(b.as_ref()),
+                LowerFactor::new(l.as_ref()),
                 (y.as_ref(), &omega),
                 &modes,
                 x0.as_ref(),
@@ -756,9 +757,9 @@ mod tests {
                 purified: false,
             };
             let fast = refine_pair_projected(
-                Operand::new(a.as_ref()),
-                b.as_ref(),
-                Metric::Cholesky(l.as_ref()),
+                &Operand::new(a.as_ref()),
+                &Operand::new(b.as_ref()),
+                Metric::Cholesky(LowerFactor::new(l.as_ref())),
                 &mut correction,
                 &x0,
             )
@@ -792,9 +793,9 @@ mod tests {
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)] + 0.3 * x[(r, 1)]).collect();
         assert!(
             refine_pair_projected(
-                Operand::new(a.as_ref()),
-                b.as_ref(),
-                Metric::Cholesky(l.as_ref()),
+                &Operand::new(a.as_ref()),
+                &Operand::new(b.as_ref()),
+                Metric::Cholesky(LowerFactor::new(l.as_ref())),
                 &mut spectrum,
                 &x0
             )
@@ -808,9 +809,9 @@ mod tests {
             modes: 0..1,
         };
         let w = refine_pair_projected(
-            Operand::new(a.as_ref()),
-            b.as_ref(),
-            Metric::Cholesky(l.as_ref()),
+            &Operand::new(a.as_ref()),
+            &Operand::new(b.as_ref()),
+            Metric::Cholesky(LowerFactor::new(l.as_ref())),
             &mut right,
             &x0,
         )

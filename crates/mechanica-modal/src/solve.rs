@@ -456,7 +456,7 @@ impl Finish<'_> {
         // condensed pencil is refined when its condensation is exact (diagonal A), in the metric
         // of the condensed pencil.
         let metric = match (lift.is_none(), self.condensation) {
-            (true, _) => Some(Metric::Cholesky(self.l)),
+            (true, _) => Some(Metric::Cholesky(crate::reduce::LowerFactor::new(self.l))),
             (false, Some(c)) => Some(Metric::Condensed(c)),
             (false, None) => None,
         };
@@ -471,7 +471,7 @@ impl Finish<'_> {
                     wanted && refinable(g, &omega, &report.error_bounds, &omega_all, def.first)
                 })
                 .collect();
-            let mass = Operand::new(a);
+            let (mass, stiffness) = (Operand::new(a), Operand::new(b));
             // Clusters are independent: each is refined from its own columns of X, sequentially
             // inside, and the clusters are shared among the threads.
             let start = xm.as_ref();
@@ -483,7 +483,7 @@ impl Finish<'_> {
                     modes: def.first + g.start..def.first + g.end,
                 });
                 let correction = spectrum.as_mut().map(|s| s as &mut dyn ReducedCorrection);
-                refine_cluster(mass, b, metric, correction, x0.as_ref(), omega[g.start])
+                refine_cluster(&mass, &stiffness, metric, correction, x0.as_ref(), omega[g.start])
             };
             // Simple modes of a definite pencil are refined as one batch whose corrections are
             // block products ([`refine_simple_modes`]); a mode whose batch step fails, and
@@ -495,8 +495,15 @@ impl Finish<'_> {
                 if !singles.is_empty() {
                     let x0 = Mat::from_fn(n, singles.len(), |i, c| start[(i, jobs[singles[c]].start)]);
                     let modes: Vec<usize> = singles.iter().map(|&j| def.first + jobs[j].start).collect();
-                    let pairs =
-                        refine_simple_modes(mass, b, l, (y.as_ref(), &omega_all), &modes, x0.as_ref(), self.par);
+                    let pairs = refine_simple_modes(
+                        &mass,
+                        &stiffness,
+                        l,
+                        (y.as_ref(), &omega_all),
+                        &modes,
+                        x0.as_ref(),
+                        self.par,
+                    );
                     for (&j, pair) in singles.iter().zip(pairs) {
                         refined[j] = pair.map(RefinedCluster::single);
                     }

@@ -83,6 +83,8 @@ pub(crate) fn sharpen(
         .map(|i| report.error_bounds[i].max(a_priori.bound(omega[i])))
         .collect();
     let mass = crate::dd::Operand::new(a);
+    let stiffness = crate::dd::Operand::new(b);
+    let factor = crate::reduce::LowerFactor::new(pencil.l);
     for g in clusters(omega, &separable) {
         // A block needs the vectors of all its members: consecutive flagged columns.
         let Some(col) = flagged.iter().position(|&i| i == g.start) else {
@@ -100,9 +102,9 @@ pub(crate) fn sharpen(
             purified: false,
         };
         let refined = refine_cluster(
-            mass,
-            b,
-            Metric::Cholesky(pencil.l),
+            &mass,
+            &stiffness,
+            Metric::Cholesky(factor),
             Some(&mut correction),
             x0.as_ref(),
             omega[g.start],
