@@ -148,7 +148,9 @@ pub enum Residuals {
     Exact,
     /// Gaussian sketches ([`crate::sketch`], O(k·n²) flops with k = 32): each backward error and
     /// the orthogonality error (then a bound on ‖XᵀAX − I‖_F) is an upper bound that fails with
-    /// probability at most 1e-12; typically 2–4 times the exact value.
+    /// probability at most 1e-12; typically 2–4 times the exact value. Where the exact products
+    /// cost less (all pairs below n ≈ 200, or a few pairs of any pencil) they are formed
+    /// instead, and the report's `residuals` says `Exact`.
     Sketched,
 }
 
@@ -180,8 +182,22 @@ fn mass_product(mut out: MatMut<'_, f64>, a: MatRef<'_, f64>, x: MatRef<'_, f64>
     }
 }
 
+/// Whether the exact products of m pairs of order n cost less time than their sketches: A X,
+/// B X and XᵀAX take 4n²m + 2nm² flops in large products; the sketches 4kn² + 10knm flops in
+/// thin products (counted twice: they run at about half the rate) and k(n + m) Gaussian
+/// numbers (a logarithm and a cosine each, about 1000 flops' time). For all pairs the
+/// crossover is n ≈ 200 (measured: sketched 1.3–5× slower at n = 12–120, 1.2× faster at 250);
+/// for a few pairs of a large pencil the exact products are cheaper at any n.
+pub(crate) fn exact_costs_less(n: usize, m: usize) -> bool {
+    let (n, m, k) = (n as f64, m as f64, crate::sketch::SKETCH_SIZE as f64);
+    let exact = 4.0 * n * n * m + 2.0 * n * m * m;
+    let sketch = 2.0 * (4.0 * k * n * n + 10.0 * k * n * m) + 1000.0 * k * (n + m);
+    exact <= sketch
+}
+
 impl PairProducts {
-    /// A X and B X (2n²m flops each), or their sketches.
+    /// A X and B X (2n²m flops each), or their sketches where those cost less
+    /// ([`exact_costs_less`]).
     pub(crate) fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: MatRef<'_, f64>, how: Residuals, par: Par) -> Self {
         match how {
             Residuals::Exact => {
@@ -192,6 +208,7 @@ impl PairProducts {
                 faer::linalg::matmul::matmul(bx.as_mut(), faer::Accum::Replace, b, x, 1.0, par);
                 Self::Exact { ax, bx }
             }
+            Residuals::Sketched if exact_costs_less(a.nrows(), x.ncols()) => Self::new(a, b, x, Residuals::Exact, par),
             Residuals::Sketched => {
                 let sketch = Sketch::new(a, b, x, par);
                 let orthogonality = sketch.orthogonality_bound(a, x, par);

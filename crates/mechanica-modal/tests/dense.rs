@@ -764,21 +764,27 @@ fn tiny_orders_do_not_reach_faer_size_limits() {
     }
 }
 
-/// The sketched report bounds the exact one from above, within the factor its lower tail
-/// allows, on a rotated chain, a free chain (rigid-body mode) and a graded 1e12 chain; every
-/// ω² still lies within its (sketched) bound of the closed form.
-#[test]
-fn sketched_residuals_bound_the_exact_ones() {
-    let n = 240;
+/// The fixed chain with masses 1 + i/n (ω² of the unit chain), turned by a random rotation.
+fn rotated_graded_mass_chain(n: usize) -> (Mat<f64>, Mat<f64>) {
     let d = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 / n as f64 } else { 0.0 });
     let (_, t) = families::fixed_chain(n);
     let b = Mat::from_fn(n, n, |i, j| (d[(i, i)] * d[(j, j)]).sqrt() * t[(i, j)]);
-    let (ra, rb) = families::rotate(&d, &b, &families::random_orthogonal(n, 9));
-    let (fa, fb) = families::free_chain(60);
-    let graded = families::spring_chain(&families::graded_exponents(24, 12), &[0; 24]);
+    families::rotate(&d, &b, &families::random_orthogonal(n, 9))
+}
+
+/// The sketched report bounds the exact one from above, within the factor its lower tail
+/// allows, on a rotated chain, a free chain (rigid-body mode) and a graded 1e12 chain; every
+/// ω² still lies within its (sketched) bound of the closed form. (Orders past the crossover
+/// below which the exact products are formed instead.)
+#[test]
+fn sketched_residuals_bound_the_exact_ones() {
+    let n = 300;
+    let (ra, rb) = rotated_graded_mass_chain(n);
+    let (fa, fb) = families::free_chain(n);
+    let graded = families::spring_chain(&families::graded_exponents(n, 12), &vec![0; n]);
     let cases = [
         (pencil(&ra, &rb), families::fixed_chain_omega_sq(n)),
-        (pencil(&fa, &fb), families::free_chain_omega_sq(60)),
+        (pencil(&fa, &fb), families::free_chain_omega_sq(n)),
         (pencil(&graded.0, &graded.1), Vec::new()),
     ];
     for (p, exact) in &cases {
@@ -815,6 +821,41 @@ fn sketched_residuals_bound_the_exact_ones() {
         assert!(s_orth >= e_orth, "{s_orth:e} < {e_orth:e}");
         assert!(sketched.accuracy.meets_backward_error_target(p.dim()));
         assert!(sketched.accuracy.inertia_check.expect("check").consistent);
+    }
+}
+
+/// A sketch requested where the exact products cost less (all pairs of a small pencil, or a
+/// few pairs of a larger one) gives the exact report: the same backward errors and
+/// orthogonality error as asking for it, and `residuals` says so.
+#[test]
+fn sketches_are_not_formed_where_exact_products_cost_less() {
+    let n = 240;
+    let (ra, rb) = rotated_graded_mass_chain(n);
+    let (small_a, small_b) = families::rotate(
+        &Mat::<f64>::identity(30, 30),
+        &families::fixed_chain(30).1,
+        &families::random_orthogonal(30, 3),
+    );
+    for (p, selection) in [
+        (pencil(&small_a, &small_b), Selection::All),
+        (pencil(&ra, &rb), Selection::Lowest(5)),
+    ] {
+        let options = |residuals| SolveOptions {
+            selection,
+            residuals,
+            ..SolveOptions::default()
+        };
+        let exact = solve(&p, &options(Residuals::Exact)).expect("exact");
+        let asked_sketch = solve(&p, &options(Residuals::Sketched)).expect("sketched");
+        assert_eq!(asked_sketch.accuracy.residuals, Residuals::Exact);
+        let etas = |s: &mechanica_modal::ModalSolution| -> Vec<Option<f64>> {
+            s.modes.iter().map(|m| m.backward_error).collect()
+        };
+        assert_eq!(etas(&asked_sketch), etas(&exact));
+        assert_eq!(
+            asked_sketch.accuracy.orthogonality_error,
+            exact.accuracy.orthogonality_error
+        );
     }
 }
 
