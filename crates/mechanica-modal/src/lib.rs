@@ -43,6 +43,7 @@ mod condense;
 mod dd;
 pub mod error;
 pub mod families;
+mod fork_join;
 pub mod inertia;
 pub mod lanczos;
 pub mod matrix_market;

@@ -12,6 +12,7 @@
 //! (SciPy's `eigh(B, A)`) does the dense work whatever A is. The test is exact (every
 //! off-diagonal entry of the symmetrised A is zero); a nearly diagonal A takes the dense path.
 
+use crate::fork_join::by_column_chunks;
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{BlockStructure, matmul as tri_matmul};
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
@@ -167,8 +168,12 @@ fn factor_recursive(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
 /// C = L⁻¹ B L⁻ᵀ, reading only the lower triangle of `b`; returns C with its lower triangle
 /// valid (the upper triangle is unspecified).
 pub fn reduce(l: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Mat<f64> {
+    reduce_owned(l, b.to_owned(), par)
+}
+
+/// [`reduce`] of a copy of B that the caller no longer needs (reduced in place, no copy).
+pub(crate) fn reduce_owned(l: MatRef<'_, f64>, mut c: Mat<f64>, par: Par) -> Mat<f64> {
     let par = factor_parallelism(l.nrows(), par);
-    let mut c = b.to_owned();
     if is_diagonal(l) {
         scale_lower_in_place(l, c.as_mut());
     } else {
@@ -268,31 +273,6 @@ fn subtract_in_place(mut target: MatMut<'_, f64>, amount: MatRef<'_, f64>) {
             *t -= a;
         }
     }
-}
-
-/// Runs `solve` on column chunks of `rhs`, one chunk per thread of `par` (each chunk solved
-/// sequentially). For triangular solves with many right-hand sides this keeps both threads on
-/// whole columns; faer's parallel triangular solve was measured 1.1–1.4× slower on a
-/// 256-column triangle with 744 right-hand sides and on n×n back-transformations at n = 1000.
-fn by_column_chunks(rhs: MatMut<'_, f64>, par: Par, solve: &(dyn Fn(MatMut<'_, f64>) + Sync)) {
-    let threads = match par {
-        Par::Rayon(threads) => threads.get().min(rhs.ncols() / 64).max(1),
-        Par::Seq => 1,
-    };
-    split_columns(rhs, threads, solve);
-}
-
-fn split_columns(rhs: MatMut<'_, f64>, threads: usize, solve: &(dyn Fn(MatMut<'_, f64>) + Sync)) {
-    if threads <= 1 {
-        return solve(rhs);
-    }
-    let left_threads = threads / 2;
-    let split = rhs.ncols() * left_threads / threads;
-    let (left, right) = rhs.split_at_col_mut(split);
-    rayon::join(
-        || split_columns(left, left_threads, solve),
-        || split_columns(right, threads - left_threads, solve),
-    );
 }
 
 /// The plain reduction C = L⁻¹ (L⁻¹ B)ᵀ by two full triangular solves (2n³ flops); kept as the

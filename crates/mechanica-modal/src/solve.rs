@@ -10,8 +10,9 @@
 use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::condense::Condensation;
 use crate::dd::Operand;
+use crate::fork_join::join;
 use crate::inertia::{InertiaCount, all_above, count_below};
-use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
+use crate::reduce::{Cholesky, back_transform, cholesky_owned, reduce_owned};
 use crate::refine::{Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, refine_cluster, refine_simple_modes};
 use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
 use crate::{ModalError, PencilProblem};
@@ -230,6 +231,17 @@ pub(crate) fn solve_definite(
     vectors: bool,
     par: Par,
 ) -> Result<Definite, ModalError> {
+    solve_definite_owned(l, b.to_owned(), selection, vectors, par)
+}
+
+/// [`solve_definite`] on a copy of B that the caller no longer needs (reduced in place).
+fn solve_definite_owned(
+    l: MatRef<'_, f64>,
+    b: Mat<f64>,
+    selection: Selection,
+    vectors: bool,
+    par: Par,
+) -> Result<Definite, ModalError> {
     let n = b.nrows();
     if n == 0 {
         // faer's eigensolvers underflow a size computation at n = 0; never call them there.
@@ -246,7 +258,7 @@ pub(crate) fn solve_definite(
         });
     }
     let clock = Instant::now();
-    let c = reduce(l, b, par);
+    let c = reduce_owned(l, b, par);
     let mut timings = DenseTimings {
         factor: clock.elapsed(),
         ..DenseTimings::default()
@@ -325,10 +337,14 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     // The refinement and the residual bounds need the vectors even when the caller does not.
     let want_vectors = options.vectors || options.refinement == Refinement::Always;
     let clock = Instant::now();
-    match cholesky(a, par) {
+    // The copies of A (factored in place) and B (reduced in place) are written on two threads:
+    // the first write of a fresh n×n buffer faults every page, and faults on two cores proceed
+    // in parallel (6.5 ms per 8 MB on one core of the Zen 3 host).
+    let (a_copy, b_copy) = join(|| a.to_owned(), || b.to_owned(), par);
+    match cholesky_owned(a_copy, par) {
         Cholesky::Factor(l) => {
             let cholesky_time = clock.elapsed();
-            let mut def = solve_definite(l.as_ref(), b, options.selection, want_vectors, par)?;
+            let mut def = solve_definite_owned(l.as_ref(), b_copy, options.selection, want_vectors, par)?;
             if !want_vectors && options.refinement == Refinement::Auto {
                 // Values only: the modes whose a-priori bound is too weak get their vectors
                 // (crate::values_only), unless they are so many that all vectors cost less.

@@ -1,0 +1,38 @@
+//! Fork–join helpers that respect a [`Par`]: two closures, or column chunks of a matrix, on the
+//! threads of Rayon's global pool when `par` allows more than one, else in turn.
+
+use faer::{MatMut, Par};
+
+/// Runs two closures, on two threads of Rayon's global pool when `par` allows more than one
+/// (the pool, not `par`'s count, decides how many run at once).
+pub(crate) fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send, par: Par) -> (A, B) {
+    match par {
+        Par::Rayon(threads) if threads.get() > 1 => rayon::join(a, b),
+        _ => (a(), b()),
+    }
+}
+
+/// Runs `solve` on column chunks of `rhs`, one chunk per thread of `par` (each chunk solved
+/// sequentially). For triangular solves with many right-hand sides this keeps both threads on
+/// whole columns; faer's parallel triangular solve was measured 1.1–1.4× slower on a
+/// 256-column triangle with 744 right-hand sides and on n×n back-transformations at n = 1000.
+pub(crate) fn by_column_chunks(rhs: MatMut<'_, f64>, par: Par, solve: &(dyn Fn(MatMut<'_, f64>) + Sync)) {
+    let threads = match par {
+        Par::Rayon(threads) => threads.get().min(rhs.ncols() / 64).max(1),
+        Par::Seq => 1,
+    };
+    split_columns(rhs, threads, solve);
+}
+
+fn split_columns(rhs: MatMut<'_, f64>, threads: usize, solve: &(dyn Fn(MatMut<'_, f64>) + Sync)) {
+    if threads <= 1 {
+        return solve(rhs);
+    }
+    let left_threads = threads / 2;
+    let split = rhs.ncols() * left_threads / threads;
+    let (left, right) = rhs.split_at_col_mut(split);
+    rayon::join(
+        || split_columns(left, left_threads, solve),
+        || split_columns(right, threads - left_threads, solve),
+    );
+}
