@@ -16,6 +16,8 @@
 use crate::sketch::Sketch;
 use crate::solve::InertiaCheck;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
+use faer::sparse::SparseColMat;
+use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::{Mat, MatMut, MatRef, Par};
 use std::ops::Range;
 
@@ -157,8 +159,12 @@ pub enum Residuals {
 /// The products behind the residuals of a set of pairs; refined columns are recomputed one by
 /// one, so the report after refinement costs O(n²) per refined mode.
 pub(crate) enum PairProducts {
-    /// A X and B X.
-    Exact { ax: Mat<f64>, bx: Mat<f64> },
+    /// A X and B X, and B by its nonzeros when it has few.
+    Exact {
+        ax: Mat<f64>,
+        bx: Mat<f64>,
+        sparse_b: Option<SparseColMat<usize, f64>>,
+    },
     /// S A X and S B X, and the bound on ‖XᵀAX − I‖_F; `stale` once a column changed after
     /// the bound was computed.
     Sketched {
@@ -195,6 +201,21 @@ pub(crate) fn exact_costs_less(n: usize, m: usize) -> bool {
     exact <= sketch
 }
 
+/// out = B X; a B with few nonzeros (a banded or assembled stiffness stored densely, kept by
+/// its nonzeros in `sparse_b`) costs 2·nnz·m flops instead of the 2n²m of a matrix product.
+fn stiffness_product(
+    out: MatMut<'_, f64>,
+    b: MatRef<'_, f64>,
+    sparse_b: Option<&SparseColMat<usize, f64>>,
+    x: MatRef<'_, f64>,
+    par: Par,
+) {
+    match sparse_b {
+        Some(s) => sparse_dense_matmul(out, faer::Accum::Replace, s.as_ref(), x, 1.0, par),
+        None => faer::linalg::matmul::matmul(out, faer::Accum::Replace, b, x, 1.0, par),
+    }
+}
+
 impl PairProducts {
     /// A X and B X (2n²m flops each), or their sketches where those cost less
     /// ([`exact_costs_less`]).
@@ -204,9 +225,10 @@ impl PairProducts {
                 let (n, m) = (a.nrows(), x.ncols());
                 let mut ax = Mat::<f64>::zeros(n, m);
                 let mut bx = Mat::<f64>::zeros(n, m);
+                let sparse_b = crate::dd::sparse_columns(b);
                 mass_product(ax.as_mut(), a, x, par);
-                faer::linalg::matmul::matmul(bx.as_mut(), faer::Accum::Replace, b, x, 1.0, par);
-                Self::Exact { ax, bx }
+                stiffness_product(bx.as_mut(), b, sparse_b.as_ref(), x, par);
+                Self::Exact { ax, bx, sparse_b }
             }
             Residuals::Sketched if exact_costs_less(a.nrows(), x.ncols()) => Self::new(a, b, x, Residuals::Exact, par),
             Residuals::Sketched => {
@@ -231,10 +253,10 @@ impl PairProducts {
         par: Par,
     ) {
         match self {
-            Self::Exact { ax, bx } => {
+            Self::Exact { ax, bx, sparse_b } => {
                 let xi = x.subcols(i, 1);
                 mass_product(ax.as_mut().subcols_mut(i, 1), a, xi, par);
-                faer::linalg::matmul::matmul(bx.as_mut().subcols_mut(i, 1), faer::Accum::Replace, b, xi, 1.0, par);
+                stiffness_product(bx.as_mut().subcols_mut(i, 1), b, sparse_b.as_ref(), xi, par);
             }
             Self::Sketched { sketch, stale, .. } => {
                 sketch.update_column(x, i);
@@ -254,12 +276,12 @@ impl PairProducts {
         par: Par,
     ) {
         match self {
-            Self::Exact { ax, bx } => {
+            Self::Exact { ax, bx, sparse_b } => {
                 let changed = Mat::from_fn(x.nrows(), cols.len(), |i, k| x[(i, cols[k])]);
                 let mut a_changed = Mat::<f64>::zeros(x.nrows(), cols.len());
                 let mut b_changed = Mat::<f64>::zeros(x.nrows(), cols.len());
                 mass_product(a_changed.as_mut(), a, changed.as_ref(), par);
-                faer::linalg::matmul::matmul(b_changed.as_mut(), faer::Accum::Replace, b, changed.as_ref(), 1.0, par);
+                stiffness_product(b_changed.as_mut(), b, sparse_b.as_ref(), changed.as_ref(), par);
                 for (k, &c) in cols.iter().enumerate() {
                     ax.col_mut(c).copy_from(a_changed.col(k));
                     bx.col_mut(c).copy_from(b_changed.col(k));
@@ -286,7 +308,7 @@ impl PairProducts {
         let xi = x.col(i);
         let n = xi.nrows();
         let (r, xax) = match self {
-            Self::Exact { ax, bx } => {
+            Self::Exact { ax, bx, .. } => {
                 let (axi, bxi) = (ax.col(i), bx.col(i));
                 let r = (0..n).map(|k| (bxi[k] - omega_sq * axi[k]).powi(2)).sum::<f64>().sqrt();
                 (r, (0..n).map(|k| xi[k] * axi[k]).sum::<f64>())
@@ -713,6 +735,53 @@ mod tests {
     use super::*;
     use crate::families;
     use crate::reduce::{Cholesky, cholesky};
+
+    /// A banded stiffness is multiplied by its nonzeros (and a dense one is not), with the
+    /// products of the dense kernel to rounding: B X, a batch of changed columns and one changed
+    /// column, entry by entry within n·u·(|B||X|).
+    #[test]
+    fn banded_stiffness_products_match_the_dense_ones() {
+        let n = 120;
+        let b = Mat::from_fn(n, n, |i, j| match i.abs_diff(j) {
+            0 => 2e6 + i as f64,
+            1 => -1e6,
+            2 => 0.25,
+            _ => 0.0,
+        });
+        let a = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 } else { 0.0 });
+        let mut x = crate::sketch::gaussian(n, 7, 3);
+        let mut products = PairProducts::new(a.as_ref(), b.as_ref(), x.as_ref(), Residuals::Exact, Par::Seq);
+        let check = |products: &PairProducts, x: &Mat<f64>| {
+            let PairProducts::Exact { bx, sparse_b, .. } = products else {
+                panic!("exact products asked for")
+            };
+            assert!(sparse_b.is_some());
+            let dense = &b * x;
+            let magnitude = b.map(|v| v.abs()) * x.map(|v| v.abs());
+            for j in 0..x.ncols() {
+                for i in 0..n {
+                    let tol = n as f64 * f64::EPSILON * magnitude[(i, j)];
+                    assert!((bx[(i, j)] - dense[(i, j)]).abs() <= tol, "({i}, {j})");
+                }
+            }
+        };
+        check(&products, &x);
+        for i in 0..n {
+            x[(i, 2)] = (i as f64).sin();
+            x[(i, 5)] = (i as f64).cos();
+        }
+        products.update_columns(a.as_ref(), b.as_ref(), x.as_ref(), &[2, 5], Par::Seq);
+        x[(0, 6)] = 3.0;
+        products.update_column(a.as_ref(), b.as_ref(), x.as_ref(), 6, Par::Seq);
+        check(&products, &x);
+        let full = Mat::from_fn(n, n, |i, j| 1.0 / (1.0 + i as f64 + j as f64));
+        let PairProducts::Exact { sparse_b, .. } =
+            PairProducts::new(a.as_ref(), full.as_ref(), x.as_ref(), Residuals::Exact, Par::Seq)
+        else {
+            panic!("exact products asked for")
+        };
+        assert!(sparse_b.is_none());
+    }
 
     /// The probabilistic bound of ‖A⁻¹‖₂ lies above the true norm and within its worst-case
     /// overestimate (α√(2/π)·max‖ω_i‖)^(1/q) (reached by A = I), for a rotated mass matrix

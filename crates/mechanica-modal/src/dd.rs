@@ -196,7 +196,7 @@ impl<'a> Operand<'a> {
         let structure = if crate::reduce::is_diagonal(matrix) && crate::reduce::is_diagonal(matrix.transpose()) {
             Structure::Diagonal
         } else {
-            match nonzeros_by_columns(matrix, matrix.nrows() * matrix.ncols() / SPARSE_FRACTION) {
+            match sparse_columns(matrix) {
                 Some(sparse) => Structure::Sparse(sparse),
                 None => Structure::Dense,
             }
@@ -224,6 +224,12 @@ impl<'a> Operand<'a> {
             Structure::Dense => mat_vec(self.matrix, x),
         }
     }
+}
+
+/// The nonzero entries of `m` by columns when it has at most n²/[`SPARSE_FRACTION`] of them
+/// (one scan, stopping past that many), else None.
+pub(crate) fn sparse_columns(m: MatRef<'_, f64>) -> Option<faer::sparse::SparseColMat<usize, f64>> {
+    nonzeros_by_columns(m, m.nrows() * m.ncols() / SPARSE_FRACTION)
 }
 
 /// The nonzero entries of `m` by columns (rows ascending), or None past `limit` nonzeros.
