@@ -287,7 +287,7 @@ pub fn reduce_two_solves(l: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Ma
 /// X = L⁻ᵀ Y in place (back-transformation of eigenvectors of C to those of the pencil); a
 /// diagonal L divides each row.
 pub fn back_transform(l: MatRef<'_, f64>, y: MatMut<'_, f64>, par: Par) {
-    solve_transposed_in_place(l, is_diagonal(l), y, par);
+    LowerFactor::new(l).solve_transposed(y, par);
 }
 
 /// A lower Cholesky factor L of A with whether it is diagonal, found once: the many solves with
@@ -319,18 +319,14 @@ impl<'a> LowerFactor<'a> {
 
     /// Y ← L⁻ᵀ Y in place.
     pub(crate) fn solve_transposed(&self, y: MatMut<'_, f64>, par: Par) {
-        solve_transposed_in_place(self.l, self.diagonal, y, par);
+        let l = self.l;
+        if self.diagonal {
+            return divide_rows(l, y);
+        }
+        by_column_chunks(y, par, &|rhs| {
+            solve_upper_triangular_in_place(l.transpose(), rhs, Par::Seq)
+        });
     }
-}
-
-/// Y ← L⁻ᵀ Y in place for L known to be diagonal or not.
-fn solve_transposed_in_place(l: MatRef<'_, f64>, diagonal: bool, y: MatMut<'_, f64>, par: Par) {
-    if diagonal {
-        return divide_rows(l, y);
-    }
-    by_column_chunks(y, par, &|rhs| {
-        solve_upper_triangular_in_place(l.transpose(), rhs, Par::Seq)
-    });
 }
 
 /// Y ← diag(L)⁻¹ Y.

@@ -672,6 +672,23 @@ mod tests {
         .expect("the bordered Newton step converges")
     }
 
+    /// The projected step from x₀ on the dense pencil (A, B) with factor L, through `correction`.
+    fn projected(
+        a: &Mat<f64>,
+        b: &Mat<f64>,
+        l: &Mat<f64>,
+        correction: &mut dyn ReducedCorrection,
+        x0: &[f64],
+    ) -> Option<RefinedPair> {
+        refine_pair_projected(
+            &Operand::new(a.as_ref()),
+            &Operand::new(b.as_ref()),
+            Metric::Cholesky(LowerFactor::new(l.as_ref())),
+            correction,
+            x0,
+        )
+    }
+
     #[test]
     fn spectral_and_bordered_refinement_agree_on_a_graded_chain() {
         let (a, b, l, y, omega, x) = graded();
@@ -682,14 +699,7 @@ mod tests {
                 modes: i..i + 1,
             };
             let x0: Vec<f64> = (0..16).map(|r| x[(r, i)]).collect();
-            let fast = refine_pair_projected(
-                &Operand::new(a.as_ref()),
-                &Operand::new(b.as_ref()),
-                Metric::Cholesky(LowerFactor::new(l.as_ref())),
-                &mut spectrum,
-                &x0,
-            )
-            .expect("converges");
+            let fast = projected(&a, &b, &l, &mut spectrum, &x0).expect("converges");
             let slow = bordered(&a, &b, &l, &x0, omega[i]);
             let w = slow.omega_sq;
             assert!(
@@ -756,14 +766,7 @@ mod tests {
                 z: z.subcols(i, 1).to_owned(),
                 purified: false,
             };
-            let fast = refine_pair_projected(
-                &Operand::new(a.as_ref()),
-                &Operand::new(b.as_ref()),
-                Metric::Cholesky(LowerFactor::new(l.as_ref())),
-                &mut correction,
-                &x0,
-            )
-            .expect("the tridiagonal correction converges");
+            let fast = projected(&a, &b, &l, &mut correction, &x0).expect("the tridiagonal correction converges");
             let slow = bordered(&a, &b, &l, &x0, values[i]);
             let w = slow.omega_sq;
             assert!(
@@ -791,16 +794,7 @@ mod tests {
         };
         // Start from a mixture of modes 0 and 1, so the wrong ω²₁ drives the correction.
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)] + 0.3 * x[(r, 1)]).collect();
-        assert!(
-            refine_pair_projected(
-                &Operand::new(a.as_ref()),
-                &Operand::new(b.as_ref()),
-                Metric::Cholesky(LowerFactor::new(l.as_ref())),
-                &mut spectrum,
-                &x0
-            )
-            .is_none()
-        );
+        assert!(projected(&a, &b, &l, &mut spectrum, &x0).is_none());
         let slow = bordered(&a, &b, &l, &x0, omega[0]);
         let x0: Vec<f64> = (0..16).map(|r| x[(r, 0)]).collect();
         let mut right = ReducedSpectrum {
@@ -808,15 +802,7 @@ mod tests {
             omega_sq: &omega,
             modes: 0..1,
         };
-        let w = refine_pair_projected(
-            &Operand::new(a.as_ref()),
-            &Operand::new(b.as_ref()),
-            Metric::Cholesky(LowerFactor::new(l.as_ref())),
-            &mut right,
-            &x0,
-        )
-        .expect("converges")
-        .omega_sq;
+        let w = projected(&a, &b, &l, &mut right, &x0).expect("converges").omega_sq;
         assert!(
             (slow.omega_sq - w).abs() <= 4.0 * f64::EPSILON * w,
             "{} vs {w}",
