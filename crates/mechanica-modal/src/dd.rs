@@ -209,6 +209,21 @@ impl<'a> Operand<'a> {
         self.matrix
     }
 
+    /// The nonzeros of column j as (row, value), rows ascending; None for a dense operand.
+    pub(crate) fn column_nonzeros(&self, j: usize) -> Option<Vec<(usize, f64)>> {
+        match &self.structure {
+            Structure::Dense => None,
+            Structure::Diagonal => {
+                let d = self.matrix[(j, j)];
+                Some(if d != 0.0 { vec![(j, d)] } else { Vec::new() })
+            }
+            Structure::Sparse(m) => {
+                let m = m.as_ref();
+                Some(m.row_idx_of_col(j).zip(m.val_of_col(j).iter().copied()).collect())
+            }
+        }
+    }
+
     /// M x in double-double, with the values of [`mat_vec`].
     pub(crate) fn product(&self, x: &[f64]) -> Vec<Dd> {
         match &self.structure {

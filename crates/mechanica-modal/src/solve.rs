@@ -13,7 +13,9 @@ use crate::dd::Operand;
 use crate::fork_join::join;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky_owned, reduce_owned};
-use crate::refine::{Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, refine_cluster, refine_simple_modes};
+use crate::refine::{
+    Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, SparseShifts, refine_cluster, refine_simple_modes,
+};
 use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
@@ -488,6 +490,11 @@ impl Finish<'_> {
                 })
                 .collect();
             let (mass, stiffness) = (Operand::new(a), Operand::new(b));
+            let shifts = if jobs.is_empty() {
+                None
+            } else {
+                SparseShifts::new(&mass, &stiffness)
+            };
             // Clusters are independent: each is refined from its own columns of X, sequentially
             // inside, and the clusters are shared among the threads.
             let start = xm.as_ref();
@@ -499,14 +506,24 @@ impl Finish<'_> {
                     modes: def.first + g.start..def.first + g.end,
                 });
                 let correction = spectrum.as_mut().map(|s| s as &mut dyn ReducedCorrection);
-                refine_cluster(&mass, &stiffness, metric, correction, x0.as_ref(), omega[g.start])
+                refine_cluster(
+                    &mass,
+                    &stiffness,
+                    shifts.as_ref(),
+                    metric,
+                    correction,
+                    x0.as_ref(),
+                    omega[g.start],
+                )
             };
             // Simple modes of a definite pencil are refined as one batch whose corrections are
             // block products ([`refine_simple_modes`]); a mode whose batch step fails, and
-            // every cluster, takes its own path.
+            // every cluster, takes its own path. A sparse pencil's simple modes take theirs at
+            // once: a sparse bordered factorization per mode costs less than the batch's
+            // products through Y (`refine::refine_pair_sparse`).
             let mut refined: Vec<Option<RefinedCluster>> = vec![None; jobs.len()];
             let mut pending: Vec<usize> = (0..jobs.len()).collect();
-            if let (Metric::Cholesky(l), Some(y)) = (metric, def.reduced.as_ref()) {
+            if let (Metric::Cholesky(l), Some(y), None) = (metric, def.reduced.as_ref(), &shifts) {
                 let singles: Vec<usize> = pending.iter().copied().filter(|&j| jobs[j].len() == 1).collect();
                 if !singles.is_empty() {
                     let x0 = Mat::from_fn(n, singles.len(), |i, c| start[(i, jobs[singles[c]].start)]);

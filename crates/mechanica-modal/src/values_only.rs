@@ -85,6 +85,7 @@ pub(crate) fn sharpen(
     let mass = crate::dd::Operand::new(a);
     let stiffness = crate::dd::Operand::new(b);
     let factor = crate::reduce::LowerFactor::new(pencil.l);
+    let shifts = crate::refine::SparseShifts::new(&mass, &stiffness);
     for g in clusters(omega, &separable) {
         // A block needs the vectors of all its members: consecutive flagged columns.
         let Some(col) = flagged.iter().position(|&i| i == g.start) else {
@@ -104,6 +105,7 @@ pub(crate) fn sharpen(
         let refined = refine_cluster(
             &mass,
             &stiffness,
+            shifts.as_ref(),
             Metric::Cholesky(factor),
             Some(&mut correction),
             x0.as_ref(),
