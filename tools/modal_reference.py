@@ -65,6 +65,9 @@ CASES = [
     ("graded_stiffness_and_mass_n30", graded_exponents(30, 6), [-e for e in graded_exponents(30, 6)]),
     # Stiff at the ground, soft at the tip: 1e12 .. 1.
     ("reversed_graded_n24", list(reversed(graded_exponents(24, 12))), [0] * 24),
+    # Long enough (3n - 2 nonzeros <= n^2/16) that the solver keeps B by its nonzeros and
+    # refines its simple modes by sparse bordered Newton steps.
+    ("graded_stiffness_n96", graded_exponents(96, 12), [0] * 96),
 ]
 
 

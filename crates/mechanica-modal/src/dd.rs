@@ -383,6 +383,61 @@ fn sparse_mat_vec_as<const FUSED: bool>(m: faer::sparse::SparseColMatRef<'_, usi
     acc
 }
 
+/// A vector held to twice the working precision as hi + lo, entry by entry (|lo_i| at most
+/// half an ulp of hi_i): a refined eigenvector whose residual must not be limited by the
+/// rounding of its entries (in a stiff chain, k·u·|x| with k = 1e12 at a stiff spring).
+#[derive(Debug, Clone)]
+pub(crate) struct SplitVector {
+    /// The entries rounded to double.
+    pub hi: Vec<f64>,
+    /// What the rounding left out.
+    pub lo: Vec<f64>,
+}
+
+impl SplitVector {
+    /// A double vector (its low parts zero).
+    pub(crate) fn of(hi: Vec<f64>) -> Self {
+        let lo = vec![0.0; hi.len()];
+        Self { hi, lo }
+    }
+
+    /// self += d, in double-double.
+    pub(crate) fn add(&mut self, d: &[f64]) {
+        for ((hi, lo), &di) in self.hi.iter_mut().zip(self.lo.iter_mut()).zip(d) {
+            let sum = Dd { hi: *hi, lo: *lo }.plus(Dd::of(di));
+            (*hi, *lo) = (sum.hi, sum.lo);
+        }
+    }
+
+    /// self ·= s, in double-double.
+    pub(crate) fn scale(&mut self, s: f64) {
+        for (hi, lo) in self.hi.iter_mut().zip(self.lo.iter_mut()) {
+            let product = Dd { hi: *hi, lo: *lo }.times(Dd::of(s));
+            (*hi, *lo) = (product.hi, product.lo);
+        }
+    }
+}
+
+impl Operand<'_> {
+    /// M (hi + lo) in double-double: M·hi as [`Operand::product`], plus M·lo, whose own
+    /// rounding is of order u² relative to M·hi (lo is below the rounding of hi).
+    pub(crate) fn product_split(&self, x: &SplitVector) -> Vec<Dd> {
+        let mut out = self.product(&x.hi);
+        if x.lo.iter().any(|&v| v != 0.0) {
+            for (o, l) in out.iter_mut().zip(self.product(&x.lo)) {
+                *o = o.plus(l);
+            }
+        }
+        out
+    }
+}
+
+/// Σ_i x_i·y_i for a split x: hi·y in double-double plus lo·y in double (of order u² relative).
+pub(crate) fn dot_split(x: &SplitVector, y: &[Dd]) -> Dd {
+    let low: f64 = x.lo.iter().zip(y).map(|(l, v)| l * v.hi).sum();
+    dot(&x.hi, y).plus(Dd::of(low))
+}
+
 /// Σ_i x[i]·y[i] with y in double-double.
 pub(crate) fn dot(x: &[f64], y: &[Dd]) -> Dd {
     #[cfg(target_arch = "x86_64")]

@@ -40,7 +40,7 @@ fn cases() -> Vec<Case> {
             other => panic!("unknown key {other}"),
         }
     }
-    assert_eq!(out.len(), 3);
+    assert_eq!(out.len(), 4);
     out
 }
 
@@ -54,6 +54,7 @@ fn reference_chains_are_the_ones_the_crate_builds() {
     let c = cases();
     assert_eq!(c[0].stiffness, families::graded_exponents(24, 12));
     assert_eq!(c[1].stiffness, families::graded_exponents(30, 6));
+    assert_eq!(c[3].stiffness, families::graded_exponents(96, 12));
 }
 
 /// The option sets of an automatically refined solve: all pairs, and values only (where the
