@@ -27,8 +27,11 @@
 //!   Newton steps with double-double residuals (`refine`), and replaces its bound by a
 //!   gap-weighted residual bound. The Newton correction is applied through the reduced
 //!   problem's computed eigen-decomposition (O(n²) per step); only when that stops contracting
-//!   is the bordered matrix factored (LBLᵀ, n³/3). Tested on graded chains with ratios up to 1e12 against
-//!   60-digit mpmath references (tools/modal_reference.py). A values-only solve forms the
+//!   is the bordered matrix factored (LBLᵀ, n³/3). When A and B both have few nonzeros (banded
+//!   or assembled matrices stored densely) each simple mode instead takes bordered steps on a
+//!   sparse LU of B − ω₀²A, with its iterate in double-double, so that its certified bound is
+//!   not limited by rounding the vector (down to u·ω²). Tested on graded chains with ratios up
+//!   to 1e12 against 60-digit mpmath references (tools/modal_reference.py). A values-only solve forms the
 //!   vectors of its weakly bounded modes only, by inverse iteration on the tridiagonal form
 //!   (`values_only`), measures their bounds and refines them the same way.
 //! - **Sparse** ([`solve_sparse`] on a [`SparsePencil`] from faer `SparseColMat`s, triplets or
