@@ -548,6 +548,51 @@ pub(crate) fn refine_cluster_projected(
     None
 }
 
+/// More projected Newton steps ([`refine_cluster_projected`] for one mode) on a refined simple
+/// mode, with the iterate in double-double ([`SplitVector`]): where rounding a double vector
+/// limits the residual (k·u·|x| at a stiff spring of a graded pencil), the steps go on while
+/// they halve, to about u² of the iterate. A step that does not halve is not taken. `steps` is
+/// what the mode took before; None if no step was taken or one was not finite.
+pub(crate) fn polish_simple_mode(
+    a: &Operand<'_>,
+    b: &Operand<'_>,
+    metric: Metric<'_>,
+    correction: &mut dyn ReducedCorrection,
+    x0: &[f64],
+    steps: usize,
+) -> Option<RefinedPair> {
+    let n = x0.len();
+    let mut x = SplitVector::of(x0.to_vec());
+    let mut previous = f64::INFINITY;
+    let mut taken = 0;
+    for _ in 0..MAX_PROJECTED_STEPS {
+        let ax = a.product_split(&x);
+        let bx = b.product_split(&x);
+        let rho = dot_split(&x, &bx).over(dot_split(&x, &ax));
+        let w = Mat::from_fn(n, 1, |i, _| bx[i].minus(rho.times(ax[i])).to_f64());
+        let delta = metric.correction(w, rho.to_f64(), correction);
+        let step: Vec<f64> = delta.col(0).iter().map(|d| -d).collect();
+        if !step.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let xmax = x.hi.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let dmax = step.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if dmax > 0.5 * previous {
+            break;
+        }
+        x.add(&step);
+        taken += 1;
+        if dmax <= 4.0 * f64::EPSILON * f64::EPSILON * xmax {
+            break;
+        }
+        previous = dmax;
+    }
+    if taken == 0 {
+        return None;
+    }
+    finish_pair(a, b, metric, x, steps + taken)
+}
+
 /// [`refine_cluster_projected`] for many simple modes at once, for a positive definite A with
 /// the reduced spectrum at hand: the same projected Newton step per mode (ρ_k its Rayleigh
 /// quotient, the correction L⁻ᵀ Σ_{j≠k} y_j y_jᵀ/(ω̃²_j − ρ_k) L⁻¹ r_k), but the correction of
@@ -653,10 +698,11 @@ pub(crate) fn refine_simple_modes(
 }
 
 /// A sparse pencil's (`shifts`) single mode by [`refine_pair_sparse`] first, and a cluster's
-/// members one by one ([`refine_members_sparse`]); then
+/// members one by one ([`refine_members`]); then
 /// [`refine_cluster_projected`] through `correction` when there is one, and for a single mode
 /// the dense bordered Newton step of [`refine_pair`] where that declines (the bordered step
-/// needs a simple eigenvalue, so a larger cluster has no fallback).
+/// needs a simple eigenvalue; a dense pencil's cluster whose block refinement fails tries its
+/// members one by one on dense factorizations, (n + 1)³/3 each).
 pub(crate) fn refine_cluster(
     a: &Operand<'_>,
     b: &Operand<'_>,
@@ -669,28 +715,30 @@ pub(crate) fn refine_cluster(
     let single = (x0.ncols() == 1).then(|| x0.col(0).iter().copied().collect::<Vec<f64>>());
     let sparse = match (&single, shifts) {
         (Some(x), Some(shifts)) => refine_pair_sparse(a, b, shifts, metric, x, omega0).map(RefinedCluster::single),
-        (None, Some(shifts)) => refine_members_sparse(a, b, shifts, metric, x0),
+        (None, Some(_)) => refine_members(a, b, shifts, metric, x0),
         (_, None) => None,
     };
     sparse
         .or_else(|| correction.and_then(|c| refine_cluster_projected(a, b, metric, c, x0)))
-        .or_else(|| {
-            let pair = single.and_then(|x| refine_pair(a, b, metric, &x, omega0));
-            pair.map(RefinedCluster::single)
+        .or_else(|| match (single, shifts) {
+            (Some(x), _) => refine_pair(a, b, metric, &x, omega0).map(RefinedCluster::single),
+            (None, None) => refine_members(a, b, None, metric, x0),
+            (None, Some(_)) => None,
         })
 }
 
-/// The members of a cluster of a sparse pencil refined one by one ([`refine_pair_sparse`], each
-/// from its own start vector and Rayleigh quotient): modes whose first-order bounds overlap but
-/// whose eigenvalues are simple (in a graded chain the unrefined bounds are wide). Accepted
-/// only when the refined intervals ω²_k ± (‖r_k‖_{A⁻¹} + u|ω²_k|) are separated (the clusters of
+/// The members of a cluster refined one by one by bordered Newton steps (each from its own
+/// start vector and Rayleigh quotient; on a sparse LU with `shifts`, [`refine_pair_sparse`],
+/// else the dense LBLᵀ of [`refine_pair`]): modes whose first-order bounds overlap but whose
+/// eigenvalues are simple (in a graded chain the unrefined bounds are wide). Accepted only when
+/// the refined intervals ω²_k ± (‖r_k‖_{A⁻¹} + u|ω²_k|) are separated (the clusters of
 /// `solve::clusters`, ascending, all single) and the vectors A-orthogonal to √u: each member
 /// is then a simple eigenvalue of its own. None otherwise (a repeated eigenvalue, or two
-/// members that converged to the same pair): the block methods are tried instead.
-fn refine_members_sparse(
+/// members that converged to the same pair).
+fn refine_members(
     a: &Operand<'_>,
     b: &Operand<'_>,
-    shifts: &SparseShifts,
+    shifts: Option<&SparseShifts>,
     metric: Metric<'_>,
     x0: MatRef<'_, f64>,
 ) -> Option<RefinedCluster> {
@@ -698,7 +746,11 @@ fn refine_members_sparse(
     for k in 0..x0.ncols() {
         let x: Vec<f64> = x0.col(k).iter().copied().collect();
         let rayleigh = dot(&x, &b.product(&x)).over(dot(&x, &a.product(&x))).to_f64();
-        pairs.push(refine_pair_sparse(a, b, shifts, metric, &x, rayleigh)?);
+        let pair = match shifts {
+            Some(shifts) => refine_pair_sparse(a, b, shifts, metric, &x, rayleigh),
+            None => refine_pair(a, b, metric, &x, rayleigh),
+        };
+        pairs.push(pair?);
     }
     let omega: Vec<f64> = pairs.iter().map(|p| p.omega_sq).collect();
     let reach: Vec<f64> = pairs

@@ -14,7 +14,8 @@ use crate::fork_join::join;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky_owned, reduce_owned};
 use crate::refine::{
-    Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, SparseShifts, refine_cluster, refine_simple_modes,
+    Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts, polish_simple_mode,
+    refine_cluster, refine_simple_modes,
 };
 use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
 use crate::{ModalError, PencilProblem};
@@ -415,6 +416,34 @@ pub(crate) struct Finish<'a> {
 }
 
 impl Finish<'_> {
+    /// The refined modes' residual bounds ([`accuracy::residual_bounds`]), in the definite
+    /// pencil the residuals belong to: (B, A) itself, or the condensed (S, A₁) with the modes'
+    /// rows at the coordinates with mass.
+    fn residual_bounds(
+        &self,
+        report: &mut AccuracyReport,
+        omega: &[f64],
+        omega_all: &[f64],
+        first: usize,
+        residuals: &[RefinedResidual],
+        x: MatRef<'_, f64>,
+    ) {
+        let all: Vec<usize> = (0..omega.len()).collect();
+        let condensed = self.condensation.map(|c| (c.condensed_mass(), c.massed_rows(x)));
+        let (basis_a, basis_x) = match &condensed {
+            Some((a1, z)) => (a1.as_ref(), z.as_ref()),
+            None => (self.problem.a(), x),
+        };
+        let basis = accuracy::ModeBasis {
+            a: basis_a,
+            l: self.l,
+            x: basis_x,
+            modes: &all,
+            unselected: None,
+        };
+        accuracy::residual_bounds(report, omega, omega_all, first, residuals, &basis, self.par);
+    }
+
     /// `def` holds the finite spectrum of the (possibly condensed) pencil; `lift` maps its
     /// vectors to the original coordinates (None: identity); `infinite` are unit null vectors
     /// of A appended as infinite modes.
@@ -573,24 +602,54 @@ impl Finish<'_> {
                 report.set_pair_error(products, xm.as_ref(), i, omega[i]);
             }
             split_refined_clusters(&mut residuals, &omega, &report.residual_norms_a_inv);
-            let all: Vec<usize> = (0..m).collect();
-            // The bounds hold in the definite pencil the residuals belong to: (B, A) itself, or
-            // the condensed (S, A₁) with the modes' rows at the coordinates with mass.
-            let condensed = self
-                .condensation
-                .map(|c| (c.condensed_mass(), c.massed_rows(xm.as_ref())));
-            let (basis_a, basis_x) = match &condensed {
-                Some((a1, z)) => (a1.as_ref(), z.as_ref()),
-                None => (a, xm.as_ref()),
-            };
-            let basis = accuracy::ModeBasis {
-                a: basis_a,
-                l: self.l,
-                x: basis_x,
-                modes: &all,
-                unselected: None,
-            };
-            accuracy::residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, &basis, self.par);
+            let first_order = (report.error_bounds.clone(), report.bound_kinds.clone());
+            self.residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, xm.as_ref());
+            // Simple modes refined in double (the batch, the projected step) whose bound is still
+            // weak: their residual is limited by rounding the vector; more projected steps with
+            // a double-double iterate, kept where they lower the residual, and the bounds again.
+            if let (Metric::Cholesky(_), Some(y), None) = (metric, def.reduced.as_ref(), &shifts) {
+                let weak: Vec<usize> = (0..residuals.len())
+                    .filter(|&k| {
+                        let i = residuals[k].mode;
+                        residuals[k].cluster.len() == 1 && weakly_bounded(report.error_bounds[i], omega[i])
+                    })
+                    .collect();
+                let polish = |&k: &usize| {
+                    let i = residuals[k].mode;
+                    let mut spectrum = ReducedSpectrum {
+                        y: y.as_ref(),
+                        omega_sq: &omega_all,
+                        modes: def.first + i..def.first + i + 1,
+                    };
+                    let steps = report.refinement_steps[i];
+                    polish_simple_mode(&mass, &stiffness, metric, &mut spectrum, xm.col_as_slice(i), steps)
+                };
+                let polished: Vec<Option<RefinedPair>> = match self.par {
+                    Par::Seq => weak.iter().map(polish).collect(),
+                    _ => weak.par_iter().map(polish).collect(),
+                };
+                let mut improved: Vec<usize> = Vec::new();
+                for (&k, pair) in weak.iter().zip(polished) {
+                    let i = residuals[k].mode;
+                    let Some(p) = pair.filter(|p| Some(p.residual_a_inv) < report.residual_norms_a_inv[i]) else {
+                        continue;
+                    };
+                    xm.col_as_slice_mut(i).copy_from_slice(&p.x);
+                    omega[i] = p.omega_sq;
+                    report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
+                    report.refinement_steps[i] = p.steps;
+                    residuals[k].residual = p.residual;
+                    improved.push(i);
+                }
+                if !improved.is_empty() {
+                    products.update_columns(a, b, xm.as_ref(), &improved, self.par);
+                    (report.error_bounds, report.bound_kinds) = first_order;
+                    for &i in &improved {
+                        report.set_pair_error(products, xm.as_ref(), i, omega[i]);
+                    }
+                    self.residual_bounds(&mut report, &omega, &omega_all, def.first, &residuals, xm.as_ref());
+                }
+            }
         }
         timings.refine = clock.elapsed();
         let clock = Instant::now();
