@@ -765,8 +765,15 @@ static void repeated_stiff_pair(void) {
  * double-double iterates: the lowest three modes, with vectors and values only, are within
  * their bounds of the 60-digit mpmath references (tools/modal_reference.txt,
  * graded_stiffness_n96), and the bounds certify 12 digits or more (before: 8.9e-7 relative for
- * the lowest with vectors, 0.47 values only). Without refinement the lowest bound is weak. */
+ * the lowest with vectors, 0.47 values only). Without refinement the lowest bound is weak. The
+ * same chain turned densely must be certified to 8 digits by the dense refinement paths. */
 #define NS96 96
+/* Entry (r, c) of the 4×4 Hadamard matrix over 2: ±1/2 by the parity of r AND c. */
+static double hadamard_entry(int r, int c) {
+    int bits = r & c;
+    return ((bits ^ (bits >> 1)) & 1) ? -0.5 : 0.5;
+}
+
 static void long_graded_chain(void) {
     static double a[NS96 * NS96], b[NS96 * NS96];
     double k[NS96 + 1];
@@ -811,6 +818,42 @@ static void long_graded_chain(void) {
     CHECK_NEAR(low[0].omega_sq, reference[0], low[0].error_bound);
     CHECK(low[0].error_bound > 1e-8 * reference[0]);
     mech_modal_result_destroy(plain);
+
+    /* The same chain turned by Q = diag(H, H, …), H the 4×4 Hadamard matrix over 2: exactly
+     * orthogonal, and QᵀBQ is (integer sums)/4, formed exactly, so the eigenvalues are the
+     * references'. Its 4×4-block tridiagonal stiffness is dense to the solver: the dense
+     * refinement paths must certify Auto's 8 digits too. */
+    static double ta[NS96 * NS96], tb[NS96 * NS96];
+    for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i) {
+            double sa = 0.0, sb = 0.0;
+            /* (QᵀMQ)_ij = Σ_kl Q_ki M_kl Q_lj, Q_ki nonzero only for k in i's block of four. */
+            for (int k = 4 * (i / 4); k < 4 * (i / 4) + 4; ++k) {
+                for (int l = 4 * (j / 4); l < 4 * (j / 4) + 4; ++l) {
+                    double q = hadamard_entry(k % 4, i % 4) * hadamard_entry(l % 4, j % 4);
+                    sa += q * a[k + n * l];
+                    sb += q * b[k + n * l];
+                }
+            }
+            ta[i + n * j] = sa;
+            tb[i + n * j] = sb;
+        }
+    }
+    for (int vectors = 0; vectors < 2; ++vectors) {
+        mech_modal_options_t o = default_options();
+        o.vectors = vectors;
+        o.selection = MECH_MODAL_SELECTION_LOWEST;
+        o.count = 3;
+        mech_modal_result_t *r = NULL;
+        CHECK_STATUS(mech_modal_solve(n, ta, tb, &o, &r), MECH_STATUS_OK);
+        mech_modal_mode_t m[3];
+        CHECK_STATUS(mech_modal_result_modes(r, m, 3), MECH_STATUS_OK);
+        for (int i = 0; i < 3; ++i) {
+            CHECK_NEAR(m[i].omega_sq, reference[i], m[i].error_bound);
+            CHECK(m[i].error_bound <= 1e-8 * reference[i]);
+        }
+        mech_modal_result_destroy(r);
+    }
 }
 
 /* Three uncoupled free chains of unit masses and springs (each with one rigid-body mode),
