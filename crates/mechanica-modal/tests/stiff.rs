@@ -399,7 +399,13 @@ fn hadamard_turned(c: &Case) -> PencilProblem {
     let (a, b) = families::spring_chain(&c.stiffness, &c.mass);
     let n = a.nrows();
     assert_eq!(n % 4, 0);
-    let sign = |i: usize, j: usize| if (i & j).count_ones().is_multiple_of(2) { 0.5 } else { -0.5 };
+    let sign = |i: usize, j: usize| {
+        if (i & j).count_ones().is_multiple_of(2) {
+            0.5
+        } else {
+            -0.5
+        }
+    };
     let q = mechanica_modal::faer::Mat::from_fn(n, n, |i, j| if i / 4 == j / 4 { sign(i % 4, j % 4) } else { 0.0 });
     let turn = |m: &mechanica_modal::faer::Mat<f64>| q.transpose() * m * &q;
     PencilProblem::new(turn(&a).as_ref(), turn(&b).as_ref()).expect("valid turned chain")
