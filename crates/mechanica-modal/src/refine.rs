@@ -161,8 +161,7 @@ pub(crate) fn refine_pair_sparse(
 /// with both values on it, and its LU symbolic analysis (column ordering, structure), found once
 /// for every shift of a refinement stage.
 pub(crate) struct SparseShifts {
-    column_starts: Vec<usize>,
-    rows: Vec<usize>,
+    pattern: faer::sparse::SymbolicSparseColMat<usize>,
     b_values: Vec<f64>,
     a_values: Vec<f64>,
     symbolic: faer::sparse::linalg::solvers::SymbolicLu<usize>,
@@ -191,11 +190,10 @@ impl SparseShifts {
             }
             column_starts.push(rows.len());
         }
-        let pattern = faer::sparse::SymbolicSparseColMat::new_checked(n, n, column_starts.clone(), None, rows.clone());
+        let pattern = faer::sparse::SymbolicSparseColMat::new_checked(n, n, column_starts, None, rows);
         let symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.as_ref()).ok()?;
         Some(Self {
-            column_starts,
-            rows,
+            pattern,
             b_values,
             a_values,
             symbolic,
@@ -204,15 +202,13 @@ impl SparseShifts {
 
     /// The LU factorization with partial pivoting of B − shift·A; None if it fails.
     fn factor(&self, shift: f64) -> Option<faer::sparse::linalg::solvers::Lu<usize, f64>> {
-        let n = self.column_starts.len() - 1;
         let values: Vec<f64> = self
             .b_values
             .iter()
             .zip(&self.a_values)
             .map(|(b, a)| b - shift * a)
             .collect();
-        let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(n, n, &self.column_starts, None, &self.rows);
-        let k = faer::sparse::SparseColMatRef::new(pattern, &values);
+        let k = faer::sparse::SparseColMatRef::new(self.pattern.as_ref(), &values);
         faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(self.symbolic.clone(), k).ok()
     }
 }
