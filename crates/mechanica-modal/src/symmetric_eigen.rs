@@ -45,6 +45,11 @@ pub const PANEL: usize = 32;
 /// at order 1000).
 const PARALLEL_SYMV_FROM: usize = 640;
 
+/// From this trailing order the trailing update of a team's tridiagonalization is split between
+/// the caller and the team's helper (each half one sequential product) instead of faer's pool,
+/// whose threads have gone to sleep during the panel and contend with the spinning helper.
+const SPLIT_UPDATE_FROM: usize = 128;
+
 /// The eigen-decomposition of a symmetric matrix: values ascending, vectors orthonormal.
 #[derive(Debug, Clone)]
 pub struct SymmetricEigen {
@@ -345,23 +350,47 @@ fn reduce_panels(a: &mut Mat<f64>, t: &mut Tridiagonal, team: Option<(&SymvTeam,
         let mut rhs = wv.as_mut().submatrix_mut(0, 0, m, 2 * nb);
         rhs.rb_mut().subcols_mut(0, nb).copy_from(w2);
         rhs.rb_mut().subcols_mut(nb, nb).copy_from(v2);
-        tri_matmul(
-            a.as_mut().submatrix_mut(q, q, m, m),
-            BlockStructure::TriangularLower,
-            Accum::Add,
-            lhs.rb(),
-            BlockStructure::Rectangular,
-            rhs.rb().transpose(),
-            BlockStructure::Rectangular,
-            -1.0,
-            par,
-        );
+        let trailing = a.as_mut().submatrix_mut(q, q, m, m);
+        match team {
+            Some((team, helper)) if m >= SPLIT_UPDATE_FROM => {
+                // The helper is awake (between two symmetric products): it takes the lower
+                // right triangle, this thread the columns left of it, half the area each.
+                let split = ((1.0 - std::f64::consts::FRAC_1_SQRT_2) * m as f64) as usize;
+                let (left_triangle, _, below_left, mut right_triangle) = trailing.split_at_mut(split, split);
+                let (lhs_top, lhs_bottom) = lhs.rb().split_at_row(split);
+                let (rhs_top, rhs_bottom) = rhs.rb().split_at_row(split);
+                team.beside(
+                    helper,
+                    &mut || subtract_lower_product(right_triangle.rb_mut(), lhs_bottom, rhs_bottom, Par::Seq),
+                    || {
+                        subtract_lower_product(left_triangle, lhs_top, rhs_top, Par::Seq);
+                        matmul(below_left, Accum::Add, lhs_bottom, rhs_top.transpose(), -1.0, Par::Seq);
+                    },
+                );
+            }
+            _ => subtract_lower_product(trailing, lhs.rb(), rhs.rb(), par),
+        }
         for k in p..q {
             t.diag[k] = a[(k, k)];
             a[(k + 1, k)] = t.subdiag[k];
         }
         p = q;
     }
+}
+
+/// The lower triangle of `target` −= `lhs` `rhs`ᵀ.
+fn subtract_lower_product(target: MatMut<'_, f64>, lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>, par: Par) {
+    tri_matmul(
+        target,
+        BlockStructure::TriangularLower,
+        Accum::Add,
+        lhs,
+        BlockStructure::Rectangular,
+        rhs.transpose(),
+        BlockStructure::Rectangular,
+        -1.0,
+        par,
+    );
 }
 
 /// Reduces columns p..p+nb (`dlatrd`, lower): for each column k it applies the panel's earlier

@@ -16,13 +16,23 @@ use std::time::{Duration, Instant};
 /// no faster at n = 1000–2000, 2 ms slower at 1000).
 const SPIN: Duration = Duration::from_micros(200);
 
-/// One posted job: the columns `start..end` of S = A(q.., q..) times the reflector A(q.., q − 1).
+/// One posted job: either the columns `start..end` of S = A(q.., q..) times the reflector
+/// A(q.., q − 1), or (`task` set) a closure lent by [`SymvTeam::beside`].
 struct Job {
     matrix: AtomicPtr<Mat<f64>>,
     q: AtomicUsize,
     start: AtomicUsize,
     end: AtomicUsize,
+    task: Mutex<Option<LentTask>>,
 }
+
+/// A closure lent to the helper by [`SymvTeam::beside`], its lifetime erased: `beside` does not
+/// return, nor unwind, before the job is settled (run by the helper, or taken back unstarted).
+struct LentTask(*mut (dyn FnMut() + Send + 'static));
+
+// SAFETY: the closure itself is `Send`; the pointer is dereferenced only by the thread that
+// claimed the job, while `beside` keeps the closure borrowed.
+unsafe impl Send for LentTask {}
 
 /// The state shared by the caller and the helper. Jobs are numbered 1, 2, …; job g is posted
 /// when `posted` = g, owned by whoever moves `claimed` from g − 1 to g, and done by the helper
@@ -51,6 +61,7 @@ impl SymvTeam {
                 q: AtomicUsize::new(0),
                 start: AtomicUsize::new(0),
                 end: AtomicUsize::new(0),
+                task: Mutex::new(None),
             },
             posted: AtomicUsize::new(0),
             claimed: AtomicUsize::new(0),
@@ -89,6 +100,19 @@ impl SymvTeam {
                 .is_err()
             {
                 continue; // the caller took this job itself
+            }
+            let lent = match self.job.task.lock() {
+                Ok(mut slot) => slot.take(),
+                Err(_) => None,
+            };
+            if let Some(LentTask(task)) = lent {
+                // SAFETY: `beside` lent this closure for job `posted`, which this thread has
+                // claimed, and keeps it borrowed until `finished` reaches the job.
+                let run = || unsafe { (*task)() };
+                let ok = std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).is_ok();
+                self.helper_ok.store(ok, Ordering::Release);
+                self.finished.store(posted, Ordering::Release);
+                continue;
             }
             let q = self.job.q.load(Ordering::Acquire);
             let cols = self.job.start.load(Ordering::Acquire)..self.job.end.load(Ordering::Acquire);
@@ -145,14 +169,66 @@ impl SymvTeam {
             kernel(a, q, split..m, v, &mut partial);
             y.iter_mut().zip(&partial).for_each(|(e, p)| *e += p);
         };
-        if self
-            .claimed
-            .compare_exchange(job - 1, job, Ordering::AcqRel, Ordering::Acquire)
-            .is_ok()
-        {
+        if self.take_back(job) {
             // The helper has not started.
             return second_half_here(y);
         }
+        self.wait_for(job);
+        match self.partial.lock() {
+            Ok(partial) if self.helper_ok.load(Ordering::Acquire) => {
+                y.iter_mut().zip(partial.iter()).for_each(|(e, p)| *e += p);
+            }
+            // The helper failed (a bug): its half is computed here, so the product stays right.
+            _ => second_half_here(y),
+        }
+    }
+}
+
+impl SymvTeam {
+    /// Runs `here` on this thread and `there` on the helper at the same time, and returns when
+    /// both are done; if the helper has not started `there` when `here` is done, `there` runs
+    /// here too. The two closures must touch disjoint data. A panic in `there` on the helper
+    /// is raised again here, after the job is settled.
+    pub(crate) fn beside(&self, helper: &Thread, there: &mut (dyn FnMut() + Send), here: impl FnOnce()) {
+        let job = self.posted.load(Ordering::Relaxed) + 1;
+        let lent: *mut (dyn FnMut() + Send + '_) = there;
+        // SAFETY: only the lifetime is erased; `Settle` (or the code after `here`) keeps `there`
+        // borrowed until the helper is done with it or it was taken back unstarted.
+        let lent: *mut (dyn FnMut() + Send + 'static) = unsafe { std::mem::transmute(lent) };
+        match self.job.task.lock() {
+            Ok(mut slot) => *slot = Some(LentTask(lent)),
+            Err(_) => {
+                // A poisoned slot (a bug): both run here, in turn.
+                here();
+                return there();
+            }
+        }
+        self.posted.store(job, Ordering::Release);
+        helper.unpark();
+        let settle = Settle { team: self, job };
+        here();
+        std::mem::forget(settle);
+        if self.take_back(job) {
+            if let Ok(mut slot) = self.job.task.lock() {
+                slot.take();
+            }
+            return there();
+        }
+        self.wait_for(job);
+        if !self.helper_ok.load(Ordering::Acquire) {
+            panic!("the helper thread's half of a split update failed");
+        }
+    }
+
+    /// Claims job `job` for the caller if the helper has not: true if the caller now owns it.
+    fn take_back(&self, job: usize) -> bool {
+        self.claimed
+            .compare_exchange(job - 1, job, Ordering::AcqRel, Ordering::Acquire)
+            .is_ok()
+    }
+
+    /// Waits until the helper has finished job `job` (spinning, yielding now and then).
+    fn wait_for(&self, job: usize) {
         let mut spins = 0_u32;
         while self.finished.load(Ordering::Acquire) != job {
             spins = spins.wrapping_add(1);
@@ -162,12 +238,25 @@ impl SymvTeam {
                 std::hint::spin_loop();
             }
         }
-        match self.partial.lock() {
-            Ok(partial) if self.helper_ok.load(Ordering::Acquire) => {
-                y.iter_mut().zip(partial.iter()).for_each(|(e, p)| *e += p);
+    }
+}
+
+/// Settles a lent job when [`SymvTeam::beside`]'s own half unwinds: the lent closure is taken
+/// back if the helper has not started it, else waited for, so that it is never used after its
+/// borrow ends.
+struct Settle<'a> {
+    team: &'a SymvTeam,
+    job: usize,
+}
+
+impl Drop for Settle<'_> {
+    fn drop(&mut self) {
+        if self.team.take_back(self.job) {
+            if let Ok(mut slot) = self.team.job.task.lock() {
+                slot.take();
             }
-            // The helper failed (a bug): its half is computed here, so the product stays right.
-            _ => second_half_here(y),
+        } else {
+            self.team.wait_for(self.job);
         }
     }
 }
@@ -189,6 +278,77 @@ mod tests {
     use super::*;
 
     fn no_work(_: &Mat<f64>, _: usize, _: std::ops::Range<usize>, _: &[f64], _: &mut [f64]) {}
+
+    /// Runs `body` with a serving helper (stopped when `body` returns or unwinds).
+    fn with_helper(body: impl FnOnce(&SymvTeam, &Thread)) {
+        let team = SymvTeam::new();
+        std::thread::scope(|scope| {
+            let helper = scope.spawn(|| team.serve(no_work)).thread().clone();
+            let _stop = team.stop_on_drop(&helper);
+            body(&team, &helper);
+        });
+    }
+
+    #[test]
+    fn each_lent_half_runs_exactly_once_whoever_takes_it() {
+        with_helper(|team, helper| {
+            for round in 1..=300_u64 {
+                let (mut left, mut right) = (vec![0_u64; 64], vec![0_u64; 64]);
+                // Rounds whose own half is slow let the helper take the lent half; in the quick
+                // ones the caller often takes it back unstarted.
+                team.beside(helper, &mut || right.iter_mut().for_each(|e| *e += round), || {
+                    if round % 3 == 0 {
+                        std::thread::sleep(Duration::from_micros(300));
+                    }
+                    left.iter_mut().for_each(|e| *e += round);
+                });
+                assert!(left.iter().chain(&right).all(|&e| e == round), "round {round}");
+            }
+        });
+    }
+
+    #[test]
+    fn a_panic_in_the_own_half_waits_for_the_lent_half_to_end() {
+        with_helper(|team, helper| {
+            let started = AtomicBool::new(false);
+            let mut finished = false;
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                team.beside(
+                    helper,
+                    &mut || {
+                        started.store(true, Ordering::Release);
+                        std::thread::sleep(Duration::from_millis(20));
+                        finished = true;
+                    },
+                    || {
+                        while !started.load(Ordering::Acquire) {
+                            std::hint::spin_loop();
+                        }
+                        panic!("a deliberate failure in the caller's half");
+                    },
+                )
+            }));
+            assert!(outcome.is_err());
+            // The helper had started the lent half, so the unwinding waited for its end.
+            assert!(finished);
+            // The team still serves.
+            let mut again = 0;
+            team.beside(helper, &mut || again += 1, || {});
+            assert_eq!(again, 1);
+        });
+    }
+
+    #[test]
+    fn a_panic_in_the_lent_half_reaches_the_caller() {
+        with_helper(|team, helper| {
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                team.beside(helper, &mut || panic!("a deliberate failure in the lent half"), || {
+                    std::thread::sleep(Duration::from_millis(5));
+                })
+            }));
+            assert!(outcome.is_err());
+        });
+    }
 
     #[test]
     fn a_panic_in_the_caller_stops_the_helper() {
