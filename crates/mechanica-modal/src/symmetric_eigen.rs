@@ -15,7 +15,9 @@
 //! half of every matrix-vector product runs on a spinning helper thread (module `symv_team`):
 //! with the pool's sleeping threads, woken once per column, the reduction took 41–47 ms at
 //! n = 1000 and 0.29–0.37 s at n = 2000; with the team 34 ms and 0.21–0.24 s (OpenBLAS `dsytrd`
-//! 35 ms and 0.22–0.27 s on the same machine).
+//! 35 ms and 0.22–0.27 s on the same machine). The helper also takes the panel's correction of
+//! each product (dlatrd's y −= V Wᵀv + W Vᵀv) and half of each trailing update, which faer's
+//! pool did with threads that had gone to sleep during the panel.
 
 use crate::ModalError;
 use crate::symv_team::SymvTeam;
@@ -308,7 +310,7 @@ fn tridiagonalize(a: &mut Mat<f64>, par: Par) -> Tridiagonal {
     } else {
         let team = SymvTeam::new();
         std::thread::scope(|scope| {
-            match std::thread::Builder::new().spawn_scoped(scope, || team.serve(symv_columns)) {
+            match std::thread::Builder::new().spawn_scoped(scope, || team.serve()) {
                 Ok(helper) => {
                     let helper = helper.thread().clone();
                     // Stopped on every exit, also by unwinding: the scope joins the helper.
@@ -407,8 +409,7 @@ fn reduce_panel(
     team: Option<(&SymvTeam, &Thread)>,
 ) {
     let n = a.nrows();
-    let mut y = vec![0.0; n];
-    let mut coefficients = Mat::<f64>::zeros(PANEL, 1);
+    let (mut y, mut partial) = (vec![0.0; n], vec![0.0; n]);
     for i in 0..nb {
         let k = p + i;
         if i > 0 {
@@ -445,21 +446,8 @@ fn reduce_panel(
         a[(k + 1, k)] = 1.0;
         let tau_inv = tau.recip();
         let m = n - k - 1;
-        // y = A(k+1.., k+1..) v, v = a(k+1.., k), with the not yet updated trailing matrix.
         let y = &mut y[..m];
-        symv_lower(a, k + 1, y, team);
-        let mut y_mat = faer::MatMut::from_column_major_slice_mut(&mut *y, m, 1);
-        if i > 0 {
-            let v_panel = a.as_ref().submatrix(k + 1, p, m, i);
-            let w_panel = w.as_ref().submatrix(k + 1, 0, m, i);
-            let v = a.as_ref().submatrix(k + 1, k, m, 1);
-            let mut c = coefficients.as_mut().subrows_mut(0, i);
-            // y −= V (Wᵀ v) + W (Vᵀ v)
-            matmul(c.rb_mut(), Accum::Replace, w_panel.transpose(), v, 1.0, Par::Seq);
-            matmul(y_mat.rb_mut(), Accum::Add, v_panel, c.rb(), -1.0, Par::Seq);
-            matmul(c.rb_mut(), Accum::Replace, v_panel.transpose(), v, 1.0, Par::Seq);
-            matmul(y_mat.rb_mut(), Accum::Add, w_panel, c.rb(), -1.0, Par::Seq);
-        }
+        panel_product(a, w, p, i, y, &mut partial[..m], team);
         let v = &a.col_as_slice(k)[k + 1..];
         let mut dot = 0.0;
         for (yr, vr) in y.iter_mut().zip(v) {
@@ -474,22 +462,76 @@ fn reduce_panel(
     }
 }
 
-/// y = S v for the trailing symmetric block S = A(q.., q..) (lower triangle read) and
-/// v = A(q.., q − 1), the current reflector; with a team, from order [`PARALLEL_SYMV_FROM`] the
-/// two threads take column ranges of equal area and their partial products are summed.
-fn symv_lower(a: &Mat<f64>, q: usize, y: &mut [f64], team: Option<(&SymvTeam, &Thread)>) {
-    let m = a.nrows() - q;
+/// dlatrd's y for column k = p + i of a panel: y = S v − V (Wᵀ v) − W (Vᵀ v), with
+/// S = A(k+1.., k+1..) (lower triangle read, not yet updated by the panel), v = A(k+1.., k),
+/// V = A(k+1.., p..k) and W = w(k+1.., 0..i). With a team, from order [`PARALLEL_SYMV_FROM`],
+/// the helper computes the right-hand columns of S v and the correction into `partial`, this
+/// thread the left-hand columns, so that the two take about the same time.
+fn panel_product(
+    a: &Mat<f64>,
+    w: &Mat<f64>,
+    p: usize,
+    i: usize,
+    y: &mut [f64],
+    partial: &mut [f64],
+    team: Option<(&SymvTeam, &Thread)>,
+) {
+    let q = p + i + 1;
+    let m = y.len();
+    let v = &a.col_as_slice(q - 1)[q..];
     match team {
         Some((team, helper)) if m >= PARALLEL_SYMV_FROM => {
-            // Column j costs m − j: the first (1 − 1/√2)·m columns hold half the triangle.
-            let split = ((1.0 - std::f64::consts::FRAC_1_SQRT_2) * m as f64) as usize;
-            team.product(helper, symv_columns, a, q, split, y);
+            let split = caller_columns(m, i);
+            team.beside(
+                helper,
+                &mut || {
+                    partial.fill(0.0);
+                    symv_columns(a, q, split..m, v, partial);
+                    subtract_panel_correction(a, w, p, i, partial);
+                },
+                || {
+                    y.fill(0.0);
+                    symv_columns(a, q, 0..split, v, y);
+                },
+            );
+            y.iter_mut().zip(partial.iter()).for_each(|(e, h)| *e += h);
         }
         _ => {
-            y.iter_mut().for_each(|e| *e = 0.0);
-            symv_columns(a, q, 0..m, &a.col_as_slice(q - 1)[q..], y);
+            y.fill(0.0);
+            symv_columns(a, q, 0..m, v, y);
+            subtract_panel_correction(a, w, p, i, y);
         }
     }
+}
+
+/// How many leading columns of an order-m S the caller takes in [`panel_product`]: column j
+/// costs m − j, so the first s columns hold s·m − s²/2 of the triangle; the caller takes a
+/// quarter of m² plus m·i, the estimated cost of the helper's correction (4 passes over the two
+/// m×i panels, held in cache).
+fn caller_columns(m: usize, i: usize) -> usize {
+    let m_f = m as f64;
+    let target = 0.25 * m_f * m_f + m_f * i as f64;
+    let remaining = (m_f * m_f - 2.0 * target).max(0.0);
+    ((m_f - remaining.sqrt()) as usize).min(m)
+}
+
+/// y −= V (Wᵀ v) + W (Vᵀ v) of [`panel_product`] (nothing for a panel's first column).
+fn subtract_panel_correction(a: &Mat<f64>, w: &Mat<f64>, p: usize, i: usize, y: &mut [f64]) {
+    if i == 0 {
+        return;
+    }
+    let k = p + i;
+    let m = y.len();
+    let v_panel = a.as_ref().submatrix(k + 1, p, m, i);
+    let w_panel = w.as_ref().submatrix(k + 1, 0, m, i);
+    let v = a.as_ref().submatrix(k + 1, k, m, 1);
+    let mut coefficients = [0.0; PANEL];
+    let mut c = faer::MatMut::from_column_major_slice_mut(&mut coefficients[..i], i, 1);
+    let mut y = faer::MatMut::from_column_major_slice_mut(y, m, 1);
+    matmul(c.rb_mut(), Accum::Replace, w_panel.transpose(), v, 1.0, Par::Seq);
+    matmul(y.rb_mut(), Accum::Add, v_panel, c.rb(), -1.0, Par::Seq);
+    matmul(c.rb_mut(), Accum::Replace, v_panel.transpose(), v, 1.0, Par::Seq);
+    matmul(y.rb_mut(), Accum::Add, w_panel, c.rb(), -1.0, Par::Seq);
 }
 
 /// Adds the contributions of columns `cols` of S = A(q.., q..) to y = S v.
@@ -715,13 +757,15 @@ mod tests {
                 symv_columns(&a, q, 0..split, v, &mut dispatched);
                 symv_columns(&a, q, split..m, v, &mut dispatched);
                 let mut parallel = vec![0.0; m];
+                let mut partial = vec![0.0; m];
                 let team = SymvTeam::new();
                 std::thread::scope(|scope| {
-                    let helper = scope.spawn(|| team.serve(symv_columns)).thread().clone();
+                    let helper = scope.spawn(|| team.serve()).thread().clone();
                     // Repeated, so that both the helper's and the caller's claim of the second
                     // half occur (which one wins depends on timing).
                     for _ in 0..20 {
-                        symv_lower(&a, q, &mut parallel, Some((&team, &helper)));
+                        let w = Mat::<f64>::zeros(0, 0);
+                        panel_product(&a, &w, q - 1, 0, &mut parallel, &mut partial, Some((&team, &helper)));
                     }
                     team.stop(&helper);
                 });
@@ -734,6 +778,53 @@ mod tests {
                             exact[i]
                         );
                     }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn panel_products_subtract_the_pending_update_on_either_thread() {
+        // y = S v − V (Wᵀ v) − W (Vᵀ v) against its definition, with the helper taking the
+        // correction (order 700 > PARALLEL_SYMV_FROM) and without a team.
+        let n = 700;
+        let a = symmetric(n, 3);
+        let w = symmetric(n, 4);
+        for (p, i) in [(0, 1), (0, 5), (3, 31)] {
+            let q = p + i + 1;
+            let m = n - q;
+            let v = &a.col_as_slice(q - 1)[q..];
+            let exact: Vec<f64> = (0..m)
+                .map(|r| {
+                    let sv: f64 = (0..m).map(|j| a[(q + r.max(j), q + r.min(j))] * v[j]).sum();
+                    let correction: f64 = (0..i)
+                        .map(|c| {
+                            let wtv: f64 = (0..m).map(|j| w[(q + j, c)] * v[j]).sum();
+                            let vtv: f64 = (0..m).map(|j| a[(q + j, p + c)] * v[j]).sum();
+                            a[(q + r, p + c)] * wtv + w[(q + r, c)] * vtv
+                        })
+                        .sum();
+                    sv - correction
+                })
+                .collect();
+            let scale = a.norm_max() * (a.norm_max() + w.norm_max()) * m as f64;
+            let tol = 8.0 * m as f64 * f64::EPSILON * scale;
+            let (mut alone, mut together, mut partial) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+            panel_product(&a, &w, p, i, &mut alone, &mut partial, None);
+            let team = SymvTeam::new();
+            std::thread::scope(|scope| {
+                let helper = scope.spawn(|| team.serve()).thread().clone();
+                panel_product(&a, &w, p, i, &mut together, &mut partial, Some((&team, &helper)));
+                team.stop(&helper);
+            });
+            for r in 0..m {
+                for (name, got) in [("alone", &alone), ("with the helper", &together)] {
+                    assert!(
+                        (got[r] - exact[r]).abs() <= tol,
+                        "p {p} i {i} row {r}: {name} {} vs {}",
+                        got[r],
+                        exact[r]
+                    );
                 }
             }
         }

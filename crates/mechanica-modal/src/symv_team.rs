@@ -1,30 +1,19 @@
-//! A second thread for the symmetric matrix-vector products of one tridiagonalization
-//! ([`crate::symmetric_eigen`]): the panel reduction needs one product per column, each a few
-//! tens of microseconds at orders 1000–2000, and a pool thread that has gone to sleep between
-//! them takes about as long to wake. The team's helper waits for the next column by spinning
-//! (then parking, so that it leaves the core to the pool during the trailing updates), and a
-//! half that it has not claimed yet when the caller's own half is done is computed by the
-//! caller instead, so a late helper never delays a product.
+//! A second thread for one tridiagonalization ([`crate::symmetric_eigen`]): the panel reduction
+//! needs one symmetric matrix-vector product per column, each a few tens of microseconds at
+//! orders 1000–2000, and a pool thread that has gone to sleep between them takes about as long
+//! to wake. The team's helper waits for the next job by spinning (then parking), and takes one
+//! half of each product and of each panel's trailing update ([`SymvTeam::beside`]); a half that
+//! it has not claimed yet when the caller's own half is done is run by the caller instead, so a
+//! late helper never delays the reduction.
 
-use faer::Mat;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::thread::Thread;
 use std::time::{Duration, Instant};
 
 /// How long the helper spins for the next job before it parks (measured: 20 µs and 2 ms were
 /// no faster at n = 1000–2000, 2 ms slower at 1000).
 const SPIN: Duration = Duration::from_micros(200);
-
-/// One posted job: either the columns `start..end` of S = A(q.., q..) times the reflector
-/// A(q.., q − 1), or (`task` set) a closure lent by [`SymvTeam::beside`].
-struct Job {
-    matrix: AtomicPtr<Mat<f64>>,
-    q: AtomicUsize,
-    start: AtomicUsize,
-    end: AtomicUsize,
-    task: Mutex<Option<LentTask>>,
-}
 
 /// A closure lent to the helper by [`SymvTeam::beside`], its lifetime erased: `beside` does not
 /// return, nor unwind, before the job is settled (run by the helper, or taken back unstarted).
@@ -38,42 +27,29 @@ unsafe impl Send for LentTask {}
 /// when `posted` = g, owned by whoever moves `claimed` from g − 1 to g, and done by the helper
 /// when `finished` = g.
 pub(crate) struct SymvTeam {
-    job: Job,
+    task: Mutex<Option<LentTask>>,
     posted: AtomicUsize,
     claimed: AtomicUsize,
     finished: AtomicUsize,
     stop: AtomicBool,
-    /// Whether the helper's last job completed (false after a panic in it, a bug).
+    /// Whether the helper's last job completed (false after a panic in it).
     helper_ok: AtomicBool,
-    /// The helper's partial product.
-    partial: Mutex<Vec<f64>>,
 }
-
-/// The kernel both threads run: adds columns `cols` of S = A(q.., q..) times v = A(q.., q − 1)
-/// to `y` (see `symmetric_eigen::symv_columns`).
-pub(crate) type Kernel = fn(&Mat<f64>, usize, std::ops::Range<usize>, &[f64], &mut [f64]);
 
 impl SymvTeam {
     pub(crate) fn new() -> Self {
         Self {
-            job: Job {
-                matrix: AtomicPtr::new(std::ptr::null_mut()),
-                q: AtomicUsize::new(0),
-                start: AtomicUsize::new(0),
-                end: AtomicUsize::new(0),
-                task: Mutex::new(None),
-            },
+            task: Mutex::new(None),
             posted: AtomicUsize::new(0),
             claimed: AtomicUsize::new(0),
             finished: AtomicUsize::new(0),
             stop: AtomicBool::new(false),
             helper_ok: AtomicBool::new(true),
-            partial: Mutex::new(Vec::new()),
         }
     }
 
     /// The helper's loop: run until [`SymvTeam::stop`].
-    pub(crate) fn serve(&self, kernel: Kernel) {
+    pub(crate) fn serve(&self) {
         let mut seen = 0;
         loop {
             let since = Instant::now();
@@ -94,41 +70,22 @@ impl SymvTeam {
                 }
             };
             seen = posted;
-            if self
-                .claimed
-                .compare_exchange(posted - 1, posted, Ordering::AcqRel, Ordering::Acquire)
-                .is_err()
-            {
-                continue; // the caller took this job itself
+            if !self.take(posted) {
+                continue; // the caller took this job back
             }
-            let lent = match self.job.task.lock() {
+            let lent = match self.task.lock() {
                 Ok(mut slot) => slot.take(),
                 Err(_) => None,
             };
-            if let Some(LentTask(task)) = lent {
-                // SAFETY: `beside` lent this closure for job `posted`, which this thread has
-                // claimed, and keeps it borrowed until `finished` reaches the job.
-                let run = || unsafe { (*task)() };
-                let ok = std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).is_ok();
-                self.helper_ok.store(ok, Ordering::Release);
-                self.finished.store(posted, Ordering::Release);
-                continue;
-            }
-            let q = self.job.q.load(Ordering::Acquire);
-            let cols = self.job.start.load(Ordering::Acquire)..self.job.end.load(Ordering::Acquire);
-            // SAFETY: the pointer was made from a live `&Mat` by `product` just before it posted
-            // this job, and the caller neither writes to the matrix nor returns from `product`
-            // until `finished` reaches this job (or it claimed the job itself, which failed here).
-            let a = unsafe { &*self.job.matrix.load(Ordering::Acquire) };
-            let m = a.nrows() - q;
-            let run = || {
-                let mut partial = self.partial.lock().map_err(|_| ())?;
-                partial.clear();
-                partial.resize(m, 0.0);
-                kernel(a, q, cols, &a.col_as_slice(q - 1)[q..], &mut partial);
-                Ok::<(), ()>(())
+            let ok = match lent {
+                Some(LentTask(task)) => {
+                    // SAFETY: `beside` lent this closure for job `posted`, which this thread
+                    // has claimed, and keeps it borrowed until `finished` reaches the job.
+                    let run = || unsafe { (*task)() };
+                    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).is_ok()
+                }
+                None => false,
             };
-            let ok = matches!(std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)), Ok(Ok(())));
             self.helper_ok.store(ok, Ordering::Release);
             self.finished.store(posted, Ordering::Release);
         }
@@ -146,56 +103,18 @@ impl SymvTeam {
         StopOnDrop { team: self, helper }
     }
 
-    /// y = S v for S = A(q.., q..), v = A(q.., q − 1): columns `split..` go to the helper,
-    /// `..split` are computed here; y is overwritten.
-    pub(crate) fn product(&self, helper: &Thread, kernel: Kernel, a: &Mat<f64>, q: usize, split: usize, y: &mut [f64]) {
-        let m = a.nrows() - q;
-        let job = self.posted.load(Ordering::Relaxed) + 1;
-        self.job
-            .matrix
-            .store(std::ptr::from_ref(a).cast_mut(), Ordering::Release);
-        self.job.q.store(q, Ordering::Release);
-        self.job.start.store(split, Ordering::Release);
-        self.job.end.store(m, Ordering::Release);
-        self.posted.store(job, Ordering::Release);
-        helper.unpark();
-        let v = &a.col_as_slice(q - 1)[q..];
-        y.iter_mut().for_each(|e| *e = 0.0);
-        kernel(a, q, 0..split, v, y);
-        // The helper's half computed here, into a separate partial sum as the helper does, so
-        // that y is bitwise the same whichever thread did the work.
-        let second_half_here = |y: &mut [f64]| {
-            let mut partial = vec![0.0; m];
-            kernel(a, q, split..m, v, &mut partial);
-            y.iter_mut().zip(&partial).for_each(|(e, p)| *e += p);
-        };
-        if self.take_back(job) {
-            // The helper has not started.
-            return second_half_here(y);
-        }
-        self.wait_for(job);
-        match self.partial.lock() {
-            Ok(partial) if self.helper_ok.load(Ordering::Acquire) => {
-                y.iter_mut().zip(partial.iter()).for_each(|(e, p)| *e += p);
-            }
-            // The helper failed (a bug): its half is computed here, so the product stays right.
-            _ => second_half_here(y),
-        }
-    }
-}
-
-impl SymvTeam {
     /// Runs `here` on this thread and `there` on the helper at the same time, and returns when
     /// both are done; if the helper has not started `there` when `here` is done, `there` runs
-    /// here too. The two closures must touch disjoint data. A panic in `there` on the helper
-    /// is raised again here, after the job is settled.
+    /// here too. The two closures must touch disjoint data, and each must give the same result
+    /// whichever thread runs it. A panic in `there` on the helper is raised again here, after
+    /// the job is settled.
     pub(crate) fn beside(&self, helper: &Thread, there: &mut (dyn FnMut() + Send), here: impl FnOnce()) {
         let job = self.posted.load(Ordering::Relaxed) + 1;
         let lent: *mut (dyn FnMut() + Send + '_) = there;
         // SAFETY: only the lifetime is erased; `Settle` (or the code after `here`) keeps `there`
         // borrowed until the helper is done with it or it was taken back unstarted.
         let lent: *mut (dyn FnMut() + Send + 'static) = unsafe { std::mem::transmute(lent) };
-        match self.job.task.lock() {
+        match self.task.lock() {
             Ok(mut slot) => *slot = Some(LentTask(lent)),
             Err(_) => {
                 // A poisoned slot (a bug): both run here, in turn.
@@ -208,23 +127,28 @@ impl SymvTeam {
         let settle = Settle { team: self, job };
         here();
         std::mem::forget(settle);
-        if self.take_back(job) {
-            if let Ok(mut slot) = self.job.task.lock() {
-                slot.take();
-            }
+        if self.take(job) {
+            self.clear_task();
             return there();
         }
         self.wait_for(job);
         if !self.helper_ok.load(Ordering::Acquire) {
-            panic!("the helper thread's half of a split update failed");
+            panic!("the helper thread's half of a split step failed");
         }
     }
 
-    /// Claims job `job` for the caller if the helper has not: true if the caller now owns it.
-    fn take_back(&self, job: usize) -> bool {
+    /// Claims job `job` (for the helper, or back for the caller): true if this call owns it.
+    fn take(&self, job: usize) -> bool {
         self.claimed
             .compare_exchange(job - 1, job, Ordering::AcqRel, Ordering::Acquire)
             .is_ok()
+    }
+
+    /// Empties the task slot of a job the caller took back.
+    fn clear_task(&self) {
+        if let Ok(mut slot) = self.task.lock() {
+            slot.take();
+        }
     }
 
     /// Waits until the helper has finished job `job` (spinning, yielding now and then).
@@ -251,10 +175,8 @@ struct Settle<'a> {
 
 impl Drop for Settle<'_> {
     fn drop(&mut self) {
-        if self.team.take_back(self.job) {
-            if let Ok(mut slot) = self.team.job.task.lock() {
-                slot.take();
-            }
+        if self.team.take(self.job) {
+            self.team.clear_task();
         } else {
             self.team.wait_for(self.job);
         }
@@ -277,13 +199,11 @@ impl Drop for StopOnDrop<'_> {
 mod tests {
     use super::*;
 
-    fn no_work(_: &Mat<f64>, _: usize, _: std::ops::Range<usize>, _: &[f64], _: &mut [f64]) {}
-
     /// Runs `body` with a serving helper (stopped when `body` returns or unwinds).
     fn with_helper(body: impl FnOnce(&SymvTeam, &Thread)) {
         let team = SymvTeam::new();
         std::thread::scope(|scope| {
-            let helper = scope.spawn(|| team.serve(no_work)).thread().clone();
+            let helper = scope.spawn(|| team.serve()).thread().clone();
             let _stop = team.stop_on_drop(&helper);
             body(&team, &helper);
         });
@@ -357,7 +277,7 @@ mod tests {
         let team = SymvTeam::new();
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             std::thread::scope(|scope| {
-                let helper = scope.spawn(|| team.serve(no_work)).thread().clone();
+                let helper = scope.spawn(|| team.serve()).thread().clone();
                 let _stop = team.stop_on_drop(&helper);
                 panic!("a deliberate failure in the caller's work");
             })
