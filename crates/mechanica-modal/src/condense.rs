@@ -84,7 +84,13 @@ pub(crate) fn solve_semidefinite(
         condensed_stiffness_negatives: Some(negatives),
         condensation: condensed.refinable.then_some(&condensed),
     };
-    finish.run(def, infinite, Some(&lift), Method::CondensedReduction { massless: r })
+    finish.run(
+        def,
+        infinite,
+        Some(&lift),
+        Method::CondensedReduction { massless: r },
+        None,
+    )
 }
 
 /// The static condensation of the pencil (B, A) as refinement needs it: the exact identity

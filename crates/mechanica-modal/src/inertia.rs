@@ -46,8 +46,14 @@ pub fn count_below(problem: &PencilProblem, shift: f64) -> Result<InertiaCount, 
 /// costs a third of the LBLᵀ of [`count_below`] (n³/3 flops at Cholesky speed).
 /// `spare` is a matrix whose storage may be reused (any contents).
 pub(crate) fn all_above(problem: &PencilProblem, shift: f64, spare: Option<Mat<f64>>, par: faer::Par) -> bool {
+    let mut k = shifted_lower(problem, shift, spare);
+    crate::reduce::factor_in_place(k.as_mut(), par).is_ok()
+}
+
+/// The lower triangle of B − shift·A (the strict upper triangle is left as it was), written
+/// into `spare` when that is n×n, else into a new matrix.
+pub(crate) fn shifted_lower(problem: &PencilProblem, shift: f64, spare: Option<Mat<f64>>) -> Mat<f64> {
     let (a, b) = (problem.a(), problem.b());
-    // Only the lower triangle is formed and factored.
     let n = problem.dim();
     let mut k = match spare {
         Some(m) if m.nrows() == n && m.ncols() == n => m,
@@ -60,7 +66,7 @@ pub(crate) fn all_above(problem: &PencilProblem, shift: f64, spare: Option<Mat<f
             *kij = bij - shift * aij;
         }
     }
-    crate::reduce::factor_in_place(k.as_mut(), par).is_ok()
+    k
 }
 
 /// (negative, zero, positive) eigenvalue counts of the symmetric matrix `k` (lower triangle read).

@@ -47,6 +47,7 @@ mod dd;
 pub mod error;
 pub mod families;
 mod fork_join;
+mod idle_certificate;
 pub mod inertia;
 pub mod lanczos;
 pub mod matrix_market;

@@ -2,17 +2,19 @@
 
 use crate::ModalError;
 use faer::{Mat, MatRef};
+use std::sync::Arc;
 
 /// Symmetry is accepted when |M_ij − M_ji| ≤ `SYMMETRY_ULPS` · u · max|M|: the rounding
 /// that assembling a matrix in a different summation order can leave, and no more.
 pub const SYMMETRY_ULPS: f64 = 64.0;
 
 /// A symmetric pencil: mass matrix A (positive semidefinite) and stiffness matrix B
-/// (symmetric, any inertia), both n×n and finite. Stored symmetrised exactly.
+/// (symmetric, any inertia), both n×n and finite. Stored symmetrised exactly, and shared (a
+/// clone, or the solver's idle-time certificate thread, holds the same storage).
 #[derive(Debug, Clone)]
 pub struct PencilProblem {
-    a: Mat<f64>,
-    b: Mat<f64>,
+    a: Arc<Mat<f64>>,
+    b: Arc<Mat<f64>>,
 }
 
 impl PencilProblem {
@@ -20,8 +22,8 @@ impl PencilProblem {
     pub fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Result<Self, ModalError> {
         let n = a.nrows();
         Ok(Self {
-            a: checked_symmetric("A", a, n)?,
-            b: checked_symmetric("B", b, n)?,
+            a: Arc::new(checked_symmetric("A", a, n)?),
+            b: Arc::new(checked_symmetric("B", b, n)?),
         })
     }
 
@@ -32,12 +34,12 @@ impl PencilProblem {
 
     /// The mass matrix A.
     pub fn a(&self) -> MatRef<'_, f64> {
-        self.a.as_ref()
+        self.a.as_ref().as_ref()
     }
 
     /// The stiffness matrix B.
     pub fn b(&self) -> MatRef<'_, f64> {
-        self.b.as_ref()
+        self.b.as_ref().as_ref()
     }
 }
 

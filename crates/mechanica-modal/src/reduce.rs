@@ -89,8 +89,7 @@ pub(crate) fn is_diagonal(m: MatRef<'_, f64>) -> bool {
 /// not positive, NaN, or ≤ n·u·max_j a_jj fails).
 fn factor_diagonal_in_place(mut l: MatMut<'_, f64>) -> Result<(), usize> {
     let n = l.nrows();
-    let max_diag = (0..n).map(|i| l[(i, i)]).fold(0.0_f64, f64::max);
-    let tolerance = n as f64 * f64::EPSILON * max_diag;
+    let tolerance = n as f64 * f64::EPSILON * max_diagonal(l.rb());
     if let Some(pivot) = (0..n).find(|&i| {
         let pivot = l[(i, i)];
         pivot.is_nan() || pivot <= tolerance
@@ -107,12 +106,21 @@ fn factor_diagonal_in_place(mut l: MatMut<'_, f64>) -> Result<(), usize> {
 /// cleared); Err(pivot) at the first pivot that is not positive or is negligible (l_ii² ≤
 /// n·u·max_j l_jj before factoring).
 pub(crate) fn factor_in_place(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
-    let n = l.nrows();
-    let par = factor_parallelism(n, par);
-    let max_diag = (0..n).map(|i| l[(i, i)]).fold(0.0_f64, f64::max);
+    let (max_diag, par) = (max_diagonal(l.rb()), factor_parallelism(l.nrows(), par));
     factor_recursive(l.rb_mut(), par)?;
+    check_pivots(l.rb(), max_diag)
+}
+
+/// The largest diagonal entry of `l`: before factoring, the scale of the pivot test.
+pub(crate) fn max_diagonal(l: MatRef<'_, f64>) -> f64 {
+    (0..l.nrows()).map(|i| l[(i, i)]).fold(0.0_f64, f64::max)
+}
+
+/// The pivot test of a finished factor: Err(pivot) at the first l_ii² that is NaN (an overflowed
+/// elimination) or ≤ n·u·`max_diag`.
+pub(crate) fn check_pivots(l: MatRef<'_, f64>, max_diag: f64) -> Result<(), usize> {
+    let n = l.nrows();
     let tolerance = n as f64 * f64::EPSILON * max_diag;
-    // A NaN pivot (an overflowed elimination) is refused too.
     match (0..n).find(|&i| {
         let pivot = l[(i, i)] * l[(i, i)];
         pivot.is_nan() || pivot <= tolerance
@@ -120,6 +128,33 @@ pub(crate) fn factor_in_place(mut l: MatMut<'_, f64>, par: Par) -> Result<(), us
         Some(pivot) => Err(pivot),
         None => Ok(()),
     }
+}
+
+/// One sequential step of a blocked right-looking Cholesky: factors columns start..start+width
+/// of `l` (the earlier ones factored) and subtracts their outer product from the trailing block.
+pub(crate) fn factor_block_step(mut l: MatMut<'_, f64>, start: usize, width: usize) -> Result<(), usize> {
+    let n = l.nrows();
+    let rest = l.rb_mut().submatrix_mut(start, start, n - start, n - start);
+    let (mut l11, _, mut l21, l22) = rest.split_at_mut(width, width);
+    factor_recursive(l11.rb_mut(), Par::Seq).map_err(|pivot| pivot + start)?;
+    solve_lower_triangular_in_place(l11.rb(), l21.rb_mut().transpose_mut(), Par::Seq);
+    subtract_outer_product(l22, l21.rb(), Par::Seq);
+    Ok(())
+}
+
+/// The lower triangle of `target` −= `factor` `factor`ᵀ.
+fn subtract_outer_product(target: MatMut<'_, f64>, factor: MatRef<'_, f64>, par: Par) {
+    tri_matmul(
+        target,
+        BlockStructure::TriangularLower,
+        Accum::Add,
+        factor,
+        BlockStructure::Rectangular,
+        factor.transpose(),
+        BlockStructure::Rectangular,
+        -1.0,
+        par,
+    );
 }
 
 /// Recursive right-looking Cholesky (Gustavson, "Recursion leads to automatic variable
@@ -151,17 +186,7 @@ fn factor_recursive(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
     let (mut l11, _, mut l21, mut l22) = l.split_at_mut(n1, n1);
     factor_recursive(l11.rb_mut(), par)?;
     solve_lower_triangular_in_place(l11.rb(), l21.rb_mut().transpose_mut(), par);
-    tri_matmul(
-        l22.rb_mut(),
-        BlockStructure::TriangularLower,
-        Accum::Add,
-        l21.rb(),
-        BlockStructure::Rectangular,
-        l21.rb().transpose(),
-        BlockStructure::Rectangular,
-        -1.0,
-        par,
-    );
+    subtract_outer_product(l22.rb_mut(), l21.rb(), par);
     factor_recursive(l22, par).map_err(|pivot| pivot + n1)
 }
 

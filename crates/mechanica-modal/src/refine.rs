@@ -1074,7 +1074,7 @@ mod tests {
         let (a, b, l, _, _, _) = graded();
         let c = reduce(l.as_ref(), b.as_ref(), Par::Seq);
         let (values, mut form) =
-            crate::symmetric_eigen::symmetric_values_keeping_form(c, Par::Seq).expect("values converge");
+            crate::symmetric_eigen::symmetric_values_keeping_form(c, Par::Seq, None).expect("values converge");
         let (mut x, z) = form.eigenvectors(&values[..4]).expect("inverse iteration converges");
         back_transform(l.as_ref(), x.as_mut(), Par::Seq);
         for i in 0..4 {

@@ -11,13 +11,16 @@ use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::condense::Condensation;
 use crate::dd::Operand;
 use crate::fork_join::join;
+use crate::idle_certificate::IdleCertificate;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky_owned, reduce_owned};
 use crate::refine::{
     Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts, polish_simple_mode,
     refine_cluster, refine_simple_modes,
 };
-use crate::symmetric_eigen::{TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form};
+use crate::symmetric_eigen::{
+    OnTridiagonal, TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form,
+};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
 use rayon::prelude::*;
@@ -57,6 +60,10 @@ pub enum Refinement {
 
 /// Dense problems smaller than this are solved on one thread.
 pub const SEQUENTIAL_BELOW: usize = 192;
+
+/// From this order an all-modes solve factors its bottom certificate on idle time (module
+/// `idle_certificate`); below it the factorization is cheap and a thread's start is not.
+const IDLE_CERTIFICATE_FROM: usize = 640;
 
 /// Auto refinement starts when the reduction guarantees fewer than 8 digits of a mode's ω².
 pub const AUTO_REFINE_RELATIVE_BOUND: f64 = 1e-8;
@@ -234,7 +241,7 @@ pub(crate) fn solve_definite(
     vectors: bool,
     par: Par,
 ) -> Result<Definite, ModalError> {
-    solve_definite_owned(l, b.to_owned(), selection, vectors, par)
+    solve_definite_owned(l, b.to_owned(), selection, vectors, par, None)
 }
 
 /// [`solve_definite`] on a copy of B that the caller no longer needs (reduced in place).
@@ -244,6 +251,7 @@ fn solve_definite_owned(
     selection: Selection,
     vectors: bool,
     par: Par,
+    on_tridiagonal: Option<OnTridiagonal<'_>>,
 ) -> Result<Definite, ModalError> {
     let n = b.nrows();
     if n == 0 {
@@ -268,7 +276,7 @@ fn solve_definite_owned(
     };
     let clock = Instant::now();
     if !vectors {
-        let (omega_sq, form) = symmetric_values_keeping_form(c, par)?;
+        let (omega_sq, form) = symmetric_values_keeping_form(c, par, on_tridiagonal)?;
         let (first, end) = select(&omega_sq, selection)?;
         timings.eigen = clock.elapsed();
         return Ok(Definite {
@@ -282,7 +290,7 @@ fn solve_definite_owned(
             timings,
         });
     }
-    let (eigen, mut spent) = symmetric_eigen_returning_input(c, true, par)?;
+    let (eigen, mut spent) = symmetric_eigen_returning_input(c, true, par, on_tridiagonal)?;
     let omega_sq = eigen.values;
     let (first, end) = select(&omega_sq, selection)?;
     let (x, y) = match eigen.vectors {
@@ -347,7 +355,14 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     match cholesky_owned(a_copy, par) {
         Cholesky::Factor(l) => {
             let cholesky_time = clock.elapsed();
-            let mut def = solve_definite_owned(l.as_ref(), b_copy, options.selection, want_vectors, par)?;
+            // All modes of a large pencil: the bottom certificate is factored on idle time.
+            let mut certificate = None;
+            let mut start_certificate =
+                |diag: &[f64], subdiag: &[f64]| certificate = IdleCertificate::start(problem, diag, subdiag);
+            let idle_time =
+                matches!(options.selection, Selection::All) && n >= IDLE_CERTIFICATE_FROM && par.degree() > 1;
+            let hook: Option<OnTridiagonal<'_>> = if idle_time { Some(&mut start_certificate) } else { None };
+            let mut def = solve_definite_owned(l.as_ref(), b_copy, options.selection, want_vectors, par, hook)?;
             if !want_vectors && options.refinement == Refinement::Auto {
                 // Values only: the modes whose a-priori bound is too weak get their vectors
                 // (crate::values_only), unless they are so many that all vectors cost less.
@@ -377,7 +392,7 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 condensed_stiffness_negatives: None,
                 condensation: None,
             };
-            finish.run(def, Vec::new(), None, Method::CholeskyReduction)
+            finish.run(def, Vec::new(), None, Method::CholeskyReduction, certificate)
         }
         Cholesky::Failed { pivot } => crate::condense::solve_semidefinite(problem, pivot, options, norm_a, norm_b, par),
     }
@@ -453,6 +468,7 @@ impl Finish<'_> {
         infinite: Vec<Vec<f64>>,
         lift: Option<Lift<'_>>,
         method: Method,
+        idle_certificate: Option<IdleCertificate>,
     ) -> Result<ModalSolution, ModalError> {
         let (a, b) = (self.problem.a(), self.problem.b());
         let n = self.problem.dim();
@@ -667,6 +683,7 @@ impl Finish<'_> {
             &report.error_bounds,
             self.condensed_stiffness_negatives,
             def.reduced.or_else(|| form.map(TridiagonalForm::into_storage)),
+            idle_certificate,
             self.par,
         )?;
         timings.inertia = clock.elapsed();
@@ -870,6 +887,7 @@ fn inertia_check(
     bounds: &[f64],
     condensed_stiffness_negatives: Option<usize>,
     spare: Option<Mat<f64>>,
+    idle_certificate: Option<IdleCertificate>,
     par: Par,
 ) -> Result<Option<InertiaCheck>, ModalError> {
     if omega_all.is_empty() {
@@ -883,7 +901,15 @@ fn inertia_check(
         // instability, below the lowest computed ω²) with a Cholesky factorization.
         let lowest = omega_all[0];
         let shift = lowest - (0.5 * lowest.abs()).max(2.0 * bounds[0]);
-        if shift < lowest && all_above(problem, shift, spare, par) {
+        // The factorization begun on idle time (at half of T's lowest eigenvalue) serves when
+        // its shift is this one to 8 digits, or higher and still below the lowest ω² by more
+        // than twice its bound.
+        let usable = |s: f64| s >= shift - 1e-8 * shift.abs() && s < lowest - 2.0 * bounds[0];
+        let certified = match idle_certificate.and_then(IdleCertificate::finished) {
+            Some((idle_shift, true)) if usable(idle_shift) => Some(idle_shift),
+            _ => (shift < lowest && all_above(problem, shift, spare, par)).then_some(shift),
+        };
+        if let Some(shift) = certified {
             return Ok(Some(InertiaCheck {
                 count: InertiaCount {
                     shift,

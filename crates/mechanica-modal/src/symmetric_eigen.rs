@@ -69,9 +69,13 @@ struct Tridiagonal {
     tau: Vec<f64>,
 }
 
+/// Called with T's diagonal and off-diagonal as soon as the tridiagonal form is known (the
+/// solver starts its idle-time certificate there, module `idle_certificate`).
+pub(crate) type OnTridiagonal<'a> = &'a mut dyn FnMut(&[f64], &[f64]);
+
 /// Eigen-decomposition of the symmetric matrix `c` (only its lower triangle is read).
 pub fn symmetric_eigen(c: Mat<f64>, vectors: bool, par: Par) -> Result<SymmetricEigen, ModalError> {
-    symmetric_eigen_returning_input(c, vectors, par).map(|(eigen, _)| eigen)
+    symmetric_eigen_returning_input(c, vectors, par, None).map(|(eigen, _)| eigen)
 }
 
 /// [`symmetric_eigen`], also handing back the input's storage (overwritten by the Householder
@@ -81,6 +85,7 @@ pub(crate) fn symmetric_eigen_returning_input(
     mut c: Mat<f64>,
     vectors: bool,
     par: Par,
+    on_tridiagonal: Option<OnTridiagonal<'_>>,
 ) -> Result<(SymmetricEigen, Mat<f64>), ModalError> {
     let n = c.nrows();
     if n == 0 {
@@ -91,10 +96,13 @@ pub(crate) fn symmetric_eigen_returning_input(
         return Ok((eigen, c));
     }
     if !vectors {
-        let (values, form) = symmetric_values_keeping_form(c, par)?;
+        let (values, form) = symmetric_values_keeping_form(c, par, on_tridiagonal)?;
         return Ok((SymmetricEigen { values, vectors: None }, form.into_storage()));
     }
     let t = tridiagonalize(&mut c, par);
+    if let Some(hook) = on_tridiagonal {
+        hook(&t.diag, &t.subdiag);
+    }
     let (values, mut z) = match tridiagonal_divide_and_conquer(&t.diag, &t.subdiag, par) {
         Some(pairs) => pairs,
         None => faer_tridiagonal_eigen(&t, par)?,
@@ -179,6 +187,7 @@ pub(crate) struct TridiagonalForm {
 pub(crate) fn symmetric_values_keeping_form(
     mut c: Mat<f64>,
     par: Par,
+    on_tridiagonal: Option<OnTridiagonal<'_>>,
 ) -> Result<(Vec<f64>, TridiagonalForm), ModalError> {
     let n = c.nrows();
     let t = if n == 0 {
@@ -190,6 +199,9 @@ pub(crate) fn symmetric_values_keeping_form(
     } else {
         tridiagonalize(&mut c, par)
     };
+    if let Some(hook) = on_tridiagonal {
+        hook(&t.diag, &t.subdiag);
+    }
     let values = tridiagonal_eigenvalues(&t.diag, &t.subdiag).map_err(|_| ModalError::NoConvergence { n })?;
     let form = TridiagonalForm {
         t,

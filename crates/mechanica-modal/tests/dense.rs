@@ -71,6 +71,38 @@ fn rotated_chain_keeps_its_spectrum() {
     check_against(&pencil(&ar, &br), &families::fixed_chain_omega_sq(n));
 }
 
+/// Large enough (n ≥ 640) for the bottom certificate to be factored on idle time: whichever
+/// path decides it (the idle thread at half of T's lowest eigenvalue, or the report at half the
+/// lowest computed ω²), the certified shift lies below the closed-form lowest ω², at half the
+/// computed one to 8 digits, with no mode below it; values only takes the same path.
+#[test]
+fn large_solves_certify_the_bottom_below_the_closed_form() {
+    let n = 700;
+    let q = families::random_orthogonal(n, 3);
+    let (a, b) = families::rotate(&Mat::identity(n, n), &families::fixed_chain(n).1, &q);
+    let p = pencil(&a, &b);
+    let lowest = families::fixed_chain_omega_sq(n)[0];
+    for vectors in [true, false] {
+        for _ in 0..3 {
+            let options = SolveOptions {
+                vectors,
+                residuals: Residuals::Sketched,
+                ..SolveOptions::default()
+            };
+            let sol = solve(&p, &options).expect("solve");
+            let check = sol.accuracy.inertia_check.expect("sturm check");
+            assert!(
+                check.consistent && check.count.below == 0 && check.computed_below == 0,
+                "{check:?}"
+            );
+            let shift = check.count.shift;
+            assert!(shift < lowest, "shift {shift:e} not below ω²₁ = {lowest:e}");
+            let half = 0.5 * sol.modes[0].omega_sq;
+            assert!((shift - half).abs() <= 1e-8 * half, "shift {shift:e} vs {half:e}");
+        }
+    }
+}
+
 /// Lumped masses graded over twelve decades with a dense stiffness, all stored exactly: with H
 /// the Sylvester–Hadamard matrix of order 128 and d_i = 4^k_i (k_i from −10 to 10), A = D and
 /// B = D^½ (HᵀTH/128) D^½ are exact in binary (integers times powers of two), and
