@@ -577,6 +577,13 @@ static void dense_blocked_path(void) {
     CHECK_STATUS(mech_modal_result_accuracy(r, &acc), MECH_STATUS_OK);
     CHECK(acc.orthogonality_error >= 0.0 && acc.orthogonality_error <= 10.0 * ND * u_round);
     CHECK(acc.inertia_checked == 1 && acc.inertia_consistent == 1);
+    /* Every mode computed: the Sturm check certifies the bottom of the spectrum (from n = 640
+     * factored on idle core time): no mode below half the lowest computed ω², which lies below
+     * the closed form's lowest. */
+    double lowest = 4.0 * sin(pi / (2.0 * (ND + 1))) * sin(pi / (2.0 * (ND + 1)));
+    CHECK(acc.inertia_below == 0 && acc.computed_below == 0);
+    CHECK(acc.inertia_shift > 0.0 && acc.inertia_shift < lowest);
+    CHECK_NEAR(acc.inertia_shift, 0.5 * modes[0].omega_sq, 1e-8 * modes[0].omega_sq);
     mech_modal_result_destroy(r);
 
     /* Values only: without refinement every bound is the a-priori one (a backward error of n·u

@@ -16,8 +16,10 @@
 //!   and a Sturm check with every solve. The residuals are exact by default (5n²m flops);
 //!   [`Residuals::Sketched`] bounds them from above with Gaussian sketches ([`sketch`]) at
 //!   O(n²) cost, each bound failing with probability ≤ 1e-12. The Sturm check of an all-pairs
-//!   solve certifies the bottom of the spectrum with a Cholesky factorization of B − sA; subsets
-//!   count with an LBLᵀ factorization at a shift in a gap next to the selection.
+//!   solve certifies the bottom of the spectrum with a Cholesky factorization of B − sA
+//!   (from n = 640 factored on idle core time while the eigenvectors are formed, module
+//!   `idle_certificate`); subsets count with an LBLᵀ factorization at a shift in a gap next to
+//!   the selection.
 //! - **Classification** ([`ModeKind`]): zero when |ω²| is within its own error bound.
 //!   Repeated frequencies are grouped ([`ModeGroup`]) with an A-orthonormal eigenspace basis.
 //! - **Semidefinite A**: massless directions are condensed out and reported as infinite modes;
