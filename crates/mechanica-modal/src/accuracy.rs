@@ -13,7 +13,7 @@
 //!   |Δλ| ≤ min(ε, ε²/δ) (residual and Kato–Temple bounds, Parlett, "The Symmetric Eigenvalue
 //!   Problem", §4.5 and §10.5, applied to L⁻¹(B)L⁻ᵀ) ([`BoundKind::Residual`]).
 
-use crate::sketch::Sketch;
+use crate::sketch::{Sketch, SketchRows};
 use crate::solve::InertiaCheck;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::sparse::SparseColMat;
@@ -219,7 +219,15 @@ fn stiffness_product(
 impl PairProducts {
     /// A X and B X (2n²m flops each), or their sketches where those cost less
     /// ([`exact_costs_less`]).
-    pub(crate) fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: MatRef<'_, f64>, how: Residuals, par: Par) -> Self {
+    /// `rows`: the sketch's S·A and S·B when already formed.
+    pub(crate) fn new(
+        a: MatRef<'_, f64>,
+        b: MatRef<'_, f64>,
+        x: MatRef<'_, f64>,
+        how: Residuals,
+        rows: Option<SketchRows>,
+        par: Par,
+    ) -> Self {
         match how {
             Residuals::Exact => {
                 let (n, m) = (a.nrows(), x.ncols());
@@ -230,9 +238,11 @@ impl PairProducts {
                 stiffness_product(bx.as_mut(), b, sparse_b.as_ref(), x, par);
                 Self::Exact { ax, bx, sparse_b }
             }
-            Residuals::Sketched if exact_costs_less(a.nrows(), x.ncols()) => Self::new(a, b, x, Residuals::Exact, par),
+            Residuals::Sketched if exact_costs_less(a.nrows(), x.ncols()) => {
+                Self::new(a, b, x, Residuals::Exact, None, par)
+            }
             Residuals::Sketched => {
-                let sketch = Sketch::new(a, b, x, par);
+                let sketch = Sketch::new(a, b, x, rows, par);
                 let orthogonality = sketch.orthogonality_bound(a, x, par);
                 Self::Sketched {
                     sketch,
@@ -750,7 +760,7 @@ mod tests {
         });
         let a = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 } else { 0.0 });
         let mut x = crate::sketch::gaussian(n, 7, 3);
-        let mut products = PairProducts::new(a.as_ref(), b.as_ref(), x.as_ref(), Residuals::Exact, Par::Seq);
+        let mut products = PairProducts::new(a.as_ref(), b.as_ref(), x.as_ref(), Residuals::Exact, None, Par::Seq);
         let check = |products: &PairProducts, x: &Mat<f64>| {
             let PairProducts::Exact { bx, sparse_b, .. } = products else {
                 panic!("exact products asked for")
@@ -776,7 +786,7 @@ mod tests {
         check(&products, &x);
         let full = Mat::from_fn(n, n, |i, j| 1.0 / (1.0 + i as f64 + j as f64));
         let PairProducts::Exact { sparse_b, .. } =
-            PairProducts::new(a.as_ref(), full.as_ref(), x.as_ref(), Residuals::Exact, Par::Seq)
+            PairProducts::new(a.as_ref(), full.as_ref(), x.as_ref(), Residuals::Exact, None, Par::Seq)
         else {
             panic!("exact products asked for")
         };

@@ -89,7 +89,7 @@ pub(crate) fn solve_semidefinite(
         infinite,
         Some(&lift),
         Method::CondensedReduction { massless: r },
-        None,
+        Default::default(),
     )
 }
 

@@ -50,6 +50,7 @@ pub mod error;
 pub mod families;
 mod fork_join;
 mod idle_certificate;
+mod idle_task;
 pub mod inertia;
 pub mod lanczos;
 pub mod matrix_market;

@@ -55,6 +55,24 @@ fn product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>, par: Par) -> Mat<f64> {
     out
 }
 
+/// The sketch's rows S·A and S·B (k×n): they do not depend on the modes, so a solve can form
+/// them early (on idle core time, module `idle_task`).
+pub(crate) struct SketchRows {
+    sa: Mat<f64>,
+    sb: Mat<f64>,
+}
+
+impl SketchRows {
+    /// S·A and S·B for the fixed-seed Gaussian S of every report.
+    pub(crate) fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Self {
+        let s = gaussian(SKETCH_SIZE, a.nrows(), 1);
+        Self {
+            sa: product(s.as_ref(), a, par),
+            sb: product(s.as_ref(), b, par),
+        }
+    }
+}
+
 /// The sketched products S·A·X and S·B·X of a set of pairs, and the bound factor 1/√(t·k).
 pub(crate) struct Sketch {
     sa: Mat<f64>,
@@ -65,10 +83,19 @@ pub(crate) struct Sketch {
 }
 
 impl Sketch {
-    /// S A, S B (k×n) and their products with X (4·k·n² + 4·k·n·m flops).
-    pub(crate) fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: MatRef<'_, f64>, par: Par) -> Self {
-        let s = gaussian(SKETCH_SIZE, a.nrows(), 1);
-        let (sa, sb) = (product(s.as_ref(), a, par), product(s.as_ref(), b, par));
+    /// S A, S B (k×n; taken from `rows` when given, 4·k·n² flops otherwise) and their products
+    /// with X (4·k·n·m flops).
+    pub(crate) fn new(
+        a: MatRef<'_, f64>,
+        b: MatRef<'_, f64>,
+        x: MatRef<'_, f64>,
+        rows: Option<SketchRows>,
+        par: Par,
+    ) -> Self {
+        let n = a.nrows();
+        let SketchRows { sa, sb } = rows
+            .filter(|r| r.sa.shape() == (SKETCH_SIZE, n) && r.sb.shape() == (SKETCH_SIZE, n))
+            .unwrap_or_else(|| SketchRows::new(a, b, par));
         let (sax, sbx) = (product(sa.as_ref(), x, par), product(sb.as_ref(), x, par));
         let factor = 1.0 / (chernoff_fraction(SKETCH_SIZE, FAILURE_PROBABILITY) * SKETCH_SIZE as f64).sqrt();
         Self {
@@ -168,11 +195,35 @@ mod tests {
         let a = Mat::<f64>::identity(n, n);
         let b = gaussian(n, n, 11);
         let x = Mat::<f64>::identity(n, 50);
-        let sketch = Sketch::new(a.as_ref(), b.as_ref(), x.as_ref(), Par::Seq);
+        let sketch = Sketch::new(a.as_ref(), b.as_ref(), x.as_ref(), None, Par::Seq);
         for i in 0..50 {
             let exact = (0..n).map(|r| b[(r, i)].powi(2)).sum::<f64>().sqrt();
             let bound = sketch.residual_bound(i, 0.0);
             assert!(bound >= exact && bound <= 8.0 * exact, "column {i}: {bound} vs {exact}");
+        }
+    }
+
+    /// Rows formed early are the ones used (rows of 2B double every residual bound), and rows of
+    /// another order are ignored (the sketch forms its own).
+    #[test]
+    fn rows_formed_early_are_used_when_they_fit() {
+        let n = 120;
+        let a = Mat::<f64>::identity(n, n);
+        let b = gaussian(n, n, 11);
+        let twice = Mat::from_fn(n, n, |i, j| 2.0 * b[(i, j)]);
+        let x = Mat::<f64>::identity(n, 30);
+        let plain = Sketch::new(a.as_ref(), b.as_ref(), x.as_ref(), None, Par::Seq);
+        let doubled_rows = SketchRows::new(a.as_ref(), twice.as_ref(), Par::Seq);
+        let doubled = Sketch::new(a.as_ref(), b.as_ref(), x.as_ref(), Some(doubled_rows), Par::Seq);
+        let small = SketchRows::new(
+            a.as_ref().submatrix(0, 0, 60, 60),
+            twice.as_ref().submatrix(0, 0, 60, 60),
+            Par::Seq,
+        );
+        let ignored = Sketch::new(a.as_ref(), b.as_ref(), x.as_ref(), Some(small), Par::Seq);
+        for i in 0..30 {
+            assert_eq!(doubled.residual_bound(i, 0.0), 2.0 * plain.residual_bound(i, 0.0));
+            assert_eq!(ignored.residual_bound(i, 0.0), plain.residual_bound(i, 0.0));
         }
     }
 
@@ -183,7 +234,7 @@ mod tests {
         let a = Mat::<f64>::identity(n, n);
         let noise = gaussian(n, n, 5);
         let x = Mat::from_fn(n, n, |i, j| if i == j { 1.0 } else { 0.0 } + 1e-9 * noise[(i, j)]);
-        let sketch = Sketch::new(a.as_ref(), a.as_ref(), x.as_ref(), Par::Seq);
+        let sketch = Sketch::new(a.as_ref(), a.as_ref(), x.as_ref(), None, Par::Seq);
         let g = x.transpose() * &x;
         let exact = Mat::from_fn(n, n, |i, j| g[(i, j)] - if i == j { 1.0 } else { 0.0 }).norm_l2();
         let bound = sketch.orthogonality_bound(a.as_ref(), x.as_ref(), Par::Seq);

@@ -12,12 +12,14 @@ use crate::condense::Condensation;
 use crate::dd::Operand;
 use crate::fork_join::join;
 use crate::idle_certificate::IdleCertificate;
+use crate::idle_task::IdleTask;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky_owned, reduce_owned};
 use crate::refine::{
     Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts, polish_simple_mode,
     refine_cluster, refine_simple_modes,
 };
+use crate::sketch::SketchRows;
 use crate::symmetric_eigen::{
     OnTridiagonal, TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form,
 };
@@ -61,9 +63,10 @@ pub enum Refinement {
 /// Dense problems smaller than this are solved on one thread.
 pub const SEQUENTIAL_BELOW: usize = 192;
 
-/// From this order an all-modes solve factors its bottom certificate on idle time (module
-/// `idle_certificate`); below it the factorization is cheap and a thread's start is not.
-const IDLE_CERTIFICATE_FROM: usize = 640;
+/// From this order an all-modes solve puts work off its critical path on idle core time (module
+/// `idle_task`: the norms, the sketch's rows, the bottom certificate); below it that work is
+/// cheap and a thread's start is not.
+const IDLE_TIME_FROM: usize = 640;
 
 /// Auto refinement starts when the reduction guarantees fewer than 8 digits of a mode's ω².
 pub const AUTO_REFINE_RELATIVE_BOUND: f64 = 1e-8;
@@ -343,10 +346,13 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     if n == 0 {
         return select(&[], options.selection).map(|_| empty_solution());
     }
-    let norm_a = accuracy::frobenius_norm(a);
-    let norm_b = accuracy::frobenius_norm(b);
     // The refinement and the residual bounds need the vectors even when the caller does not.
     let want_vectors = options.vectors || options.refinement == Refinement::Always;
+    // All modes of a large pencil: work off the critical path goes to idle core time.
+    let idle_time = matches!(options.selection, Selection::All) && n >= IDLE_TIME_FROM && par.degree() > 1;
+    let early_inputs = idle_time
+        .then(|| EarlyInputs::start(problem, want_vectors && options.residuals == Residuals::Sketched))
+        .flatten();
     let clock = Instant::now();
     // The copies of A (factored in place) and B (reduced in place) are written on two threads:
     // the first write of a fresh n×n buffer faults every page, and faults on two cores proceed
@@ -355,14 +361,17 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     match cholesky_owned(a_copy, par) {
         Cholesky::Factor(l) => {
             let cholesky_time = clock.elapsed();
-            // All modes of a large pencil: the bottom certificate is factored on idle time.
+            // The bottom certificate is factored on idle time once T is known.
             let mut certificate = None;
             let mut start_certificate =
-                |diag: &[f64], subdiag: &[f64]| certificate = IdleCertificate::start(problem, diag, subdiag);
-            let idle_time =
-                matches!(options.selection, Selection::All) && n >= IDLE_CERTIFICATE_FROM && par.degree() > 1;
+                |diag: &[f64], subdiag: &[f64]| certificate = crate::idle_certificate::start(problem, diag, subdiag);
             let hook: Option<OnTridiagonal<'_>> = if idle_time { Some(&mut start_certificate) } else { None };
             let mut def = solve_definite_owned(l.as_ref(), b_copy, options.selection, want_vectors, par, hook)?;
+            let early = early_inputs.and_then(IdleTask::finished);
+            let (norm_a, norm_b) = match &early {
+                Some(inputs) => inputs.norms,
+                None => (accuracy::frobenius_norm(a), accuracy::frobenius_norm(b)),
+            };
             if !want_vectors && options.refinement == Refinement::Auto {
                 // Values only: the modes whose a-priori bound is too weak get their vectors
                 // (crate::values_only), unless they are so many that all vectors cost less.
@@ -392,10 +401,49 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 condensed_stiffness_negatives: None,
                 condensation: None,
             };
-            finish.run(def, Vec::new(), None, Method::CholeskyReduction, certificate)
+            let idle = IdleResults {
+                certificate,
+                sketch_rows: early.and_then(|inputs| inputs.sketch_rows),
+            };
+            finish.run(def, Vec::new(), None, Method::CholeskyReduction, idle)
         }
-        Cholesky::Failed { pivot } => crate::condense::solve_semidefinite(problem, pivot, options, norm_a, norm_b, par),
+        Cholesky::Failed { pivot } => {
+            let (norm_a, norm_b) = (accuracy::frobenius_norm(a), accuracy::frobenius_norm(b));
+            crate::condense::solve_semidefinite(problem, pivot, options, norm_a, norm_b, par)
+        }
     }
+}
+
+/// What an all-modes solve computes on idle core time from its start (module `idle_task`): the
+/// Frobenius norms of A and B and, for a sketched report, the sketch's rows S·A and S·B.
+struct EarlyInputs {
+    norms: (f64, f64),
+    sketch_rows: Option<SketchRows>,
+}
+
+impl EarlyInputs {
+    /// Starts the task (None when no thread could be started).
+    fn start(problem: &PencilProblem, sketched: bool) -> Option<IdleTask<Self>> {
+        let problem = problem.clone();
+        IdleTask::spawn("mechanica-idle-inputs", move |stop| {
+            let (a, b) = (problem.a(), problem.b());
+            let norms = (accuracy::frobenius_norm(a), accuracy::frobenius_norm(b));
+            if stop.load(std::sync::atomic::Ordering::Acquire) {
+                return None;
+            }
+            let sketch_rows = sketched.then(|| SketchRows::new(a, b, Par::Seq));
+            Some(Self { norms, sketch_rows })
+        })
+    }
+}
+
+/// What idle core time delivered to the report (each None when not started or not finished).
+#[derive(Default)]
+pub(crate) struct IdleResults {
+    /// The bottom certificate, module `idle_certificate`.
+    pub(crate) certificate: Option<IdleCertificate>,
+    /// The sketch's S·A and S·B.
+    pub(crate) sketch_rows: Option<SketchRows>,
 }
 
 fn empty_solution() -> ModalSolution {
@@ -468,7 +516,7 @@ impl Finish<'_> {
         infinite: Vec<Vec<f64>>,
         lift: Option<Lift<'_>>,
         method: Method,
-        idle_certificate: Option<IdleCertificate>,
+        idle: IdleResults,
     ) -> Result<ModalSolution, ModalError> {
         let (a, b) = (self.problem.a(), self.problem.b());
         let n = self.problem.dim();
@@ -484,7 +532,7 @@ impl Finish<'_> {
         let clock = Instant::now();
         let mut products = x
             .as_ref()
-            .map(|x| accuracy::PairProducts::new(a, b, x.as_ref(), self.options.residuals, self.par));
+            .map(|x| accuracy::PairProducts::new(a, b, x.as_ref(), self.options.residuals, idle.sketch_rows, self.par));
         // Values only: the a-priori error model (computed once, here or by `solve`).
         let mut a_priori = None;
         let mut report = match (&x, &products) {
@@ -683,7 +731,7 @@ impl Finish<'_> {
             &report.error_bounds,
             self.condensed_stiffness_negatives,
             def.reduced.or_else(|| form.map(TridiagonalForm::into_storage)),
-            idle_certificate,
+            idle.certificate,
             self.par,
         )?;
         timings.inertia = clock.elapsed();

@@ -65,7 +65,7 @@ pub(crate) fn sharpen(
     };
     back_transform(pencil.l, x.as_mut(), pencil.par);
     let (a, b) = (pencil.a, pencil.b);
-    let mut products = PairProducts::new(a, b, x.as_ref(), pencil.residuals, pencil.par);
+    let mut products = PairProducts::new(a, b, x.as_ref(), pencil.residuals, None, pencil.par);
     for (col, &i) in flagged.iter().enumerate() {
         let (_, bound) = products.pair_error(x.as_ref(), col, omega[i], report.norm_a, report.norm_b);
         report.error_bounds[i] = bound;

@@ -71,7 +71,8 @@ fn rotated_chain_keeps_its_spectrum() {
     check_against(&pencil(&ar, &br), &families::fixed_chain_omega_sq(n));
 }
 
-/// Large enough (n ≥ 640) for the bottom certificate to be factored on idle time: whichever
+/// Large enough (n ≥ 640) for the report's inputs and the bottom certificate to be formed on
+/// idle time: the lowest 20 ω² lie within their bounds of the closed form; whichever
 /// path decides it (the idle thread at half of T's lowest eigenvalue, or the report at half the
 /// lowest computed ω²), the certified shift lies below the closed-form lowest ω², at half the
 /// computed one to 8 digits, with no mode below it; values only takes the same path.
@@ -90,6 +91,17 @@ fn large_solves_certify_the_bottom_below_the_closed_form() {
                 ..SolveOptions::default()
             };
             let sol = solve(&p, &options).expect("solve");
+            // The report's inputs formed on idle time (norms, sketch rows) serve as well.
+            if vectors {
+                assert!(sol.accuracy.meets_backward_error_target(n));
+            }
+            for (m, w) in sol.modes.iter().zip(families::fixed_chain_omega_sq(n)).take(20) {
+                assert!(
+                    (m.omega_sq - w).abs() <= m.error_bound + 4.0 * U * w,
+                    "{} vs {w}",
+                    m.omega_sq
+                );
+            }
             let check = sol.accuracy.inertia_check.expect("sturm check");
             assert!(
                 check.consistent && check.count.below == 0 && check.computed_below == 0,
