@@ -138,19 +138,19 @@ pub(crate) fn factor_block_step(mut l: MatMut<'_, f64>, start: usize, width: usi
     let (mut l11, _, mut l21, l22) = rest.split_at_mut(width, width);
     factor_recursive(l11.rb_mut(), Par::Seq).map_err(|pivot| pivot + start)?;
     solve_lower_triangular_in_place(l11.rb(), l21.rb_mut().transpose_mut(), Par::Seq);
-    subtract_outer_product(l22, l21.rb(), Par::Seq);
+    subtract_lower_product(l22, l21.rb(), l21.rb(), Par::Seq);
     Ok(())
 }
 
-/// The lower triangle of `target` −= `factor` `factor`ᵀ.
-fn subtract_outer_product(target: MatMut<'_, f64>, factor: MatRef<'_, f64>, par: Par) {
+/// The lower triangle of `target` −= `lhs` `rhs`ᵀ (the other triangle is not touched).
+pub(crate) fn subtract_lower_product(target: MatMut<'_, f64>, lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>, par: Par) {
     tri_matmul(
         target,
         BlockStructure::TriangularLower,
         Accum::Add,
-        factor,
+        lhs,
         BlockStructure::Rectangular,
-        factor.transpose(),
+        rhs.transpose(),
         BlockStructure::Rectangular,
         -1.0,
         par,
@@ -186,7 +186,7 @@ fn factor_recursive(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
     let (mut l11, _, mut l21, mut l22) = l.split_at_mut(n1, n1);
     factor_recursive(l11.rb_mut(), par)?;
     solve_lower_triangular_in_place(l11.rb(), l21.rb_mut().transpose_mut(), par);
-    subtract_outer_product(l22.rb_mut(), l21.rb(), par);
+    subtract_lower_product(l22.rb_mut(), l21.rb(), l21.rb(), par);
     factor_recursive(l22, par).map_err(|pivot| pivot + n1)
 }
 
@@ -264,28 +264,8 @@ fn reduce_blocks(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>, mut scratch: MatMut
     let mut half = scratch.rb_mut().submatrix_mut(0, 0, n - n1, n1);
     matmul(half.as_mut(), Accum::Replace, l21, c11.as_ref(), 0.5, par);
     subtract_in_place(c21.as_mut(), half.as_ref());
-    tri_matmul(
-        c22.as_mut(),
-        BlockStructure::TriangularLower,
-        Accum::Add,
-        c21.as_ref(),
-        BlockStructure::Rectangular,
-        l21.transpose(),
-        BlockStructure::Rectangular,
-        -1.0,
-        par,
-    );
-    tri_matmul(
-        c22.as_mut(),
-        BlockStructure::TriangularLower,
-        Accum::Add,
-        l21,
-        BlockStructure::Rectangular,
-        c21.as_ref().transpose(),
-        BlockStructure::Rectangular,
-        -1.0,
-        par,
-    );
+    subtract_lower_product(c22.as_mut(), c21.as_ref(), l21, par);
+    subtract_lower_product(c22.as_mut(), l21, c21.as_ref(), par);
     subtract_in_place(c21.as_mut(), half.as_ref());
     solve_lower_triangular_in_place(l22, c21.as_mut(), par);
     reduce_blocks(l22, c22, scratch, par);

@@ -75,8 +75,7 @@ impl SketchRows {
 
 /// The sketched products S·A·X and S·B·X of a set of pairs, and the bound factor 1/√(t·k).
 pub(crate) struct Sketch {
-    sa: Mat<f64>,
-    sb: Mat<f64>,
+    rows: SketchRows,
     sax: Mat<f64>,
     sbx: Mat<f64>,
     factor: f64,
@@ -93,24 +92,18 @@ impl Sketch {
         par: Par,
     ) -> Self {
         let n = a.nrows();
-        let SketchRows { sa, sb } = rows
+        let rows = rows
             .filter(|r| r.sa.shape() == (SKETCH_SIZE, n) && r.sb.shape() == (SKETCH_SIZE, n))
             .unwrap_or_else(|| SketchRows::new(a, b, par));
-        let (sax, sbx) = (product(sa.as_ref(), x, par), product(sb.as_ref(), x, par));
+        let (sax, sbx) = (product(rows.sa.as_ref(), x, par), product(rows.sb.as_ref(), x, par));
         let factor = 1.0 / (chernoff_fraction(SKETCH_SIZE, FAILURE_PROBABILITY) * SKETCH_SIZE as f64).sqrt();
-        Self {
-            sa,
-            sb,
-            sax,
-            sbx,
-            factor,
-        }
+        Self { rows, sax, sbx, factor }
     }
 
     /// Recomputes column i after x_i changed.
     pub(crate) fn update_column(&mut self, x: MatRef<'_, f64>, i: usize) {
         let xi = x.subcols(i, 1);
-        let (sa, sb) = (self.sa.as_ref(), self.sb.as_ref());
+        let (sa, sb) = (self.rows.sa.as_ref(), self.rows.sb.as_ref());
         faer::linalg::matmul::matmul(
             self.sax.as_mut().subcols_mut(i, 1),
             Accum::Replace,

@@ -20,6 +20,7 @@
 //! pool did with threads that had gone to sleep during the panel.
 
 use crate::ModalError;
+use crate::reduce::subtract_lower_product;
 use crate::symv_team::SymvTeam;
 use crate::tridiagonal_divide::tridiagonal_divide_and_conquer;
 use crate::tridiagonal_values::tridiagonal_eigenvalues;
@@ -34,7 +35,6 @@ use faer::linalg::householder::{
     upgrade_householder_factor,
 };
 use faer::linalg::matmul::matmul;
-use faer::linalg::matmul::triangular::{BlockStructure, matmul as tri_matmul};
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, ColMut, ColRef, Conj, Mat, MatMut, MatRef, Par};
 use std::thread::Thread;
@@ -369,7 +369,7 @@ fn reduce_panels(a: &mut Mat<f64>, t: &mut Tridiagonal, team: Option<(&SymvTeam,
             Some((team, helper)) if m >= SPLIT_UPDATE_FROM => {
                 // The helper is awake (between two symmetric products): it takes the lower
                 // right triangle, this thread the columns left of it, half the area each.
-                let split = ((1.0 - std::f64::consts::FRAC_1_SQRT_2) * m as f64) as usize;
+                let split = columns_holding(m, 0.25 * (m * m) as f64);
                 let (left_triangle, _, below_left, mut right_triangle) = trailing.split_at_mut(split, split);
                 let (lhs_top, lhs_bottom) = lhs.rb().split_at_row(split);
                 let (rhs_top, rhs_bottom) = rhs.rb().split_at_row(split);
@@ -390,21 +390,6 @@ fn reduce_panels(a: &mut Mat<f64>, t: &mut Tridiagonal, team: Option<(&SymvTeam,
         }
         p = q;
     }
-}
-
-/// The lower triangle of `target` −= `lhs` `rhs`ᵀ.
-fn subtract_lower_product(target: MatMut<'_, f64>, lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>, par: Par) {
-    tri_matmul(
-        target,
-        BlockStructure::TriangularLower,
-        Accum::Add,
-        lhs,
-        BlockStructure::Rectangular,
-        rhs.transpose(),
-        BlockStructure::Rectangular,
-        -1.0,
-        par,
-    );
 }
 
 /// Reduces columns p..p+nb (`dlatrd`, lower): for each column k it applies the panel's earlier
@@ -493,7 +478,9 @@ fn panel_product(
     let v = &a.col_as_slice(q - 1)[q..];
     match team {
         Some((team, helper)) if m >= PARALLEL_SYMV_FROM => {
-            let split = caller_columns(m, i);
+            // The caller takes a quarter of m² plus m·i, the estimated cost of the helper's
+            // correction (4 passes over the two m×i panels, held in cache).
+            let split = columns_holding(m, 0.25 * (m * m) as f64 + (m * i) as f64);
             team.beside(
                 helper,
                 &mut || {
@@ -516,14 +503,11 @@ fn panel_product(
     }
 }
 
-/// How many leading columns of an order-m S the caller takes in [`panel_product`]: column j
-/// costs m − j, so the first s columns hold s·m − s²/2 of the triangle; the caller takes a
-/// quarter of m² plus m·i, the estimated cost of the helper's correction (4 passes over the two
-/// m×i panels, held in cache).
-fn caller_columns(m: usize, i: usize) -> usize {
+/// The number s of leading columns of an order-m lower triangle that hold `area` entries:
+/// column j has m − j, so s·m − s²/2 = area (half the triangle: s = (1 − 1/√2)·m).
+fn columns_holding(m: usize, area: f64) -> usize {
     let m_f = m as f64;
-    let target = 0.25 * m_f * m_f + m_f * i as f64;
-    let remaining = (m_f * m_f - 2.0 * target).max(0.0);
+    let remaining = (m_f * m_f - 2.0 * area).max(0.0);
     ((m_f - remaining.sqrt()) as usize).min(m)
 }
 
