@@ -142,6 +142,16 @@ pub(crate) fn factor_block_step(mut l: MatMut<'_, f64>, start: usize, width: usi
     Ok(())
 }
 
+/// Completes a blocked right-looking Cholesky whose first `start` columns are factored and
+/// whose trailing block holds their Schur complement, on `par`'s threads; then the pivot test of
+/// [`check_pivots`] with `max_diag`, the largest diagonal entry before factoring.
+pub(crate) fn factor_trailing(mut l: MatMut<'_, f64>, start: usize, max_diag: f64, par: Par) -> Result<(), usize> {
+    let rest = l.nrows() - start.min(l.nrows());
+    let trailing = l.rb_mut().submatrix_mut(start, start, rest, rest);
+    factor_recursive(trailing, factor_parallelism(rest, par)).map_err(|pivot| pivot + start)?;
+    check_pivots(l.rb(), max_diag)
+}
+
 /// The lower triangle of `target` −= `lhs` `rhs`ᵀ (the other triangle is not touched).
 pub(crate) fn subtract_lower_product(target: MatMut<'_, f64>, lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>, par: Par) {
     tri_matmul(

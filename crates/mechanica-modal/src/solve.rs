@@ -11,7 +11,7 @@ use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::condense::Condensation;
 use crate::dd::Operand;
 use crate::fork_join::join;
-use crate::idle_certificate::IdleCertificate;
+use crate::idle_certificate::{IdleCertificate, Outcome};
 use crate::idle_task::IdleTask;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky_owned, reduce_owned};
@@ -954,10 +954,20 @@ fn inertia_check(
         // its shift is this one to 8 digits, or higher and still below the lowest ω² by more
         // than twice its bound.
         let usable = |s: f64| s >= shift - 1e-8 * shift.abs() && s < lowest - 2.0 * bounds[0];
-        let certified = match idle_certificate.and_then(IdleCertificate::finished) {
-            Some((idle_shift, true)) if usable(idle_shift) => Some(idle_shift),
-            _ => (shift < lowest && all_above(problem, shift, spare, par)).then_some(shift),
+        // A factor the thread had begun is finished here on every thread.
+        let from_idle = match idle_certificate.and_then(IdleCertificate::collect) {
+            Some(Outcome::Decided {
+                shift: idle_shift,
+                positive: true,
+            }) if usable(idle_shift) => Some(idle_shift),
+            Some(Outcome::Partial(partial)) if usable(partial.shift) => {
+                let idle_shift = partial.shift;
+                partial.finish(par).then_some(idle_shift)
+            }
+            _ => None,
         };
+        let certified =
+            from_idle.or_else(|| (shift < lowest && all_above(problem, shift, spare, par)).then_some(shift));
         if let Some(shift) = certified {
             return Ok(Some(InertiaCheck {
                 count: InertiaCount {
