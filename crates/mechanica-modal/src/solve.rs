@@ -354,10 +354,16 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
         .then(|| EarlyInputs::start(problem, want_vectors && options.residuals == Residuals::Sketched))
         .flatten();
     let clock = Instant::now();
-    // The copies of A (factored in place) and B (reduced in place) are written on two threads:
-    // the first write of a fresh n×n buffer faults every page, and faults on two cores proceed
-    // in parallel (6.5 ms per 8 MB on one core of the Zen 3 host).
-    let (a_copy, b_copy) = join(|| a.to_owned(), || b.to_owned(), par);
+    // The copies of A (factored in place) and B (reduced in place) are allocated on this thread
+    // (whose heap keeps freed memory for the next solve; see `tridiagonal_divide`) and written
+    // on two threads: the first write of fresh memory faults every page, and faults on two
+    // cores proceed in parallel (6.5 ms per 8 MB on one core of the Zen 3 host).
+    let (mut a_copy, mut b_copy) = (Mat::<f64>::with_capacity(n, n), Mat::<f64>::with_capacity(n, n));
+    join(
+        || a_copy.resize_with(n, n, |i, j| a[(i, j)]),
+        || b_copy.resize_with(n, n, |i, j| b[(i, j)]),
+        par,
+    );
     match cholesky_owned(a_copy, par) {
         Cholesky::Factor(l) => {
             let cholesky_time = clock.elapsed();
