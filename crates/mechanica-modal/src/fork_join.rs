@@ -12,6 +12,19 @@ pub(crate) fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnc
     }
 }
 
+/// `f` of every item, on the threads of Rayon's global pool when `par` allows more than one and
+/// there are at least two items; a single item runs on the calling thread, so that its own
+/// products can still use the pool (inside a pool thread, `dd::mat_vec` runs on one thread).
+pub(crate) fn map_items<T: Sync, R: Send>(items: &[T], par: Par, f: impl Fn(&T) -> R + Sync + Send) -> Vec<R> {
+    match par {
+        Par::Rayon(threads) if threads.get() > 1 && items.len() > 1 => {
+            use rayon::prelude::*;
+            items.par_iter().map(f).collect()
+        }
+        _ => items.iter().map(f).collect(),
+    }
+}
+
 /// Runs `solve` on column chunks of `rhs`, one chunk per thread of `par` (each chunk solved
 /// sequentially). For triangular solves with many right-hand sides this keeps both threads on
 /// whole columns; faer's parallel triangular solve was measured 1.1–1.4× slower on a

@@ -29,6 +29,7 @@
 
 use crate::condense::Condensation;
 use crate::dd::{Dd, Operand, SplitVector, dot, dot_split};
+use crate::fork_join::map_items;
 use crate::reduce::LowerFactor;
 use crate::symmetric_eigen::TridiagonalForm;
 use crate::tridiagonal_vectors::{ShiftedTridiagonal, one_norm};
@@ -36,7 +37,6 @@ use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Accum, Mat, MatRef, Par, Side};
-use rayon::prelude::*;
 use std::ops::Range;
 
 /// Maximum Newton steps per pair.
@@ -632,10 +632,7 @@ pub(crate) fn refine_simple_modes(
             let r: Vec<f64> = (0..n).map(|i| bx[i].minus(rho.times(ax[i])).to_f64()).collect();
             (rho.to_f64(), r)
         };
-        let residuals: Vec<(f64, Vec<f64>)> = match par {
-            Par::Seq => active.iter().map(residual_of).collect(),
-            _ => active.par_iter().map(residual_of).collect(),
-        };
+        let residuals: Vec<(f64, Vec<f64>)> = map_items(&active, par, residual_of);
         let mut w = Mat::from_fn(n, active.len(), |i, c| residuals[c].1[i]);
         l.solve(w.as_mut(), par);
         let mut coefficients = Mat::<f64>::zeros(y.ncols(), active.len());
@@ -683,14 +680,20 @@ pub(crate) fn refine_simple_modes(
         }
     }
     let metric = Metric::Cholesky(l);
-    let finish_one = |(mode, state): (usize, &State)| match *state {
-        State::Converged { steps } => finish_pair(a, b, metric, SplitVector::of(x.col_as_slice(mode).to_vec()), steps),
-        State::Iterating | State::Failed => None,
-    };
-    match par {
-        Par::Seq => state.iter().enumerate().map(finish_one).collect(),
-        _ => state.par_iter().enumerate().map(finish_one).collect(),
+    let converged: Vec<(usize, usize)> = (0..k)
+        .filter_map(|mode| match state[mode] {
+            State::Converged { steps } => Some((mode, steps)),
+            State::Iterating | State::Failed => None,
+        })
+        .collect();
+    let finished = map_items(&converged, par, |&(mode, steps)| {
+        finish_pair(a, b, metric, SplitVector::of(x.col_as_slice(mode).to_vec()), steps)
+    });
+    let mut pairs: Vec<Option<RefinedPair>> = vec![None; k];
+    for (&(mode, _), pair) in converged.iter().zip(finished) {
+        pairs[mode] = pair;
     }
+    pairs
 }
 
 /// A sparse pencil's (`shifts`) single mode by [`refine_pair_sparse`] first, and a cluster's

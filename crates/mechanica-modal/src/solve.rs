@@ -10,7 +10,7 @@
 use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::condense::Condensation;
 use crate::dd::Operand;
-use crate::fork_join::join;
+use crate::fork_join::{join, map_items};
 use crate::idle_certificate::{IdleCertificate, Outcome};
 use crate::idle_task::IdleTask;
 use crate::inertia::{InertiaCount, all_above, count_below};
@@ -25,7 +25,6 @@ use crate::symmetric_eigen::{
 };
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
-use rayon::prelude::*;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
@@ -642,10 +641,7 @@ impl Finish<'_> {
                     pending.retain(|&j| refined[j].is_none());
                 }
             }
-            let rest: Vec<Option<RefinedCluster>> = match self.par {
-                Par::Seq => pending.iter().map(|&j| refine_one(&jobs[j])).collect(),
-                _ => pending.par_iter().map(|&j| refine_one(&jobs[j])).collect(),
-            };
+            let rest: Vec<Option<RefinedCluster>> = map_items(&pending, self.par, |&j| refine_one(&jobs[j]));
             for (&j, cluster) in pending.iter().zip(rest) {
                 refined[j] = cluster;
             }
@@ -694,10 +690,7 @@ impl Finish<'_> {
                     let steps = report.refinement_steps[i];
                     polish_simple_mode(&mass, &stiffness, metric, &mut spectrum, xm.col_as_slice(i), steps)
                 };
-                let polished: Vec<Option<RefinedPair>> = match self.par {
-                    Par::Seq => weak.iter().map(polish).collect(),
-                    _ => weak.par_iter().map(polish).collect(),
-                };
+                let polished: Vec<Option<RefinedPair>> = map_items(&weak, self.par, polish);
                 let mut improved: Vec<usize> = Vec::new();
                 for (&k, pair) in weak.iter().zip(polished) {
                     let i = residuals[k].mode;
