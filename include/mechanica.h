@@ -3190,6 +3190,15 @@ void mech_modal_result_destroy(struct mech_modal_result_t *result);
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * Returns to the system the working matrices that dense solves keep for the next solve (up to
+ * five n×n matrices of the largest recent order; see the README's known limits). The next
+ * dense solve allocates afresh. Safe to call at any time, from any thread.
+ */
+void mech_modal_release_scratch(void);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * Stores the number of modes in `*modes` and the order n of the pencil in `*dim`.
  *
  * # Safety

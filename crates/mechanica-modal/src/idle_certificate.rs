@@ -56,7 +56,9 @@ pub(crate) struct PartialFactor {
 impl PartialFactor {
     /// Factors the remaining columns on `par`'s threads: whether B − sA is positive definite.
     pub(crate) fn finish(mut self, par: Par) -> bool {
-        factor_trailing(self.factor.as_mut(), self.factored, self.max_diag, par).is_ok()
+        let positive = factor_trailing(self.factor.as_mut(), self.factored, self.max_diag, par).is_ok();
+        crate::scratch::give_back(self.factor);
+        positive
     }
 }
 
@@ -116,7 +118,7 @@ fn factor_shifted(
         return None;
     }
     let shift = 0.5 * lowest;
-    let mut factor = shifted_lower(problem, shift, None);
+    let mut factor = shifted_lower(problem, shift);
     let max_diag = max_diagonal(factor.as_ref());
     let n = factor.nrows();
     let mut done = 0;
@@ -131,12 +133,14 @@ fn factor_shifted(
         }
         let width = BLOCK.min(n - done);
         if factor_block_step(factor.as_mut(), done, width).is_err() {
+            crate::scratch::give_back(factor);
             return Some(Outcome::Decided { shift, positive: false });
         }
         done += width;
         factored.store(done, Ordering::Release);
     }
     let positive = check_pivots(factor.as_ref(), max_diag).is_ok();
+    crate::scratch::give_back(factor);
     Some(Outcome::Decided { shift, positive })
 }
 
@@ -214,7 +218,7 @@ mod tests {
         let (problem, lowest) = fixed_chain(n);
         let second = 2.0 - 2.0 * (2.0 * std::f64::consts::PI / (n as f64 + 1.0)).cos();
         for (shift, positive) in [(0.5 * lowest, true), (0.5 * (lowest + second), false)] {
-            let mut factor = shifted_lower(&problem, shift, None);
+            let mut factor = shifted_lower(&problem, shift);
             let max_diag = max_diagonal(factor.as_ref());
             for start in [0, BLOCK] {
                 factor_block_step(factor.as_mut(), start, BLOCK).expect("the leading blocks are definite");

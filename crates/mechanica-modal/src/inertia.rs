@@ -44,28 +44,21 @@ pub fn count_below(problem: &PencilProblem, shift: f64) -> Result<InertiaCount, 
 /// Whether every mode has ω² > `shift`: B − shift·A is positive definite to working precision
 /// (its Cholesky factorization succeeds with no negligible pivot). The count 0 it certifies
 /// costs a third of the LBLᵀ of [`count_below`] (n³/3 flops at Cholesky speed).
-/// `spare` is a matrix whose storage may be reused (any contents).
-pub(crate) fn all_above(problem: &PencilProblem, shift: f64, spare: Option<Mat<f64>>, par: faer::Par) -> bool {
-    let mut k = shifted_lower(problem, shift, spare);
-    crate::reduce::factor_in_place(k.as_mut(), par).is_ok()
+/// The factorization works in kept storage (module `scratch`), given back afterwards.
+pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> bool {
+    let mut k = shifted_lower(problem, shift);
+    let positive = crate::reduce::factor_in_place(k.as_mut(), par).is_ok();
+    crate::scratch::give_back(k);
+    positive
 }
 
-/// The lower triangle of B − shift·A (the strict upper triangle is left as it was), written
-/// into `spare` when that is n×n, else into a new matrix.
-pub(crate) fn shifted_lower(problem: &PencilProblem, shift: f64, spare: Option<Mat<f64>>) -> Mat<f64> {
+/// The lower triangle of B − shift·A (the strict upper triangle zero), in kept storage when
+/// some fits (module `scratch`).
+pub(crate) fn shifted_lower(problem: &PencilProblem, shift: f64) -> Mat<f64> {
     let (a, b) = (problem.a(), problem.b());
     let n = problem.dim();
-    let mut k = match spare {
-        Some(m) if m.nrows() == n && m.ncols() == n => m,
-        _ => Mat::<f64>::zeros(n, n),
-    };
-    for j in 0..n {
-        let column = &mut k.col_as_slice_mut(j)[j..];
-        let (b_col, a_col) = (b.col(j).subrows(j, n - j), a.col(j).subrows(j, n - j));
-        for ((kij, bij), aij) in column.iter_mut().zip(b_col.iter()).zip(a_col.iter()) {
-            *kij = bij - shift * aij;
-        }
-    }
+    let mut k = crate::scratch::empty(n, n);
+    k.resize_with(n, n, |i, j| if i >= j { b[(i, j)] - shift * a[(i, j)] } else { 0.0 });
     k
 }
 

@@ -58,6 +58,7 @@ pub mod problem;
 pub mod reduce;
 mod refine;
 pub mod response;
+pub mod scratch;
 pub mod sketch;
 pub mod solve;
 pub mod sparse_inertia;
@@ -78,6 +79,7 @@ pub use lanczos::{DENSE_LIMIT, SparseModalSolution, SparseOptions, SparseReport,
 pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use problem::PencilProblem;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
+pub use scratch::release as release_scratch;
 pub use solve::{
     DenseTimings, InertiaCheck, Method, ModalSolution, Mode, ModeGroup, ModeKind, Refinement, Selection, SolveOptions,
     classify, solve,

@@ -353,11 +353,11 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
         .then(|| EarlyInputs::start(problem, want_vectors && options.residuals == Residuals::Sketched))
         .flatten();
     let clock = Instant::now();
-    // The copies of A (factored in place) and B (reduced in place) are allocated on this thread
-    // (whose heap keeps freed memory for the next solve; see `tridiagonal_divide`) and written
-    // on two threads: the first write of fresh memory faults every page, and faults on two
-    // cores proceed in parallel (6.5 ms per 8 MB on one core of the Zen 3 host).
-    let (mut a_copy, mut b_copy) = (Mat::<f64>::with_capacity(n, n), Mat::<f64>::with_capacity(n, n));
+    // The copies of A (factored in place) and B (reduced in place) take kept working storage
+    // (module `scratch`) and are written on two threads: the first write of fresh memory faults
+    // every page, and faults on two cores proceed in parallel (6.5 ms per 8 MB on one core of
+    // the Zen 3 host).
+    let (mut a_copy, mut b_copy) = (crate::scratch::empty(n, n), crate::scratch::empty(n, n));
     join(
         || a_copy.resize_with(n, n, |i, j| a[(i, j)]),
         || b_copy.resize_with(n, n, |i, j| b[(i, j)]),
@@ -410,7 +410,9 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 certificate,
                 sketch_rows: early.and_then(|inputs| inputs.sketch_rows),
             };
-            finish.run(def, Vec::new(), None, Method::CholeskyReduction, idle)
+            let solution = finish.run(def, Vec::new(), None, Method::CholeskyReduction, idle);
+            crate::scratch::give_back(l);
+            solution
         }
         Cholesky::Failed { pivot } => {
             let (norm_a, norm_b) = (accuracy::frobenius_norm(a), accuracy::frobenius_norm(b));
@@ -723,13 +725,15 @@ impl Finish<'_> {
         let clock = Instant::now();
         // The reduced eigenvectors are no longer needed: their storage takes the certificate's
         // matrix (a fresh n×n allocation costs its page faults).
+        if let Some(storage) = def.reduced.or_else(|| form.map(TridiagonalForm::into_storage)) {
+            crate::scratch::give_back(storage);
+        }
         report.inertia_check = inertia_check(
             self.problem,
             &omega_all,
             (def.first, def.end),
             &report.error_bounds,
             self.condensed_stiffness_negatives,
-            def.reduced.or_else(|| form.map(TridiagonalForm::into_storage)),
             idle.certificate,
             self.par,
         )?;
@@ -934,7 +938,6 @@ fn inertia_check(
     (first, end): (usize, usize),
     bounds: &[f64],
     condensed_stiffness_negatives: Option<usize>,
-    spare: Option<Mat<f64>>,
     idle_certificate: Option<IdleCertificate>,
     par: Par,
 ) -> Result<Option<InertiaCheck>, ModalError> {
@@ -965,8 +968,7 @@ fn inertia_check(
             }
             _ => None,
         };
-        let certified =
-            from_idle.or_else(|| (shift < lowest && all_above(problem, shift, spare, par)).then_some(shift));
+        let certified = from_idle.or_else(|| (shift < lowest && all_above(problem, shift, par)).then_some(shift));
         if let Some(shift) = certified {
             return Ok(Some(InertiaCheck {
                 count: InertiaCount {

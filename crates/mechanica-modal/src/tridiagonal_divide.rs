@@ -63,17 +63,16 @@ pub(crate) fn tridiagonal_divide_and_conquer(diag: &[f64], offdiag: &[f64], par:
     }
     let mut d: Vec<f64> = diag.iter().map(|x| x / scale).collect();
     let mut e: Vec<f64> = offdiag.iter().map(|x| x / scale).collect();
-    // Three n×n buffers, two zeroed on one thread and one on the other. They are allocated
-    // here, on the calling thread: memory allocated on a pool thread comes from that thread's
-    // allocator arena, which returns it to the system when freed, so every solve faulted its
-    // pages anew (about 3 µs per 4 KiB page on the 2-core Zen 3 host, 6.5 ms per 8 MB); the
-    // calling thread's heap keeps freed memory for the next solve (measured at n = 1000: 4–6
-    // thousand page faults per solve before, 240 after). Fresh memory still faults on the two
-    // threads that first write it, in parallel.
+    // Three n×n buffers in kept storage (module `scratch`), two zeroed on one thread and one on
+    // the other: fresh memory faults every 4 KiB page on its first write (about 3 µs each on
+    // the 2-core Zen 3 host, 6.5 ms per 8 MB), and faults on two cores proceed in parallel. New
+    // storage is allocated here, on the calling thread: memory allocated on a pool thread comes
+    // from that thread's allocator arena, which returns it to the system when freed (measured
+    // at n = 1000: 4–6 thousand page faults per solve before, 240 after).
     let (mut u, mut work, mut secular) = (
-        Mat::<f64>::with_capacity(n, n),
-        Mat::<f64>::with_capacity(n, n),
-        Mat::<f64>::with_capacity(n, n),
+        crate::scratch::empty(n, n),
+        crate::scratch::empty(n, n),
+        crate::scratch::empty(n, n),
     );
     join(
         || {
@@ -99,6 +98,8 @@ pub(crate) fn tridiagonal_divide_and_conquer(diag: &[f64], offdiag: &[f64], par:
     for (j, &c) in order.iter().enumerate() {
         work.col_mut(j).copy_from(u.col(c));
     }
+    crate::scratch::give_back(u);
+    crate::scratch::give_back(secular);
     Some((values, work))
 }
 

@@ -312,6 +312,14 @@ pub unsafe extern "C" fn mech_modal_result_destroy(result: *mut mech_modal_resul
     }
 }
 
+/// Returns to the system the working matrices that dense solves keep for the next solve (up to
+/// five n×n matrices of the largest recent order; see the README's known limits). The next
+/// dense solve allocates afresh. Safe to call at any time, from any thread.
+#[unsafe(no_mangle)]
+pub extern "C" fn mech_modal_release_scratch() {
+    mechanica_modal::release_scratch();
+}
+
 /// Borrows the result behind a handle.
 ///
 /// # Safety
