@@ -2,11 +2,12 @@
 //! B − sA that proves no mode lies below s, module `solve`'s inertia check), factored on idle
 //! core time ([`crate::idle_task`]) while the eigenvectors are formed.
 //!
-//! The task starts when T (the tridiagonal form) is known: it takes the shift s = ½λ₁ from T's
-//! lowest eigenvalue λ₁ (bisection on Sturm counts), forms the lower triangle of B − sA and
-//! factors it by a blocked right-looking Cholesky, one sequential block at a time, with the
-//! pivot test of the synchronous certificate. The report uses its decision when its shift is
-//! the report's own (half the lowest computed ω²) to 8 digits. When the report needs it before
+//! The task starts when T (the tridiagonal form) is known: the solve takes the shift s = ½λ₁
+//! from T's lowest eigenvalue λ₁ (bisection on Sturm counts), and the thread forms the lower
+//! triangle of B − sA and factors it by a blocked right-looking Cholesky, one sequential block
+//! at a time, with the pivot test of the synchronous certificate. The report certifies at s
+//! whenever s is its own rule's shift (half the lowest computed ω²) to 8 digits, with the
+//! thread's decision or its own factorization: the reported shift does not depend on which. When the report needs it before
 //! the thread is done, the thread hands over its partial factor at the end of its current block
 //! and the report factors the remaining columns on all threads: a right-looking factorization
 //! past its first third of the columns has done 70 % of its flops. Measured at n = 1000: the
@@ -37,15 +38,14 @@ const HANDOVER_FROM: f64 = 0.125;
 
 /// What the thread decided or had done.
 pub(crate) enum Outcome {
-    /// Factored to the end at `shift`: whether B − sA is positive definite.
-    Decided { shift: f64, positive: bool },
+    /// Factored to the end: whether B − sA is positive definite.
+    Decided { positive: bool },
     /// Stopped before the end: the rest is the report's.
     Partial(PartialFactor),
 }
 
 /// A blocked right-looking Cholesky of B − sA stopped between two blocks.
 pub(crate) struct PartialFactor {
-    pub(crate) shift: f64,
     /// Columns 0..factored hold L; the trailing block holds their Schur complement.
     factor: Mat<f64>,
     factored: usize,
@@ -84,40 +84,43 @@ impl IdleCertificate {
     }
 }
 
+/// The bottom certificate's shift s = ½λ₁(T), taken on the calling thread (a bisection on
+/// Sturm counts, O(n) per step), so that the report certifies the same shift whether or not the
+/// thread finished, and the factorization at s begun on idle time.
+pub(crate) struct BottomCertificate {
+    pub(crate) shift: f64,
+    /// None when no thread could be started.
+    pub(crate) idle: Option<IdleCertificate>,
+}
+
 /// Starts the certificate of the pencil `problem` whose reduced matrix has the tridiagonal form
-/// (`diag`, `subdiag`). None when no thread could be started.
-pub(crate) fn start(problem: &PencilProblem, diag: &[f64], subdiag: &[f64]) -> Option<IdleCertificate> {
-    let diag_len = diag.len();
-    let (diag, subdiag) = (diag.to_vec(), subdiag.to_vec());
+/// (`diag`, `subdiag`). None when λ₁(T) ≤ 0 (a zero or unstable bottom, whose shift depends on
+/// the error bounds, not known yet) or T is not finite.
+pub(crate) fn start(problem: &PencilProblem, diag: &[f64], subdiag: &[f64]) -> Option<BottomCertificate> {
+    let lowest = lowest_eigenvalue(diag, subdiag).filter(|&l| l > 0.0)?;
+    let shift = 0.5 * lowest;
     let problem = problem.clone();
     let factored = Arc::new(AtomicUsize::new(0));
     let progress = Arc::clone(&factored);
     let task = IdleTask::spawn("mechanica-idle-certificate", move |stop| {
-        factor_shifted(&problem, &diag, &subdiag, stop, &progress)
-    })?;
-    Some(IdleCertificate {
-        task,
-        factored,
-        n: diag_len,
+        factor_shifted(&problem, shift, stop, &progress)
+    });
+    Some(BottomCertificate {
+        shift,
+        idle: task.map(|task| IdleCertificate {
+            task,
+            factored,
+            n: diag.len(),
+        }),
     })
 }
 
-/// The thread's work: s = ½λ₁(T), then the Cholesky factorization of B − sA by blocks until
-/// done or `stop` (then the partial factor). None when λ₁ ≤ 0 (a zero or unstable bottom, whose
-/// shift depends on the error bounds, not known yet), T is not finite, or the work was stopped
-/// before the factorization began.
-fn factor_shifted(
-    problem: &PencilProblem,
-    diag: &[f64],
-    subdiag: &[f64],
-    stop: &AtomicBool,
-    factored: &AtomicUsize,
-) -> Option<Outcome> {
-    let lowest = lowest_eigenvalue(diag, subdiag)?;
-    if lowest <= 0.0 || stop.load(Ordering::Acquire) {
+/// The thread's work: the Cholesky factorization of B − sA by blocks until done or `stop`
+/// (then the partial factor); None when stopped before it began.
+fn factor_shifted(problem: &PencilProblem, shift: f64, stop: &AtomicBool, factored: &AtomicUsize) -> Option<Outcome> {
+    if stop.load(Ordering::Acquire) {
         return None;
     }
-    let shift = 0.5 * lowest;
     let mut factor = shifted_lower(problem, shift);
     let max_diag = max_diagonal(factor.as_ref());
     let n = factor.nrows();
@@ -125,7 +128,6 @@ fn factor_shifted(
     while done < n {
         if stop.load(Ordering::Acquire) {
             return Some(Outcome::Partial(PartialFactor {
-                shift,
                 factor,
                 factored: done,
                 max_diag,
@@ -134,14 +136,14 @@ fn factor_shifted(
         let width = BLOCK.min(n - done);
         if factor_block_step(factor.as_mut(), done, width).is_err() {
             crate::scratch::give_back(factor);
-            return Some(Outcome::Decided { shift, positive: false });
+            return Some(Outcome::Decided { positive: false });
         }
         done += width;
         factored.store(done, Ordering::Release);
     }
     let positive = check_pivots(factor.as_ref(), max_diag).is_ok();
     crate::scratch::give_back(factor);
-    Some(Outcome::Decided { shift, positive })
+    Some(Outcome::Decided { positive })
 }
 
 #[cfg(test)]
@@ -161,10 +163,10 @@ mod tests {
         (problem, 2.0 - 2.0 * (std::f64::consts::PI / (n as f64 + 1.0)).cos())
     }
 
-    /// The thread's outcome once it has returned, as (shift, positive) when it decided.
-    fn decided(certificate: &IdleCertificate, limit: Duration) -> Option<(f64, bool)> {
+    /// The thread's decision once it has returned: whether B − sA is positive definite.
+    fn decided(certificate: &IdleCertificate, limit: Duration) -> Option<bool> {
         certificate.task.wait_for_result(limit, |outcome| match outcome {
-            Outcome::Decided { shift, positive } => Some((*shift, *positive)),
+            Outcome::Decided { positive } => Some(*positive),
             Outcome::Partial(_) => None,
         })?
     }
@@ -173,8 +175,10 @@ mod tests {
     fn the_idle_thread_certifies_half_the_lowest_value() {
         let n = 300;
         let (problem, lowest) = fixed_chain(n);
-        let certificate = start(&problem, &vec![2.0; n], &vec![-1.0; n - 1]).expect("a thread");
-        let (shift, positive) = decided(&certificate, Duration::from_secs(120)).expect("decided");
+        let bottom = start(&problem, &vec![2.0; n], &vec![-1.0; n - 1]).expect("a positive bottom");
+        let certificate = bottom.idle.expect("a thread");
+        let positive = decided(&certificate, Duration::from_secs(120)).expect("decided");
+        let shift = bottom.shift;
         // Bisection resolves λ₁ to a few u·‖T‖ (‖T‖ ≤ 4).
         assert!(
             (shift - 0.5 * lowest).abs() <= 16.0 * f64::EPSILON,
@@ -185,7 +189,7 @@ mod tests {
         assert_eq!(certificate.factored.load(Ordering::Acquire), n);
         assert!(matches!(
             certificate.collect(),
-            Some(Outcome::Decided { shift: s, positive: true }) if s == shift
+            Some(Outcome::Decided { positive: true })
         ));
     }
 
@@ -195,9 +199,10 @@ mod tests {
         // indefinite and the factorization must fail.
         let n = 300;
         let (problem, lowest) = fixed_chain(n);
-        let certificate = start(&problem, &vec![4.0 * lowest; n], &vec![0.0; n - 1]).expect("a thread");
-        let (shift, positive) = decided(&certificate, Duration::from_secs(120)).expect("decided");
-        assert!((shift - 2.0 * lowest).abs() <= 16.0 * f64::EPSILON);
+        let bottom = start(&problem, &vec![4.0 * lowest; n], &vec![0.0; n - 1]).expect("a positive bottom");
+        let certificate = bottom.idle.expect("a thread");
+        let positive = decided(&certificate, Duration::from_secs(120)).expect("decided");
+        assert!((bottom.shift - 2.0 * lowest).abs() <= 16.0 * f64::EPSILON);
         assert!(!positive);
     }
 
@@ -205,9 +210,9 @@ mod tests {
     fn a_bottom_at_or_below_zero_is_left_to_the_caller() {
         let n = 50;
         let (problem, _) = fixed_chain(n);
-        let certificate = start(&problem, &vec![-1.0; n], &vec![0.0; n - 1]).expect("a thread");
-        assert!(decided(&certificate, Duration::from_millis(300)).is_none());
-        assert!(certificate.collect().is_none());
+        assert!(start(&problem, &vec![-1.0; n], &vec![0.0; n - 1]).is_none());
+        assert!(start(&problem, &vec![0.0; n], &vec![0.0; n - 1]).is_none());
+        assert!(start(&problem, &vec![f64::NAN; n], &vec![0.0; n - 1]).is_none());
     }
 
     /// A factorization stopped after two blocks and finished on two threads decides as a whole
@@ -224,7 +229,6 @@ mod tests {
                 factor_block_step(factor.as_mut(), start, BLOCK).expect("the leading blocks are definite");
             }
             let partial = PartialFactor {
-                shift,
                 factor,
                 factored: 2 * BLOCK,
                 max_diag,

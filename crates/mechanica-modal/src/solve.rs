@@ -11,7 +11,7 @@ use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::condense::Condensation;
 use crate::dd::Operand;
 use crate::fork_join::{join, map_items};
-use crate::idle_certificate::{IdleCertificate, Outcome};
+use crate::idle_certificate::{BottomCertificate, IdleCertificate, Outcome};
 use crate::idle_task::IdleTask;
 use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::reduce::{Cholesky, back_transform, cholesky_owned, reduce_owned};
@@ -438,7 +438,7 @@ impl EarlyInputs {
             if stop.load(std::sync::atomic::Ordering::Acquire) {
                 return None;
             }
-            let sketch_rows = sketched.then(|| SketchRows::new(a, b, Par::Seq));
+            let sketch_rows = sketched.then(|| SketchRows::new(a, b));
             Some(Self { norms, sketch_rows })
         })
     }
@@ -447,8 +447,9 @@ impl EarlyInputs {
 /// What idle core time delivered to the report (each None when not started or not finished).
 #[derive(Default)]
 pub(crate) struct IdleResults {
-    /// The bottom certificate, module `idle_certificate`.
-    pub(crate) certificate: Option<IdleCertificate>,
+    /// The bottom certificate's shift and its factorization begun on idle time, module
+    /// `idle_certificate`.
+    pub(crate) certificate: Option<BottomCertificate>,
     /// The sketch's S·A and S·B.
     pub(crate) sketch_rows: Option<SketchRows>,
 }
@@ -938,7 +939,7 @@ fn inertia_check(
     (first, end): (usize, usize),
     bounds: &[f64],
     condensed_stiffness_negatives: Option<usize>,
-    idle_certificate: Option<IdleCertificate>,
+    bottom: Option<BottomCertificate>,
     par: Par,
 ) -> Result<Option<InertiaCheck>, ModalError> {
     if omega_all.is_empty() {
@@ -951,21 +952,19 @@ fn inertia_check(
         // Every mode selected: certify the bottom of the spectrum (no mode, and so no
         // instability, below the lowest computed ω²) with a Cholesky factorization.
         let lowest = omega_all[0];
-        let shift = lowest - (0.5 * lowest.abs()).max(2.0 * bounds[0]);
-        // The factorization begun on idle time (at half of T's lowest eigenvalue) serves when
-        // its shift is this one to 8 digits, or higher and still below the lowest ω² by more
-        // than twice its bound.
-        let usable = |s: f64| s >= shift - 1e-8 * shift.abs() && s < lowest - 2.0 * bounds[0];
+        let rule = lowest - (0.5 * lowest.abs()).max(2.0 * bounds[0]);
+        // Half of T's lowest eigenvalue (the shift the idle thread factors at) is taken when it
+        // is the rule's to 8 digits, or higher and still below the lowest ω² by more than twice
+        // its bound: then the certified shift does not depend on whether the thread finished.
+        let usable = |s: f64| s >= rule - 1e-8 * rule.abs() && s < lowest - 2.0 * bounds[0];
+        let (shift, idle) = match bottom {
+            Some(b) if usable(b.shift) => (b.shift, b.idle),
+            _ => (rule, None),
+        };
         // A factor the thread had begun is finished here on every thread.
-        let from_idle = match idle_certificate.and_then(IdleCertificate::collect) {
-            Some(Outcome::Decided {
-                shift: idle_shift,
-                positive: true,
-            }) if usable(idle_shift) => Some(idle_shift),
-            Some(Outcome::Partial(partial)) if usable(partial.shift) => {
-                let idle_shift = partial.shift;
-                partial.finish(par).then_some(idle_shift)
-            }
+        let from_idle = match idle.and_then(IdleCertificate::collect) {
+            Some(Outcome::Decided { positive: true, .. }) => Some(shift),
+            Some(Outcome::Partial(partial)) => partial.finish(par).then_some(shift),
             _ => None,
         };
         let certified = from_idle.or_else(|| (shift < lowest && all_above(problem, shift, par)).then_some(shift));

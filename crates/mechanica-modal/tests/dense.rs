@@ -71,11 +71,17 @@ fn rotated_chain_keeps_its_spectrum() {
     check_against(&pencil(&ar, &br), &families::fixed_chain_omega_sq(n));
 }
 
+/// The certified shift, the error bounds, the backward errors and the orthogonality error.
+type ReportedNumbers = (f64, Vec<f64>, Vec<Option<f64>>, Option<f64>);
+
 /// Large enough (n ≥ 640) for the report's inputs and the bottom certificate to be formed on
 /// idle time: the lowest 20 ω² lie within their bounds of the closed form; whichever
 /// path decides it (the idle thread at half of T's lowest eigenvalue, or the report at half the
 /// lowest computed ω²), the certified shift lies below the closed-form lowest ω², at half the
-/// computed one to 8 digits, with no mode below it; values only takes the same path.
+/// computed one to 8 digits, with no mode below it; values only takes the same path. The three
+/// solves of each kind report the same numbers to the bit, whichever work the idle threads
+/// finished first (the certified shift is half of T's lowest eigenvalue on both paths, and the
+/// sketch's rows are formed alike).
 #[test]
 fn large_solves_certify_the_bottom_below_the_closed_form() {
     let n = 700;
@@ -84,6 +90,7 @@ fn large_solves_certify_the_bottom_below_the_closed_form() {
     let p = pencil(&a, &b);
     let lowest = families::fixed_chain_omega_sq(n)[0];
     for vectors in [true, false] {
+        let mut first_report: Option<ReportedNumbers> = None;
         for _ in 0..3 {
             let options = SolveOptions {
                 vectors,
@@ -111,6 +118,16 @@ fn large_solves_certify_the_bottom_below_the_closed_form() {
             assert!(shift < lowest, "shift {shift:e} not below ω²₁ = {lowest:e}");
             let half = 0.5 * sol.modes[0].omega_sq;
             assert!((shift - half).abs() <= 1e-8 * half, "shift {shift:e} vs {half:e}");
+            let report = (
+                shift,
+                sol.modes.iter().map(|m| m.error_bound).collect::<Vec<f64>>(),
+                sol.modes.iter().map(|m| m.backward_error).collect::<Vec<Option<f64>>>(),
+                sol.accuracy.orthogonality_error,
+            );
+            match &first_report {
+                Some(first) => assert!(*first == report, "the report changed between two solves"),
+                None => first_report = Some(report),
+            }
         }
     }
 }
