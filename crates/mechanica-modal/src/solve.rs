@@ -963,7 +963,7 @@ fn inertia_check(
         };
         // A factor the thread had begun is finished here on every thread.
         let from_idle = match idle.and_then(IdleCertificate::collect) {
-            Some(Outcome::Decided { positive: true, .. }) => Some(shift),
+            Some(Outcome::Decided { positive: true }) => Some(shift),
             Some(Outcome::Partial(partial)) => partial.finish(par).then_some(shift),
             _ => None,
         };
