@@ -3,11 +3,17 @@
 //! methods alike; the median over the rounds and its ratio to dsygvd's median are printed.
 //!
 //! `OPENBLAS_CORETYPE=Haswell cargo bench -p mechanica-benches --bench modal_interleaved -- 1000 2000 4000`
-//! (sizes optional; rounds: `ROUNDS=7`, default 5). Problem: [`rotated_fixed_chain`], or with
+//! (sizes optional; rounds: `ROUNDS=7`, default 5; `METHODS=sketched` keeps only the methods whose
+//! label contains that text, and the LAPACK rows). Problem: [`rotated_fixed_chain`], or with
 //! `FAMILY=lumped` [`lumped_fixed_chain`] (diagonal masses, dense stiffness), where a third LAPACK
 //! row scales C = D^−½ B D^−½ by hand and calls `dsyevd`, what an expert LAPACK user would do;
 //! its time includes the scaling and the back-scaling of the vectors. Values-only rows are
 //! compared with `dsygvd` without vectors, the others with `dsygvd` with vectors.
+//!
+//! Besides the ratio of medians, each row gives the median of the per-round ratios (a method's
+//! time over `dsygvd`'s in the same round, which cancels the host's slow drifts) and a 90 %
+//! bootstrap interval of that median (2000 resamples of the rounds). The order of the methods is
+//! rotated from one round to the next, so that no method always runs right after LAPACK.
 
 use mechanica::modal::{PencilProblem, Refinement, Residuals, SolveOptions, solve};
 use mechanica_benches::lapack;
@@ -78,8 +84,13 @@ fn main() {
         ),
         ("LAPACK dsygvd values only", None, false),
     ];
-    println!("| n | method | median s | ratio to dsygvd | min s | max s |");
-    println!("|---|---|---|---|---|---|");
+    let filter = std::env::var("METHODS").unwrap_or_default();
+    let methods: Vec<_> = methods
+        .into_iter()
+        .filter(|(label, options, _)| options.is_none() || label.contains(filter.as_str()))
+        .collect();
+    println!("| n | method | median s | ratio to dsygvd | paired ratio, median [90 % interval] | min s | max s |");
+    println!("|---|---|---|---|---|---|---|");
     for n in sizes {
         let (a, b) = if lumped {
             lumped_fixed_chain(n)
@@ -94,7 +105,7 @@ fn main() {
         let mut times = vec![Vec::new(); methods.len()];
         let masses: Vec<f64> = (0..n).map(|i| a[(i, i)]).collect();
         let mut scaled_times = Vec::new();
-        for _ in 0..rounds {
+        for round in 0..rounds {
             if lumped {
                 let clock = Instant::now();
                 let ok = std::hint::black_box(scaled_dsyevd(&ka, &masses, n)).is_ok();
@@ -104,7 +115,9 @@ fn main() {
                 }
                 std::thread::sleep(Duration::from_millis(200));
             }
-            for (k, (_, options, vectors)) in methods.iter().enumerate() {
+            for turn in 0..methods.len() {
+                let k = (turn + round) % methods.len();
+                let (_, options, vectors) = &methods[k];
                 let clock = Instant::now();
                 let ok = match options {
                     Some(o) => std::hint::black_box(solve(&problem, o)).is_ok(),
@@ -119,12 +132,12 @@ fn main() {
             }
         }
         // Each mechanica row is compared with LAPACK computing the same (with or without vectors).
-        let lapack_median = |vectors: bool| {
+        let lapack_times = |vectors: bool| {
             let k = methods
                 .iter()
                 .position(|(_, o, v)| o.is_none() && *v == vectors)
                 .unwrap_or(methods.len() - 1);
-            median(times[k].clone())
+            &times[k]
         };
         for (k, (label, _, vectors)) in methods.iter().enumerate() {
             let t = &times[k];
@@ -133,9 +146,13 @@ fn main() {
                 t.iter().copied().fold(0.0, f64::max),
             );
             let m = median(t.clone());
+            let reference = lapack_times(*vectors);
+            let paired: Vec<f64> = t.iter().zip(reference).map(|(ours, lapack)| ours / lapack).collect();
+            let (low, high) = bootstrap_median_interval(&paired);
             println!(
-                "| {n} | {label} | {m:.3} | {:.2} | {lo:.3} | {hi:.3} |",
-                m / lapack_median(*vectors)
+                "| {n} | {label} | {m:.3} | {:.2} | {:.2} [{low:.2}, {high:.2}] | {lo:.3} | {hi:.3} |",
+                m / median(reference.clone()),
+                median(paired.clone()),
             );
         }
         if lumped {
@@ -143,13 +160,38 @@ fn main() {
                 scaled_times.iter().copied().fold(f64::INFINITY, f64::min),
                 scaled_times.iter().copied().fold(0.0, f64::max),
             );
+            let reference = lapack_times(true);
+            let paired: Vec<f64> = scaled_times.iter().zip(reference).map(|(s, l)| s / l).collect();
+            let (low, high) = bootstrap_median_interval(&paired);
             let m = median(scaled_times);
             println!(
-                "| {n} | LAPACK dsyevd on D^−½BD^−½, scaled by hand (all pairs) | {m:.3} | {:.2} | {lo:.3} | {hi:.3} |",
-                m / lapack_median(true)
+                "| {n} | LAPACK dsyevd on D^−½BD^−½, scaled by hand (all pairs) | {m:.3} | {:.2} | {:.2} [{low:.2}, {high:.2}] | {lo:.3} | {hi:.3} |",
+                m / median(reference.clone()),
+                median(paired),
             );
         }
     }
+}
+
+/// The 5th and 95th percentiles of the median of `samples` resampled with replacement (2000
+/// resamples drawn by a fixed linear congruential generator, so that a run can be repeated).
+fn bootstrap_median_interval(samples: &[f64]) -> (f64, f64) {
+    if samples.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut draw = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((state >> 33) as usize) % samples.len()
+    };
+    let medians: Vec<f64> = (0..2000)
+        .map(|_| median((0..samples.len()).map(|_| samples[draw()]).collect()))
+        .collect();
+    let mut sorted = medians;
+    sorted.sort_by(f64::total_cmp);
+    (sorted[sorted.len() / 20], sorted[sorted.len() * 19 / 20])
 }
 
 /// All pairs of a lumped-mass pencil the way an expert calls LAPACK: C = D^−½ B D^−½ formed by

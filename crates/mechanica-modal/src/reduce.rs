@@ -57,26 +57,28 @@ pub(crate) enum Cholesky {
 /// Cholesky factor L (lower) of A = L Lᵀ. A pivot l_ii² ≤ n·u·max_j A_jj counts as failed,
 /// since A is then semidefinite to working precision.
 pub(crate) fn cholesky(a: MatRef<'_, f64>, par: Par) -> Cholesky {
-    cholesky_owned(a.to_owned(), par)
+    cholesky_owned(Mat::from_fn(a.nrows(), a.ncols(), |i, j| lower_entry(a, i, j)), par)
 }
 
-/// [`cholesky`] of a matrix the caller no longer needs (factored in place, no copy).
+/// Entry (i, j) of the lower triangle of `a`, zero above the diagonal: a copy made of these
+/// reads only the half of `a` that the factorization and the reduction use.
+pub(crate) fn lower_entry(a: MatRef<'_, f64>, i: usize, j: usize) -> f64 {
+    if i >= j { a[(i, j)] } else { 0.0 }
+}
+
+/// [`cholesky`] of a matrix the caller no longer needs (factored in place, no copy). Its
+/// strict upper triangle must be zero (as [`lower_entry`] leaves it): it is not read, and stays
+/// zero as that of L.
 pub(crate) fn cholesky_owned(mut l: Mat<f64>, par: Par) -> Cholesky {
     let factored = if is_diagonal(l.as_ref()) {
         factor_diagonal_in_place(l.as_mut())
     } else {
         factor_in_place(l.as_mut(), par)
     };
-    if let Err(pivot) = factored {
-        return Cholesky::Failed { pivot };
+    match factored {
+        Err(pivot) => Cholesky::Failed { pivot },
+        Ok(()) => Cholesky::Factor(l),
     }
-    let n = l.nrows();
-    for j in 0..n {
-        for i in 0..j {
-            l[(i, j)] = 0.0;
-        }
-    }
-    Cholesky::Factor(l)
 }
 
 /// Whether the strict lower triangle of `m` is zero (an exact test: early exit at the first
@@ -102,8 +104,8 @@ fn factor_diagonal_in_place(mut l: MatMut<'_, f64>) -> Result<(), usize> {
     Ok(())
 }
 
-/// Factors the lower triangle of `l` in place (the strict upper triangle is neither read nor
-/// cleared); Err(pivot) at the first pivot that is not positive or is negligible (l_ii² ≤
+/// Factors the lower triangle of `l` in place (the strict upper triangle is not read, and stays
+/// zero if it was); Err(pivot) at the first pivot that is not positive or is negligible (l_ii² ≤
 /// n·u·max_j l_jj before factoring).
 pub(crate) fn factor_in_place(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
     let (max_diag, par) = (max_diagonal(l.rb()), factor_parallelism(l.nrows(), par));
@@ -187,6 +189,11 @@ fn factor_recursive(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
             stack,
             Default::default(),
         );
+        // faer's kernel leaves scratch values in the block's strict upper triangle, which is
+        // part of L's (zero) strict upper triangle.
+        for j in 1..n {
+            l.rb_mut().col_mut(j).subrows_mut(0, j).fill(0.0);
+        }
         return match result {
             Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) => Err(index),
             _ => Ok(()),

@@ -14,7 +14,7 @@ use crate::fork_join::{join, map_items};
 use crate::idle_certificate::{BottomCertificate, IdleCertificate, Outcome};
 use crate::idle_task::IdleTask;
 use crate::inertia::{InertiaCount, all_above, count_below};
-use crate::reduce::{Cholesky, back_transform, cholesky_owned, reduce_owned};
+use crate::reduce::{Cholesky, back_transform, cholesky_owned, lower_entry, reduce_owned};
 use crate::refine::{
     Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts, polish_simple_mode,
     refine_cluster, refine_simple_modes,
@@ -356,11 +356,12 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     // The copies of A (factored in place) and B (reduced in place) take kept working storage
     // (module `scratch`) and are written on two threads: the first write of fresh memory faults
     // every page, and faults on two cores proceed in parallel (6.5 ms per 8 MB on one core of
-    // the Zen 3 host).
+    // the Zen 3 host). Only the lower triangles are read (the factorization and the reduction
+    // use no other entry); the upper ones are zeroed, as L's must be.
     let (mut a_copy, mut b_copy) = (crate::scratch::empty(n, n), crate::scratch::empty(n, n));
     join(
-        || a_copy.resize_with(n, n, |i, j| a[(i, j)]),
-        || b_copy.resize_with(n, n, |i, j| b[(i, j)]),
+        || a_copy.resize_with(n, n, |i, j| lower_entry(a, i, j)),
+        || b_copy.resize_with(n, n, |i, j| lower_entry(b, i, j)),
         par,
     );
     match cholesky_owned(a_copy, par) {
