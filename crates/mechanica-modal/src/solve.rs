@@ -63,9 +63,13 @@ pub enum Refinement {
 pub const SEQUENTIAL_BELOW: usize = 192;
 
 /// From this order an all-modes solve puts work off its critical path on idle core time (module
-/// `idle_task`: the norms, the sketch's rows, the bottom certificate); below it that work is
-/// cheap and a thread's start is not.
-const IDLE_TIME_FROM: usize = 640;
+/// `idle_task`: the norms, the sketch's rows, the bottom certificate): from the first order
+/// solved on two threads. Measured (rotated chain, sketched report, medians of 15 solves in two
+/// alternations, against the earlier threshold of 640): n = 250 18.4 / 17.6 → 14.8 / 13.6 ms,
+/// n = 350 29.8 / 31.7 → 28.7 / 26.3 ms, n = 500 (threshold 300) 57.5 / 55.8 / 54.0 → 51.3 /
+/// 50.2 / 50.0 ms; below the factorization's own threshold one core is idle while the other
+/// factors A.
+const IDLE_TIME_FROM: usize = SEQUENTIAL_BELOW;
 
 /// Auto refinement starts when the reduction guarantees fewer than 8 digits of a mode's ω².
 pub const AUTO_REFINE_RELATIVE_BOUND: f64 = 1e-8;
