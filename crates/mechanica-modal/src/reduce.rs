@@ -284,7 +284,12 @@ fn reduce_blocks(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>, mut scratch: MatMut
     subtract_lower_product(c22.as_mut(), c21.as_ref(), l21, par);
     subtract_lower_product(c22.as_mut(), l21, c21.as_ref(), par);
     subtract_in_place(c21.as_mut(), half.as_ref());
-    solve_lower_triangular_in_place(l22, c21.as_mut(), par);
+    // C21 = L22⁻¹ (W − H) on column chunks, one per thread (faer's parallel solve of the same:
+    // medians 7.0 / 50.8 / 438 ms against 5.9 / 44.5 / 332 ms summed over the steps at
+    // n = 1000 / 2000 / 4000).
+    by_column_chunks(c21.as_mut(), par, &|rhs| {
+        solve_lower_triangular_in_place(l22, rhs, Par::Seq)
+    });
     reduce_blocks(l22, c22, scratch, par);
 }
 
