@@ -140,37 +140,39 @@ fn main() {
             &times[k]
         };
         for (k, (label, _, vectors)) in methods.iter().enumerate() {
-            let t = &times[k];
-            let (lo, hi) = (
-                t.iter().copied().fold(f64::INFINITY, f64::min),
-                t.iter().copied().fold(0.0, f64::max),
-            );
-            let m = median(t.clone());
-            let reference = lapack_times(*vectors);
-            let paired: Vec<f64> = t.iter().zip(reference).map(|(ours, lapack)| ours / lapack).collect();
-            let (low, high) = bootstrap_median_interval(&paired);
             println!(
-                "| {n} | {label} | {m:.3} | {:.2} | {:.2} [{low:.2}, {high:.2}] | {lo:.3} | {hi:.3} |",
-                m / median(reference.clone()),
-                median(paired.clone()),
+                "| {n} | {label} | {} |",
+                row_statistics(&times[k], lapack_times(*vectors))
             );
         }
         if lumped {
-            let (lo, hi) = (
-                scaled_times.iter().copied().fold(f64::INFINITY, f64::min),
-                scaled_times.iter().copied().fold(0.0, f64::max),
-            );
-            let reference = lapack_times(true);
-            let paired: Vec<f64> = scaled_times.iter().zip(reference).map(|(s, l)| s / l).collect();
-            let (low, high) = bootstrap_median_interval(&paired);
-            let m = median(scaled_times);
             println!(
-                "| {n} | LAPACK dsyevd on D^−½BD^−½, scaled by hand (all pairs) | {m:.3} | {:.2} | {:.2} [{low:.2}, {high:.2}] | {lo:.3} | {hi:.3} |",
-                m / median(reference.clone()),
-                median(paired),
+                "| {n} | LAPACK dsyevd on D^−½BD^−½, scaled by hand (all pairs) | {} |",
+                row_statistics(&scaled_times, lapack_times(true))
             );
         }
     }
+}
+
+/// A row's statistics of `times` against the LAPACK times of the same rounds: median, ratio of
+/// medians, median of the per-round ratios with its 90 % bootstrap interval, min and max.
+fn row_statistics(times: &[f64], reference: &[f64]) -> String {
+    let (lo, hi) = (
+        times.iter().copied().fold(f64::INFINITY, f64::min),
+        times.iter().copied().fold(0.0, f64::max),
+    );
+    let m = median(times.to_vec());
+    let paired: Vec<f64> = times
+        .iter()
+        .zip(reference)
+        .map(|(ours, lapack)| ours / lapack)
+        .collect();
+    let (low, high) = bootstrap_median_interval(&paired);
+    format!(
+        "{m:.3} | {:.2} | {:.2} [{low:.2}, {high:.2}] | {lo:.3} | {hi:.3}",
+        m / median(reference.to_vec()),
+        median(paired),
+    )
 }
 
 /// The 5th and 95th percentiles of the median of `samples` resampled with replacement (2000
@@ -186,10 +188,9 @@ fn bootstrap_median_interval(samples: &[f64]) -> (f64, f64) {
             .wrapping_add(1_442_695_040_888_963_407);
         ((state >> 33) as usize) % samples.len()
     };
-    let medians: Vec<f64> = (0..2000)
+    let mut sorted: Vec<f64> = (0..2000)
         .map(|_| median((0..samples.len()).map(|_| samples[draw()]).collect()))
         .collect();
-    let mut sorted = medians;
     sorted.sort_by(f64::total_cmp);
     (sorted[sorted.len() / 20], sorted[sorted.len() * 19 / 20])
 }
