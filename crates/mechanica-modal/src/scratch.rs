@@ -30,7 +30,7 @@ struct Pool {
 }
 
 impl Pool {
-    /// The smallest kept matrix whose shape covers rows × cols, emptied (0×0, its storage kept).
+    /// The smallest kept matrix whose shape covers rows × cols, in the shape it was given back in.
     fn take(&mut self, rows: usize, cols: usize) -> Option<Mat<f64>> {
         let fitting = self
             .kept
@@ -39,9 +39,7 @@ impl Pool {
             .filter(|(_, m)| m.nrows() >= rows && m.ncols() >= cols)
             .min_by_key(|(_, m)| m.nrows() * m.ncols())
             .map(|(index, _)| index)?;
-        let mut matrix = self.kept.swap_remove(fitting);
-        matrix.truncate(0, 0);
-        Some(matrix)
+        Some(self.kept.swap_remove(fitting))
     }
 
     /// Keeps `matrix` when it is large enough, dropping the smallest one beyond [`KEPT`].
@@ -65,8 +63,23 @@ static POOL: Mutex<Pool> = Mutex::new(Pool { kept: Vec::new() });
 /// process's main one when called from the solve; memory of a pool thread's heap is returned to
 /// the system when freed). Fill it with `resize_with`.
 pub(crate) fn empty(rows: usize, cols: usize) -> Mat<f64> {
+    let mut matrix = stale(rows, cols);
+    matrix.truncate(0, 0);
+    matrix
+}
+
+/// A rows × cols matrix of unspecified entries without a pass over its memory: kept storage
+/// truncated to that shape (the values a previous solve left), else new storage as an empty
+/// 0×0 matrix that the caller fills with `resize_with` (its first write faults the pages in).
+pub(crate) fn stale(rows: usize, cols: usize) -> Mat<f64> {
     let kept = POOL.lock().ok().and_then(|mut pool| pool.take(rows, cols));
-    kept.unwrap_or_else(|| Mat::with_capacity(rows, cols))
+    match kept {
+        Some(mut matrix) => {
+            matrix.truncate(rows, cols);
+            matrix
+        }
+        None => Mat::with_capacity(rows, cols),
+    }
 }
 
 /// Keeps a working matrix the solve no longer needs, for the next solve.
@@ -99,7 +112,10 @@ mod tests {
         let storage = old.as_ptr();
         pool.give_back(old);
         let mut reused = pool.take(400, 400).expect("kept");
-        assert_eq!((reused.nrows(), reused.ncols()), (0, 0));
+        assert_eq!((reused.nrows(), reused.ncols()), (400, 400));
+        reused.truncate(300, 200);
+        assert_eq!(reused[(299, 199)], 7.0, "truncated, the stale values stay");
+        reused.truncate(0, 0);
         reused.resize_with(400, 400, |i, j| (i + 400 * j) as f64);
         assert_eq!(reused.as_ptr(), storage);
         for j in 0..400 {

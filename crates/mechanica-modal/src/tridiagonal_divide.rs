@@ -29,7 +29,7 @@
 use crate::fork_join::join;
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
-use faer::{Accum, Mat, MatMut, Par};
+use faer::{Accum, Mat, MatMut, MatRef, Par};
 
 /// Leaves of at most this many rows are solved by the implicit QL iteration (LAPACK's SMLSIZ
 /// is 25; here a power of two so that the halves of a power-of-two order are equal).
@@ -69,17 +69,27 @@ pub(crate) fn tridiagonal_divide_and_conquer(diag: &[f64], offdiag: &[f64], par:
     // storage is allocated here, on the calling thread: memory allocated on a pool thread comes
     // from that thread's allocator arena, which returns it to the system when freed (measured
     // at n = 1000: 4–6 thousand page faults per solve before, 240 after).
+    // Kept storage is used with the values it holds: no entry is read before it is written
+    // (each merge reads only the rows where a column can be nonzero, see `merge`). That spares
+    // zeroing three n×n matrices, and the merges copy only nonzero rows; with the final copy
+    // skipped when the top merge deflates nothing, this stage's min / q1 / median over 29 solves
+    // at n = 1000 went from 32.9 / 36.6 / 42.9 to 29.8 / 34.1 / 36.8 ms.
     let (mut u, mut work, mut secular) = (
-        crate::scratch::empty(n, n),
-        crate::scratch::empty(n, n),
-        crate::scratch::empty(n, n),
+        crate::scratch::stale(n, n),
+        crate::scratch::stale(n, n),
+        crate::scratch::stale(n, n),
     );
+    let fill_fresh = |m: &mut Mat<f64>| {
+        if m.nrows() != n {
+            m.resize_with(n, n, |_, _| 0.0);
+        }
+    };
     join(
         || {
-            u.resize_with(n, n, |_, _| 0.0);
-            work.resize_with(n, n, |_, _| 0.0);
+            fill_fresh(&mut u);
+            fill_fresh(&mut work);
         },
-        || secular.resize_with(n, n, |_, _| 0.0),
+        || fill_fresh(&mut secular),
         par,
     );
     let mut order = vec![0; n];
@@ -95,19 +105,25 @@ pub(crate) fn tridiagonal_divide_and_conquer(diag: &[f64], offdiag: &[f64], par:
     if values.iter().any(|v| !v.is_finite()) {
         return None;
     }
+    crate::scratch::give_back(secular);
+    // Without deflation at the top merge its columns are already ascending.
+    if order.iter().enumerate().all(|(j, &c)| j == c) {
+        crate::scratch::give_back(work);
+        return Some((values, u));
+    }
     for (j, &c) in order.iter().enumerate() {
         work.col_mut(j).copy_from(u.col(c));
     }
     crate::scratch::give_back(u);
-    crate::scratch::give_back(secular);
     Some((values, work))
 }
 
 /// The storage of one node of the recursion: its diagonal blocks of the eigenvector matrix and
 /// of two workspaces of the same size (children get disjoint diagonal blocks, so that they can
-/// run on two threads).
+/// run on two threads). Entries hold stale values until written.
 struct Node<'a> {
-    /// On return: the node's eigenvectors as columns (in the order of the node's values).
+    /// On return: the node's eigenvectors as columns (in the order of the node's values), every
+    /// entry written.
     u: MatMut<'a, f64>,
     /// Gathered columns of the children's eigenvectors.
     work: MatMut<'a, f64>,
@@ -161,12 +177,46 @@ fn solve_node(d: &mut [f64], e: &mut [f64], nodes: Node<'_>, order: &mut [usize]
     merge(d, beta, n1, Node { u, work, secular }, order, par)
 }
 
-/// Where a column of the children's eigenvector matrix is nonzero.
+/// Where a column of the children's eigenvector matrix is nonzero. Only those rows of it are
+/// written (a child writes its own block of rows); the others are zero by definition and hold
+/// stale values.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Rows {
     Top,
     Bottom,
     Both,
+}
+
+impl Rows {
+    /// The rows of a node of order n, torn after row n1, that this column may have nonzero.
+    fn range(self, n1: usize, n: usize) -> std::ops::Range<usize> {
+        match self {
+            Rows::Top => 0..n1,
+            Rows::Bottom => n1..n,
+            Rows::Both => 0..n,
+        }
+    }
+}
+
+/// Writes column `col`'s zero rows (those outside `rows`) of a node of order n torn after row n1.
+fn write_zero_rows(mut u: MatMut<'_, f64>, col: usize, rows: Rows, n1: usize) {
+    let n = u.nrows();
+    let column = u.rb_mut().col_mut(col);
+    match rows {
+        Rows::Top => column.subrows_mut(n1, n - n1).fill(0.0),
+        Rows::Bottom => column.subrows_mut(0, n1).fill(0.0),
+        Rows::Both => {}
+    }
+}
+
+/// Copies the rows of column `from` of `u` that may be nonzero (`rows`, in a node torn after row
+/// n1) into column `to` of `work`.
+fn copy_nonzero_rows(work: MatMut<'_, f64>, to: usize, u: MatRef<'_, f64>, from: usize, rows: Rows, n1: usize) {
+    let range = rows.range(n1, u.nrows());
+    let (start, len) = (range.start, range.len());
+    work.col_mut(to)
+        .subrows_mut(start, len)
+        .copy_from(u.col(from).subrows(start, len));
 }
 
 /// Combines the solved halves (values `d` in column order, ascending orders `order[..n1]` and
@@ -210,12 +260,11 @@ fn merge(d: &mut [f64], beta: f64, n1: usize, nodes: Node<'_>, order: &mut [usiz
             if ((d[c] - d[j]) * cos * sin).abs() <= tol {
                 // Rotate columns j and c so that z_j = 0: G = [cos sin; −sin cos] on (j, c).
                 let span = if rows[j] == rows[c] { rows[c] } else { Rows::Both };
-                let range = match span {
-                    Rows::Top => 0..n1,
-                    Rows::Bottom => n1..n,
-                    Rows::Both => 0..n,
-                };
-                for r in range {
+                if span == Rows::Both {
+                    write_zero_rows(u.rb_mut(), j, rows[j], n1);
+                    write_zero_rows(u.rb_mut(), c, rows[c], n1);
+                }
+                for r in span.range(n1, n) {
                     let (uj, uc) = (u[(r, j)], u[(r, c)]);
                     u[(r, j)] = cos * uj + sin * uc;
                     u[(r, c)] = cos * uc - sin * uj;
@@ -257,9 +306,15 @@ fn merge(d: &mut [f64], beta: f64, n1: usize, nodes: Node<'_>, order: &mut [usiz
     };
     secular_vectors(&poles, &z_kept, &position, rho, deltas.rb_mut(), par);
 
-    // Gather the kept columns (typed order), then the deflated ones.
-    for (r, &c) in typed.iter().chain(&deflated).enumerate() {
-        work.rb_mut().col_mut(r).copy_from(u.rb().col(c));
+    // Gather the kept columns (typed order; only their nonzero rows, the only ones the products
+    // below read), then the deflated ones with their zero rows written (they become columns of
+    // the node as they are).
+    for (r, &c) in typed.iter().enumerate() {
+        copy_nonzero_rows(work.rb_mut(), r, u.rb(), c, rows[c], n1);
+    }
+    for (r, &c) in deflated.iter().enumerate().map(|(i, c)| (k + i, c)) {
+        copy_nonzero_rows(work.rb_mut(), r, u.rb(), c, rows[c], n1);
+        write_zero_rows(work.rb_mut(), r, rows[c], n1);
     }
     let vectors = deltas.rb();
     let (upper_rows, lower_rows) = (top_count + (k - top_count - bottom_count), k - top_count);
@@ -900,6 +955,49 @@ mod tests {
         check(&vec![0.0; n], &vec![0.0; n - 1], Par::Seq);
         let e: Vec<f64> = (0..n - 1).map(|i| if i % 3 == 0 { 0.0 } else { 1.0 }).collect();
         check(&vec![1.0; n], &e, Par::Seq);
+    }
+
+    /// Working storage full of NaN, as kept storage may hold anything: every entry the recursion
+    /// reads was written first (a NaN read would reach a vector), so the pairs are as accurate as
+    /// from zeroed storage. Glued Wilkinson matrices rotate columns of both halves together
+    /// (close poles across the tear); heavy and no deflation; one and two threads.
+    #[test]
+    fn stale_working_storage_is_never_read() {
+        let mut glued_d = Vec::new();
+        let mut glued_e = Vec::new();
+        for b in 0..12 {
+            glued_d.extend((0..21).map(|i| (10.0 - i as f64).abs() / 10.0));
+            glued_e.extend(std::iter::repeat_n(0.1, 20));
+            if b + 1 < 12 {
+                glued_e.push(1e-13);
+            }
+        }
+        let n = 300;
+        let random_d = pseudo_random(n, 3);
+        let random_e = pseudo_random(n - 1, 4);
+        let tiny_e = vec![1e-17; n - 1];
+        let cases: [(&[f64], &[f64]); 3] = [(&glued_d, &glued_e), (&random_d, &random_e), (&vec![1.0; n], &tiny_e)];
+        for (d, e) in cases {
+            for par in [Par::Seq, Par::rayon(2)] {
+                let n = d.len();
+                let nan = || Mat::from_fn(n, n, |_, _| f64::NAN);
+                let (mut u, mut work, mut secular) = (nan(), nan(), nan());
+                let (mut values, mut off) = (d.to_vec(), e.to_vec());
+                let mut order = vec![0; n];
+                let nodes = Node {
+                    u: u.as_mut(),
+                    work: work.as_mut(),
+                    secular: secular.as_mut(),
+                };
+                assert!(solve_node(&mut values, &mut off, nodes, &mut order, par));
+                let sorted: Vec<f64> = order.iter().map(|&c| values[c]).collect();
+                let z = Mat::from_fn(n, n, |i, j| u[(i, order[j])]);
+                let (residual, orth) = errors(d, e, &sorted, &z);
+                let limit = 4.0 * n as f64 * EPS;
+                assert!(residual <= limit, "n {n}: residual {residual:e}");
+                assert!(orth <= limit, "n {n}: orthogonality {orth:e}");
+            }
+        }
     }
 
     #[test]
