@@ -274,6 +274,17 @@ fn reduce_blocks(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>, mut scratch: MatMut
     let (mut c11, _, mut c21, mut c22) = c.split_at_mut(n1, n1);
     reduce_blocks(l11, c11.as_mut(), scratch.rb_mut(), par);
     mirror_lower(c11.as_mut());
+    if n - n1 <= SPLIT_STEP_UP_TO && par.degree() > 1 {
+        let half = scratch.rb_mut().submatrix_mut(0, 0, n - n1, n1);
+        let step = StepBlocks {
+            l11,
+            l21,
+            l22,
+            c11: c11.as_ref(),
+        };
+        step.on_two_threads(c21, c22.as_mut(), half);
+        return reduce_blocks(l22, c22, scratch, par);
+    }
     // W = B21 L11⁻ᵀ  ⇔  L11 Wᵀ = B21ᵀ (the rows of W are independent right-hand sides).
     by_column_chunks(c21.as_mut().transpose_mut(), par, &|rhs| {
         solve_lower_triangular_in_place(l11, rhs, Par::Seq)
@@ -291,6 +302,93 @@ fn reduce_blocks(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>, mut scratch: MatMut
         solve_lower_triangular_in_place(l22, rhs, Par::Seq)
     });
     reduce_blocks(l22, c22, scratch, par);
+}
+
+/// Trailing orders up to which a step of the reduction runs as three two-thread phases of
+/// sequential kernels instead of faer's parallel kernels, whose every call synchronizes the
+/// threads. Measured on the rotated chain: the reduction alone at n = 1000 (medians of 12) 35
+/// against 39.5 ms, but every step in phases at n = 2000 197 against 169 ms (large products
+/// gain from faer's shared packing); with this threshold the factor stage (copies, Cholesky,
+/// reduction; 80 alternated solves) at n = 1000 took q1 / median / q3 39.5 / 44.8 / 49.6
+/// against 41.0 / 47.9 / 53.4 ms, and at n = 2000 (12 solves) a median of 216 against 237 ms.
+const SPLIT_STEP_UP_TO: usize = 1024;
+
+/// The blocks of L and C11 that one step of the reduction reads.
+struct StepBlocks<'a> {
+    l11: MatRef<'a, f64>,
+    l21: MatRef<'a, f64>,
+    l22: MatRef<'a, f64>,
+    c11: MatRef<'a, f64>,
+}
+
+impl StepBlocks<'_> {
+    /// One step of [`reduce_blocks`] on two threads, each running sequential kernels: W and
+    /// W − H by halves of the rows of C21, the symmetric rank-2k update of C22 by two parts of
+    /// its lower triangle of equal area, and (W − 2H) solved with L22 by halves of the columns.
+    fn on_two_threads(&self, mut c21: MatMut<'_, f64>, c22: MatMut<'_, f64>, mut half: MatMut<'_, f64>) {
+        let rows = c21.nrows() / 2;
+        {
+            let (c21_top, c21_bottom) = c21.rb_mut().split_at_row_mut(rows);
+            let (half_top, half_bottom) = half.rb_mut().split_at_row_mut(rows);
+            let (l21_top, l21_bottom) = self.l21.split_at_row(rows);
+            rayon::join(
+                || self.w_minus_h(c21_top, half_top, l21_top),
+                || self.w_minus_h(c21_bottom, half_bottom, l21_bottom),
+            );
+        }
+        subtract_lower_rank_2k_on_two_threads(c22, c21.as_ref(), self.l21);
+        let cols = c21.ncols() / 2;
+        let (c21_left, c21_right) = c21.split_at_col_mut(cols);
+        let (half_left, half_right) = half.as_ref().split_at_col(cols);
+        let finish = |mut c: MatMut<'_, f64>, h: MatRef<'_, f64>| {
+            subtract_in_place(c.as_mut(), h);
+            solve_lower_triangular_in_place(self.l22, c, Par::Seq);
+        };
+        rayon::join(|| finish(c21_left, half_left), || finish(c21_right, half_right));
+    }
+
+    /// Rows of C21 ← B21 L11⁻ᵀ − H with H = ½ L21 C11 (kept in `half`), sequentially.
+    fn w_minus_h(&self, mut c21: MatMut<'_, f64>, mut half: MatMut<'_, f64>, l21: MatRef<'_, f64>) {
+        solve_lower_triangular_in_place(self.l11, c21.as_mut().transpose_mut(), Par::Seq);
+        matmul(half.as_mut(), Accum::Replace, l21, self.c11, 0.5, Par::Seq);
+        subtract_in_place(c21, half.as_ref());
+    }
+}
+
+/// The lower triangle of `target` −= x yᵀ + y xᵀ on two threads, each with sequential kernels:
+/// the columns before c = m(1 − 1/√2) (a triangle and the rectangle below it) and the triangle
+/// after, of equal area.
+fn subtract_lower_rank_2k_on_two_threads(target: MatMut<'_, f64>, x: MatRef<'_, f64>, y: MatRef<'_, f64>) {
+    let cut = (target.nrows() as f64 * (1.0 - std::f64::consts::FRAC_1_SQRT_2)) as usize;
+    let (mut top_left, _, mut bottom_left, mut bottom_right) = target.split_at_mut(cut, cut);
+    let (x_top, x_bottom) = x.split_at_row(cut);
+    let (y_top, y_bottom) = y.split_at_row(cut);
+    rayon::join(
+        || {
+            subtract_lower_product(top_left.as_mut(), x_top, y_top, Par::Seq);
+            subtract_lower_product(top_left.as_mut(), y_top, x_top, Par::Seq);
+            matmul(
+                bottom_left.as_mut(),
+                Accum::Add,
+                x_bottom,
+                y_top.transpose(),
+                -1.0,
+                Par::Seq,
+            );
+            matmul(
+                bottom_left.as_mut(),
+                Accum::Add,
+                y_bottom,
+                x_top.transpose(),
+                -1.0,
+                Par::Seq,
+            );
+        },
+        || {
+            subtract_lower_product(bottom_right.as_mut(), x_bottom, y_bottom, Par::Seq);
+            subtract_lower_product(bottom_right.as_mut(), y_bottom, x_bottom, Par::Seq);
+        },
+    );
 }
 
 /// `target` −= `amount`, entry by entry.
@@ -409,8 +507,10 @@ mod tests {
 
     #[test]
     fn symmetric_reduction_matches_two_triangular_solves() {
-        // 700: several blocks of REDUCE_BLOCK, each step's H in the shared scratch, on two threads.
-        for n in [1, 5, 48, 49, 130, 257, 700] {
+        // 700: several blocks of REDUCE_BLOCK, each step's H in the shared scratch, on two threads
+        // (every step as two-thread phases); 1300: the first steps with faer's parallel kernels
+        // (trailing order above SPLIT_STEP_UP_TO), the later ones in phases.
+        for n in [1, 5, 48, 49, 130, 257, 700, 1300] {
             let a = spd(n, 1);
             let b = spd(n, 2);
             let Cholesky::Factor(l) = cholesky(a.as_ref(), Par::Seq) else {
