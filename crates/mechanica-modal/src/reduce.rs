@@ -274,7 +274,7 @@ fn reduce_blocks(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>, mut scratch: MatMut
     let (mut c11, _, mut c21, mut c22) = c.split_at_mut(n1, n1);
     reduce_blocks(l11, c11.as_mut(), scratch.rb_mut(), par);
     mirror_lower(c11.as_mut());
-    if n - n1 <= SPLIT_STEP_UP_TO && par.degree() > 1 {
+    if n - n1 <= SPLIT_STEP_UP_TO && par.degree() == 2 {
         let half = scratch.rb_mut().submatrix_mut(0, 0, n - n1, n1);
         let step = StepBlocks {
             l11,
@@ -311,6 +311,8 @@ fn reduce_blocks(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>, mut scratch: MatMut
 /// gain from faer's shared packing); with this threshold the factor stage (copies, Cholesky,
 /// reduction; 80 alternated solves) at n = 1000 took q1 / median / q3 39.5 / 44.8 / 49.6
 /// against 41.0 / 47.9 / 53.4 ms, and at n = 2000 (12 solves) a median of 216 against 237 ms.
+/// Only with exactly two threads (the measured case): with more, faer's parallel kernels use
+/// them all, where the phases would use two.
 const SPLIT_STEP_UP_TO: usize = 1024;
 
 /// The blocks of L and C11 that one step of the reduction reads.
