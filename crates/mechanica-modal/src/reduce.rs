@@ -154,6 +154,14 @@ pub(crate) fn factor_trailing(mut l: MatMut<'_, f64>, start: usize, max_diag: f6
     check_pivots(l.rb(), max_diag)
 }
 
+/// The number s of leading columns of an order-m lower triangle that hold `area` entries:
+/// column j has m − j, so s·m − s²/2 = area (half the triangle: s = (1 − 1/√2)·m).
+pub(crate) fn columns_holding(m: usize, area: f64) -> usize {
+    let m_f = m as f64;
+    let remaining = (m_f * m_f - 2.0 * area).max(0.0);
+    ((m_f - remaining.sqrt()) as usize).min(m)
+}
+
 /// The lower triangle of `target` −= `lhs` `rhs`ᵀ (the other triangle is not touched).
 pub(crate) fn subtract_lower_product(target: MatMut<'_, f64>, lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>, par: Par) {
     tri_matmul(
@@ -358,10 +366,11 @@ impl StepBlocks<'_> {
 }
 
 /// The lower triangle of `target` −= x yᵀ + y xᵀ on two threads, each with sequential kernels:
-/// the columns before c = m(1 − 1/√2) (a triangle and the rectangle below it) and the triangle
-/// after, of equal area.
+/// the leading columns holding half the triangle (a triangle and the rectangle below it) and the
+/// triangle after them.
 fn subtract_lower_rank_2k_on_two_threads(target: MatMut<'_, f64>, x: MatRef<'_, f64>, y: MatRef<'_, f64>) {
-    let cut = (target.nrows() as f64 * (1.0 - std::f64::consts::FRAC_1_SQRT_2)) as usize;
+    let m = target.nrows();
+    let cut = columns_holding(m, 0.25 * (m * m) as f64);
     let (mut top_left, _, mut bottom_left, mut bottom_right) = target.split_at_mut(cut, cut);
     let (x_top, x_bottom) = x.split_at_row(cut);
     let (y_top, y_bottom) = y.split_at_row(cut);

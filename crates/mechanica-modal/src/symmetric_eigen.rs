@@ -20,7 +20,7 @@
 //! pool did with threads that had gone to sleep during the panel.
 
 use crate::ModalError;
-use crate::reduce::subtract_lower_product;
+use crate::reduce::{columns_holding, subtract_lower_product};
 use crate::symv_team::SymvTeam;
 use crate::tridiagonal_divide::tridiagonal_divide_and_conquer;
 use crate::tridiagonal_values::tridiagonal_eigenvalues;
@@ -501,14 +501,6 @@ fn panel_product(
             subtract_panel_correction(a, w, p, i, y);
         }
     }
-}
-
-/// The number s of leading columns of an order-m lower triangle that hold `area` entries:
-/// column j has m − j, so s·m − s²/2 = area (half the triangle: s = (1 − 1/√2)·m).
-fn columns_holding(m: usize, area: f64) -> usize {
-    let m_f = m as f64;
-    let remaining = (m_f * m_f - 2.0 * area).max(0.0);
-    ((m_f - remaining.sqrt()) as usize).min(m)
 }
 
 /// y −= V (Wᵀ v) + W (Vᵀ v) of [`panel_product`] (nothing for a panel's first column).
