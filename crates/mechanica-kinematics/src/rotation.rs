@@ -619,9 +619,9 @@ mod tests {
 
     proptest! {
         #[test]
-        fn exp_log_round_trip(x in -3.0f64..3.0, y in -3.0f64..3.0, z in -3.0f64..3.0) {
+        // Components within ±1.81 keep |φ| ≤ 1.81·√3 ≈ 3.135 < π without rejecting samples.
+        fn exp_log_round_trip(x in -1.81f64..1.81, y in -1.81f64..1.81, z in -1.81f64..1.81) {
             let phi = Vector3::new(x, y, z);
-            prop_assume!(phi.norm() < PI - 1e-6);
             let r = exp_map(&phi).expect("finite");
             let m = r.matrix();
             let ortho = (m.transpose() * m - Matrix3::identity()).norm();
@@ -635,7 +635,12 @@ mod tests {
             let q_ref = UnitQuaternion::from_scaled_axis(phi);
             let d = (q.coords - q_ref.coords).norm().min((q.coords + q_ref.coords).norm());
             prop_assert!(d < 8.0 * EPS);
-            prop_assert!((rotation_from_quaternion(&q).matrix() - m).norm() < 8.0 * EPS);
+            // The round trip returns a rotation to rounding, while m carries the entry errors
+            // of Rodrigues' sum above (‖δR‖_F up to about 4 eps (1 + θ²)); so the two differ by
+            // that plus the quaternion's few ulps, not by a few ulps alone (θ = 2.88 gave 8.25 eps).
+            prop_assert!(
+                (rotation_from_quaternion(&q).matrix() - m).norm() < 8.0 * EPS * (1.0 + phi.norm_squared())
+            );
         }
     }
 }
