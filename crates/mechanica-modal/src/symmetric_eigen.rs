@@ -20,12 +20,12 @@
 //! pool did with threads that had gone to sleep during the panel.
 
 use crate::ModalError;
+use crate::fork_join::by_column_chunks;
 use crate::reduce::{columns_holding, subtract_lower_product};
 use crate::symv_team::SymvTeam;
 use crate::tridiagonal_divide::tridiagonal_divide_and_conquer;
 use crate::tridiagonal_values::tridiagonal_eigenvalues;
 use crate::tridiagonal_vectors::tridiagonal_eigenvectors;
-use faer::dyn_stack::StackReq;
 use faer::linalg::evd::{ComputeEigenvectors, self_adjoint_evd_scratch, tridiagonal_self_adjoint_evd};
 use faer::linalg::householder::{
     apply_block_householder_sequence_on_the_left_in_place_scratch,
@@ -107,19 +107,14 @@ pub(crate) fn symmetric_eigen_returning_input(
         Some(pairs) => pairs,
         None => faer_tridiagonal_eigen(&t, par)?,
     };
-    let mut mem = faer::dyn_stack::MemBuffer::new(
-        apply_block_householder_sequence_on_the_left_in_place_scratch::<f64>(n, block_size(n), n),
-    );
-    let stack = faer::dyn_stack::MemStack::new(&mut mem);
     if n > 1 {
         let factor = block_factor(&c, &t.tau, par);
-        apply_block_householder_sequence_on_the_left_in_place_with_conj(
+        apply_reflectors(
             c.as_ref().submatrix(1, 0, n - 1, n - 1),
             factor.as_ref(),
-            Conj::No,
             z.as_mut().subrows_mut(1, n - 1),
+            false,
             par,
-            stack,
         );
     }
     Ok((
@@ -250,37 +245,55 @@ impl TridiagonalForm {
         if n < 2 {
             return;
         }
-        let k = z.ncols();
         let factor = self
             .factor
             .get_or_insert_with(|| block_factor(&self.reflectors, &self.t.tau, self.par));
-        let bs = block_size(n);
-        let mut mem = faer::dyn_stack::MemBuffer::new(StackReq::any_of(&[
-            apply_block_householder_sequence_on_the_left_in_place_scratch::<f64>(n - 1, bs, k),
-            apply_block_householder_sequence_transpose_on_the_left_in_place_scratch::<f64>(n - 1, bs, k),
-        ]));
-        let stack = faer::dyn_stack::MemStack::new(&mut mem);
         let basis = self.reflectors.as_ref().submatrix(1, 0, n - 1, n - 1);
-        type Apply = fn(MatRef<'_, f64>, MatRef<'_, f64>, Conj, MatMut<'_, f64>, Par, &mut faer::dyn_stack::MemStack);
-        let apply: Apply = if transpose {
-            apply_block_householder_sequence_transpose_on_the_left_in_place_with_conj::<f64>
-        } else {
-            apply_block_householder_sequence_on_the_left_in_place_with_conj::<f64>
-        };
-        apply(
-            basis,
-            factor.as_ref(),
-            Conj::No,
-            z.subrows_mut(1, n - 1),
-            self.par,
-            stack,
-        );
+        apply_reflectors(basis, factor.as_ref(), z.subrows_mut(1, n - 1), transpose, self.par);
     }
 
     /// The reduced matrix's storage (n×n), for reuse by the caller.
     pub(crate) fn into_storage(self) -> Mat<f64> {
         self.reflectors
     }
+}
+
+/// Z ← Q Z (or Qᵀ Z) for the blocked reflectors `basis` with triangular factors `factor`
+/// (faer's layout, [`block_factor`]), on column chunks of Z, one per thread of `par`, each
+/// chunk sequential: the threads then never wait for each other between blocks of reflectors.
+/// Measured at n = 1000, Q·Z of all n columns inside the solve (36 solves alternating with
+/// faer's parallel application): median 42.3 against 48.0 ms, paired ratio 0.89 [q1 0.82,
+/// q3 0.95]; alone (60 alternated runs, twice) 44.0 / 40.3 against 47.9 / 46.5 ms.
+fn apply_reflectors(basis: MatRef<'_, f64>, factor: MatRef<'_, f64>, z: MatMut<'_, f64>, transpose: bool, par: Par) {
+    let bs = factor.nrows();
+    by_column_chunks(z, par, &|mut chunk| {
+        let (m, k) = (chunk.nrows(), chunk.ncols());
+        let mut mem = faer::dyn_stack::MemBuffer::new(if transpose {
+            apply_block_householder_sequence_transpose_on_the_left_in_place_scratch::<f64>(m, bs, k)
+        } else {
+            apply_block_householder_sequence_on_the_left_in_place_scratch::<f64>(m, bs, k)
+        });
+        let stack = faer::dyn_stack::MemStack::new(&mut mem);
+        if transpose {
+            apply_block_householder_sequence_transpose_on_the_left_in_place_with_conj(
+                basis,
+                factor,
+                Conj::No,
+                chunk.rb_mut(),
+                Par::Seq,
+                stack,
+            );
+        } else {
+            apply_block_householder_sequence_on_the_left_in_place_with_conj(
+                basis,
+                factor,
+                Conj::No,
+                chunk.rb_mut(),
+                Par::Seq,
+                stack,
+            );
+        }
+    });
 }
 
 /// Block size of the compact WY factors used to apply Q (faer's own choice for this order).
