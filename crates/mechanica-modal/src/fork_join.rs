@@ -30,22 +30,27 @@ pub(crate) fn map_items<T: Sync, R: Send>(items: &[T], par: Par, f: impl Fn(&T) 
 /// whole columns; faer's parallel triangular solve was measured 1.1–1.4× slower on a
 /// 256-column triangle with 744 right-hand sides and on n×n back-transformations at n = 1000.
 pub(crate) fn by_column_chunks(rhs: MatMut<'_, f64>, par: Par, solve: &(dyn Fn(MatMut<'_, f64>) + Sync)) {
+    by_column_chunks_at(rhs, par, &|_, chunk| solve(chunk));
+}
+
+/// [`by_column_chunks`], telling `solve` the index in `rhs` of its chunk's first column.
+pub(crate) fn by_column_chunks_at(rhs: MatMut<'_, f64>, par: Par, solve: &(dyn Fn(usize, MatMut<'_, f64>) + Sync)) {
     let threads = match par {
         Par::Rayon(threads) => threads.get().min(rhs.ncols() / 64).max(1),
         Par::Seq => 1,
     };
-    split_columns(rhs, threads, solve);
+    split_columns(rhs, 0, threads, solve);
 }
 
-fn split_columns(rhs: MatMut<'_, f64>, threads: usize, solve: &(dyn Fn(MatMut<'_, f64>) + Sync)) {
+fn split_columns(rhs: MatMut<'_, f64>, first: usize, threads: usize, solve: &(dyn Fn(usize, MatMut<'_, f64>) + Sync)) {
     if threads <= 1 {
-        return solve(rhs);
+        return solve(first, rhs);
     }
     let left_threads = threads / 2;
     let split = rhs.ncols() * left_threads / threads;
     let (left, right) = rhs.split_at_col_mut(split);
     rayon::join(
-        || split_columns(left, left_threads, solve),
-        || split_columns(right, threads - left_threads, solve),
+        || split_columns(left, first, left_threads, solve),
+        || split_columns(right, first + split, threads - left_threads, solve),
     );
 }

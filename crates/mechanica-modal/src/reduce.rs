@@ -12,7 +12,7 @@
 //! (SciPy's `eigh(B, A)`) does the dense work whatever A is. The test is exact (every
 //! off-diagonal entry of the symmetrised A is zero); a nearly diagonal A takes the dense path.
 
-use crate::fork_join::by_column_chunks;
+use crate::fork_join::{by_column_chunks, by_column_chunks_at};
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{BlockStructure, matmul as tri_matmul};
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
@@ -426,6 +426,17 @@ pub fn back_transform(l: MatRef<'_, f64>, y: MatMut<'_, f64>, par: Par) {
     LowerFactor::new(l).solve_transposed(y, par);
 }
 
+/// X = L⁻ᵀ Y into `x` (same shape as `y`, which is left unchanged): each thread copies its own
+/// column chunk of Y and solves it, so the copy runs on both threads and the solve finds its
+/// columns in cache.
+pub(crate) fn back_transform_into(l: MatRef<'_, f64>, y: MatRef<'_, f64>, x: MatMut<'_, f64>, par: Par) {
+    let factor = LowerFactor::new(l);
+    by_column_chunks_at(x, par, &|first, mut chunk| {
+        chunk.copy_from(y.subcols(first, chunk.ncols()));
+        factor.solve_transposed(chunk, Par::Seq);
+    });
+}
+
 /// A lower Cholesky factor L of A with whether it is diagonal, found once: the many solves with
 /// L and Lᵀ of refinement then divide rows for lumped masses instead of costing n² per column.
 #[derive(Clone, Copy)]
@@ -538,6 +549,37 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The copying back-transformation solves L^T X = Y(:, first..end) column for column, on
+    /// one thread and on two (chunks start at nonzero column offsets of the selection), for a
+    /// dense and for a diagonal L; Y is left unchanged.
+    #[test]
+    fn back_transform_into_solves_the_selected_columns() {
+        let n = 300;
+        let dense = match cholesky(spd(n, 4).as_ref(), Par::Seq) {
+            Cholesky::Factor(l) => l,
+            Cholesky::Failed { .. } => panic!("spd matrix must factor"),
+        };
+        let diagonal = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 } else { 0.0 });
+        let y = spd(n, 5);
+        let (first, count) = (37, 201);
+        for l in [&dense, &diagonal] {
+            for par in [Par::Seq, Par::rayon(2)] {
+                let mut x = Mat::<f64>::from_fn(n, count, |_, _| f64::NAN);
+                back_transform_into(l.as_ref(), y.subcols(first, count), x.as_mut(), par);
+                // L^T X reproduces the selected columns to a few n*u of their size.
+                let back = l.transpose() * &x;
+                let scale = y.norm_max() + l.norm_max() * x.norm_max();
+                for j in 0..count {
+                    for i in 0..n {
+                        let error = (back[(i, j)] - y[(i, first + j)]).abs();
+                        assert!(error <= 4.0 * n as f64 * f64::EPSILON * scale, "({i}, {j}): {error:e}");
+                    }
+                }
+            }
+        }
+        assert_eq!(y, spd(n, 5));
     }
 
     #[test]

@@ -14,7 +14,7 @@ use crate::fork_join::{join, map_items};
 use crate::idle_certificate::{BottomCertificate, IdleCertificate, Outcome};
 use crate::idle_task::IdleTask;
 use crate::inertia::{InertiaCount, all_above, count_below};
-use crate::reduce::{Cholesky, back_transform, cholesky_owned, lower_entry, reduce_owned};
+use crate::reduce::{Cholesky, back_transform_into, cholesky_owned, lower_entry, reduce_owned};
 use crate::refine::{
     Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts, polish_simple_mode,
     refine_cluster, refine_simple_modes,
@@ -301,10 +301,11 @@ fn solve_definite_owned(
     let (first, end) = select(&omega_sq, selection)?;
     let (x, y) = match eigen.vectors {
         Some(y) => {
-            // X = L⁻ᵀ Y(:, first..end), written into the reduced matrix's spent storage.
+            // X = L⁻ᵀ Y(:, first..end), written into the reduced matrix's spent storage (copy and
+            // solve per thread: stage median 19.1 against 20.4 ms at n = 1000, 36 solves
+            // alternating with a copy on one thread before the solve).
             spent.truncate(n, end - first);
-            spent.copy_from(y.subcols(first, end - first));
-            back_transform(l, spent.as_mut(), par);
+            back_transform_into(l, y.subcols(first, end - first), spent.as_mut(), par);
             (spent, y)
         }
         None => return Err(ModalError::NoConvergence { n }),
