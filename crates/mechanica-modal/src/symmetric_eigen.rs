@@ -20,7 +20,7 @@
 //! pool did with threads that had gone to sleep during the panel.
 
 use crate::ModalError;
-use crate::fork_join::by_column_chunks;
+use crate::fork_join::{COLUMNS_PER_CHUNK, by_column_chunks};
 use crate::reduce::{columns_holding, subtract_lower_product};
 use crate::symv_team::SymvTeam;
 use crate::tridiagonal_divide::tridiagonal_divide_and_conquer;
@@ -278,6 +278,13 @@ fn apply_reflectors(basis: MatRef<'_, f64>, factor: MatRef<'_, f64>, z: MatMut<'
         )
     };
     let bs = factor.nrows();
+    // Too few columns for two chunks (the values-only path's few vectors): one chunk, with
+    // faer's parallel application inside it.
+    let inside = if z.ncols() < 2 * COLUMNS_PER_CHUNK {
+        par
+    } else {
+        Par::Seq
+    };
     by_column_chunks(z, par, &|chunk| {
         let mut mem = faer::dyn_stack::MemBuffer::new(scratch(chunk.nrows(), bs, chunk.ncols()));
         apply(
@@ -285,7 +292,7 @@ fn apply_reflectors(basis: MatRef<'_, f64>, factor: MatRef<'_, f64>, z: MatMut<'
             factor,
             Conj::No,
             chunk,
-            Par::Seq,
+            inside,
             faer::dyn_stack::MemStack::new(&mut mem),
         );
     });
