@@ -527,6 +527,14 @@ mod tests {
         a
     }
 
+    /// A dense Cholesky factor (of a random SPD matrix from `seed`) and a diagonal one,
+    /// diag(1, 2, …, n), the two kinds of L that [`LowerFactor`] tells apart.
+    fn dense_and_diagonal_factors(n: usize, seed: u64) -> (Mat<f64>, Mat<f64>) {
+        let dense = cholesky_lower(spd(n, seed).as_ref(), Par::Seq).expect("spd matrix must factor");
+        let diagonal = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 } else { 0.0 });
+        (dense, diagonal)
+    }
+
     #[test]
     fn symmetric_reduction_matches_two_triangular_solves() {
         // 700: several blocks of REDUCE_BLOCK, each step's H in the shared scratch, on two threads
@@ -557,11 +565,7 @@ mod tests {
     #[test]
     fn back_transform_into_solves_the_selected_columns() {
         let n = 300;
-        let dense = match cholesky(spd(n, 4).as_ref(), Par::Seq) {
-            Cholesky::Factor(l) => l,
-            Cholesky::Failed { .. } => panic!("spd matrix must factor"),
-        };
-        let diagonal = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 } else { 0.0 });
+        let (dense, diagonal) = dense_and_diagonal_factors(n, 4);
         let y = spd(n, 5);
         let (first, count) = (37, 201);
         for l in [&dense, &diagonal] {
@@ -699,11 +703,7 @@ mod tests {
         // L⁻¹Y and L⁻ᵀY by column chunks on two threads, and by row division for a diagonal L,
         // against faer's sequential triangular solves (entrywise within a few u of the result).
         let n = 300;
-        let dense = match cholesky(spd(n, 7).as_ref(), Par::Seq) {
-            Cholesky::Factor(l) => l,
-            Cholesky::Failed { .. } => panic!("spd matrix must factor"),
-        };
-        let diagonal = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 } else { 0.0 });
+        let (dense, diagonal) = dense_and_diagonal_factors(n, 7);
         let y = spd(n, 8);
         for (l, is_diag) in [(&dense, false), (&diagonal, true)] {
             let factor = LowerFactor::new(l.as_ref());

@@ -64,8 +64,9 @@ pub(crate) fn tridiagonal_divide_and_conquer(diag: &[f64], offdiag: &[f64], par:
     let mut d: Vec<f64> = diag.iter().map(|x| x / scale).collect();
     let mut e: Vec<f64> = offdiag.iter().map(|x| x / scale).collect();
     // Three n×n buffers in kept storage (module `scratch`); fresh ones are zeroed, two on one
-    // thread and one on the other: fresh memory faults every 4 KiB page on its first write (about 3 µs each on
-    // the 2-core Zen 3 host, 6.5 ms per 8 MB), and faults on two cores proceed in parallel. New
+    // thread and one on the other: fresh memory faults every 4 KiB page on its first write
+    // (about 3 µs each on the 2-core Zen 3 host, 6.5 ms per 8 MB), and faults on two cores
+    // proceed in parallel. New
     // storage is allocated here, on the calling thread: memory allocated on a pool thread comes
     // from that thread's allocator arena, which returns it to the system when freed (measured
     // at n = 1000: 4–6 thousand page faults per solve before, 240 after).
