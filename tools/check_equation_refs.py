@@ -5,8 +5,9 @@ Usage: python3 tools/check_equation_refs.py [--verbose] [--root DIR]
 
 Scanned: the comments and string literals of crates/**/*.rs, benches/**/*.rs and
 ffi-tests/**/*.rs, the comments of include/*.h, and docs/*.md and README.md (all but
-docs/theory.md itself). Code outside comments and strings is never read, so a literal such as
-`Some(1.5)` is not taken for equation (1.5).
+docs/theory.md itself; prose and the comments of fenced code, not `inline code`). Code outside
+comments and strings is never read, so a literal such as `Some(1.5)` is not taken for
+equation (1.5).
 
 What counts as a citation:
 - syllabus labels N.M (chapter 1-9, number 1-999, optional '*'): a list of labels or ranges
@@ -116,9 +117,11 @@ def c_comment_text(source):
 
 
 def markdown_text(source):
-    """Markdown prose plus the comments and strings of fenced code blocks."""
+    """Markdown prose without inline code spans, plus the comments and strings of fenced code
+    blocks."""
     parts = re.split(r"(^```[^\n]*\n.*?^```[ \t]*$)", source, flags=re.S | re.M)
-    return "".join(rust_text(p) if p.startswith("```") else p for p in parts)
+    blank_code = lambda m: " " * len(m.group(0))
+    return "".join(rust_text(p) if p.startswith("```") else re.sub(r"`[^`\n]*`", blank_code, p) for p in parts)
 
 
 def endpoints(match):
