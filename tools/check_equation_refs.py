@@ -16,7 +16,8 @@ What counts as a citation:
   components)"), or that follows the word "syllabus" or the words "remark after". A range
   counts as its two endpoints. A range whose endpoints lie in different chapters, or a number
   followed by a unit or a factor ("2.7–3.4× faster", "0.21–0.24 s"), is not a citation;
-- syllabus sections "§8e", "§8f–g", "syllabus 5c–d" (both ends of a range of letters);
+- syllabus sections "§8e", "§8f–g", "syllabus 5c–d and 7h–k" (both ends of a range of
+  letters);
 - "EB1911 (13)" and "EB1911 §22 (15)", with ranges "EB1911 (15)–(16)";
 - "FM 4.61" and "FM 4.83–4.86".
 
@@ -44,7 +45,9 @@ LIST = rf"(?<![0-9.]){PLAIN_RANGE}(?:(?:\s*[,;]\s*|\s+and\s+){PLAIN_RANGE})*"
 # ones the list must end at punctuation ("S_n in 7.96)" but not "in 2.1 M triangles").
 STRONG_KEYWORD_LIST = re.compile(rf"(?:syllabus|remark after|those of|form of)\s+({LIST})")
 WEAK_KEYWORD_LIST = re.compile(rf"\b(?:in|from|of)\s+({LIST})(?=\s*(?:[).;:]|,\s|$))", re.M)
-SECTION_RE = re.compile(r"(?:§\s*|syllabus\s+)(?P<chapter>[1-9])(?P<first>[a-k])(?:\s*[–-]\s*(?P<last>[a-k]))?(?![0-9a-z.])")
+SECTION = r"[1-9][a-k](?:\s*[–-]\s*[a-k])?(?![0-9a-z.])"
+SECTION_LIST_RE = re.compile(rf"(?:§\s*|syllabus\s+)({SECTION}(?:(?:\s*,\s*§?|\s+and\s+§?){SECTION})*)")
+SECTION_RE = re.compile(r"(?P<chapter>[1-9])(?P<first>[a-k])(?:\s*[–-]\s*(?P<last>[a-k]))?")
 EB_RE = re.compile(r"EB1911\s*(?P<section>§\s*2[12]\s*)?\((?P<first>[0-9]{1,2})\)(?:\s*[–-]\s*\((?P<last>[0-9]{1,2})\))?")
 FM_RE = re.compile(r"\bFM\s+(?P<first>4\.[0-9]{1,3})(?:\s*[–-]\s*(?P<last>4\.[0-9]{1,3}))?")
 THEORY_LABEL_RE = re.compile(rf"\(({NUMBER})\)")
@@ -188,9 +191,10 @@ def citations(text):
                 labels = endpoints(item)
                 if same_chapter(labels):
                     found += [("syllabus", f"({label})", item.group(0), match.start()) for label in labels]
-    for match in SECTION_RE.finditer(text):
-        letters = [match.group("first")] + ([match.group("last")] if match.group("last") else [])
-        found += [("section", f"§{match.group('chapter')}{letter}", match.group(0), match.start()) for letter in letters]
+    for listed in SECTION_LIST_RE.finditer(text):
+        for match in SECTION_RE.finditer(listed.group(1)):
+            letters = [match.group("first")] + ([match.group("last")] if match.group("last") else [])
+            found += [("section", f"§{match.group('chapter')}{letter}", match.group(0), listed.start()) for letter in letters]
     for match in EB_RE.finditer(text):
         section = "§22 " if match.group("section") and "22" in match.group("section") else ""
         found += [("EB1911", f"EB1911 {section}({number})", match.group(0), match.start()) for number in endpoints(match)]
