@@ -9,7 +9,7 @@ Models (built identically in the Rust bench):
 
 For each: forwardKinematics(q) and computeJointJacobians(q) (FK plus every joint's world
 Jacobian), timed from Python with time.perf_counter, so the Python call overhead
-(~0.1-0.3 us) is included, as in the issue's anchors. Reports the best of 7 repeats of
+(~0.1-0.3 us) is included, as in a Python user's loop. Reports the best of 7 repeats of
 20000 calls, in ns per call.
 
 Run:  pip install pin && python3 tools/kinematics_pinocchio_bench.py > tools/kinematics_pinocchio_bench.txt

@@ -9,7 +9,7 @@ every body, the base included, a 2 kg box 0.1 × 0.1 × 0.3 m with its centre 0.
 joint. Pinocchio's free flyer has 7 coordinates (quaternion) and 6 velocities, so nv = 44 as in
 mechanica (whose free joint uses a rotation vector). pin.crba runs its own forward pass, so
 both sides include forward kinematics. Timed from Python with time.perf_counter (the Python
-call overhead, ~0.1-0.3 us, is included, as in the issue's anchor); best of 7 repeats of 20000
+call overhead, ~0.1-0.3 us, is included, as in a Python user's loop); best of 7 repeats of 20000
 calls.
 
 Run:  pip install pin && python3 tools/mass_pinocchio_bench.py > tools/mass_pinocchio_bench.out
