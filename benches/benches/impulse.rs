@@ -3,7 +3,7 @@
 //! - `impulse_contact/*`: one two-body point impact, end to end (mobility assembly, impact
 //!   process, both body responses): a frictionless contact as the baseline, a frictional
 //!   contact whose slip halts and sticks (closed-form segments), and a 3-D swerving slip
-//!   integrated at the default tolerance 1e-10. Goal for the frictional contact: < 1 µs.
+//!   integrated at the default tolerance 1e-10 (timings: docs/benchmarks.md).
 //! - `impulse_swerve`: error against run time of the swerving-slip integration over the
 //!   tolerance, written to `target/reports/impulse_swerve.csv` and `.svg`. The error is
 //!   measured against a tolerance-1e-14 run; the reported error estimate is listed beside it.

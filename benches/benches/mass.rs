@@ -10,8 +10,8 @@
 //!
 //! `mass_matrix_crba_44dof`: forward kinematics plus the composite-rigid-body mass matrix of a
 //! 44-DOF humanoid-like tree; tools/mass_pinocchio_bench.py builds the same tree in Pinocchio
-//! and times `pin.crba` (committed output: tools/mass_pinocchio_bench.out; the unloaded
-//! anchor is about 6 µs from Python). Ratios: tools/mass_bench_comparison.md.
+//! and times `pin.crba` (committed output: tools/mass_pinocchio_bench.out). Ratios:
+//! tools/mass_bench_comparison.md and docs/benchmarks.md.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use mechanica::kinematics::nalgebra::{Isometry3, Vector3};

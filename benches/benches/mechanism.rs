@@ -4,7 +4,7 @@
 //! head of 2 and four fingers of 4 (44 revolute joints, axes cycling x, y, z), rod links of
 //! 0.25 m and 1 kg, a torsional spring of 50 N·m/rad in every joint, and gravity. Steps:
 //! - `assemble_a`: A(q) by the composite-rigid-body recursion (8.28);
-//! - `assemble_b`: U*, its gradient and its exact Hessian B(q) (8.79);
+//! - `assemble_b`: U*, its gradient and its exact Hessian B(q) (8.85);
 //! - `modes_all`: A, B, the dense solve of every mode with its accuracy report, body
 //!   displacements and effective masses (`mechanism_modes`).
 //!

@@ -18,8 +18,8 @@
 //!   conquer, the driver of SciPy `eigh`) from the system OpenBLAS with its default threads,
 //!   linked by `benches/build.rs` when found (skipped with a note otherwise). Run with
 //!   `OPENBLAS_CORETYPE=Haswell` where OpenBLAS falls back to its slow `Prescott` kernels (see
-//!   `modal_report.rs`). The input copies
-//!   LAPACK needs (it overwrites A and B) are inside the timed region, as mechanica copies too.
+//!   `modal_report.rs`). The input copies LAPACK needs (it overwrites A and B) are inside the
+//!   timed region, as mechanica copies too.
 //!
 //! tools/modal_scipy_bench.py times SciPy's `eigh` on the same family from Python
 //! (tools/modal_scipy_bench.out).
@@ -27,7 +27,7 @@
 //! Group `modal_sparse`: the 10 lowest modes of the 300×300 grid Laplacian (n = 90 000) by
 //! `solve_sparse` (shift-invert block Lanczos, inertia-certified). Peer: SciPy `eigsh`
 //! (ARPACK + SuperLU shift-invert), timed by tools/modal_sparse_scipy.py on the same matrix,
-//! numbers in tools/modal_sparse_scipy.out (the issue quotes Spectra at 1.6 s, unloaded).
+//! numbers in tools/modal_sparse_scipy.out.
 //!
 //! Group `modal_stiff`: all pairs of the graded stiff chain (unit masses, stiffnesses over 12
 //! decades, n = 500), where `Refinement::Auto` certifies the weakly bounded low half of the

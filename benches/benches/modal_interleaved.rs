@@ -11,7 +11,7 @@
 //! compared with `dsygvd` without vectors, the others with `dsygvd` with vectors.
 //!
 //! Besides the ratio of medians, each row gives the median of the per-round ratios (a method's
-//! time over `dsygvd`'s in the same round, which cancels the host's slow drifts) and a 90 %
+//! time over `dsygvd`'s in the same round, which cancels the machine's slow drifts) and a 90 %
 //! bootstrap interval of that median (2000 resamples of the rounds). The order of the methods is
 //! rotated from one round to the next, so that no method always runs right after LAPACK.
 

@@ -1,6 +1,6 @@
-//! Work-precision report of the modal solvers (issue 5, part 8): error against run time for
-//! every applicable method on each problem family, with LAPACK `dsygvd` (OpenBLAS, its default
-//! threads) and nalgebra as peers in the same run.
+//! Work-precision report of the modal solvers: error against run time for every applicable
+//! method on each problem family, with LAPACK `dsygvd` (OpenBLAS, its default threads) and
+//! nalgebra as peers in the same run.
 //!
 //! Run: `cargo bench -p mechanica-benches --bench modal_report [-- FAMILY...]` with FAMILY among
 //! `fixed free ring rotated lumped graded grid stages` (default: all; `stages-small` = the stages at
@@ -10,10 +10,10 @@
 //! 10 ω² against run time, one series per method, one point per size) and
 //! `modal-<family>-backward.svg` (max backward error against run time), and prints the tables.
 //!
-//! - **OpenBLAS kernels.** Debian's OpenBLAS 0.3.21 does not recognise recent Xeons and falls
-//!   back to its `Prescott` (SSE3) kernels, several times slower; the report prints the kernel
-//!   family, and `OPENBLAS_CORETYPE=Haswell` selects the AVX2 kernels SciPy's own OpenBLAS uses
-//!   on this machine. Measure the peer with the right kernels.
+//! - **OpenBLAS kernels.** Some OpenBLAS builds (Debian's 0.3.21 among them) do not recognise
+//!   recent Xeons and fall back to their `Prescott` (SSE3) kernels, several times slower; the
+//!   report prints the kernel family, and `OPENBLAS_CORETYPE=Haswell` selects the AVX2 kernels
+//!   that SciPy's own OpenBLAS uses on such CPUs. Measure the peer with the right kernels.
 //! - **Timing.** Not criterion: each point is the median of at least 3 runs, repeated until 0.3 s
 //!   have elapsed, and exactly 3 runs for n ≥ 2000 (a 4000 solve takes seconds)
 //!   ([`mechanica_benches::median_seconds`]). Input copies are inside the timed region for every

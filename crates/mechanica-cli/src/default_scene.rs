@@ -1,4 +1,4 @@
-//! The built-in default scene: the example scenes a spring-loaded pendulum chain (mass
+//! The built-in default scene: two example scenes, a spring-loaded pendulum chain (mass
 //! properties, equilibrium, stability, modes, free response, an impact) and a bead on a
 //! rotating hoop (a relative equilibrium in a rotating frame), run through the same pipeline
 //! as any scene file and merged into one report, followed by Kane's double pendulum striking a

@@ -1,5 +1,6 @@
-//! The `mechanica` command line: runs a scene (at first, the built-in default scene) and
-//! prints a readable report, or JSON with `--json`.
+//! The `mechanica` command line: runs a scene file, a URDF robot or the built-in default scene,
+//! computes the mass properties of a mesh file, or the modes of a pencil from Matrix Market
+//! files, and prints a readable report, or JSON with `--json`.
 
 mod default_scene;
 mod mass_command;

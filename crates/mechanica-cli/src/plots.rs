@@ -18,7 +18,7 @@ pub struct ModeShape {
 pub struct ResponseSeries {
     /// Sample times, s.
     pub times: Vec<f64>,
-    /// values[k][i] = δ_k(t_i).
+    /// `values[k][i]` = δ_k(t_i).
     pub values: Vec<Vec<f64>>,
 }
 

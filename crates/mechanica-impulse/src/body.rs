@@ -29,9 +29,9 @@ use nalgebra::{DMatrix, Matrix3, Matrix6, SMatrix, Vector3, Vector6};
 
 /// Relative threshold below which an eigenvalue of an inertia tensor counts as zero:
 /// eigenvalues ≤ `INERTIA_ZERO_RELATIVE · λ_max` are treated as exactly zero (a rod or a point).
-/// 1e-12 is ~5000 ulps: wide enough for tensors assembled by Steiner sums and rotations,
-/// far below any physical ratio of inertias (a 1 km rod of 1 mm radius has ratio 1e-12·… ≈ 1e-12
-/// only at 1e6 slenderness, which callers should model as a rod).
+/// 1e-12 is ~5000 ulps: wide enough for tensors assembled by Steiner sums and rotations, and
+/// below the inertia ratio 6 r²/L² of any physical rod (a 1 km rod of 1 mm radius still has
+/// 6e-12); bodies more slender than that should be modelled as rods.
 pub const INERTIA_ZERO_RELATIVE: f64 = 1e-12;
 
 /// Tolerance for a contact point to lie on a zero-inertia axis: |a × d| ≤ tol·max(|d|, L)

@@ -51,7 +51,7 @@ pub enum RestitutionLaw {
 /// coefficient f ≥ 0 (f = +∞ means no slip) and the restitution law.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactLaw {
-    /// Coefficient of restitution λ (seed notation), e ∈ [0, 1].
+    /// Coefficient of restitution λ (syllabus notation), e ∈ [0, 1].
     pub restitution: f64,
     /// Isotropic Coulomb friction coefficient f ≥ 0; `f64::INFINITY` for a contact that cannot slip.
     pub friction: f64,
@@ -156,7 +156,13 @@ pub struct ContactImpulse {
 /// Resolves one impact in contact space: `w_w` is the contact mobility W (symmetric positive
 /// semidefinite, W frame), `u_w` the relative velocity u⁻ of body 2's contact point with
 /// respect to body 1's, `n_w` the unit normal pointing into body 2 (7.72). Approach means
-/// u⁻·n < 0; a grazing or separating contact receives no impulse.
+/// u⁻·n < 0; a grazing or separating contact receives no impulse. The accuracy of the
+/// impulse is reported as [`ContactImpulse::integration_error`] (0 for closed-form segments).
+///
+/// Errors: non-finite input, a W that is not symmetric PSD, a normal that is not a unit
+/// vector, an invalid [`ContactLaw`], [`ImpulseError::Singular`] when no impulse can stop the
+/// approach (W_nn ≈ 0) or the tolerance is not positive, and [`ImpulseError::NotConverged`] when the process jams or exceeds
+/// [`ImpactOptions::max_steps`].
 pub fn resolve_in_contact_space(
     w_w: &Matrix3<f64>,
     u_w: &Vector3<f64>,

@@ -1,7 +1,7 @@
 //! Fixation of a body point (7.100–7.108): a single impulse S at the body point X brings X
 //! to rest at once.
 //!
-//! The seed solves J_X Ω = J₀ ω + (x₀ − x) × m v₀ (7.105) with J_X from Steiner. Here the
+//! The syllabus solves J_X Ω = J₀ ω + (x₀ − x) × m v₀ (7.105) with J_X from Steiner. Here the
 //! same condition is written in contact space, which also covers hinged bodies and bodies
 //! with infinite mass or degenerate inertia: v_X⁺ = v_X⁻ + W_X S = 0 with the point mobility
 //! W_X = J_X G J_Xᵀ, solved by Cholesky (W_X is positive definite for any body of finite
@@ -27,7 +27,12 @@ pub struct Fixation {
     pub residual: f64,
 }
 
-/// Brings the body point at `p_wx` to rest by a single impulse at that point (7.100–7.108).
+/// Brings the body point at `p_wx` (world frame) to rest by a single impulse at that point
+/// (7.100–7.108). The result reports the velocity left at X as [`Fixation::residual`].
+///
+/// Errors: a non-finite point, [`ImpulseError::ZeroInertiaAxisExcited`] for a point off a
+/// zero-inertia axis, and [`ImpulseError::Singular`] when W_X is singular and the
+/// pseudo-inverse leaves |v_X| > 1e-9·|v_X⁻| (X cannot be stopped by an impulse at X).
 pub fn fix_point(body: &RigidBody, p_wx: &Vector3<f64>) -> Result<Fixation, ImpulseError> {
     check_all_finite("fixed point", p_wx.iter())?;
     body.check_impulse_point("fixed point", p_wx)?;

@@ -1,5 +1,7 @@
 //! Impulse dynamics: impulses, collisions with restitution and friction, fixation and
-//! Lagrange's impulse equations (syllabus 5c–d and 7h–k, see THEORY.md).
+//! Lagrange's impulse equations (syllabus §5c–d and §7h–k). Equation numbers such as (7.94) are
+//! the syllabus numbering, listed in `docs/theory.md`. Units are SI (kg, m, s; impulses in N·s,
+//! energies in J).
 //!
 //! - [`point`]: impulses on point masses and point collisions (5.10–5.23);
 //! - [`body`]: rigid bodies through their mobility, with infinite mass, locked axes,

@@ -71,7 +71,8 @@ pub struct MechanismInertia {
 
 impl MechanismInertia {
     /// A(q) of `tree` at the configuration of the last `update_positions` in `ws`, by the
-    /// composite-rigid-body recursion of `mass` (8.28), factored.
+    /// composite-rigid-body recursion of `mass` (8.28), factored. Fails with
+    /// [`ImpulseError::SingularMassMatrix`] when a pivot is ≤ [`MASS_MATRIX_PIVOT_RELATIVE`]·A_kk.
     pub fn new(tree: &KinematicTree, ws: &Workspace, mass: &mut TreeMass) -> Result<Self, ImpulseError> {
         let n = tree.dof();
         let mut a = vec![0.0; n * n];
@@ -80,7 +81,9 @@ impl MechanismInertia {
     }
 
     /// Factors a given symmetric mass matrix `a` (n×n, column-major; only the lower triangle
-    /// is read for the factor, the whole matrix is kept for residuals).
+    /// is read for the factor, the whole matrix is kept for residuals). Fails on a wrong length,
+    /// a non-finite entry or a pivot ≤ [`MASS_MATRIX_PIVOT_RELATIVE`]·A_kk
+    /// ([`ImpulseError::SingularMassMatrix`]).
     pub fn from_mass_matrix(n: usize, a: Vec<f64>) -> Result<Self, ImpulseError> {
         if a.len() != n * n {
             return Err(ImpulseError::DimensionMismatch {
@@ -287,7 +290,10 @@ pub(crate) fn point_jacobian_into(
 
 /// Applies the point impulses `impulses` to the tree at the configuration of `ws` (positions
 /// updated) moving with `q_dot`, through Lagrange's impulse equations (7.115–7.117), with the
-/// factored mass matrix `inertia` of the same configuration.
+/// factored mass matrix `inertia` of the same configuration. Lengths of `q_dot` and of the
+/// factor must match the tree's dof; every impulse is checked (body index, finite values).
+/// The accuracy of the solve A Δq̇ = Q_S is reported as
+/// [`GeneralizedImpulseResponse::backward_error`].
 pub fn apply_point_impulses(
     tree: &KinematicTree,
     ws: &Workspace,

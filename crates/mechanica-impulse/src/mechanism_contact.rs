@@ -377,7 +377,7 @@ pub(crate) fn assemble_impact(
 
 /// Resolves the impact of a mechanism at a single contact with the impulse-parameterised
 /// process of [`crate::contact_space`] (the same Newton/Poisson/Stronge semantics, modes and
-/// swerving-slip integration as the two-body contact of part 3), using the contact's 3×3
+/// swerving-slip integration as the two-body [`crate::contact::resolve_contact`]), using the contact's 3×3
 /// Delassus block W = J A⁻¹ Jᵀ (7.115–7.117).
 pub fn resolve_single_contact(
     tree: &KinematicTree,

@@ -91,7 +91,7 @@ fn rel_err(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 }
 
 /// A single free body (slender cylinder, tilted) as a one-body mechanism striking the ground
-/// must give exactly the two-body contact of part 3 against a fixed ground, for a smooth,
+/// must give exactly the two-body contact (`resolve_contact`) against a fixed ground, for a smooth,
 /// a sticking, a sliding and a swerving (3-D) impact.
 #[test]
 fn free_body_mechanism_equals_rigid_body_contact() {
@@ -157,7 +157,7 @@ fn free_body_mechanism_equals_rigid_body_contact() {
 
 /// A body on a revolute hinge struck at a point: Δθ̇ = (r × S)·a / I_a with I_a the moment of
 /// inertia about the hinge axis (7.87*–7.91* reduced to one coordinate), and the same as the
-/// hinged rigid body of part 2.
+/// hinged rigid body (`RigidBody::hinged_on_axis`).
 #[test]
 fn pendulum_struck_at_a_point() {
     let axis = Vector3::new(0.2, 0.3, 0.9).normalize();
@@ -713,11 +713,11 @@ fn extreme_mass_ratios() {
     }
 }
 
-/// The case proptest found (saved in mechanism.proptest-regressions): a hinge and a ball joint,
-/// two frictional contacts (f = 0.001 and 1.3) along one tilted normal, six impulse rows on
-/// four freedoms. The Gauss–Seidel impulses drifted along the Delassus null space to ~1e25 and
-/// the impact reported ΔT = −2e50 while the velocities gained 1e34; it is now refused with a
-/// typed error naming the drift.
+/// A case from mechanism.proptest-regressions: a hinge and a ball joint, two frictional
+/// contacts (f = 0.001 and 1.3) along one tilted normal, six impulse rows on four freedoms.
+/// Unchecked, the Gauss–Seidel impulses drift along the Delassus null space to ~1e25 and the
+/// energy bookkeeping breaks down (ΔT = −2e50 reported while the velocities gain 1e34); the
+/// solve refuses it with a typed error naming the drift.
 #[test]
 fn redundant_contacts_whose_impulses_drift_are_refused() {
     let joints = [Joint::Revolute { axis: Vector3::z() }, Joint::Spherical];

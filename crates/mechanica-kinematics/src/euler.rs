@@ -1,4 +1,4 @@
-//! Euler angles: the EB1911 convention (θ, φ, ψ) of seed 001 and the twelve intrinsic axis
+//! Euler angles: the EB1911 convention (θ, φ, ψ) (see docs/theory.md) and the twelve intrinsic axis
 //! sequences (aerospace ZYX, robotics XYZ and ZYZ among them), conversions from rotations that
 //! stay accurate at and near gimbal lock, and the maps between Euler rates and the angular
 //! velocity ω (EB1911 (13)), with a typed error where the rate map is singular.
@@ -142,7 +142,8 @@ impl EulerSequence {
     }
 }
 
-/// The elementary rotation by `angle` about coordinate axis `axis` (0, 1, 2).
+/// The elementary rotation by `angle` (rad) about coordinate axis `axis` (0 = x, 1 = y, any
+/// other value = z), in the right-handed sense. Exact to rounding of `sin_cos`.
 pub fn elementary_rotation(axis: usize, angle: f64) -> Matrix3<f64> {
     let (s, c) = angle.sin_cos();
     match axis {
@@ -161,7 +162,8 @@ fn check_angles(angles: &[f64; 3], what: &'static str) -> Result<(), KinematicsE
     Ok(())
 }
 
-/// The rotation R = R_i(a) R_j(b) R_k(c) of the intrinsic sequence `seq`, angles = [a, b, c].
+/// The rotation R = R_i(a) R_j(b) R_k(c) (body → fixed, `R_WB`) of the intrinsic sequence
+/// `seq`, angles = [a, b, c] in radians. Fails on a non-finite angle.
 pub fn rotation_from_euler(seq: EulerSequence, angles: &[f64; 3]) -> Result<Rotation3<f64>, KinematicsError> {
     check_angles(angles, "Euler angles")?;
     let (i, j, k) = seq.axes();
@@ -184,7 +186,9 @@ pub struct EulerDecomposition {
     pub singularity_distance: f64,
 }
 
-/// The Euler angles of `r` in the sequence `seq` (see the module docs for ranges and locks).
+/// The Euler angles (rad) of `r` in the sequence `seq` (see the module docs for ranges and
+/// locks). The angles reproduce `r` to a few ulps; [`EulerDecomposition::singularity_distance`]
+/// says how well a and c are determined individually.
 pub fn euler_from_rotation(seq: EulerSequence, r: &Rotation3<f64>) -> EulerDecomposition {
     let m = r.matrix();
     let (i, j, k, kp, eps) = seq.frame();
@@ -243,7 +247,9 @@ pub fn euler_rate_matrix(seq: EulerSequence, angles: &[f64; 3], frame: AngularVe
     }
 }
 
-/// The angular velocity from Euler angles and their rates, ω = E(angles) rates.
+/// The angular velocity ω (rad/s) from Euler angles (rad) and their rates (rad/s),
+/// ω = E(angles) rates (see [`euler_rate_matrix`]), in the components chosen by `frame`.
+/// Fails on a non-finite input.
 pub fn angular_velocity_from_euler_rates(
     seq: EulerSequence,
     angles: &[f64; 3],
@@ -294,7 +300,7 @@ pub fn euler_rates_from_angular_velocity(
     })
 }
 
-/// Euler's angles as the EB1911 article uses them (seed 001, §22): θ the nutation (angle
+/// Euler's angles as the EB1911 article uses them (§22, see docs/theory.md): θ the nutation (angle
 /// between the fixed z axis and the body axis OC), φ the spin about OC, ψ the precession
 /// about the fixed z axis. The rotation is R = R_z(ψ) R_y(θ) R_z(φ), i.e. [`EulerSequence::Zyz`]
 /// with angles [ψ, θ, φ]; with this R the body components of ω are exactly (13).

@@ -1,7 +1,9 @@
 //! Kinematics of rigid bodies and mechanisms.
 //!
 //! Rotations, rigid motion fields, relative motion and kinematic trees, following
-//! the syllabus chapters 1–2 (equation numbers refer to `seeds/000`, see THEORY.md).
+//! chapters 1–2 of the syllabus. Equation numbers such as (2.13) are the syllabus numbering,
+//! listed in `docs/theory.md`; "EB1911 (13)" is equation (13) of the Britannica article
+//! "Mechanics", also defined there.
 //!
 //! Frames follow the Drake naming style: `p_AB_W` is the position of B relative to A,
 //! expressed in frame W. All quantities are SI and `f64`.

@@ -2,7 +2,7 @@
 //! acceleration of a point split into drag ("sleep"), Coriolis and relative parts.
 //!
 //! The moving frame is a [`RigidMotion`]; the point's relative motion ξ, ξ̇, ξ̈ is given in
-//! moving-frame components. Results are world components.
+//! moving-frame components. Results are world components, SI units, exact up to rounding.
 
 use crate::KinematicsError;
 use crate::rigid_motion::RigidMotion;

@@ -2,7 +2,8 @@
 //!
 //! All vectors are fixed-frame (world) components unless named `_B`. `c` is the world position
 //! of the body's reference point (the origin of the body frame), ω the angular velocity, which
-//! is the same whichever body point is taken as reference (2.14–2.16).
+//! is the same whichever body point is taken as reference (2.14–2.16). Units are SI (m, m/s,
+//! m/s², rad/s, rad/s²); the fields are evaluated by their closed forms, exact up to rounding.
 
 use crate::KinematicsError;
 use crate::rotation::check_finite_vec;

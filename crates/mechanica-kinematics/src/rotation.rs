@@ -18,7 +18,7 @@ pub const ROTATION_TOLERANCE: f64 = 1e-12;
 /// [`ROTATION_TOLERANCE`]).
 pub const AXIS_TOLERANCE: f64 = 1e-12;
 
-/// The skew-symmetric matrix Ω with Ω x = ω × x (2.11).
+/// The skew-symmetric matrix Ω with Ω x = ω × x (2.10, 2.12).
 pub fn skew(w: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0)
 }

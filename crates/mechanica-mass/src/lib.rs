@@ -1,6 +1,8 @@
 //! Mass properties of points, rods, laminae, solids, meshes, composites and mechanisms.
 //!
-//! Equation numbers refer to the syllabus (`seeds/000`, chapter 3), see THEORY.md.
+//! Equation numbers such as (3.27) are the syllabus numbering (mostly chapter 3), listed in
+//! `docs/theory.md`. Units are SI (kg, m, kg·m²).
+//!
 //! - [`properties`]: the [`MassProperties`] value, composition, holes, transformation, Steiner;
 //! - [`principal`]: principal moments and a canonical principal frame;
 //! - [`validity`]: the physical validity check and repair;

@@ -70,7 +70,7 @@ impl From<&BaseState> for DragField {
 /// The output buffers of [`TreeMass::energy_split`].
 #[derive(Debug)]
 pub struct SplitBuffers<'a> {
-    /// A(q), dof × dof, column-major.
+    /// A(q), dof × dof, column-major; must come in zeroed (see [`TreeMass::mass_matrix`]).
     pub mass_matrix: &'a mut [f64],
     /// b(q, t) = ∂T₁/∂q̇, dof entries.
     pub b: &'a mut [f64],
@@ -179,7 +179,11 @@ impl TreeMass {
     }
 
     /// The mass matrix A(q) (8.28) at the configuration of the last `update_positions` in `ws`,
-    /// into `out` (dof × dof, column-major), by the composite-rigid-body recursion.
+    /// into `out` (dof × dof, column-major; kg, kg·m or kg·m² by the units of q_k and q_l), by
+    /// the composite-rigid-body recursion: exact up to rounding, symmetric by construction.
+    /// Only the entries of coordinate pairs on one root path are written; the others are zero
+    /// in A and are left as they are, so `out` must come in zeroed. Fails when `out` has the
+    /// wrong length or `ws` holds no positions for `tree`.
     pub fn mass_matrix(&mut self, tree: &KinematicTree, ws: &Workspace, out: &mut [f64]) -> Result<(), MassError> {
         let n = tree.dof();
         if out.len() != n * n {
@@ -235,7 +239,8 @@ impl TreeMass {
     }
 
     /// The generalized momenta ∂T/∂q̇ = A q̇ (7.55, 8.27) and the kinetic energy
-    /// T = ½ q̇ᵀ A q̇ for a fixed base, computing A into `a_out` (dof × dof, column-major).
+    /// T = ½ q̇ᵀ A q̇ for a fixed base, computing A into `a_out` (dof × dof, column-major,
+    /// zeroed by the caller as for [`TreeMass::mass_matrix`]).
     /// With a moving base these are T₂ and its momenta only; see [`TreeMass::energy_split`].
     pub fn momenta_and_energy(
         &mut self,
@@ -272,7 +277,8 @@ impl TreeMass {
     /// The split T = T₀ + T₁ + T₂ (9.7–9.10) for a tree whose base moves with the drag field
     /// `drag` (usually `DragField::from(ws.base())`), at the positions of the last
     /// `update_positions` and the velocities `q_dot`. Writes A(q), b(q, t) and the generalized
-    /// momenta ∂T/∂q̇ = A q̇ + b into `out`.
+    /// momenta ∂T/∂q̇ = A q̇ + b into `out` (its `mass_matrix` zeroed by the caller as for
+    /// [`TreeMass::mass_matrix`]).
     ///
     /// The drag field ∂x/∂t = v₀ + ω₀ × (x − p₀) is rigid, so with the composite (m_c, x_c, J_c)
     /// of the subtree moved by q_k: b_k = m_c u_k·u(x_c) + w_k·J_c ω₀, and T₀ is the energy of the

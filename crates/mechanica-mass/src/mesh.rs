@@ -91,8 +91,8 @@ impl Default for MeshOptions {
 /// Where [`mesh_mass_properties`] takes the edge topology from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TopologySource {
-    /// Classify every edge (the default). On large meshes this is about 60 % of the time
-    /// (32.9 of 55.6 ms at 2.1 M triangles, idle).
+    /// Classify every edge (the default). On large meshes the edge check takes more time than
+    /// the integrals (see docs/benchmarks.md).
     Check,
     /// The topology an earlier call found for the same triangle array, for meshes whose
     /// vertices move while their connectivity stays (a deforming body re-integrated every step):
@@ -174,11 +174,12 @@ fn reference_point(vertices: &[[f64; 3]]) -> Result<([f64; 3], f64), MassError> 
 }
 
 /// Mass properties of the triangle mesh (`vertices`, `triangles`) with the given amount of
-/// material and options. Closed solids use the divergence theorem on the polynomial integrals
-/// of 1, x, x², xy over each triangle's cone (the
-/// signed tetrahedra between a reference point and each triangle);
-/// shells integrate over the triangles directly. The inertia is J = tr(S)·I − S from the central second moments S = ∫ρ y yᵀ
-/// (3.17–3.18).
+/// material and options, in the frame of the vertices (m, kg, kg·m²). Closed solids use the
+/// divergence theorem on the polynomial integrals of 1, x, x², xy over each triangle's cone
+/// (the signed tetrahedra between a reference point and each triangle); shells integrate over
+/// the triangles directly. The inertia is J = tr(S)·I − S from the central second moments
+/// S = ∫ρ y yᵀ (3.17–3.18). The integrals are exact up to rounding, bounded by
+/// [`MeshMassProperties::relative_error_bound`].
 ///
 /// Errors: [`MassError::EmptyMesh`], [`MassError::NonFiniteVertex`],
 /// [`MassError::IndexOutOfRange`], [`MassError::TooManyVertices`], [`MassError::TooManyTriangles`],

@@ -2,7 +2,9 @@
 //!
 //! Each primitive is given in its own body frame B; the doc of each function states where the
 //! origin and axes of B lie. Rods, laminae and points have semidefinite (or planar) inertia
-//! (remark after 3.14). Integrals are those of 3.17–3.18 evaluated in closed form.
+//! (remark after 3.14). Integrals are those of 3.17–3.18 evaluated in closed form, so the
+//! results are exact up to rounding. Non-finite or non-positive dimensions, masses and densities
+//! are refused with a [`MassError`] naming the input.
 
 use crate::error::{check_dimension, check_finite};
 use crate::{MassError, MassProperties};

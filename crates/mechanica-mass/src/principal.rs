@@ -33,7 +33,7 @@ pub enum Multiplicity {
 /// Principal moments and axes of an inertia tensor J expressed in a frame F.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PrincipalAxes {
-    /// Principal moments I₁ ≤ I₂ ≤ I₃ (3.21), kg·m².
+    /// Principal moments I₁ ≤ I₂ ≤ I₃ (3.20), kg·m².
     pub moments: Vector3<f64>,
     /// R_FP: its columns are the principal axes, expressed in F, in the order of `moments`,
     /// forming a right-handed frame, so that J = R diag(moments) Rᵀ.

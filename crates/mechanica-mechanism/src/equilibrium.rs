@@ -1,4 +1,4 @@
-//! Equilibria: grad U*(q) = 0 (8.79) by Newton's method with a backtracking line search on
+//! Equilibria: grad U*(q) = 0 (8.74) by Newton's method with a backtracking line search on
 //! ‖grad U*‖, inside the joint limits.
 //!
 //! Newton's direction d = −B⁻¹ g is a descent direction of ½‖g‖² whenever B is nonsingular, so
@@ -7,8 +7,9 @@
 //! the eigenvalues kept away from zero by δ = √u·‖B‖, so a singular B (a neutral direction)
 //! gives a bounded step instead of a blow-up. Coordinates resting on a limit that pushes them
 //! outwards are frozen and the Newton step is taken in the others (projected Newton); trial
-//! points are clipped to the limits. Spherical and free joints are re-centred ([`Mechanism::rebase`]) before every
-//! Hessian, so the returned q is in the mechanism's final chart.
+//! points are clipped to the limits. Spherical and free joints are re-centred
+//! ([`Mechanism::rebase`]) before every Hessian, so the returned q is in the mechanism's final
+//! chart.
 //!
 //! **Convergence criterion.** ‖g‖ ≤ τ with τ = 64·n·u·(‖B(q₀)‖_F·max(1, ‖q₀‖) + ‖g(q₀)‖) by
 //! default: the size of the rounding error of g near q₀. The report gives ‖g‖ and the last

@@ -188,7 +188,7 @@ impl Mechanism {
     }
 
     /// U*(q) = U(q) − T₀(q) with its exact gradient and, when asked, its exact Hessian B(q) =
-    /// ∂²U*/∂q∂q (8.79). Errors name the potential that failed.
+    /// ∂²U*/∂q∂q (8.85). Errors name the potential that failed.
     pub fn potential(&self, q: &[f64], with_hessian: bool) -> Result<PotentialSum, MechanismError> {
         let ws = self.positions(q)?;
         let config = Configuration::new(&self.tree, &ws, q, &self.bodies)?;

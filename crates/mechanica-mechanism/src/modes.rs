@@ -1,5 +1,5 @@
 //! Stability and small oscillations of a mechanism about an equilibrium q₀ (§8f–g):
-//! A(q₀) δ̈ + G(q₀) δ̇ + B(q₀) δ = 0 with A the mass matrix (8.28), B = ∂²U*/∂q∂q (8.79) and G
+//! A(q₀) δ̈ + G(q₀) δ̇ + B(q₀) δ = 0 with A the mass matrix (8.28), B = ∂²U*/∂q∂q (8.85) and G
 //! the gyroscopic matrix of a rotating frame (zero otherwise).
 //!
 //! - **Stability** comes from the modes of the pencil (A, B) solved by the modal crate: the
@@ -23,7 +23,8 @@ use faer::c64;
 use mechanica_modal::{ModalSolution, ModeKind, PencilProblem, SolveOptions, solve};
 use nalgebra::Vector3;
 
-/// The stability of an equilibrium from the inertia of B relative to A (8.79–8.80).
+/// The stability of an equilibrium from the inertia of B relative to A (Lyapunov, 8.79–8.83;
+/// small oscillations, 8.84–8.90).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Stability {
     /// B positive definite: every mode oscillates.
