@@ -138,7 +138,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
         };
         let recentred = mechanism.has_rotation_vectors();
         let mut notes = Vec::new();
-        let mut step = timed_step("equilibrium: Newton on grad U* (8.79)", || {
+        let mut step = timed_step("equilibrium: Newton on grad U* (8.74)", || {
             let eq = find_equilibrium(&mut mechanism, &q, &options).map_err(|e| e.to_string())?;
             let quantities = vec![
                 quantity("q at equilibrium", eq.q.clone(), "rad | m", None),

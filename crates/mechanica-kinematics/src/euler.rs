@@ -300,7 +300,7 @@ pub fn euler_rates_from_angular_velocity(
     })
 }
 
-/// Euler's angles as the EB1911 article uses them (§22, see docs/theory.md): θ the nutation (angle
+/// Euler's angles as the EB1911 article uses them (§21, see docs/theory.md): θ the nutation (angle
 /// between the fixed z axis and the body axis OC), φ the spin about OC, ψ the precession
 /// about the fixed z axis. The rotation is R = R_z(ψ) R_y(θ) R_z(φ), i.e. [`EulerSequence::Zyz`]
 /// with angles [ψ, θ, φ]; with this R the body components of ω are exactly (13).

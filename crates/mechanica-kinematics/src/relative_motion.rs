@@ -65,7 +65,7 @@ pub fn decompose(frame: &RigidMotion, rel: &RelativeMotion) -> Result<Decomposed
     })
 }
 
-/// The rate-of-change rule for any vector q = R η carried by a frame rotating at ω (2.33–2.35):
+/// The rate-of-change rule for any vector q = R η carried by a frame rotating at ω (2.36):
 /// q̇ = ω × q + q̇_rel, with q̇_rel = R η̇ the rate seen in the moving frame.
 pub fn rate_in_fixed_frame(omega: &Vector3<f64>, q: &Vector3<f64>, q_dot_rel: &Vector3<f64>) -> Vector3<f64> {
     omega.cross(q) + q_dot_rel
@@ -163,7 +163,7 @@ mod tests {
         let a_fd = (x(t + h) - 2.0 * x(t) + x(t - h)) / (h * h);
         assert!((d.velocity() - v_fd).norm() < 100.0 * (h * h + f64::EPSILON / h));
         assert!((d.acceleration() - a_fd).norm() < 1000.0 * (h * h + 10.0 * f64::EPSILON / (h * h)));
-        // (2.33–2.35) with q = R ξ: q̇ = ω × q + R ξ̇.
+        // (2.36) with q = R ξ: q̇ = ω × q + R ξ̇.
         let q = r * rel.xi;
         let q_fd = (frame_at(t + h).0 * xi_at(t + h) - frame_at(t - h).0 * xi_at(t - h)) / (2.0 * h);
         let rule = rate_in_fixed_frame(&frame.omega, &q, &d.v_rel);

@@ -238,7 +238,7 @@ impl TreeMass {
         Ok(())
     }
 
-    /// The generalized momenta ∂T/∂q̇ = A q̇ (7.55, 8.27) and the kinetic energy
+    /// The generalized momenta ∂T/∂q̇ = A q̇ (7.113; EB1911 §22 (16)) and the kinetic energy
     /// T = ½ q̇ᵀ A q̇ for a fixed base, computing A into `a_out` (dof × dof, column-major,
     /// zeroed by the caller as for [`TreeMass::mass_matrix`]).
     /// With a moving base these are T₂ and its momenta only; see [`TreeMass::energy_split`].

@@ -51,7 +51,7 @@ impl Body {
     pub fn momentum(&self, v: &Vector3<f64>) -> Vector3<f64> {
         self.props.mass * v
     }
-    /// Angular momentum about the world point `a`: J₀ω + (x₀ − a) × m v (7.69 with 7.29).
+    /// Angular momentum about the world point `a`: J₀ω + (x₀ − a) × m v (7.30).
     pub fn angular_momentum_about(&self, a: &Vector3<f64>, v: &Vector3<f64>, w: &Vector3<f64>) -> Vector3<f64> {
         self.props.inertia_c * w + (self.props.p_oc - a).cross(&(self.props.mass * v))
     }
