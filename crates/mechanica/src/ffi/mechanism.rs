@@ -3,7 +3,9 @@
 //! its exact gradient and Hessian, equilibrium search, stability and modes into caller buffers.
 
 use super::boundary::{FfiError, boundary};
-use super::kinematics::{built, mech_tree_t, tree_mut};
+use super::c_enum::*;
+use super::handle::Handle;
+use super::kinematics::mech_tree_t;
 use super::mass::mech_mass_properties_t;
 use super::modal::{
     MECH_MODAL_KIND_INFINITE, MECH_MODAL_KIND_OSCILLATORY, MECH_MODAL_KIND_UNSTABLE, MECH_MODAL_KIND_ZERO,
@@ -97,8 +99,8 @@ pub unsafe extern "C" fn mech_mechanism_create(
     boundary(|| {
         let out = Out::new(mechanism_out, "mechanism_out")?;
         // SAFETY: caller's contract.
-        let tree = unsafe { tree_mut(tree) }?;
-        let (tree, _) = built(tree)?;
+        let tree = unsafe { mech_tree_t::borrow_mut(tree, "tree") }?;
+        let (tree, _) = tree.built()?;
         // SAFETY: caller's contract.
         let raw = unsafe { read_slice(bodies, n_bodies, "bodies") }?;
         let mut masses = Vec::with_capacity(raw.len());

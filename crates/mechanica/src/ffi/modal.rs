@@ -2,6 +2,7 @@
 //! an opaque result handle, and accessors that copy into caller buffers.
 
 use super::boundary::{FfiError, boundary};
+use super::c_enum::*;
 use super::status::*;
 use super::validate::*;
 use mechanica_modal::faer::MatRef;
