@@ -1040,7 +1040,9 @@ typedef int32_t mech_modal_refinement_t;
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * Options of mech_modal_solve.
+ * Options of mech_modal_solve. The pointer is required (NULL gives MECH_STATUS_NULL_POINTER);
+ * mech_modal_options_default writes the defaults: every mode, with shapes, automatic
+ * refinement.
  */
 typedef struct mech_modal_options_t {
     /**
@@ -1075,6 +1077,41 @@ typedef struct mech_modal_options_t {
  * How the accuracy report measures residuals (int32_t; see MECH_MODAL_RESIDUALS_*).
  */
 typedef int32_t mech_modal_residuals_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * How well the modal coordinates of mech_modal_free_response reproduce the initial state, and
+ * the response's own error bound.
+ */
+typedef struct mech_modal_response_fit_t {
+    /**
+     * ‖δ(0) − Σ q_k(0) x_k‖₂ (m).
+     */
+    double displacement_residual;
+    /**
+     * ‖δ̇(0) − Σ q̇_k(0) x_k‖₂ (m/s).
+     */
+    double velocity_residual;
+    /**
+     * displacement_residual / ‖δ(0)‖₂ (0 when δ(0) = 0).
+     */
+    double relative_displacement_residual;
+    /**
+     * velocity_residual / ‖δ̇(0)‖₂ (0 when δ̇(0) = 0).
+     */
+    double relative_velocity_residual;
+    /**
+     * The largest first-order bound on ‖δ(t) − δ_exact(t)‖₂ over the requested times, from the
+     * error bounds of the frequencies (phase drift) and rounding; excludes the residuals above.
+     */
+    double max_error_bound;
+    /**
+     * Number of massless coordinates (infinite modes); they follow the massive ones statically,
+     * so with massless > 0 the residuals include the inconsistency of δ(0), δ̇(0).
+     */
+    size_t massless;
+} mech_modal_response_fit_t;
 #endif
 
 #if defined(MECH_FEATURE_MODAL)
@@ -1176,42 +1213,7 @@ typedef struct mech_modal_accuracy_t {
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * How well the modal coordinates of mech_modal_free_response reproduce the initial state, and
- * the response's own error bound.
- */
-typedef struct mech_modal_response_fit_t {
-    /**
-     * ‖δ(0) − Σ q_k(0) x_k‖₂ (m).
-     */
-    double displacement_residual;
-    /**
-     * ‖δ̇(0) − Σ q̇_k(0) x_k‖₂ (m/s).
-     */
-    double velocity_residual;
-    /**
-     * displacement_residual / ‖δ(0)‖₂ (0 when δ(0) = 0).
-     */
-    double relative_displacement_residual;
-    /**
-     * velocity_residual / ‖δ̇(0)‖₂ (0 when δ̇(0) = 0).
-     */
-    double relative_velocity_residual;
-    /**
-     * The largest first-order bound on ‖δ(t) − δ_exact(t)‖₂ over the requested times, from the
-     * error bounds of the frequencies (phase drift) and rounding; excludes the residuals above.
-     */
-    double max_error_bound;
-    /**
-     * Number of massless coordinates (infinite modes); they follow the massive ones statically,
-     * so with massless > 0 the residuals include the inconsistency of δ(0), δ̇(0).
-     */
-    size_t massless;
-} mech_modal_response_fit_t;
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Accuracy and cost summary of mech_modal_sparse_lowest.
+ * Accuracy and cost summary of mech_modal_sparse_lowest and mech_modal_sparse_solve.
  */
 typedef struct mech_modal_sparse_report_t {
     /**
@@ -1255,8 +1257,11 @@ typedef struct mech_modal_sparse_report_t {
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * Options of mech_modal_sparse_solve. Zero fields take the defaults, so a zero-initialised
- * struct with `count` set is the default solve of mech_modal_sparse_lowest.
+ * Options of mech_modal_sparse_solve. The pointer is required (NULL gives
+ * MECH_STATUS_NULL_POINTER), as `count` has no meaningful default. Zero fields other than
+ * `count` take the defaults, so a zero-initialised struct with `count` set is the default
+ * solve of mech_modal_sparse_lowest; mech_modal_sparse_options_default writes the defaults
+ * explicitly.
  */
 typedef struct mech_modal_sparse_options_t {
     /**
@@ -1959,6 +1964,21 @@ typedef struct mech_modal_sparse_details_t {
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * A X, B X and XᵀAX formed in full: exact backward errors and orthogonality (5n²m flops).
+ */
+#define MECH_MODAL_RESIDUALS_EXACT 0
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Gaussian sketches (O(32·n²) flops): each backward error and the orthogonality error (then a
+ * bound on ‖XᵀAX − I‖_F) is an upper bound that fails with probability ≤ 1e-12.
+ */
+#define MECH_MODAL_RESIDUALS_SKETCHED 1
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * λ < 0: oscillates at ω = √(−λ) rad/s.
  */
 #define MECH_MODAL_KIND_OSCILLATORY 0
@@ -1983,21 +2003,6 @@ typedef struct mech_modal_sparse_details_t {
  * Massless direction (A x = 0): infinite frequency.
  */
 #define MECH_MODAL_KIND_INFINITE 3
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * A X, B X and XᵀAX formed in full: exact backward errors and orthogonality (5n²m flops).
- */
-#define MECH_MODAL_RESIDUALS_EXACT 0
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Gaussian sketches (O(32·n²) flops): each backward error and the orthogonality error (then a
- * bound on ‖XᵀAX − I‖_F) is an upper bound that fails with probability ≤ 1e-12.
- */
-#define MECH_MODAL_RESIDUALS_SKETCHED 1
 #endif
 
 #ifdef __cplusplus
@@ -3169,8 +3174,17 @@ mech_status_t mech_mass_repair(const struct mech_mass_properties_t *properties,
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * Creates a mechanism from a finalized tree (copied: later changes to the tree do not affect
- * it) and one mass-properties value per body (in the body's frame, in body order).
+ * Creates a mechanism from a finalized tree (copied: later changes to the tree, or its
+ * destruction, do not affect it) and one mass-properties value per body (`n_bodies` of them,
+ * each in the body's frame, in body order), and writes its handle to `*mechanism_out`. The
+ * caller owns the handle and frees it with mech_mechanism_destroy. The mechanism starts
+ * without loads.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when the tree is not finalized or a body's properties
+ * are not those of a real body (mass ≤ 0 or an invalid tensor; the message names the body),
+ * except MECH_STATUS_NOT_POSITIVE_DEFINITE for a tensor that is not positive semidefinite or
+ * breaks the triangle inequality and MECH_STATUS_NON_FINITE for a NaN or infinite entry;
+ * MECH_STATUS_BAD_DIMENSION when `n_bodies` is not the tree's body count.
  *
  * # Safety
  * `tree` must be a live tree handle, `bodies` must point to `n_bodies` readable values and
@@ -3187,14 +3201,16 @@ mech_status_t mech_mechanism_create(struct mech_tree_t *tree,
  * Frees a mechanism. NULL is accepted and ignored.
  *
  * # Safety
- * `mechanism` must be NULL or a live handle, not used afterwards.
+ * `mechanism` must be NULL or a live handle from mech_mechanism_create, not used afterwards.
  */
 void mech_mechanism_destroy(struct mech_mechanism_t *mechanism);
 #endif
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * Number of coordinates of the mechanism into `*dof_out`.
+ * Writes the number of coordinates of the mechanism (the tree's dof) to `*dof_out`.
+ *
+ * Errors: none beyond the pointer checks.
  *
  * # Safety
  * `mechanism` must be a live handle and `dof_out` writable.
@@ -3205,90 +3221,14 @@ mech_status_t mech_mechanism_dof(struct mech_mechanism_t *mechanism,
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * Sets uniform gravity g (m/s², base-frame components).
+ * U*(q) (J) into `*potential_out`, its gradient ∂(U*)/∂q into `gradient_out` (n values) and,
+ * unless `hessian_out` is NULL, its Hessian B = ∂²(U*)/∂q∂q (n×n, column-major), all exact
+ * (8.79), at the coordinates q (n values; n = the mechanism's dof).
  *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_set_gravity(struct mech_mechanism_t *mechanism,
-                                         struct mech_vec3_t gravity);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Makes the base frame turn at `rate` rad/s about the unit `axis` through its origin (§8e);
- * rate 0 removes the rotation. Gravity must be along the axis.
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_set_rotating_frame(struct mech_mechanism_t *mechanism,
-                                                struct mech_vec3_t axis,
-                                                double rate);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Adds U = ½ k (q_i − rest)² on coordinate `coordinate` (not on spherical/free rotation vectors).
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_add_joint_spring(struct mech_mechanism_t *mechanism,
-                                              size_t coordinate,
-                                              double stiffness,
-                                              double rest);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Adds a spring U = ½ k (|x_a − x_b| − rest_length)² between the point `point_a` of body
- * `body_a` and `point_b` of `body_b` (body coordinates; MECH_GROUND and world coordinates for
- * the ground).
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_add_point_spring(struct mech_mechanism_t *mechanism,
-                                              int64_t body_a,
-                                              struct mech_vec3_t point_a,
-                                              int64_t body_b,
-                                              struct mech_vec3_t point_b,
-                                              double stiffness,
-                                              double rest_length);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Adds a constant world force `force` (N) at the point `point` of body `body` (U = −F·x).
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_add_force(struct mech_mechanism_t *mechanism,
-                                       size_t body,
-                                       struct mech_vec3_t point,
-                                       struct mech_vec3_t force);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Limits coordinate `coordinate` to [lower, upper] in equilibrium searches.
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_set_limits(struct mech_mechanism_t *mechanism,
-                                        size_t coordinate,
-                                        double lower,
-                                        double upper);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * U*(q) into `*potential_out`, its gradient into `gradient_out` (n values) and, unless
- * `hessian_out` is NULL, its Hessian B = ∂²(U*)/∂q∂q (n×n, column-major; spherical and free
- * joints need φ = 0, else MECH_STATUS_INVALID_ARGUMENT). All exact (8.79).
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_NON_FINITE for a NaN or
+ * infinite coordinate; MECH_STATUS_INVALID_ARGUMENT when a Hessian is asked at a non-zero
+ * rotation vector of a spherical or free joint (its Hessian is exact only at φ = 0);
+ * MECH_STATUS_SINGULAR for a spring of rest length > 0 whose ends coincide.
  *
  * # Safety
  * `mechanism` must be a live handle; `q` and `gradient_out` must hold n doubles,
@@ -3304,12 +3244,17 @@ mech_status_t mech_mechanism_potential(struct mech_mechanism_t *mechanism,
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * Searches an equilibrium from `q0` (n values) and writes it to `q_out` (n values) with its
- * report. `max_iterations` 0 means the default (100); `tolerance` ≤ 0 means the default
- * derived from rounding. Spherical and free joints are re-centred during the search: the
- * result is in the mechanism's new chart (bodies do not move). When the search fails
- * (MECH_STATUS_NOT_CONVERGED), `q_out` still receives the best point found and
- * `report_out` its gradient norm, so the caller can inspect it.
+ * Searches an equilibrium (grad U* = 0, or a minimum of U* per `seek`, a mech_seek_t) from
+ * `q0` (n values) and writes it to `q_out` (n values) with its report (U*, ‖grad U*‖ and the
+ * tolerance it met, iterations, last step) to `report_out`. `max_iterations` 0 means the
+ * default (100); `tolerance` ≤ 0 means the default derived from rounding. Spherical and free
+ * joints are re-centred during the search: the result is in the mechanism's new chart (bodies
+ * do not move).
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_BAD_ENUM for an unknown
+ * `seek`; MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_NOT_CONVERGED when
+ * the search fails, in which case `q_out` still receives the best point found and
+ * `report_out` its gradient norm (potential and last step NaN), so the caller can inspect it.
  *
  * # Safety
  * `mechanism` must be a live handle; `q0` and `q_out` must hold n doubles; `report_out`
@@ -3327,11 +3272,124 @@ mech_status_t mech_mechanism_equilibrium(struct mech_mechanism_t *mechanism,
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * The stability and the lowest `count` modes (count 0: all) of the mechanism about q (n
- * values): ω² into `omega_sq_out`, their error bounds into `error_bounds_out`, their kinds
- * (MECH_MODAL_KIND_*) into `kinds_out` (each `count` long, or n for all), the A-normalised
- * shapes into `shapes_out` (n × count column-major, may be NULL) and the verdict into
- * `stability_out`. The number of modes written goes to `*modes_out`.
+ * Sets uniform gravity g (m/s², base-frame components); it replaces any earlier value.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite component; MECH_STATUS_INVALID_ARGUMENT
+ * when the base frame rotates (mech_mechanism_set_rotating_frame) about an axis that g is not
+ * parallel to.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_set_gravity(struct mech_mechanism_t *mechanism,
+                                         struct mech_vec3_t gravity);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Makes the base frame turn at `rate` rad/s about the unit `axis` (base-frame components)
+ * through its origin, so that U* includes the centrifugal potential and the modes the
+ * Coriolis coupling (§8e); rate 0 removes the rotation.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * an axis that is not a unit vector (|‖a‖ − 1| > 1e-9) or gravity that is not along the axis.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_set_rotating_frame(struct mech_mechanism_t *mechanism,
+                                                struct mech_vec3_t axis,
+                                                double rate);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Adds the potential U = ½ k (q_i − rest)² on coordinate i = `coordinate`, with stiffness k =
+ * `stiffness` (N/m or N·m/rad per the coordinate) and rest value `rest`. Not allowed on the
+ * rotation-vector coordinates of spherical and free joints.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a coordinate out of range or of a rotation vector, or a negative stiffness.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_add_joint_spring(struct mech_mechanism_t *mechanism,
+                                              size_t coordinate,
+                                              double stiffness,
+                                              double rest);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Adds a spring U = ½ k (|x_a − x_b| − rest_length)² (k = `stiffness` in N/m, `rest_length`
+ * in m) between the point `point_a` of body `body_a` and `point_b` of `body_b` (body
+ * coordinates, m; MECH_GROUND and base-frame coordinates for the ground).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a body index below MECH_GROUND or out of range, a negative stiffness or rest length.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_add_point_spring(struct mech_mechanism_t *mechanism,
+                                              int64_t body_a,
+                                              struct mech_vec3_t point_a,
+                                              int64_t body_b,
+                                              struct mech_vec3_t point_b,
+                                              double stiffness,
+                                              double rest_length);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Adds a constant force `force` (N, base-frame components) at the point `point` (m, body
+ * coordinates) of body `body`: U = −F·x.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a body out of range.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_add_force(struct mech_mechanism_t *mechanism,
+                                       size_t body,
+                                       struct mech_vec3_t point,
+                                       struct mech_vec3_t force);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Limits coordinate `coordinate` to [lower, upper] (infinite bounds allowed) in equilibrium
+ * searches; the coordinates resting on a limit are counted in
+ * mech_equilibrium_report_t::at_limit. Not allowed on the rotation-vector coordinates of
+ * spherical and free joints.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT for a coordinate out of range or of a rotation vector,
+ * a NaN bound or lower > upper.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_set_limits(struct mech_mechanism_t *mechanism,
+                                        size_t coordinate,
+                                        double lower,
+                                        double upper);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * The stability and the lowest `count` modes (count 0: all n) of det(λA + B) = 0 for the
+ * mechanism about q (n values, normally an equilibrium), A the mass matrix and B the Hessian
+ * of U*: ω² (rad²/s²) into `omega_sq_out`, their error bounds into `error_bounds_out`, their
+ * kinds (MECH_MODAL_KIND_*) into `kinds_out` (each `count` long, or n for all; entries past
+ * the modes found are 0, 0 and MECH_MODAL_KIND_INFINITE), the A-normalised shapes into
+ * `shapes_out` (n × count column-major, may be NULL) and the verdict into `stability_out`.
+ * The number of modes written goes to `*modes_out`.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof or count > n;
+ * MECH_STATUS_NON_FINITE for a NaN or infinite coordinate; the modal solve's errors
+ * (mech_modal_solve), e.g. MECH_STATUS_NOT_POSITIVE_DEFINITE for an indefinite mass matrix.
  *
  * # Safety
  * `mechanism` must be a live handle; the buffers must have the lengths above.
@@ -3350,8 +3408,24 @@ mech_status_t mech_mechanism_modes(struct mech_mechanism_t *mechanism,
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * Writes the default options of mech_modal_solve to `options_out`: MECH_MODAL_SELECTION_ALL
+ * (count, lower and upper 0), vectors = 1, MECH_MODAL_REFINEMENT_AUTO.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `options_out` must point to a writable mech_modal_options_t.
+ */
+mech_status_t mech_modal_options_default(struct mech_modal_options_t *options_out);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * Checks that the n×n column-major matrices `a` (mass) and `b` (stiffness) form a valid
  * symmetric pencil for det(λA + B) = 0: finite, and symmetric within 64 ulps of max|entry|.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION for n = 0 or n·n overflowing; MECH_STATUS_NON_FINITE for
+ * a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT for an asymmetric matrix.
  *
  * # Safety
  * `a` and `b` must each point to n·n readable doubles.
@@ -3364,10 +3438,18 @@ mech_status_t mech_modal_check_pencil(size_t n,
 #if defined(MECH_FEATURE_MODAL)
 /**
  * Solves det(λA + B) = 0 (8.89) for the n×n column-major mass matrix `a` (symmetric positive
- * semidefinite) and stiffness matrix `b` (symmetric), with the given options, and stores a new
- * result handle in `*out`. Errors: MECH_STATUS_NOT_POSITIVE_DEFINITE when A is indefinite,
- * MECH_STATUS_SINGULAR when det(λA + B) ≡ 0, MECH_STATUS_INVALID_ARGUMENT for an asymmetric
- * matrix, a bad interval, `vectors` not 0/1 or more modes than exist.
+ * semidefinite) and stiffness matrix `b` (symmetric), with the given options, and writes a new
+ * result handle to `*out`; the caller owns it and frees it with mech_modal_result_destroy. The
+ * result carries its accuracy report (mech_modal_result_accuracy): backward errors,
+ * A-orthogonality, per-mode error bounds and a Sturm inertia check; the residuals are measured
+ * exactly (see mech_modal_solve_with_residuals).
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION for n = 0 or n·n overflowing; MECH_STATUS_BAD_ENUM for an
+ * unknown selection or refinement; MECH_STATUS_NON_FINITE for a NaN or infinite entry or
+ * interval end; MECH_STATUS_NOT_POSITIVE_DEFINITE when A is indefinite; MECH_STATUS_SINGULAR
+ * when det(λA + B) ≡ 0; MECH_STATUS_INVALID_ARGUMENT for an asymmetric matrix, a bad interval,
+ * `vectors` not 0/1 or more modes than exist; MECH_STATUS_NOT_CONVERGED when the eigensolver
+ * fails to converge.
  *
  * # Safety
  * `a` and `b` must each point to n·n readable doubles; `options` to a readable
@@ -3384,8 +3466,9 @@ mech_status_t mech_modal_solve(size_t n,
 /**
  * mech_modal_solve with a choice of how the accuracy report measures residuals:
  * MECH_MODAL_RESIDUALS_EXACT (what mech_modal_solve does) or MECH_MODAL_RESIDUALS_SKETCHED
- * (probabilistic upper bounds at O(n²) cost, for large all-pairs solves). Errors as
- * mech_modal_solve, and MECH_STATUS_BAD_ENUM for an unknown `residuals`.
+ * (probabilistic upper bounds at O(n²) cost, for large all-pairs solves).
+ *
+ * Errors: as mech_modal_solve, and MECH_STATUS_BAD_ENUM for an unknown `residuals`.
  *
  * # Safety
  * As mech_modal_solve.
@@ -3400,16 +3483,6 @@ mech_status_t mech_modal_solve_with_residuals(size_t n,
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * Frees a result of mech_modal_solve. NULL is accepted and ignored.
- *
- * # Safety
- * `result` must be NULL or a handle from mech_modal_solve not yet destroyed.
- */
-void mech_modal_result_destroy(struct mech_modal_result_t *result);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
  * Returns to the system the working matrices that dense solves keep for the next solve (up to
  * five n×n matrices of the largest recent order; see the README's known limits). The next
  * dense solve allocates afresh. Safe to call at any time, from any thread.
@@ -3419,71 +3492,11 @@ void mech_modal_release_scratch(void);
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * Stores the number of modes in `*modes` and the order n of the pencil in `*dim`.
+ * Writes to `*below` the number of modes with ω² < `shift` (rad²/s²), certified by the inertia
+ * of an LBLᵀ factorization of B − shift·A (Sylvester's law; A must be positive definite for the
+ * count to equal the number of modes). The n×n matrices are column-major.
  *
- * # Safety
- * `result` must be a live handle; `modes` and `dim` writable.
- */
-mech_status_t mech_modal_result_size(const struct mech_modal_result_t *result,
-                                     size_t *modes,
-                                     size_t *dim);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Copies λ_k (= −ω²_k) of every mode, ascending in ω², into `lambda` (capacity ≥ number of
- * modes, else MECH_STATUS_BUFFER_TOO_SMALL and nothing written).
- *
- * # Safety
- * `result` must be a live handle; `lambda` must have `capacity` writable doubles.
- */
-mech_status_t mech_modal_result_eigenvalues(const struct mech_modal_result_t *result,
-                                            double *lambda,
-                                            size_t capacity);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Copies the scalar data of every mode into `modes` (capacity ≥ number of modes).
- *
- * # Safety
- * `result` must be a live handle; `modes` must have `capacity` writable elements.
- */
-mech_status_t mech_modal_result_modes(const struct mech_modal_result_t *result,
-                                      struct mech_modal_mode_t *modes,
-                                      size_t capacity);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Copies the mode shapes as an n × (number of modes) column-major matrix into `x`
- * (capacity ≥ n·modes). Finite modes are A-orthonormal; infinite ones are unit null vectors
- * of A. MECH_STATUS_INVALID_ARGUMENT if the solve was values only.
- *
- * # Safety
- * `result` must be a live handle; `x` must have `capacity` writable doubles.
- */
-mech_status_t mech_modal_result_vectors(const struct mech_modal_result_t *result,
-                                        double *x,
-                                        size_t capacity);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Copies the accuracy summary of the solve into `*accuracy`.
- *
- * # Safety
- * `result` must be a live handle; `accuracy` writable.
- */
-mech_status_t mech_modal_result_accuracy(const struct mech_modal_result_t *result,
-                                         struct mech_modal_accuracy_t *accuracy);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Stores in `*below` the number of modes with ω² < `shift`, certified by the inertia of an
- * LBLᵀ factorization of B − shift·A (Sylvester's law; A must be positive definite for the
- * count to equal the number of modes).
+ * Errors: as mech_modal_check_pencil, and MECH_STATUS_NON_FINITE for a NaN or infinite shift.
  *
  * # Safety
  * `a` and `b` must each point to n·n readable doubles; `below` writable.
@@ -3498,14 +3511,19 @@ mech_status_t mech_modal_count_below(size_t n,
 #if defined(MECH_FEATURE_MODAL)
 /**
  * The free response of A δ̈ + B δ = 0 (8.91) from δ(0) = `delta0` and δ̇(0) = `delta_dot0`
- * (n each) at `time_count` times `times` (s, any sign): δ(t_j) = Σ_k q_k(t_j) x_k with
- * q = q₀ cos ωt + (q̇₀/ω) sin ωt for oscillatory modes, q₀ + q̇₀t for zero (rigid-body) modes
- * and q₀ cosh γt + (q̇₀/γ) sinh γt for unstable ones; massless coordinates follow statically.
- * `result` must come from mech_modal_solve with MECH_MODAL_SELECTION_ALL and vectors = 1
- * (else MECH_STATUS_INVALID_ARGUMENT). Writes δ(t_j) as column j of the n × time_count
- * column-major `delta_out` (capacity ≥ n·time_count), δ̇(t_j) likewise into `velocity_out`
- * (may be NULL), and the fit summary into `fit_out` (may be NULL). An unstable mode that
- * overflows a double at some t_j gives MECH_STATUS_INVALID_ARGUMENT; nothing is written then.
+ * (n each, in the coordinates of the pencil) at `time_count` times `times` (s, any sign):
+ * δ(t_j) = Σ_k q_k(t_j) x_k with q = q₀ cos ωt + (q̇₀/ω) sin ωt for oscillatory modes,
+ * q₀ + q̇₀t for zero (rigid-body) modes and q₀ cosh γt + (q̇₀/γ) sinh γt for unstable ones;
+ * massless coordinates follow statically. Writes δ(t_j) as column j of the n × time_count
+ * column-major `delta_out`, δ̇(t_j) likewise into `velocity_out` (may be NULL), and the fit
+ * summary with the response's error bound into `fit_out` (may be NULL).
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when `result` does not come from mech_modal_solve with
+ * MECH_MODAL_SELECTION_ALL and vectors = 1, or when an unstable mode overflows a double at
+ * some t_j; MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_BAD_DIMENSION when
+ * n·time_count overflows; MECH_STATUS_BUFFER_TOO_SMALL when `delta_capacity` (or, for a
+ * non-NULL `velocity_out`, `velocity_capacity`) is below n·time_count. Nothing is written on
+ * error.
  *
  * # Safety
  * `result` must be a live handle; `delta0`, `delta_dot0` must point to n readable doubles,
@@ -3526,22 +3544,111 @@ mech_status_t mech_modal_free_response(const struct mech_modal_result_t *result,
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * Frees a result of mech_modal_solve. NULL is accepted and ignored.
+ *
+ * # Safety
+ * `result` must be NULL or a handle from mech_modal_solve not yet destroyed; it is invalid
+ * afterwards.
+ */
+void mech_modal_result_destroy(struct mech_modal_result_t *result);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Writes the number of modes of the result to `*modes` and the order n of the pencil to `*dim`.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `result` must be a live handle; `modes` and `dim` writable.
+ */
+mech_status_t mech_modal_result_size(const struct mech_modal_result_t *result,
+                                     size_t *modes,
+                                     size_t *dim);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies λ_k = −ω²_k (rad²/s²) of every mode, ascending in ω², into `lambda`; exactly the
+ * number of modes (mech_modal_result_size) is written.
+ *
+ * Errors: MECH_STATUS_BUFFER_TOO_SMALL when `capacity` is below the number of modes.
+ *
+ * # Safety
+ * `result` must be a live handle; `lambda` must have `capacity` writable doubles.
+ */
+mech_status_t mech_modal_result_eigenvalues(const struct mech_modal_result_t *result,
+                                            double *lambda,
+                                            size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies the scalar record of every mode (λ, ω², rate, error bound, backward error, kind,
+ * group and multiplicity), ascending in ω², into `modes`.
+ *
+ * Errors: MECH_STATUS_BUFFER_TOO_SMALL when `capacity` is below the number of modes.
+ *
+ * # Safety
+ * `result` must be a live handle; `modes` must have `capacity` writable elements.
+ */
+mech_status_t mech_modal_result_modes(const struct mech_modal_result_t *result,
+                                      struct mech_modal_mode_t *modes,
+                                      size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies the mode shapes as an n × (number of modes) column-major matrix into `x`, column k
+ * belonging to mode k. Finite modes are A-orthonormal (XᵀAX = I to the reported
+ * orthogonality error); infinite ones are unit null vectors of A.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when the solve computed values only;
+ * MECH_STATUS_BUFFER_TOO_SMALL when `capacity` < n·modes.
+ *
+ * # Safety
+ * `result` must be a live handle; `x` must have `capacity` writable doubles.
+ */
+mech_status_t mech_modal_result_vectors(const struct mech_modal_result_t *result,
+                                        double *x,
+                                        size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies the accuracy summary of the solve into `*accuracy`: norms, the largest backward
+ * error and error bound, the A-orthogonality error, the refined modes and the Sturm inertia
+ * check that certifies no mode below its shift was missed.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `result` must be a live handle; `accuracy` writable.
+ */
+mech_status_t mech_modal_result_accuracy(const struct mech_modal_result_t *result,
+                                         struct mech_modal_accuracy_t *accuracy);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * The `count` lowest modes of det(λA + B) = 0 for sparse n×n A (mass, positive semidefinite)
  * and B (stiffness) in compressed sparse columns (0-based, both triangles stored; duplicates are
  * summed): shift-invert block Lanczos on a sparse Cholesky factorization, certified by a sparse
- * inertia count. Writes ω²_k ascending into `omega_sq_out` (count), their error bounds into
- * `error_bound_out` (count, may be NULL), the A-orthonormal shapes as an n × count column-major
- * matrix into `vectors_out` (may be NULL) and the summary into `report_out` (may be NULL).
- * Exactly `count` modes are returned: when `count` cuts through a repeated eigenvalue, only
- * part of its eigenspace is (ask for more to get the whole group). Copies of a repeated
- * eigenvalue missed by the first Lanczos run are found by the inertia count and recovered by
- * deflated reruns; a result is never returned uncertified. Each pair converges until its
- * Ritz residual ‖K⁻¹Ax − θx‖_A ≤ 1e-12·θ (K = B − σA, θ = 1/(ω² − σ)), so its backward
- * error is at most about 1e-12·√κ(A)·‖K‖₂/‖B‖_F (κ(A) the condition number of A); the
- * eigenvalue errors are quadratic in that residual.
- * Errors: BAD_DIMENSION for an index ≥ n, NON_FINITE, INVALID_ARGUMENT for asymmetry, bad
- * column pointers or count ∉ [1, n]; NOT_POSITIVE_DEFINITE when no shift below the spectrum
- * was found (A indefinite); NOT_CONVERGED (also when the reruns run out).
+ * inertia count. Writes ω²_k (rad²/s²) ascending into `omega_sq_out` (count), their error
+ * bounds into `error_bound_out` (count, may be NULL), the A-orthonormal shapes as an n × count
+ * column-major matrix into `vectors_out` (may be NULL) and the accuracy summary into
+ * `report_out` (may be NULL). Exactly `count` modes are returned: when `count` cuts through a
+ * repeated eigenvalue, only part of its eigenspace is (ask for more to get the whole group).
+ * Copies of a repeated eigenvalue missed by the first Lanczos run are found by the inertia
+ * count and recovered by deflated reruns; a result is never returned uncertified. Each pair
+ * converges until its Ritz residual ‖K⁻¹Ax − θx‖_A ≤ 1e-12·θ (K = B − σA, θ = 1/(ω² − σ)), so
+ * its backward error is at most about 1e-12·√κ(A)·‖K‖₂/‖B‖_F (κ(A) the condition number of
+ * A); the eigenvalue errors are quadratic in that residual.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION for n = 0 or an index ≥ n; MECH_STATUS_NON_FINITE;
+ * MECH_STATUS_INVALID_ARGUMENT for asymmetry, bad column pointers or count ∉ [1, n];
+ * MECH_STATUS_NOT_POSITIVE_DEFINITE when no shift below the spectrum was found (A indefinite);
+ * MECH_STATUS_NOT_CONVERGED (also when the reruns run out). Nothing is written on error.
  *
  * # Safety
  * Each `*_col_ptr` must point to n + 1 readable size_t, each `*_row_idx` / `*_values` to
@@ -3563,15 +3670,31 @@ mech_status_t mech_modal_sparse_lowest(size_t n,
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * Writes the default options of mech_modal_sparse_solve to `options_out`: count 10, tolerance
+ * 1e-12, block size 2, 6 Lanczos runs, automatic shift (shift_given = 0, shift = 0). Set
+ * `count` to the number of modes wanted before solving.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `options_out` must point to a writable mech_modal_sparse_options_t.
+ */
+mech_status_t mech_modal_sparse_options_default(struct mech_modal_sparse_options_t *options_out);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * The `options->count` lowest modes of det(λA + B) = 0 for sparse A and B in compressed sparse
  * columns, as mech_modal_sparse_lowest, with options (tolerance, block size, runs, shift) and
  * the full record of each mode: `modes_out` (count) receives λ, ω², the rate, the error bound,
  * the backward error, the MECH_MODAL_KIND_* classification (zero when |ω²| is within its
  * bound or within what the rounding of A and B can change), the group index and the group's
- * multiplicity. `vectors_out` (n × count, column-major, may be NULL), `report_out` and
- * `details_out` (may be NULL) as named. Errors as mech_modal_sparse_lowest, plus
- * INVALID_ARGUMENT for a tolerance outside [0, 1) or shift_given ∉ {0, 1}, NON_FINITE for a
- * non-finite tolerance or given shift; nothing is written on error.
+ * multiplicity. `vectors_out` (n × count, column-major, may be NULL), `report_out` (the
+ * accuracy summary) and `details_out` (may be NULL) as named.
+ *
+ * Errors: as mech_modal_sparse_lowest, plus MECH_STATUS_INVALID_ARGUMENT for a tolerance
+ * outside [0, 1) or shift_given ∉ {0, 1}, MECH_STATUS_NON_FINITE for a non-finite tolerance or
+ * given shift. Nothing is written on error.
  *
  * # Safety
  * As mech_modal_sparse_lowest; `options` must point to a readable struct.
