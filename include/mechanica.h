@@ -4,10 +4,27 @@
  *
  * Conventions:
  *  - every fallible call returns a ::mech_status_t (0 = MECH_STATUS_OK) and writes its
- *    outputs only on success; mech_last_error() gives the detailed message of a failure;
+ *    outputs only on success (unless its documentation says otherwise); mech_last_error()
+ *    gives the detailed message of a failure;
+ *  - pointer arguments are required unless documented "may be NULL": NULL gives
+ *    MECH_STATUS_NULL_POINTER and a pointer misaligned for its type
+ *    MECH_STATUS_MISALIGNED_POINTER (each function's "Errors:" list leaves these two out);
+ *  - a NaN or infinite input number gives MECH_STATUS_NON_FINITE, except where a function
+ *    documents another treatment (infinite friction or joint limits, mech_mass_check's flags);
+ *  - a panic inside the library gives MECH_STATUS_PANIC (a library bug; please report it);
  *  - enums are passed as int32_t and validated (unknown values give MECH_STATUS_BAD_ENUM);
+ *  - inputs are passed by value or through const pointers; outputs are written through
+ *    pointers named *_out (some early functions name an output without the suffix; their
+ *    documentation says which arguments are written);
+ *  - each options struct has a mech_X_options_default() that writes its defaults; where a
+ *    function documents that its options pointer may be NULL, NULL means those defaults;
  *  - n×n matrices are caller-owned double arrays in column-major order (as LAPACK);
- *  - vectors carry their frame in the function documentation; units are SI.
+ *  - vectors carry their frame in the function documentation; units are SI;
+ *  - opaque handles (mech_tree_t, mech_mechanism_t, mech_modal_result_t) are created by one
+ *    function, owned by the caller and freed by their destroy function, which accepts NULL;
+ *    calls on distinct handles may run on different threads at once, while a call that takes a
+ *    handle as non-const must not overlap another call on the same handle; mech_last_error()
+ *    is per thread.
  *
  * Feature selection: each part of the library is declared only when its MECH_FEATURE_*
  * macro is defined. By default all are. A program linking a library built with a subset
@@ -1873,7 +1890,7 @@ typedef struct mech_modal_sparse_details_t {
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * Not valid (see the issue flags).
+ * Not valid (see the MECH_MASS_ISSUE_* flags in mech_mass_validity_t.issues).
  */
 #define MECH_INERTIA_INVALID 0
 #endif
@@ -2582,6 +2599,8 @@ mech_status_t mech_rotation_orthonormalize(const struct mech_mat3_t *matrix,
 /**
  * Creates an empty kinematic tree and writes its handle to `*tree_out`. The caller owns the
  * handle and frees it with mech_tree_destroy.
+ *
+ * Errors: none beyond the pointer checks.
  *
  * # Safety
  * `tree_out` must point to a writable mech_tree_t pointer.

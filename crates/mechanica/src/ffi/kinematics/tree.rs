@@ -83,6 +83,8 @@ pub(crate) fn check_dof(tree: &KinematicTree, given: usize, what: &str) -> Resul
 /// Creates an empty kinematic tree and writes its handle to `*tree_out`. The caller owns the
 /// handle and frees it with mech_tree_destroy.
 ///
+/// Errors: none beyond the pointer checks.
+///
 /// # Safety
 /// `tree_out` must point to a writable mech_tree_t pointer.
 #[unsafe(no_mangle)]

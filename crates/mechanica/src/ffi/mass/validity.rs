@@ -26,7 +26,7 @@ pub const MECH_MASS_ISSUE_TRIANGLE_INEQUALITY: mech_mass_issue_t = 32;
 
 /// The kind of body valid mass properties describe.
 pub type mech_inertia_class_t = i32;
-/// Not valid (see the issue flags).
+/// Not valid (see the MECH_MASS_ISSUE_* flags in mech_mass_validity_t.issues).
 pub const MECH_INERTIA_INVALID: mech_inertia_class_t = 0;
 /// A body with extent in three directions (positive definite, strict triangle inequality).
 pub const MECH_INERTIA_SOLID: mech_inertia_class_t = 1;
