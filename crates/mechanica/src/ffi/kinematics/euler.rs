@@ -194,3 +194,19 @@ pub unsafe extern "C" fn mech_euler_rates_from_angular_velocity(
         Ok(())
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ffi::c_enum::CEnum;
+
+    #[test]
+    fn each_sequence_constant_is_its_place_in_the_list_of_all_sequences() {
+        for (i, sequence) in EulerSequence::ALL.iter().enumerate() {
+            let raw = i32::try_from(i).expect("twelve sequences");
+            assert_eq!(EulerSequence::from_c(raw), Some(*sequence));
+        }
+        assert_eq!(EulerSequence::from_c(12), None);
+        assert_eq!(EulerSequence::from_c(-1), None);
+    }
+}
