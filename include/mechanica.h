@@ -4,10 +4,27 @@
  *
  * Conventions:
  *  - every fallible call returns a ::mech_status_t (0 = MECH_STATUS_OK) and writes its
- *    outputs only on success; mech_last_error() gives the detailed message of a failure;
+ *    outputs only on success (unless its documentation says otherwise); mech_last_error()
+ *    gives the detailed message of a failure;
+ *  - pointer arguments are required unless documented "may be NULL": NULL gives
+ *    MECH_STATUS_NULL_POINTER and a pointer misaligned for its type
+ *    MECH_STATUS_MISALIGNED_POINTER (each function's "Errors:" list leaves these two out);
+ *  - a NaN or infinite input number gives MECH_STATUS_NON_FINITE, except where a function
+ *    documents another treatment (infinite friction or joint limits, mech_mass_check's flags);
+ *  - a panic inside the library gives MECH_STATUS_PANIC (a library bug; please report it);
  *  - enums are passed as int32_t and validated (unknown values give MECH_STATUS_BAD_ENUM);
+ *  - inputs are passed by value or through const pointers; outputs are written through
+ *    pointers named *_out (some early functions name an output without the suffix; their
+ *    documentation says which arguments are written);
+ *  - each options struct has a mech_X_options_default() that writes its defaults; where a
+ *    function documents that its options pointer may be NULL, NULL means those defaults;
  *  - n×n matrices are caller-owned double arrays in column-major order (as LAPACK);
- *  - vectors carry their frame in the function documentation; units are SI.
+ *  - vectors carry their frame in the function documentation; units are SI;
+ *  - opaque handles (mech_tree_t, mech_mechanism_t, mech_modal_result_t) are created by one
+ *    function, owned by the caller and freed by their destroy function, which accepts NULL;
+ *    calls on distinct handles may run on different threads at once, while a call that takes a
+ *    handle as non-const must not overlap another call on the same handle; mech_last_error()
+ *    is per thread.
  *
  * Feature selection: each part of the library is declared only when its MECH_FEATURE_*
  * macro is defined. By default all are. A program linking a library built with a subset
@@ -117,30 +134,6 @@ typedef struct mech_tree_t mech_tree_t;
  */
 typedef int32_t mech_status_t;
 
-#if defined(MECH_FEATURE_IMPULSE)
-/**
- * The outcome of a collinear collision of two point masses (syllabus 5.16–5.23).
- */
-typedef struct mech_collinear_impact_t {
-    /**
-     * Velocity of point 1 after the impact (m/s).
-     */
-    double v1_after;
-    /**
-     * Velocity of point 2 after the impact (m/s).
-     */
-    double v2_after;
-    /**
-     * Impulse on point 2 (N·s); point 1 receives its negative.
-     */
-    double impulse_on_2;
-    /**
-     * Kinetic-energy change T⁺ − T⁻ (J), ≤ 0 for restitution ≤ 1 (5.23).
-     */
-    double energy_change;
-} mech_collinear_impact_t;
-#endif
-
 /**
  * A 3-vector of doubles (x, y, z). Its frame is stated by each function that uses it.
  */
@@ -159,46 +152,6 @@ typedef struct mech_vec3_t {
     double z;
 } mech_vec3_t;
 
-#if defined(MECH_FEATURE_IMPULSE)
-/**
- * The response of a point mass to an impulse (5.13, 7.106).
- */
-typedef struct mech_point_impulse_t {
-    /**
-     * Velocity just after, V = v + S/m (m/s).
-     */
-    struct mech_vec3_t velocity_after;
-    /**
-     * ΔT = ½ S·(V + v) (J).
-     */
-    double energy_change;
-} mech_point_impulse_t;
-#endif
-
-#if defined(MECH_FEATURE_IMPULSE)
-/**
- * The outcome of a 3-D collision of two smooth point masses along a normal.
- */
-typedef struct mech_point_impact_t {
-    /**
-     * Velocity of point 1 after the impact (m/s).
-     */
-    struct mech_vec3_t velocity_after_1;
-    /**
-     * Velocity of point 2 after the impact (m/s).
-     */
-    struct mech_vec3_t velocity_after_2;
-    /**
-     * Impulse on point 2, along the normal (N·s); point 1 receives its negative.
-     */
-    struct mech_vec3_t impulse_on_2;
-    /**
-     * Kinetic-energy change (J), −½(1 − λ²) μ (approach speed)² (5.23).
-     */
-    double energy_change;
-} mech_point_impact_t;
-#endif
-
 /**
  * A 3×3 matrix of doubles in column-major order: m[row + 3*col].
  */
@@ -211,8 +164,8 @@ typedef struct mech_mat3_t {
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * Mass properties: mass (kg), centre of mass (m, in the body's reference frame) and the
- * inertia tensor about the centre of mass (kg·m², same frame).
+ * Mass properties of a body: mass (kg), centre of mass (m, in the body's reference frame) and
+ * the inertia tensor about the centre of mass (kg·m², same frame).
  */
 typedef struct mech_mass_properties_t {
     /**
@@ -370,14 +323,15 @@ typedef struct mech_impulse_contact_t {
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**
- * The contact mode of an impact (int32), as reported in ::mech_impact_result_t.
+ * The contact mode of an impact (int32), as reported in ::mech_impact_result_t and
+ * ::mech_mechanism_contact_result_t.
  */
 typedef int32_t mech_contact_mode_t;
 #endif
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**
- * The outcome of a two-body point impact.
+ * The outcome of a two-body point impact (world frame).
  */
 typedef struct mech_impact_result_t {
     /**
@@ -477,6 +431,28 @@ typedef struct mech_mechanism_response_t {
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**
+ * Accuracy and budget of a mechanism impact. A NULL options pointer means the defaults, which
+ * mech_multi_contact_options_default writes (tolerance 1e-10, 10000 sweeps, process tolerance
+ * 1e-10).
+ */
+typedef struct mech_multi_contact_options_t {
+    /**
+     * Relative complementarity tolerance of the simultaneous model (> 0; default 1e-10).
+     */
+    double tolerance;
+    /**
+     * Maximum Gauss–Seidel sweeps per phase (≥ 1; default 10000).
+     */
+    uint64_t max_iterations;
+    /**
+     * Relative tolerance of the single-contact process (> 0; default 1e-10).
+     */
+    double process_tolerance;
+} mech_multi_contact_options_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
  * A contact of a mechanism with the environment or between two of its bodies.
  */
 typedef struct mech_mechanism_contact_t {
@@ -514,26 +490,6 @@ typedef struct mech_mechanism_contact_t {
      */
     mech_restitution_law_t law;
 } mech_mechanism_contact_t;
-#endif
-
-#if defined(MECH_FEATURE_IMPULSE)
-/**
- * Accuracy and budget of a mechanism impact; pass NULL for the defaults.
- */
-typedef struct mech_multi_contact_options_t {
-    /**
-     * Relative complementarity tolerance of the simultaneous model (> 0; default 1e-10).
-     */
-    double tolerance;
-    /**
-     * Maximum Gauss–Seidel sweeps per phase (≥ 1; default 10000).
-     */
-    uint64_t max_iterations;
-    /**
-     * Relative tolerance of the single-contact process (> 0; default 1e-10).
-     */
-    double process_tolerance;
-} mech_multi_contact_options_t;
 #endif
 
 #if defined(MECH_FEATURE_IMPULSE)
@@ -616,39 +572,74 @@ typedef struct mech_mechanism_impact_t {
 } mech_mechanism_impact_t;
 #endif
 
+#if defined(MECH_FEATURE_IMPULSE)
 /**
- * A unit quaternion w + x i + y j + z k (scalar first), representing a rotation.
+ * The outcome of a collinear collision of two point masses (syllabus 5.16–5.23).
  */
-typedef struct mech_quat_t {
+typedef struct mech_collinear_impact_t {
     /**
-     * Scalar part.
+     * Velocity of point 1 after the impact (m/s).
      */
-    double w;
+    double v1_after;
     /**
-     * i component.
+     * Velocity of point 2 after the impact (m/s).
      */
-    double x;
+    double v2_after;
     /**
-     * j component.
+     * Impulse on point 2 (N·s); point 1 receives its negative.
      */
-    double y;
+    double impulse_on_2;
     /**
-     * k component.
+     * Kinetic-energy change T⁺ − T⁻ (J), ≤ 0 for restitution ≤ 1 (5.23).
      */
-    double z;
-} mech_quat_t;
+    double energy_change;
+} mech_collinear_impact_t;
+#endif
 
-#if defined(MECH_FEATURE_KINEMATICS)
+#if defined(MECH_FEATURE_IMPULSE)
 /**
- * How mech_rotation_matrix_from_quat treats a quaternion that is not of unit length.
+ * The response of a point mass to an impulse (5.13, 7.106).
  */
-typedef int32_t mech_quat_norm_t;
+typedef struct mech_point_impulse_t {
+    /**
+     * Velocity just after, V = v + S/m (m/s).
+     */
+    struct mech_vec3_t velocity_after;
+    /**
+     * ΔT = ½ S·(V + v) (J).
+     */
+    double energy_change;
+} mech_point_impulse_t;
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The outcome of a 3-D collision of two smooth point masses along a normal.
+ */
+typedef struct mech_point_impact_t {
+    /**
+     * Velocity of point 1 after the impact (m/s).
+     */
+    struct mech_vec3_t velocity_after_1;
+    /**
+     * Velocity of point 2 after the impact (m/s).
+     */
+    struct mech_vec3_t velocity_after_2;
+    /**
+     * Impulse on point 2, along the normal (N·s); point 1 receives its negative.
+     */
+    struct mech_vec3_t impulse_on_2;
+    /**
+     * Kinetic-energy change (J), −½(1 − λ²) μ (approach speed)² (5.23).
+     */
+    double energy_change;
+} mech_point_impact_t;
 #endif
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * An intrinsic Euler axis sequence: R = R_i(a) R_j(b) R_k(c), angles = {a, b, c}.
- * The EB1911 angles (θ, φ, ψ) of the seed are MECH_EULER_ZYZ with {a, b, c} = {ψ, θ, φ}.
+ * An intrinsic Euler axis sequence: R = R_i(a) R_j(b) R_k(c), angles = {a, b, c} (rad).
+ * EB1911's angles (θ, φ, ψ) are MECH_EULER_ZYZ with {a, b, c} = {ψ, θ, φ}.
  */
 typedef int32_t mech_euler_sequence_t;
 #endif
@@ -662,7 +653,15 @@ typedef int32_t mech_frame_t;
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The state of a rigid motion x = R X + c (syllabus 1.5), all world components.
+ * Which Jacobian mech_tree_jacobian computes.
+ */
+typedef int32_t mech_jacobian_kind_t;
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The state of a rigid motion x = R X + c (syllabus 1.5) at one instant, all in fixed (world)
+ * components, SI units.
  */
 typedef struct mech_rigid_motion_t {
     /**
@@ -694,7 +693,7 @@ typedef struct mech_rigid_motion_t {
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * A point's absolute motion decomposed relative to a moving frame (world components,
+ * A point's absolute motion decomposed relative to a moving frame (world components, SI units,
  * syllabus 2.22–2.32): v = v_drag + v_rel, a = a_drag + a_coriolis + a_rel.
  */
 typedef struct mech_relative_decomposition_t {
@@ -725,6 +724,35 @@ typedef struct mech_relative_decomposition_t {
 } mech_relative_decomposition_t;
 #endif
 
+/**
+ * A unit quaternion w + x i + y j + z k (scalar first), representing a rotation.
+ */
+typedef struct mech_quat_t {
+    /**
+     * Scalar part.
+     */
+    double w;
+    /**
+     * i component.
+     */
+    double x;
+    /**
+     * j component.
+     */
+    double y;
+    /**
+     * k component.
+     */
+    double z;
+} mech_quat_t;
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * How mech_rotation_matrix_from_quat treats a quaternion that is not of unit length.
+ */
+typedef int32_t mech_quat_norm_t;
+#endif
+
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
  * The joint type of a tree body.
@@ -735,8 +763,8 @@ typedef int32_t mech_joint_type_t;
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
  * The prescribed motion of a tree's base frame 0 at the current time, all in world
- * components: a moving (rheonomic) base makes the drag velocity of a point x equal to
- * v₀ + ω₀ × (x − p₀) and splits T = T₀ + T₁ + T₂ (9.7–9.10).
+ * components, SI units: a moving (rheonomic) base makes the drag velocity of a point x equal
+ * to v₀ + ω₀ × (x − p₀) and splits T = T₀ + T₁ + T₂ (9.7–9.10).
  */
 typedef struct mech_base_state_t {
     /**
@@ -764,62 +792,6 @@ typedef struct mech_base_state_t {
      */
     struct mech_vec3_t acceleration;
 } mech_base_state_t;
-#endif
-
-#if defined(MECH_FEATURE_KINEMATICS)
-/**
- * Which Jacobian mech_tree_jacobian computes.
- */
-typedef int32_t mech_jacobian_kind_t;
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * Kinds of primitive bodies for mech_mass_primitive. Each lists its `dimensions` (metres) and
- * the frame it is built in; "centred" means the origin is the centre of mass.
- */
-typedef int32_t mech_primitive_t;
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * How the `amount` argument of mech_mass_primitive and mech_mass_mesh is read.
- */
-typedef int32_t mech_amount_t;
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * Bit flags of mech_mass_validity_t.issues: what is wrong with mass properties.
- */
-typedef uint32_t mech_mass_issue_t;
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * The kind of body valid mass properties describe.
- */
-typedef int32_t mech_inertia_class_t;
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * The result of mech_mass_check.
- */
-typedef struct mech_mass_validity_t {
-    /**
-     * OR of MECH_MASS_ISSUE_* flags; 0 when the properties are valid.
-     */
-    mech_mass_issue_t issues;
-    /**
-     * A mech_inertia_class_t: MECH_INERTIA_INVALID when `issues` ≠ 0.
-     */
-    mech_inertia_class_t inertia_class;
-    /**
-     * Eigenvalues of the symmetric part of the tensor, ascending (zeros when non-finite).
-     */
-    struct mech_vec3_t moments;
-} mech_mass_validity_t;
 #endif
 
 #if defined(MECH_FEATURE_MASS)
@@ -852,8 +824,9 @@ typedef int32_t mech_degenerate_t;
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * Options of mech_mass_mesh. All zeros is the default: solid, reject open meshes, flip
- * inside-out meshes, skip degenerate triangles.
+ * Options of mech_mass_mesh and mech_mass_mesh_same_connectivity; a NULL options pointer
+ * means the defaults, which mech_mesh_options_default writes: solid, reject open meshes, flip
+ * inside-out meshes, skip degenerate triangles (all fields zero).
  */
 typedef struct mech_mesh_options_t {
     /**
@@ -873,6 +846,13 @@ typedef struct mech_mesh_options_t {
      */
     mech_degenerate_t degenerate;
 } mech_mesh_options_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * How the `amount` argument of mech_mass_primitive and mech_mass_mesh is read.
+ */
+typedef int32_t mech_amount_t;
 #endif
 
 #if defined(MECH_FEATURE_MASS)
@@ -921,6 +901,14 @@ typedef struct mech_mesh_report_t {
 
 #if defined(MECH_FEATURE_MASS)
 /**
+ * Kinds of primitive bodies for mech_mass_primitive. Each lists its `dimensions` (metres) and
+ * the frame it is built in; "centred" means the origin is the centre of mass.
+ */
+typedef int32_t mech_primitive_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
  * The kinetic energy of a tree on a moving base split by powers of q̇ (syllabus 9.7–9.10).
  */
 typedef struct mech_energy_split_t {
@@ -941,6 +929,41 @@ typedef struct mech_energy_split_t {
      */
     double total;
 } mech_energy_split_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Bit flags of mech_mass_validity_t.issues: what is wrong with mass properties.
+ */
+typedef uint32_t mech_mass_issue_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The kind of body valid mass properties describe.
+ */
+typedef int32_t mech_inertia_class_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The result of mech_mass_check.
+ */
+typedef struct mech_mass_validity_t {
+    /**
+     * OR of MECH_MASS_ISSUE_* flags; 0 when the properties are valid.
+     */
+    mech_mass_issue_t issues;
+    /**
+     * A mech_inertia_class_t: MECH_INERTIA_INVALID when `issues` ≠ 0.
+     */
+    mech_inertia_class_t inertia_class;
+    /**
+     * Eigenvalues of the symmetric part of the tensor (kg·m²), ascending (zeros when
+     * non-finite).
+     */
+    struct mech_vec3_t moments;
+} mech_mass_validity_t;
 #endif
 
 #if defined(MECH_FEATURE_MECHANISM)
@@ -1034,7 +1057,9 @@ typedef int32_t mech_modal_refinement_t;
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * Options of mech_modal_solve.
+ * Options of mech_modal_solve. The pointer is required (NULL gives MECH_STATUS_NULL_POINTER);
+ * mech_modal_options_default writes the defaults: every mode, with shapes, automatic
+ * refinement.
  */
 typedef struct mech_modal_options_t {
     /**
@@ -1069,6 +1094,41 @@ typedef struct mech_modal_options_t {
  * How the accuracy report measures residuals (int32_t; see MECH_MODAL_RESIDUALS_*).
  */
 typedef int32_t mech_modal_residuals_t;
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * How well the modal coordinates of mech_modal_free_response reproduce the initial state, and
+ * the response's own error bound.
+ */
+typedef struct mech_modal_response_fit_t {
+    /**
+     * ‖δ(0) − Σ q_k(0) x_k‖₂ (m).
+     */
+    double displacement_residual;
+    /**
+     * ‖δ̇(0) − Σ q̇_k(0) x_k‖₂ (m/s).
+     */
+    double velocity_residual;
+    /**
+     * displacement_residual / ‖δ(0)‖₂ (0 when δ(0) = 0).
+     */
+    double relative_displacement_residual;
+    /**
+     * velocity_residual / ‖δ̇(0)‖₂ (0 when δ̇(0) = 0).
+     */
+    double relative_velocity_residual;
+    /**
+     * The largest first-order bound on ‖δ(t) − δ_exact(t)‖₂ over the requested times, from the
+     * error bounds of the frequencies (phase drift) and rounding; excludes the residuals above.
+     */
+    double max_error_bound;
+    /**
+     * Number of massless coordinates (infinite modes); they follow the massive ones statically,
+     * so with massless > 0 the residuals include the inconsistency of δ(0), δ̇(0).
+     */
+    size_t massless;
+} mech_modal_response_fit_t;
 #endif
 
 #if defined(MECH_FEATURE_MODAL)
@@ -1170,42 +1230,7 @@ typedef struct mech_modal_accuracy_t {
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * How well the modal coordinates of mech_modal_free_response reproduce the initial state, and
- * the response's own error bound.
- */
-typedef struct mech_modal_response_fit_t {
-    /**
-     * ‖δ(0) − Σ q_k(0) x_k‖₂ (m).
-     */
-    double displacement_residual;
-    /**
-     * ‖δ̇(0) − Σ q̇_k(0) x_k‖₂ (m/s).
-     */
-    double velocity_residual;
-    /**
-     * displacement_residual / ‖δ(0)‖₂ (0 when δ(0) = 0).
-     */
-    double relative_displacement_residual;
-    /**
-     * velocity_residual / ‖δ̇(0)‖₂ (0 when δ̇(0) = 0).
-     */
-    double relative_velocity_residual;
-    /**
-     * The largest first-order bound on ‖δ(t) − δ_exact(t)‖₂ over the requested times, from the
-     * error bounds of the frequencies (phase drift) and rounding; excludes the residuals above.
-     */
-    double max_error_bound;
-    /**
-     * Number of massless coordinates (infinite modes); they follow the massive ones statically,
-     * so with massless > 0 the residuals include the inconsistency of δ(0), δ̇(0).
-     */
-    size_t massless;
-} mech_modal_response_fit_t;
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Accuracy and cost summary of mech_modal_sparse_lowest.
+ * Accuracy and cost summary of mech_modal_sparse_lowest and mech_modal_sparse_solve.
  */
 typedef struct mech_modal_sparse_report_t {
     /**
@@ -1249,8 +1274,11 @@ typedef struct mech_modal_sparse_report_t {
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * Options of mech_modal_sparse_solve. Zero fields take the defaults, so a zero-initialised
- * struct with `count` set is the default solve of mech_modal_sparse_lowest.
+ * Options of mech_modal_sparse_solve. The pointer is required (NULL gives
+ * MECH_STATUS_NULL_POINTER), as `count` has no meaningful default. Zero fields other than
+ * `count` take the defaults, so a zero-initialised struct with `count` set is the default
+ * solve of mech_modal_sparse_lowest; mech_modal_sparse_options_default writes the defaults
+ * explicitly.
  */
 typedef struct mech_modal_sparse_options_t {
     /**
@@ -1399,27 +1427,6 @@ typedef struct mech_modal_sparse_details_t {
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**
- * The body is free.
- */
-#define MECH_BODY_FREE 0
-#endif
-
-#if defined(MECH_FEATURE_IMPULSE)
-/**
- * The body is held by a spherical hinge at `hinge_point` (world-fixed) (7.87*–7.91*).
- */
-#define MECH_BODY_HINGE_POINT 1
-#endif
-
-#if defined(MECH_FEATURE_IMPULSE)
-/**
- * The body can only rotate about the unit `hinge_axis` through `hinge_point` (7.87*–7.91*).
- */
-#define MECH_BODY_HINGE_AXIS 2
-#endif
-
-#if defined(MECH_FEATURE_IMPULSE)
-/**
  * Newton's kinematic law u_n⁺ = −e u_n⁻ (7.94); may gain energy with friction (Kane's paradox).
  */
 #define MECH_RESTITUTION_NEWTON 0
@@ -1482,18 +1489,25 @@ typedef struct mech_modal_sparse_details_t {
 #define MECH_CONTACT_REVERSED 5
 #endif
 
-#if defined(MECH_FEATURE_KINEMATICS)
+#if defined(MECH_FEATURE_IMPULSE)
 /**
- * Accept only quaternions with |‖q‖ − 1| ≤ 1e-12; others give MECH_STATUS_INVALID_ARGUMENT.
+ * The body is free.
  */
-#define MECH_QUAT_REQUIRE_UNIT 0
+#define MECH_BODY_FREE 0
 #endif
 
-#if defined(MECH_FEATURE_KINEMATICS)
+#if defined(MECH_FEATURE_IMPULSE)
 /**
- * Normalise any non-zero quaternion first (zero gives MECH_STATUS_INVALID_ARGUMENT).
+ * The body is held by a spherical hinge at `hinge_point` (world-fixed) (7.87*–7.91*).
  */
-#define MECH_QUAT_NORMALIZE 1
+#define MECH_BODY_HINGE_POINT 1
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * The body can only rotate about the unit `hinge_axis` through `hinge_point` (7.87*–7.91*).
+ */
+#define MECH_BODY_HINGE_AXIS 2
 #endif
 
 #if defined(MECH_FEATURE_KINEMATICS)
@@ -1596,6 +1610,48 @@ typedef struct mech_modal_sparse_details_t {
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
+ * ∂x/∂q of a body point (syllabus 1.37): 3×dof.
+ */
+#define MECH_JACOBIAN_POINT 0
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * ∂ω/∂q̇ of the body: 3×dof.
+ */
+#define MECH_JACOBIAN_ANGULAR 1
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * d/dt of MECH_JACOBIAN_POINT along the current (q, q̇): 3×dof.
+ */
+#define MECH_JACOBIAN_POINT_RATE 2
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * d/dt of MECH_JACOBIAN_ANGULAR: 3×dof.
+ */
+#define MECH_JACOBIAN_ANGULAR_RATE 3
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Accept only quaternions with |‖q‖ − 1| ≤ 1e-12; others give MECH_STATUS_INVALID_ARGUMENT.
+ */
+#define MECH_QUAT_REQUIRE_UNIT 0
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Normalise any non-zero quaternion first (zero gives MECH_STATUS_INVALID_ARGUMENT).
+ */
+#define MECH_QUAT_NORMALIZE 1
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
  * One rotation about a unit axis (q: angle).
  */
 #define MECH_JOINT_REVOLUTE 0
@@ -1636,32 +1692,60 @@ typedef struct mech_modal_sparse_details_t {
 #define MECH_JOINT_FIXED 5
 #endif
 
-#if defined(MECH_FEATURE_KINEMATICS)
+#if defined(MECH_FEATURE_MASS)
 /**
- * ∂x/∂q of a body point (syllabus 1.37): 3×dof.
+ * A closed surface bounding a solid of uniform volume density.
  */
-#define MECH_JACOBIAN_POINT 0
+#define MECH_MESH_SOLID 0
 #endif
 
-#if defined(MECH_FEATURE_KINEMATICS)
+#if defined(MECH_FEATURE_MASS)
 /**
- * ∂ω/∂q̇ of the body: 3×dof.
+ * A thin shell with uniform surface density (kg/m²).
  */
-#define MECH_JACOBIAN_ANGULAR 1
+#define MECH_MESH_SHELL 1
 #endif
 
-#if defined(MECH_FEATURE_KINEMATICS)
+#if defined(MECH_FEATURE_MASS)
 /**
- * d/dt of MECH_JACOBIAN_POINT along the current (q, q̇): 3×dof.
+ * Fail with MECH_STATUS_INVALID_ARGUMENT (the message gives the boundary-edge count).
  */
-#define MECH_JACOBIAN_POINT_RATE 2
+#define MECH_OPEN_MESH_REJECT 0
 #endif
 
-#if defined(MECH_FEATURE_KINEMATICS)
+#if defined(MECH_FEATURE_MASS)
 /**
- * d/dt of MECH_JACOBIAN_ANGULAR: 3×dof.
+ * Fall back to the shell model; a density amount is then read as kg/m².
  */
-#define MECH_JACOBIAN_ANGULAR_RATE 3
+#define MECH_OPEN_MESH_SHELL 1
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Reverse the orientation and report `flipped` = 1.
+ */
+#define MECH_INSIDE_OUT_FLIP 0
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Fail with MECH_STATUS_INVALID_ARGUMENT.
+ */
+#define MECH_INSIDE_OUT_REJECT 1
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Count them in the report and leave them out of the integrals.
+ */
+#define MECH_DEGENERATE_SKIP 0
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Fail with MECH_STATUS_INVALID_ARGUMENT.
+ */
+#define MECH_DEGENERATE_REJECT 1
 #endif
 
 #if defined(MECH_FEATURE_MASS)
@@ -1806,7 +1890,7 @@ typedef struct mech_modal_sparse_details_t {
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * Not valid (see the issue flags).
+ * Not valid (see the MECH_MASS_ISSUE_* flags in mech_mass_validity_t.issues).
  */
 #define MECH_INERTIA_INVALID 0
 #endif
@@ -1837,62 +1921,6 @@ typedef struct mech_modal_sparse_details_t {
  * A point mass: zero central inertia. Valid.
  */
 #define MECH_INERTIA_POINT 4
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * A closed surface bounding a solid of uniform volume density.
- */
-#define MECH_MESH_SOLID 0
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * A thin shell with uniform surface density (kg/m²).
- */
-#define MECH_MESH_SHELL 1
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * Fail with MECH_STATUS_INVALID_ARGUMENT (the message gives the boundary-edge count).
- */
-#define MECH_OPEN_MESH_REJECT 0
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * Fall back to the shell model; a density amount is then read as kg/m².
- */
-#define MECH_OPEN_MESH_SHELL 1
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * Reverse the orientation and report `flipped` = 1.
- */
-#define MECH_INSIDE_OUT_FLIP 0
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * Fail with MECH_STATUS_INVALID_ARGUMENT.
- */
-#define MECH_INSIDE_OUT_REJECT 1
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * Count them in the report and leave them out of the integrals.
- */
-#define MECH_DEGENERATE_SKIP 0
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * Fail with MECH_STATUS_INVALID_ARGUMENT.
- */
-#define MECH_DEGENERATE_REJECT 1
 #endif
 
 #if defined(MECH_FEATURE_MECHANISM)
@@ -1953,6 +1981,21 @@ typedef struct mech_modal_sparse_details_t {
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * A X, B X and XᵀAX formed in full: exact backward errors and orthogonality (5n²m flops).
+ */
+#define MECH_MODAL_RESIDUALS_EXACT 0
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Gaussian sketches (O(32·n²) flops): each backward error and the orthogonality error (then a
+ * bound on ‖XᵀAX − I‖_F) is an upper bound that fails with probability ≤ 1e-12.
+ */
+#define MECH_MODAL_RESIDUALS_SKETCHED 1
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * λ < 0: oscillates at ω = √(−λ) rad/s.
  */
 #define MECH_MODAL_KIND_OSCILLATORY 0
@@ -1977,21 +2020,6 @@ typedef struct mech_modal_sparse_details_t {
  * Massless direction (A x = 0): infinite frequency.
  */
 #define MECH_MODAL_KIND_INFINITE 3
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * A X, B X and XᵀAX formed in full: exact backward errors and orthogonality (5n²m flops).
- */
-#define MECH_MODAL_RESIDUALS_EXACT 0
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Gaussian sketches (O(32·n²) flops): each backward error and the orthogonality error (then a
- * bound on ‖XᵀAX − I‖_F) is an upper bound that fails with probability ≤ 1e-12.
- */
-#define MECH_MODAL_RESIDUALS_SKETCHED 1
 #endif
 
 #ifdef __cplusplus
@@ -2040,59 +2068,15 @@ uint32_t mech_features(void);
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**
- * Collides point 1 (mass `m1`, velocity `v1`) with point 2 (mass `m2`, velocity `v2`) on one
- * line with Newton's restitution coefficient `restitution` ∈ [0, 1]. Points that do not
- * approach (v1 ≤ v2) receive no impulse.
+ * Builds a free ::mech_impulse_body_t into `out` from mass properties expressed in the world
+ * frame (mass in kg, centre of mass p_WC in m, central inertia in W axes in kg·m²) and the
+ * velocities just before the impact (`velocity` of the centre in m/s, `angular_velocity` in
+ * rad/s). The inverse inertia is the pseudo-inverse (eigenvalues ≤ 1e-12·λ_max count as zero),
+ * so rods and point masses are accepted.
  *
- * # Safety
- * `out` must point to a writable mech_collinear_impact_t.
- */
-mech_status_t mech_collide_collinear(double m1,
-                                     double v1,
-                                     double m2,
-                                     double v2,
-                                     double restitution,
-                                     struct mech_collinear_impact_t *out);
-#endif
-
-#if defined(MECH_FEATURE_IMPULSE)
-/**
- * Applies the impulse `impulse` (N·s) to a point of mass `mass` moving at `velocity`
- * (5.10–5.15): the momentum jumps by the impulse; the position does not change.
- *
- * # Safety
- * `velocity` and `impulse` must be readable, `out` writable.
- */
-mech_status_t mech_impulse_on_point(double mass,
-                                    const struct mech_vec3_t *velocity,
-                                    const struct mech_vec3_t *impulse,
-                                    struct mech_point_impulse_t *out);
-#endif
-
-#if defined(MECH_FEATURE_IMPULSE)
-/**
- * Collides two smooth point masses (spheres) along the unit `normal` pointing from point 1 to
- * point 2, with restitution λ ∈ [0, 1] (5.16–5.23 on the normal components). Points that do
- * not approach receive no impulse.
- *
- * # Safety
- * `v1`, `v2` and `normal` must be readable, `out` writable.
- */
-mech_status_t mech_collide_points(double m1,
-                                  const struct mech_vec3_t *v1,
-                                  double m2,
-                                  const struct mech_vec3_t *v2,
-                                  const struct mech_vec3_t *normal,
-                                  double restitution,
-                                  struct mech_point_impact_t *out);
-#endif
-
-#if defined(MECH_FEATURE_IMPULSE)
-/**
- * Builds a free ::mech_impulse_body_t from mass properties expressed in the world frame
- * (centre of mass p_WC, central inertia in W axes) and the velocities just before the impact.
- * The inverse inertia is the pseudo-inverse (eigenvalues ≤ 1e-12·λ_max count as zero), so
- * rods and point masses are accepted.
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0; MECH_STATUS_NOT_POSITIVE_DEFINITE for an inertia tensor that is not positive
+ * semidefinite.
  *
  * # Safety
  * `properties`, `velocity` and `angular_velocity` must be readable, `out` writable.
@@ -2105,9 +2089,16 @@ mech_status_t mech_impulse_body_from_mass_properties(const struct mech_mass_prop
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**
- * Applies the impulse `impulse` at the world point `point` together with the impulsive moment
- * `moment_about_point` about that point to `body` (7.61–7.71). For a hinged body the hinge
- * impulse is included (it does no work).
+ * Applies the impulse `impulse` (N·s) at the world point `point` (m) together with the
+ * impulsive moment `moment_about_point` (N·m·s) about that point to `body` (7.61–7.71), all in
+ * world components, and writes the velocities after and the energy change to `out`. For a
+ * hinged body the hinge impulse is included (it does no work).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_BAD_ENUM for an
+ * unknown `body->constraint`; MECH_STATUS_INVALID_ARGUMENT for an invalid body (negative
+ * inverse mass, non-unit hinge axis, velocities that violate the hinge) or an impulse that
+ * excites an axis of zero inertia;
+ * MECH_STATUS_NOT_POSITIVE_DEFINITE for an inverse inertia that is not positive semidefinite.
  *
  * # Safety
  * All pointers must be readable, `out` writable.
@@ -2121,8 +2112,12 @@ mech_status_t mech_impulse_apply(const struct mech_impulse_body_t *body,
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**
- * Brings the body point at `point` to rest by a single impulse at that point (7.100–7.108).
- * MECH_STATUS_SINGULAR if the point cannot be stopped (e.g. a moving body of infinite mass).
+ * Brings the body point at world position `point` (m) to rest by a single impulse at that
+ * point (7.100–7.108) and writes the impulse, the velocities after, the energy change and the
+ * residual speed of the point (the accuracy of the solve) to `out`.
+ *
+ * Errors: as mech_impulse_apply, and MECH_STATUS_SINGULAR when the point cannot be stopped
+ * (e.g. a moving body of infinite mass).
  *
  * # Safety
  * `body` and `point` must be readable, `out` writable.
@@ -2136,10 +2131,14 @@ mech_status_t mech_impulse_fix_point(const struct mech_impulse_body_t *body,
 /**
  * Resolves the impact of `body1` and `body2` at `contact` (7.72–7.99): smooth or rough
  * (isotropic Coulomb, with stick, slip, halting, reversal and 3-D swerving slip) with the
- * selected restitution law. MECH_STATUS_INVALID_ARGUMENT for a non-unit normal, restitution
- * outside [0, 1] or negative friction; MECH_STATUS_BAD_ENUM for an unknown law or constraint;
- * MECH_STATUS_SINGULAR when neither body can move along the normal; MECH_STATUS_NOT_CONVERGED
- * for a frictional jam.
+ * selected restitution law, and writes the impulse, the velocities after, the energy change
+ * and the estimated error of the impulse (`integration_error`) to `out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_BAD_ENUM for an
+ * unknown law or constraint; MECH_STATUS_INVALID_ARGUMENT for a non-unit normal, restitution
+ * outside [0, 1], negative friction, a non-positive tolerance or an invalid body (see
+ * mech_impulse_apply); MECH_STATUS_SINGULAR when neither body can move along the normal;
+ * MECH_STATUS_NOT_CONVERGED for a frictional jam.
  *
  * # Safety
  * `body1`, `body2` and `contact` must be readable, `out` writable.
@@ -2154,10 +2153,13 @@ mech_status_t mech_impulse_resolve_contact(const struct mech_impulse_body_t *bod
 /**
  * Lagrange's impulse equations A(q) Δq̇ = Σ J_kᵀ S_k (7.115–7.117) for the tree at the state
  * of mech_tree_set_state, with `bodies` = one mass-properties value per body (body frame;
- * mass ≥ 0). Writes Δq̇ (`dof` doubles) and the energy report. MECH_STATUS_NOT_POSITIVE_DEFINITE
+ * mass ≥ 0). Writes the jump of the generalized velocities Δq̇ (`dof` doubles, into
+ * `delta_q_dot`) and the energy report with the backward error of the solve (into `out`).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_NOT_POSITIVE_DEFINITE
  * when A is singular (a rod or point mass whose spin has a coordinate, a massless leaf);
- * MECH_STATUS_INVALID_ARGUMENT for a body index out of range; MECH_STATUS_BAD_DIMENSION for a
- * wrong `body_count` or `dof`.
+ * MECH_STATUS_INVALID_ARGUMENT for a body index out of range, a tree that is not finalized or
+ * has no state; MECH_STATUS_BAD_DIMENSION for a wrong `body_count` or `dof`.
  *
  * # Safety
  * `tree` must be a live handle; `bodies` must point to `body_count` readable values,
@@ -2176,18 +2178,37 @@ mech_status_t mech_impulse_mechanism_apply(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**
+ * Writes the default options of a mechanism impact (those a NULL options pointer selects) to
+ * `options_out`.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `options_out` must point to a writable mech_multi_contact_options_t.
+ */
+mech_status_t mech_multi_contact_options_default(struct mech_multi_contact_options_t *options_out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
  * Resolves an impact of the mechanism `tree` (at the state of mech_tree_set_state; `bodies`
- * one mass-properties value per body) at `contact_count` contacts. One contact: the
- * impulse-parameterised process with the contact's restitution law (as
+ * one mass-properties value per body, body frame) at `contact_count` contacts. One contact:
+ * the impulse-parameterised process with the contact's restitution law (as
  * mech_impulse_resolve_contact, on W = J A⁻¹ Jᵀ). Several contacts: the simultaneous
  * two-phase model (inelastic Signorini–Coulomb compression, then Poisson restitution with
  * friction, energy-guarded so that ΔT ≤ 0) solved by projected block Gauss–Seidel from zero
- * in contact order; see the Rust docs of mechanica_impulse::multi_contact. `options` may be
- * NULL for the defaults. Writes one result per contact, Δq̇ (`dof` doubles) and the report.
- * MECH_STATUS_SINGULAR when an approaching contact cannot move along its normal;
- * MECH_STATUS_NOT_POSITIVE_DEFINITE for a singular mass matrix; MECH_STATUS_NOT_CONVERGED for
- * a frictional jam of the single-contact process (an unconverged simultaneous solve is
- * reported by `converged` = 0, not an error).
+ * in contact order. `options` may be NULL for the defaults (see
+ * mech_multi_contact_options_default). Writes one result per contact into `results` (world
+ * frame), the jump Δq̇ (`dof` doubles) into `delta_q_dot` and the report, with its residual or
+ * integration error, into `out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_BAD_ENUM for an
+ * unknown law; MECH_STATUS_BAD_DIMENSION for a wrong `body_count` or `dof`;
+ * MECH_STATUS_INVALID_ARGUMENT for bad options, a contact law out of range, a body index out
+ * of range, or a tree that is not finalized or has no state; MECH_STATUS_SINGULAR when an
+ * approaching contact cannot move along its normal; MECH_STATUS_NOT_POSITIVE_DEFINITE for a
+ * singular mass matrix; MECH_STATUS_NOT_CONVERGED for a frictional jam of the single-contact
+ * process (an unconverged simultaneous solve is reported by `converged` = 0, not an error).
  *
  * # Safety
  * `tree` must be a live handle; `bodies` must point to `body_count` readable values,
@@ -2208,12 +2229,15 @@ mech_status_t mech_impulse_mechanism_contacts(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**
- * The contact-space (Delassus) matrix W = J A⁻¹ Jᵀ of `contact_count` contacts of the
- * mechanism at the state of mech_tree_set_state, into `delassus` (column-major, `rows` × `rows`
- * with rows = 3·contact_count; rows 3i, 3i+1, 3i+2 are the tangents t₁, t₂ and the normal of
- * contact i), its numerical rank into `rank_out`, and the contact frames (columns t₁, t₂, n;
- * world) into `frames` (`contact_count` matrices). The restitution and friction of the contacts
- * are validated but not used.
+ * The contact-space (Delassus) matrix W = J A⁻¹ Jᵀ (m/(N·s)) of `contact_count` contacts of
+ * the mechanism at the state of mech_tree_set_state, into `delassus` (column-major, `rows` ×
+ * `rows` with rows = 3·contact_count; rows 3i, 3i+1, 3i+2 are the tangents t₁, t₂ and the
+ * normal of contact i), its numerical rank into `rank_out`, and the contact frames (columns
+ * t₁, t₂, n; world) into `frames` (`contact_count` matrices). The restitution and friction of
+ * the contacts are validated but not used.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION for rows ≠ 3·contact_count or a wrong `body_count`;
+ * otherwise as mech_impulse_mechanism_contacts.
  *
  * # Safety
  * `tree` must be a live handle; `bodies` must point to `body_count` readable values,
@@ -2231,102 +2255,75 @@ mech_status_t mech_impulse_mechanism_delassus(struct mech_tree_t *tree,
                                               size_t *rank_out);
 #endif
 
-#if defined(MECH_FEATURE_KINEMATICS)
+#if defined(MECH_FEATURE_IMPULSE)
 /**
- * Converts a rotation matrix (column-major) into a unit quaternion.
+ * Collides point 1 (mass `m1` in kg, velocity `v1` in m/s) with point 2 (`m2`, `v2`) on one
+ * line with Newton's restitution coefficient `restitution` ∈ [0, 1] (5.16–5.23), writing the
+ * velocities after, the impulse and the energy change to `out`. Points that do not approach
+ * (v1 ≤ v2) receive no impulse.
  *
- * Fails with MECH_STATUS_INVALID_ARGUMENT when `rotation` is not orthogonal with det = +1
- * within 1e-12 (‖RᵀR − I‖_F).
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0 or a restitution outside [0, 1].
  *
  * # Safety
- * `rotation` must point to a readable mech_mat3_t and `quaternion_out` to a writable mech_quat_t.
+ * `out` must point to a writable mech_collinear_impact_t.
  */
-mech_status_t mech_quat_from_rotation_matrix(const struct mech_mat3_t *rotation,
-                                             struct mech_quat_t *quaternion_out);
+mech_status_t mech_collide_collinear(double m1,
+                                     double v1,
+                                     double m2,
+                                     double v2,
+                                     double restitution,
+                                     struct mech_collinear_impact_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Applies the impulse `impulse` (N·s) to a point of mass `mass` (kg) moving at `velocity`
+ * (m/s), all vectors in one frame (5.10–5.15): the momentum jumps by the impulse; the position
+ * does not change. Writes the velocity after and the energy change to `out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0.
+ *
+ * # Safety
+ * `velocity` and `impulse` must be readable, `out` writable.
+ */
+mech_status_t mech_impulse_on_point(double mass,
+                                    const struct mech_vec3_t *velocity,
+                                    const struct mech_vec3_t *impulse,
+                                    struct mech_point_impulse_t *out);
+#endif
+
+#if defined(MECH_FEATURE_IMPULSE)
+/**
+ * Collides two smooth point masses (spheres; masses `m1`, `m2` in kg, velocities `v1`, `v2` in
+ * m/s) along the unit `normal` pointing from point 1 to point 2, with restitution λ ∈ [0, 1]
+ * (5.16–5.23 on the normal components), all vectors in one frame. Points that do not approach
+ * receive no impulse. Written to `out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0, a restitution outside [0, 1] or a non-unit normal.
+ *
+ * # Safety
+ * `v1`, `v2` and `normal` must be readable, `out` writable.
+ */
+mech_status_t mech_collide_points(double m1,
+                                  const struct mech_vec3_t *v1,
+                                  double m2,
+                                  const struct mech_vec3_t *v2,
+                                  const struct mech_vec3_t *normal,
+                                  double restitution,
+                                  struct mech_point_impact_t *out);
 #endif
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The angular velocity ω (in the fixed frame) of a body with orientation R and rate Ṙ,
- * from Ω = Ṙ Rᵀ (syllabus 2.7–2.12). Both matrices are column-major.
+ * The rotation matrix R = R_i(a) R_j(b) R_k(c) (column-major) of the Euler angles `angles` =
+ * {a, b, c} (3 doubles, rad) in the sequence `sequence` (a mech_euler_sequence_t), written to
+ * `rotation_out`. Any finite angles are accepted.
  *
- * # Safety
- * `rotation` and `rotation_rate` must point to readable mech_mat3_t values and `omega_out` to a
- * writable mech_vec3_t.
- */
-mech_status_t mech_angular_velocity_from_rate(const struct mech_mat3_t *rotation,
-                                              const struct mech_mat3_t *rotation_rate,
-                                              struct mech_vec3_t *omega_out);
-#endif
-
-#if defined(MECH_FEATURE_KINEMATICS)
-/**
- * The rotation matrix (column-major) of the quaternion `quaternion`, under the norm policy
- * `norm` (a mech_quat_norm_t value; unknown values give MECH_STATUS_BAD_ENUM).
- *
- * # Safety
- * `quaternion` must point to a readable mech_quat_t and `rotation_out` to a writable mech_mat3_t.
- */
-mech_status_t mech_rotation_matrix_from_quat(const struct mech_quat_t *quaternion,
-                                             mech_quat_norm_t norm,
-                                             struct mech_mat3_t *rotation_out);
-#endif
-
-#if defined(MECH_FEATURE_KINEMATICS)
-/**
- * The rotation matrix exp([φ]×) of a rotation vector φ (Rodrigues, accurate for all |φ|,
- * including |φ| → 0).
- *
- * # Safety
- * `rotation_vector` must point to a readable mech_vec3_t and `rotation_out` to a writable mech_mat3_t.
- */
-mech_status_t mech_rotation_exp(const struct mech_vec3_t *rotation_vector,
-                                struct mech_mat3_t *rotation_out);
-#endif
-
-#if defined(MECH_FEATURE_KINEMATICS)
-/**
- * The rotation vector φ (|φ| ≤ π) of a rotation matrix: the logarithm map, accurate near the
- * identity and near half turns. Fails with MECH_STATUS_INVALID_ARGUMENT for a non-rotation.
- *
- * # Safety
- * `rotation` must point to a readable mech_mat3_t and `rotation_vector_out` to a writable mech_vec3_t.
- */
-mech_status_t mech_rotation_log(const struct mech_mat3_t *rotation,
-                                struct mech_vec3_t *rotation_vector_out);
-#endif
-
-#if defined(MECH_FEATURE_KINEMATICS)
-/**
- * The rotation by `angle` (rad) about the unit vector `axis`. A zero or non-unit axis
- * (|‖a‖ − 1| > 1e-12) gives MECH_STATUS_INVALID_ARGUMENT.
- *
- * # Safety
- * `axis` must point to a readable mech_vec3_t and `rotation_out` to a writable mech_mat3_t.
- */
-mech_status_t mech_rotation_from_axis_angle(const struct mech_vec3_t *axis,
-                                            double angle,
-                                            struct mech_mat3_t *rotation_out);
-#endif
-
-#if defined(MECH_FEATURE_KINEMATICS)
-/**
- * The rotation nearest (Frobenius norm) to a drifted matrix `matrix`: its orthogonal polar
- * factor. `correction_out` receives ‖matrix − rotation‖_F. A matrix with det ≤ 0 gives
- * MECH_STATUS_INVALID_ARGUMENT.
- *
- * # Safety
- * `matrix` must point to a readable mech_mat3_t, `rotation_out` to a writable mech_mat3_t and
- * `correction_out` to a writable double.
- */
-mech_status_t mech_rotation_orthonormalize(const struct mech_mat3_t *matrix,
-                                           struct mech_mat3_t *rotation_out,
-                                           double *correction_out);
-#endif
-
-#if defined(MECH_FEATURE_KINEMATICS)
-/**
- * The rotation matrix of Euler angles `angles` (3 doubles) in the sequence `sequence`.
+ * Errors: MECH_STATUS_BAD_ENUM for an unknown `sequence`; MECH_STATUS_NON_FINITE for a NaN or
+ * infinite angle.
  *
  * # Safety
  * `angles` must point to 3 readable doubles and `rotation_out` to a writable mech_mat3_t.
@@ -2338,11 +2335,17 @@ mech_status_t mech_rotation_from_euler(mech_euler_sequence_t sequence,
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The Euler angles {a, b, c} (into `angles_out`, 3 doubles) of a rotation in `sequence`.
- * a, c ∈ (−π, π]; b ∈ [−π/2, π/2] (Tait–Bryan) or [0, π] (proper). `gimbal_lock_out` is set to
- * 1 when |cos b| (Tait–Bryan) or |sin b| (proper) ≤ 1e-12, where only a ± c is determined (the
- * returned angles still reproduce the rotation to a few ulps; exactly at the lock c = 0), else
- * 0; `singularity_distance_out` receives that |cos b| or |sin b|.
+ * The Euler angles {a, b, c} (rad, written to the 3 doubles of `angles_out`) of the rotation
+ * matrix `rotation` (column-major) in `sequence`: a, c ∈ (−π, π]; b ∈ [−π/2, π/2]
+ * (Tait–Bryan) or [0, π] (proper). `singularity_distance_out` receives |cos b| (Tait–Bryan) or
+ * |sin b| (proper), the distance to the gimbal lock: a and c are each determined to about
+ * 2.2e-16 / distance, while the angles always reproduce the rotation to a few ulps.
+ * `gimbal_lock_out` is set to 1 when that distance is ≤ 1e-12, where only a ± c is determined
+ * (exactly at the lock c = 0), else to 0.
+ *
+ * Errors: MECH_STATUS_BAD_ENUM for an unknown `sequence`; MECH_STATUS_NON_FINITE for a NaN or
+ * infinite entry; MECH_STATUS_INVALID_ARGUMENT when `rotation` is not a rotation within
+ * ‖RᵀR − I‖_F ≤ 1e-12.
  *
  * # Safety
  * `rotation` must point to a readable mech_mat3_t, `angles_out` to 3 writable doubles,
@@ -2357,8 +2360,13 @@ mech_status_t mech_euler_from_rotation(const struct mech_mat3_t *rotation,
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The angular velocity ω = E(angles) rates (syllabus 2.7–2.12; EB1911 (13) for ZYZ in the body
- * frame), in the frame `frame`.
+ * The angular velocity ω = E(angles) · rates (rad/s; syllabus 2.7–2.12, EB1911 (13) for ZYZ in
+ * the body frame) of a body whose Euler angles `angles` (3 doubles, rad) in `sequence` change
+ * at `rates` (3 doubles, rad/s), in the components of `frame` (a mech_frame_t), written to
+ * `omega_out`.
+ *
+ * Errors: MECH_STATUS_BAD_ENUM for an unknown `sequence` or `frame`; MECH_STATUS_NON_FINITE for
+ * a NaN or infinite angle or rate.
  *
  * # Safety
  * `angles` and `rates` must point to 3 readable doubles each, `omega_out` to a writable mech_vec3_t.
@@ -2372,9 +2380,13 @@ mech_status_t mech_angular_velocity_from_euler_rates(mech_euler_sequence_t seque
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The Euler rates (3 doubles into `rates_out`) that give the angular velocity `omega`
- * (components in `frame`) at `angles`. At gimbal lock (|cos b| or |sin b| ≤ 1e-12) returns
- * MECH_STATUS_SINGULAR and writes nothing.
+ * The Euler rates {ȧ, ḃ, ċ} (rad/s, written to the 3 doubles of `rates_out`) that give the
+ * angular velocity `omega` (rad/s, components in `frame`) at the Euler angles `angles` (3
+ * doubles, rad) of `sequence`: the inverse of mech_angular_velocity_from_euler_rates. The rates
+ * carry a relative error of about 2.2e-16 / |cos b| (Tait–Bryan) or / |sin b| (proper).
+ *
+ * Errors: MECH_STATUS_BAD_ENUM for an unknown `sequence` or `frame`; MECH_STATUS_NON_FINITE for
+ * a NaN or infinite input; MECH_STATUS_SINGULAR at a gimbal lock (|cos b| or |sin b| ≤ 1e-12).
  *
  * # Safety
  * `angles` must point to 3 readable doubles, `omega` to a readable mech_vec3_t and
@@ -2389,7 +2401,35 @@ mech_status_t mech_euler_rates_from_angular_velocity(mech_euler_sequence_t seque
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The velocity v = ω × (x − c) + ċ (syllabus 2.13) of the body point at world position `x`.
+ * A 3×dof Jacobian of `body` (`kind`: a mech_jacobian_kind_t) at the state of the last
+ * mech_tree_set_state, in world components, into the caller's column-major buffer `out` of
+ * `capacity` doubles (exactly 3·dof are written; column k belongs to coordinate k). `point`
+ * (body coordinates, m) is used by the point kinds and ignored (may be NULL) by the angular
+ * kinds.
+ *
+ * Errors: MECH_STATUS_BAD_ENUM for an unknown `kind`; MECH_STATUS_NON_FINITE for a NaN or
+ * infinite `point`; MECH_STATUS_BUFFER_TOO_SMALL when capacity < 3·dof;
+ * MECH_STATUS_INVALID_ARGUMENT when the tree is not finalized, no state is set or `body` is out
+ * of range.
+ *
+ * # Safety
+ * `tree` must be a live handle; `point` NULL or readable; `out` must hold `capacity` writable doubles.
+ */
+mech_status_t mech_tree_jacobian(struct mech_tree_t *tree,
+                                 size_t body,
+                                 mech_jacobian_kind_t kind,
+                                 const struct mech_vec3_t *point,
+                                 double *out,
+                                 size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The velocity v = ω × (x − c) + ċ (m/s, syllabus 2.13) of the body point at world position
+ * `x` (m) in the rigid motion `motion`, written to `velocity_out` (world components).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
+ * `motion->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
  *
  * # Safety
  * `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
@@ -2402,8 +2442,11 @@ mech_status_t mech_velocity_field(const struct mech_rigid_motion_t *motion,
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The acceleration a = ω̇ × (x − c) + ω × (ω × (x − c)) + c̈ (syllabus 2.18) of the body point
- * at world position `x`.
+ * The acceleration a = ω̇ × (x − c) + ω × (ω × (x − c)) + c̈ (m/s², syllabus 2.18) of the body
+ * point at world position `x` (m) in the rigid motion `motion`, written to `acceleration_out`
+ * (world components).
+ *
+ * Errors: as mech_velocity_field.
  *
  * # Safety
  * `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
@@ -2417,7 +2460,11 @@ mech_status_t mech_acceleration_field(const struct mech_rigid_motion_t *motion,
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
  * Decomposes the motion of a point with relative position, velocity and acceleration `xi`,
- * `xi_dot`, `xi_ddot` (moving-frame components) in the moving frame `frame`.
+ * `xi_dot`, `xi_ddot` (moving-frame components, SI units) in the moving frame `frame` into drag,
+ * Coriolis and relative parts (syllabus 2.22–2.32), written to `decomposition_out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
+ * `frame->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
  *
  * # Safety
  * `frame` must point to a readable mech_rigid_motion_t, `xi`, `xi_dot`, `xi_ddot` to readable
@@ -2432,7 +2479,128 @@ mech_status_t mech_relative_motion_decompose(const struct mech_rigid_motion_t *f
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * Creates an empty kinematic tree into `*tree_out`. Free it with mech_tree_destroy.
+ * Converts the rotation matrix `rotation` (column-major, R maps body to fixed components) into
+ * the unit quaternion of the same rotation, written to `quaternion_out` with w ≥ 0 (Shepperd's
+ * method: accurate to a few ulps for every rotation, half turns included).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT
+ * when `rotation` is not orthogonal with det = +1 within ‖RᵀR − I‖_F ≤ 1e-12.
+ *
+ * # Safety
+ * `rotation` must point to a readable mech_mat3_t and `quaternion_out` to a writable mech_quat_t.
+ */
+mech_status_t mech_quat_from_rotation_matrix(const struct mech_mat3_t *rotation,
+                                             struct mech_quat_t *quaternion_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The angular velocity ω (rad/s, fixed-frame components) of a body with orientation R =
+ * `rotation` and rate Ṙ = `rotation_rate` (1/s), from the skew matrix Ω = Ṙ Rᵀ (syllabus
+ * 2.7–2.12), written to `omega_out`. Both matrices are column-major. The symmetric part that
+ * rounding leaves in Ṙ Rᵀ is discarded by averaging the two off-diagonal entries.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT
+ * when `rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+ *
+ * # Safety
+ * `rotation` and `rotation_rate` must point to readable mech_mat3_t values and `omega_out` to a
+ * writable mech_vec3_t.
+ */
+mech_status_t mech_angular_velocity_from_rate(const struct mech_mat3_t *rotation,
+                                              const struct mech_mat3_t *rotation_rate,
+                                              struct mech_vec3_t *omega_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation matrix R = (w² − v·v) I + 2 v vᵀ + 2 w [v]× (column-major) of the quaternion
+ * `quaternion` = (w, v), under the norm policy `norm` (a mech_quat_norm_t), written to
+ * `rotation_out`.
+ *
+ * Errors: MECH_STATUS_BAD_ENUM for an unknown `norm`; MECH_STATUS_NON_FINITE for a NaN or
+ * infinite component; MECH_STATUS_INVALID_ARGUMENT for a quaternion the policy refuses
+ * (non-unit under MECH_QUAT_REQUIRE_UNIT, zero under MECH_QUAT_NORMALIZE).
+ *
+ * # Safety
+ * `quaternion` must point to a readable mech_quat_t and `rotation_out` to a writable mech_mat3_t.
+ */
+mech_status_t mech_rotation_matrix_from_quat(const struct mech_quat_t *quaternion,
+                                             mech_quat_norm_t norm,
+                                             struct mech_mat3_t *rotation_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation matrix exp([φ]×) (column-major) of the rotation vector φ = `rotation_vector`
+ * (rad; the rotation by |φ| about φ/|φ|), by Rodrigues' formula, written to `rotation_out`.
+ * Exact to rounding for every |φ|, including |φ| → 0 and |φ| ≥ π.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite component.
+ *
+ * # Safety
+ * `rotation_vector` must point to a readable mech_vec3_t and `rotation_out` to a writable mech_mat3_t.
+ */
+mech_status_t mech_rotation_exp(const struct mech_vec3_t *rotation_vector,
+                                struct mech_mat3_t *rotation_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation vector φ (rad, |φ| ≤ π) with exp([φ]×) = `rotation` (column-major): the
+ * logarithm map, written to `rotation_vector_out`. Accurate to a few ulps of |φ| near the
+ * identity and near half turns; at exactly |φ| = π either sign is valid and one is returned.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT
+ * when `rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+ *
+ * # Safety
+ * `rotation` must point to a readable mech_mat3_t and `rotation_vector_out` to a writable mech_vec3_t.
+ */
+mech_status_t mech_rotation_log(const struct mech_mat3_t *rotation,
+                                struct mech_vec3_t *rotation_vector_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation matrix (column-major) of the rotation by `angle` (rad, right-handed) about the
+ * unit vector `axis`, written to `rotation_out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT
+ * for a zero or non-unit axis (|‖a‖ − 1| > 1e-12).
+ *
+ * # Safety
+ * `axis` must point to a readable mech_vec3_t and `rotation_out` to a writable mech_mat3_t.
+ */
+mech_status_t mech_rotation_from_axis_angle(const struct mech_vec3_t *axis,
+                                            double angle,
+                                            struct mech_mat3_t *rotation_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * The rotation nearest in the Frobenius norm to a drifted matrix `matrix` (column-major): its
+ * orthogonal polar factor U Vᵀ from the SVD matrix = U Σ Vᵀ, written to `rotation_out`;
+ * `correction_out` receives the size of the repair ‖matrix − rotation‖_F.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT for
+ * det(matrix) ≤ 0 (a reflection or a singular matrix is not a drifted rotation).
+ *
+ * # Safety
+ * `matrix` must point to a readable mech_mat3_t, `rotation_out` to a writable mech_mat3_t and
+ * `correction_out` to a writable double.
+ */
+mech_status_t mech_rotation_orthonormalize(const struct mech_mat3_t *matrix,
+                                           struct mech_mat3_t *rotation_out,
+                                           double *correction_out);
+#endif
+
+#if defined(MECH_FEATURE_KINEMATICS)
+/**
+ * Creates an empty kinematic tree and writes its handle to `*tree_out`. The caller owns the
+ * handle and frees it with mech_tree_destroy.
+ *
+ * Errors: none beyond the pointer checks.
  *
  * # Safety
  * `tree_out` must point to a writable mech_tree_t pointer.
@@ -2442,23 +2610,31 @@ mech_status_t mech_tree_create(struct mech_tree_t **tree_out);
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * Frees a tree. NULL is accepted and ignored.
+ * Frees a tree and everything it holds. NULL is accepted and ignored. Mechanisms created from
+ * the tree keep their own copy and stay valid.
  *
  * # Safety
- * `tree` must be NULL or a handle from mech_tree_create not yet destroyed.
+ * `tree` must be NULL or a handle from mech_tree_create not yet destroyed; it is invalid
+ * afterwards.
  */
 void mech_tree_destroy(struct mech_tree_t *tree);
 #endif
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * Adds a body to a tree that is not finalized yet. `parent` is the parent's body index, or
- * −1 for the root (attached to the base); it may name a body added later. `joint_type` is a
+ * Adds a body to a tree that is not finalized yet and writes its index (0, 1, … in the order
+ * of the calls) to `body_out`. `parent` is the parent's body index, or −1 for the root
+ * (attached to the base frame); it may name a body added later. `joint_type` is a
  * mech_joint_type_t; `axis` (joint-frame components, unit length) is required for revolute and
  * prismatic joints and ignored (may be NULL) otherwise. The joint frame sits at rotation
- * `placement_rotation` (a rotation matrix, column-major) and translation `placement_translation`
- * in the parent's body frame. The new body's index is written to `body_out`. Structural checks
- * (one root, no cycles, unit axes) happen in mech_tree_finalize.
+ * `placement_rotation` (a rotation matrix, column-major) and translation
+ * `placement_translation` (m) in the parent's body frame. Structural checks (one root, no
+ * cycles, parents in range) happen in mech_tree_finalize.
+ *
+ * Errors: MECH_STATUS_BAD_ENUM for an unknown `joint_type`; MECH_STATUS_NON_FINITE for a NaN or
+ * infinite entry; MECH_STATUS_INVALID_ARGUMENT for a finalized tree, a parent below −1, a
+ * placement that is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12 or a zero or non-unit axis
+ * (|‖a‖ − 1| > 1e-12). The tree is unchanged on error.
  *
  * # Safety
  * `tree` must be a live handle; `axis` NULL or readable; `placement_rotation` and
@@ -2476,8 +2652,10 @@ mech_status_t mech_tree_add_body(struct mech_tree_t *tree,
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
  * Validates the tree (at least one body, exactly one root, parents in range, no cycles) and
- * makes it ready for queries. Errors are MECH_STATUS_INVALID_ARGUMENT with the offending body
- * index in mech_last_error. Finalizing twice is an error.
+ * makes it ready for state updates and queries; bodies can no longer be added.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT for a structural error (the message in mech_last_error
+ * names the offending body) or when the tree is already finalized.
  *
  * # Safety
  * `tree` must be a live handle.
@@ -2487,7 +2665,10 @@ mech_status_t mech_tree_finalize(struct mech_tree_t *tree);
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The number of bodies and of coordinates (= velocities) of a finalized tree.
+ * The number of bodies (`body_count_out`) and of coordinates, which equals the number of
+ * velocities (`dof_out`), of a finalized tree.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when the tree is not finalized.
  *
  * # Safety
  * `tree` must be a live handle; `body_count_out` and `dof_out` writable.
@@ -2499,10 +2680,13 @@ mech_status_t mech_tree_size(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * Sets the coordinates q and velocities q̇ (each `n` = dof doubles; pass n = 0 and NULL for a
- * tree without coordinates) and computes all body poses, velocities and Jacobian columns.
- * Wrong n gives MECH_STATUS_BAD_DIMENSION; NaN/inf MECH_STATUS_NON_FINITE (the state is then
- * left unset).
+ * Sets the coordinates q and velocities q̇ (each `n` = dof doubles, SI units per joint type;
+ * pass n = 0 and NULL for a tree without coordinates) of a finalized tree and computes all
+ * body poses, velocities and Jacobian columns.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when the tree is not finalized; MECH_STATUS_BAD_DIMENSION
+ * when n ≠ dof; MECH_STATUS_NON_FINITE for a NaN or infinite entry (the state is then left
+ * unset, and queries fail until a valid state is set).
  *
  * # Safety
  * `tree` must be a live handle; `q` and `q_dot` must point to `n` readable doubles.
@@ -2520,9 +2704,9 @@ mech_status_t mech_tree_set_state(struct mech_tree_t *tree,
  * discards the computed state, so queries fail with MECH_STATUS_INVALID_ARGUMENT until the
  * state is set again. Pass the same ω₀ and v₀ to mech_tree_energy_split for the drag field.
  *
- * Errors: NULL_POINTER; NON_FINITE for a NaN/inf entry; INVALID_ARGUMENT when `rotation` is
- * not a rotation matrix (orthonormal to rounding, determinant +1) or the tree is not finalized.
- * Nothing changes on error.
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT
+ * when `base->rotation` is not a rotation (orthonormal to rounding, determinant +1) or the tree
+ * is not finalized. Nothing changes on error.
  *
  * # Safety
  * `tree` must be a live handle; `base` must point to a readable mech_base_state_t.
@@ -2533,8 +2717,11 @@ mech_status_t mech_tree_set_base(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * Sets the accelerations q̈ (`n` = dof doubles) after mech_tree_set_state and computes body
- * accelerations.
+ * Sets the accelerations q̈ (`n` = dof doubles) after mech_tree_set_state and computes the body
+ * accelerations (including the base's, see mech_tree_set_base).
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when the tree is not finalized or no state is set;
+ * MECH_STATUS_BAD_DIMENSION when n ≠ dof; MECH_STATUS_NON_FINITE for a NaN or infinite entry.
  *
  * # Safety
  * `tree` must be a live handle; `q_ddot` must point to `n` readable doubles.
@@ -2546,7 +2733,12 @@ mech_status_t mech_tree_set_accelerations(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The pose of `body`: rotation R_WB (column-major) and origin position p_WB (world).
+ * The pose of `body` at the state of the last mech_tree_set_state: its rotation R_WB
+ * (column-major, body → world) into `rotation_out` and its origin position p_WB (m, world) into
+ * `position_out`.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when the tree is not finalized, no state is set or
+ * `body` is out of range.
  *
  * # Safety
  * `tree` must be a live handle; `rotation_out` and `position_out` writable.
@@ -2559,8 +2751,12 @@ mech_status_t mech_tree_body_pose(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The angular velocity of `body` and the velocity of its point with body coordinates `point`
- * (world components), from the state of mech_tree_set_state.
+ * The angular velocity of `body` (rad/s) into `omega_out` and the velocity (m/s) of its point
+ * with body coordinates `point` (m) into `velocity_out`, both in world components, at the state
+ * of the last mech_tree_set_state.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite `point`; MECH_STATUS_INVALID_ARGUMENT
+ * when the tree is not finalized, no state is set or `body` is out of range.
  *
  * # Safety
  * `tree` must be a live handle; `point` readable; `omega_out` and `velocity_out` writable.
@@ -2574,8 +2770,12 @@ mech_status_t mech_tree_body_velocity(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
- * The angular acceleration of `body` and the acceleration of its point with body coordinates
- * `point` (world), after mech_tree_set_accelerations.
+ * The angular acceleration of `body` (rad/s²) into `omega_dot_out` and the acceleration (m/s²)
+ * of its point with body coordinates `point` (m) into `acceleration_out`, both in world
+ * components, after mech_tree_set_accelerations.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite `point`; MECH_STATUS_INVALID_ARGUMENT
+ * when the tree is not finalized, the accelerations are not set or `body` is out of range.
  *
  * # Safety
  * `tree` must be a live handle; `point` readable; both outputs writable.
@@ -2587,78 +2787,15 @@ mech_status_t mech_tree_body_acceleration(struct mech_tree_t *tree,
                                           struct mech_vec3_t *acceleration_out);
 #endif
 
-#if defined(MECH_FEATURE_KINEMATICS)
-/**
- * A 3×dof Jacobian of `body` (kind: a mech_jacobian_kind_t) into the caller's column-major
- * buffer `out` of `capacity` doubles (≥ 3·dof, else MECH_STATUS_BUFFER_TOO_SMALL; exactly
- * 3·dof are written). Column k belongs to coordinate k; world components. `point` (body
- * coordinates) is used by the point kinds and ignored (may be NULL) by the angular kinds.
- *
- * # Safety
- * `tree` must be a live handle; `point` NULL or readable; `out` must hold `capacity` writable doubles.
- */
-mech_status_t mech_tree_jacobian(struct mech_tree_t *tree,
-                                 size_t body,
-                                 mech_jacobian_kind_t kind,
-                                 const struct mech_vec3_t *point,
-                                 double *out,
-                                 size_t capacity);
-#endif
-
 #if defined(MECH_FEATURE_MASS)
 /**
- * The mass properties of a point mass `mass` at `position` (zero central inertia).
+ * The body `properties` after the rigid motion x ↦ R x + t, with R from the unit quaternion
+ * `rotation` (|‖q‖ − 1| ≤ 1e-12) and t = `translation` (m): the centre moves and the tensor
+ * becomes R J Rᵀ. Equivalently, re-expresses properties given in a body frame B in the frame F
+ * in which B has this pose. Written to `out`.
  *
- * # Safety
- * `position` must point to a readable mech_vec3_t and `out` to a writable mech_mass_properties_t.
- */
-mech_status_t mech_mass_point(double mass,
-                              const struct mech_vec3_t *position,
-                              struct mech_mass_properties_t *out);
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * The inertia tensor of `properties` about the point `point` (same frame), by Steiner's
- * theorem (syllabus 3.27–3.29).
- *
- * # Safety
- * `properties` and `point` must be readable and `inertia_out` writable.
- */
-mech_status_t mech_mass_inertia_about(const struct mech_mass_properties_t *properties,
-                                      const struct mech_vec3_t *point,
-                                      struct mech_mat3_t *inertia_out);
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * The closed-form mass properties of a primitive body `kind` (a mech_primitive_t) with
- * `dimension_count` dimensions at `dimensions` (as listed for each MECH_PRIMITIVE_* value),
- * and `amount` read as a mass or a density according to `amount_kind` (a mech_amount_t).
- * Rods, laminae and points have semidefinite inertia, which is valid.
- *
- * Errors: BAD_ENUM for unknown `kind` or `amount_kind`, BAD_DIMENSION when
- * `dimension_count` is not the count of `kind`, NON_FINITE, INVALID_ARGUMENT for a
- * non-positive dimension, mass or density, or a torus tube radius above its ring radius.
- *
- * # Safety
- * `dimensions` must point to `dimension_count` readable doubles (it may be NULL when the count
- * is 0) and `out` to a writable mech_mass_properties_t.
- */
-mech_status_t mech_mass_primitive(mech_primitive_t kind,
-                                  const double *dimensions,
-                                  size_t dimension_count,
-                                  mech_amount_t amount_kind,
-                                  double amount,
-                                  struct mech_mass_properties_t *out);
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * The same body after the rigid motion x ↦ R x + t with R from the unit quaternion
- * `rotation` (|‖q‖ − 1| ≤ 1e-12) and t = `translation`: the centre moves, the tensor becomes
- * R J Rᵀ. Equivalently, re-expresses properties given in a body frame B in the frame F in
- * which B has this pose.
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0 or a non-unit quaternion.
  *
  * # Safety
  * All pointers must be readable (inputs) or writable (`out`).
@@ -2671,11 +2808,15 @@ mech_status_t mech_mass_transform(const struct mech_mass_properties_t *propertie
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * The mass properties of the union of `count` ≥ 1 bodies: body i is `parts[i]` moved by the
- * rigid motion (`rotations[i]`, `translations[i]`) as in mech_mass_transform. Pass NULL for
- * both `rotations` and `translations` when the parts are already in one frame (passing only one
- * of them NULL is an error). Steiner's theorem (3.27–3.29) sums the tensors about the common
- * centre.
+ * The mass properties of the union of `count` ≥ 1 bodies, written to `out`: body i is
+ * `parts[i]` moved by the rigid motion (`rotations[i]`, `translations[i]`) as in
+ * mech_mass_transform. Pass NULL for both `rotations` and `translations` when the parts are
+ * already in one frame. The total mass, the mass-weighted centre (1.24) and the sum of the
+ * central tensors moved to the common centre by Steiner's theorem (3.27–3.29).
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION for count = 0; MECH_STATUS_NULL_POINTER when only one of
+ * `rotations` and `translations` is NULL; MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT
+ * for a part with mass ≤ 0 (the message names it) or a non-unit quaternion.
  *
  * # Safety
  * `parts` (and, when non-NULL, `rotations` and `translations`) must point to `count` readable
@@ -2690,10 +2831,13 @@ mech_status_t mech_mass_combine(const struct mech_mass_properties_t *parts,
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * The body `body` with the material `hole` (same frame) removed. Fails with
- * INVALID_ARGUMENT when the hole is at least as heavy as the body, and with
- * NOT_POSITIVE_DEFINITE or INVALID_ARGUMENT when the remainder is not a valid body (a hole
- * that does not fit inside).
+ * The body `body` with the material `hole` (same frame) removed, written to `out`: the inverse
+ * of mech_mass_combine.
+ *
+ * Errors: MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0 or a hole at
+ * least as heavy as the body; MECH_STATUS_NOT_POSITIVE_DEFINITE or
+ * MECH_STATUS_INVALID_ARGUMENT when the remainder is not a valid body (a hole that does not fit
+ * inside).
  *
  * # Safety
  * `body` and `hole` must be readable and `out` writable.
@@ -2705,8 +2849,29 @@ mech_status_t mech_mass_subtract(const struct mech_mass_properties_t *body,
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * The moment of inertia (e, J_A e) about the line through `point` with direction `direction`
- * (any non-zero length; normalised internally), syllabus 3.22–3.23 and 3.30.
+ * The inertia tensor J_A (kg·m², column-major, same frame) of `properties` about the point
+ * `point` (m), by Steiner's theorem J_A = J₀ + m(|d|² I − d dᵀ), d = x₀ − a (syllabus
+ * 3.27–3.29), written to `inertia_out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0.
+ *
+ * # Safety
+ * `properties` and `point` must be readable and `inertia_out` writable.
+ */
+mech_status_t mech_mass_inertia_about(const struct mech_mass_properties_t *properties,
+                                      const struct mech_vec3_t *point,
+                                      struct mech_mat3_t *inertia_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The moment of inertia (e, J_A e) (kg·m²) of `properties` about the line through `point` (m)
+ * with direction `direction` (any non-zero length; normalised internally), syllabus 3.22–3.23
+ * and 3.30, written to `moment_out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0 or a zero direction.
  *
  * # Safety
  * The inputs must be readable and `moment_out` writable.
@@ -2719,10 +2884,16 @@ mech_status_t mech_mass_moment_about_line(const struct mech_mass_properties_t *p
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * Principal moments I₁ ≤ I₂ ≤ I₃ of the central tensor (3.20–3.21) and the principal axes as
- * the columns of a right-handed rotation matrix R (column-major) with J = R diag(I) Rᵀ.
- * Repeated moments (relative gap ≤ 1e-10) give a canonical frame: the identity for three equal
- * moments; the exact symmetry axis and the coordinate axis least aligned with it for two.
+ * The principal moments I₁ ≤ I₂ ≤ I₃ (kg·m²) of the central tensor of `properties`
+ * (3.20–3.21) into `moments_out` (x, y, z = I₁, I₂, I₃) and the principal axes, in the frame of
+ * `properties`, as the columns of a right-handed rotation matrix R (column-major) with
+ * J = R diag(I) Rᵀ into `axes_out`. Repeated moments (relative gap ≤ 1e-10) give a canonical
+ * frame: the identity for three equal moments; the exact symmetry axis and the coordinate axis
+ * least aligned with it for two. The symmetric part of the tensor is decomposed; its validity
+ * is not checked (see mech_mass_check).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0.
  *
  * # Safety
  * `properties` must be readable and `moments_out`, `axes_out` writable.
@@ -2734,83 +2905,32 @@ mech_status_t mech_mass_principal_axes(const struct mech_mass_properties_t *prop
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * Checks whether `properties` could belong to a real body, and reports every problem found
- * as flags (the call itself succeeds whether or not they are valid). `relative_tolerance`
- * (≥ 0; 0 selects the default 1e-9) is relative to the trace of the tensor and decides
- * symmetry, semidefiniteness, the triangle inequality and the class (rods and laminae have
- * exact equalities, which the tolerance accepts).
+ * Writes the default mesh options (those a NULL options pointer selects) to `options_out`.
+ *
+ * Errors: none beyond the pointer checks.
  *
  * # Safety
- * `properties` must be readable and `validity_out` writable.
+ * `options_out` must point to a writable mech_mesh_options_t.
  */
-mech_status_t mech_mass_check(const struct mech_mass_properties_t *properties,
-                              double relative_tolerance,
-                              struct mech_mass_validity_t *validity_out);
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * Repairs the tensor of `properties` when mech_mass_check finds it invalid: symmetrises it,
- * clamps its principal second moments σ_k = (I_i + I_j − I_k)/2 to ≥ 0 and rebuilds
- * I_k = σ_i + σ_j (which restores semidefiniteness and the triangle inequality). Valid input is
- * copied unchanged. `relative_change_out` (may be NULL) receives ‖ΔJ‖_F/‖J‖_F. A non-finite
- * value or a negative mass cannot be repaired (INVALID_ARGUMENT / NON_FINITE).
- *
- * # Safety
- * `properties` must be readable, `out` writable, `relative_change_out` NULL or writable.
- */
-mech_status_t mech_mass_repair(const struct mech_mass_properties_t *properties,
-                               double relative_tolerance,
-                               struct mech_mass_properties_t *out,
-                               double *relative_change_out);
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * The angular momentum D_A = J₀ ω + (x₀ − a) × m v₀ (syllabus 3.5–3.7) about the point `point`
- * (fixed or moving; only its position enters) of a body whose properties are given in the
- * inertial frame at this instant, moving with centre velocity `com_velocity` and angular
- * velocity `omega` (both in that frame).
- *
- * # Safety
- * The inputs must be readable and `angular_momentum_out` writable.
- */
-mech_status_t mech_mass_angular_momentum(const struct mech_mass_properties_t *properties,
-                                         const struct mech_vec3_t *point,
-                                         const struct mech_vec3_t *com_velocity,
-                                         const struct mech_vec3_t *omega,
-                                         struct mech_vec3_t *angular_momentum_out);
-#endif
-
-#if defined(MECH_FEATURE_MASS)
-/**
- * The kinetic energy T = ½ m v₀·v₀ + ½ ω·J₀ ω (syllabus 3.37) and the momentum p = m v₀ (3.4)
- * of a body moving with centre velocity `com_velocity` and angular velocity `omega` (in the
- * frame of the properties). `momentum_out` may be NULL.
- *
- * # Safety
- * The inputs must be readable, `energy_out` writable, `momentum_out` NULL or writable.
- */
-mech_status_t mech_mass_kinetic_energy(const struct mech_mass_properties_t *properties,
-                                       const struct mech_vec3_t *com_velocity,
-                                       const struct mech_vec3_t *omega,
-                                       double *energy_out,
-                                       struct mech_vec3_t *momentum_out);
+mech_status_t mech_mesh_options_default(struct mech_mesh_options_t *options_out);
 #endif
 
 #if defined(MECH_FEATURE_MASS)
 /**
  * Mass properties of the triangle mesh with `vertex_count` vertices (x, y, z interleaved:
- * 3·vertex_count doubles, metres) and `triangle_count` triangles (3·triangle_count vertex
- * indices, counter-clockwise seen from outside), with `amount` read as a mass or a density per
- * `amount_kind`. Closed solids use exact polynomial volume integrals relative to a point near
- * the mesh, so far-from-origin meshes keep full accuracy. `options` may be NULL for the
- * defaults; `report_out` may be NULL.
+ * 3·vertex_count doubles, metres, in the frame of the result) and `triangle_count` triangles
+ * (3·triangle_count vertex indices, counter-clockwise seen from outside), with `amount` read
+ * as a mass or a density per `amount_kind` (a mech_amount_t), written to `out`. Closed solids
+ * use exact polynomial volume integrals relative to a point near the mesh, so far-from-origin
+ * meshes keep full accuracy. `options` may be NULL for the defaults (see
+ * mech_mesh_options_default); `report_out` (may be NULL) receives what was found and the
+ * relative error bound of the volume or area.
  *
- * Errors: NULL_POINTER, BAD_DIMENSION (0 triangles, sizes overflowing), BAD_ENUM,
- * NON_FINITE (a vertex; the message names it), INVALID_ARGUMENT (index out of range, open,
- * misoriented, inside-out or degenerate meshes under rejecting policies, zero volume,
- * non-positive density or mass; the message says which and how many).
+ * Errors: MECH_STATUS_BAD_DIMENSION (0 triangles, sizes overflowing); MECH_STATUS_BAD_ENUM
+ * (`amount_kind` or an options field); MECH_STATUS_NON_FINITE (a vertex; the message names
+ * it); MECH_STATUS_INVALID_ARGUMENT (index out of range, open, misoriented, inside-out or
+ * degenerate meshes under rejecting policies, zero volume, non-positive density or mass; the
+ * message says which and how many).
  *
  * # Safety
  * `vertices` must point to 3·vertex_count readable doubles, `indices` to 3·triangle_count
@@ -2830,14 +2950,14 @@ mech_status_t mech_mass_mesh(const double *vertices,
 #if defined(MECH_FEATURE_MASS)
 /**
  * As mech_mass_mesh, for a mesh whose vertices moved since an earlier call on the same
- * triangle array (a deforming body re-integrated every step): the edge-topology check, about
- * 60 % of the time of a large mesh, is skipped and its result taken from `earlier`, the
- * report of that call (its `triangles` must equal `triangle_count`). The caller vouches that
- * the triangles are unchanged; indices are still checked and an inside-out mesh is still
+ * triangle array (a deforming body re-integrated every step): the edge-topology check, the
+ * larger part of the work for a large mesh, is skipped and its result taken from `earlier`,
+ * the report of that call (its `triangles` must equal `triangle_count`). The caller vouches
+ * that the triangles are unchanged; indices are still checked and an inside-out mesh is still
  * flipped or refused.
  *
- * Errors: as mech_mass_mesh; NULL_POINTER when `earlier` is NULL; BAD_DIMENSION when its
- * triangle count differs.
+ * Errors: as mech_mass_mesh; MECH_STATUS_NULL_POINTER when `earlier` is NULL;
+ * MECH_STATUS_BAD_DIMENSION when its triangle count differs.
  *
  * # Safety
  * As mech_mass_mesh; `earlier` must point to a readable mech_mesh_report_t.
@@ -2856,14 +2976,97 @@ mech_status_t mech_mass_mesh_same_connectivity(const double *vertices,
 
 #if defined(MECH_FEATURE_MASS)
 /**
+ * The angular momentum D_A = J₀ ω + (x₀ − a) × m v₀ (kg·m²/s, syllabus 3.5–3.7) about the point
+ * `point` (m; fixed or moving, only its position enters) of a body whose `properties` are given
+ * in the inertial frame at this instant, moving with centre velocity `com_velocity` (m/s) and
+ * angular velocity `omega` (rad/s), both in that frame. Written to `angular_momentum_out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0.
+ *
+ * # Safety
+ * The inputs must be readable and `angular_momentum_out` writable.
+ */
+mech_status_t mech_mass_angular_momentum(const struct mech_mass_properties_t *properties,
+                                         const struct mech_vec3_t *point,
+                                         const struct mech_vec3_t *com_velocity,
+                                         const struct mech_vec3_t *omega,
+                                         struct mech_vec3_t *angular_momentum_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The kinetic energy T = ½ m v₀·v₀ + ½ ω·J₀ ω (J, syllabus 3.37) into `energy_out` and the
+ * momentum p = m v₀ (kg·m/s, 3.4) into `momentum_out` (may be NULL) of a body moving with
+ * centre velocity `com_velocity` (m/s) and angular velocity `omega` (rad/s), both in the frame
+ * of `properties`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input or an energy that overflows;
+ * MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0.
+ *
+ * # Safety
+ * The inputs must be readable, `energy_out` writable, `momentum_out` NULL or writable.
+ */
+mech_status_t mech_mass_kinetic_energy(const struct mech_mass_properties_t *properties,
+                                       const struct mech_vec3_t *com_velocity,
+                                       const struct mech_vec3_t *omega,
+                                       double *energy_out,
+                                       struct mech_vec3_t *momentum_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The mass properties of a point mass `mass` (kg) at `position` (m, in the frame of the
+ * result): zero central inertia, which is valid (semidefinite). Written to `out`.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0.
+ *
+ * # Safety
+ * `position` must point to a readable mech_vec3_t and `out` to a writable mech_mass_properties_t.
+ */
+mech_status_t mech_mass_point(double mass,
+                              const struct mech_vec3_t *position,
+                              struct mech_mass_properties_t *out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The closed-form mass properties of a primitive body `kind` (a mech_primitive_t) with
+ * `dimension_count` dimensions at `dimensions` (m, as listed for each MECH_PRIMITIVE_* value),
+ * and `amount` read as a mass or a density according to `amount_kind` (a mech_amount_t),
+ * written to `out` in the body's own frame. Rods, laminae and points have semidefinite
+ * inertia, which is valid.
+ *
+ * Errors: MECH_STATUS_BAD_ENUM for an unknown `kind` or `amount_kind`;
+ * MECH_STATUS_BAD_DIMENSION when `dimension_count` is not the count of `kind`;
+ * MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a non-positive dimension, mass or
+ * density, or a torus tube radius above its ring radius.
+ *
+ * # Safety
+ * `dimensions` must point to `dimension_count` readable doubles (it may be NULL when the count
+ * is 0) and `out` to a writable mech_mass_properties_t.
+ */
+mech_status_t mech_mass_primitive(mech_primitive_t kind,
+                                  const double *dimensions,
+                                  size_t dimension_count,
+                                  mech_amount_t amount_kind,
+                                  double amount,
+                                  struct mech_mass_properties_t *out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
  * The mass matrix A(q) = [α_kl] (syllabus 8.28) of a finalized tree at the coordinates of the
  * last mech_tree_set_state, by the composite-rigid-body recursion, into `a_out` (n×n doubles,
- * column-major, n = dof). `bodies` holds one mass-properties value per body (`body_count` =
- * the tree's body count), each in its own body frame; masses may be 0 (massless links).
+ * column-major, n = dof; kg, kg·m or kg·m² per the coordinates' units). `bodies` holds one
+ * mass-properties value per body (`body_count` = the tree's body count), each in its own body
+ * frame; masses may be 0 (massless links).
  *
- * Errors: NULL_POINTER; BAD_DIMENSION (n ≠ dof, n = 0, body_count ≠ body count); NON_FINITE
- * or INVALID_ARGUMENT (a body's numbers or negative mass; the message names the body);
- * INVALID_ARGUMENT (tree not finalized or no state set).
+ * Errors: MECH_STATUS_BAD_DIMENSION (n ≠ dof, n = 0, body_count ≠ body count);
+ * MECH_STATUS_NON_FINITE or MECH_STATUS_INVALID_ARGUMENT for a body's numbers or a negative
+ * mass (the message names the body); MECH_STATUS_INVALID_ARGUMENT when the tree is not
+ * finalized or no state is set.
  *
  * # Safety
  * `tree` must be a live handle; `bodies` must point to `body_count` readable entries; `a_out`
@@ -2878,10 +3081,10 @@ mech_status_t mech_tree_mass_matrix(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * The kinetic energy T = ½ q̇ᵀ A q̇ (syllabus 8.27) and the generalized momenta ∂T/∂q̇ = A q̇
- * (`momenta_out`, n = dof doubles) of a tree on a fixed base, at the state (q, q̇) of the last
- * mech_tree_set_state. `bodies` as in mech_tree_mass_matrix. For a moving base use
- * mech_tree_energy_split.
+ * The kinetic energy T = ½ q̇ᵀ A q̇ (J, syllabus 8.27) into `energy_out` and the generalized
+ * momenta ∂T/∂q̇ = A q̇ (`momenta_out`, n = dof doubles) of a tree on a fixed base, at the
+ * state (q, q̇) of the last mech_tree_set_state. `bodies` as in mech_tree_mass_matrix. For a
+ * moving base use mech_tree_energy_split.
  *
  * Errors: as mech_tree_mass_matrix (n = dof is required; n = 0 is accepted for a tree without
  * coordinates).
@@ -2900,12 +3103,12 @@ mech_status_t mech_tree_kinetic_energy(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * The centre of mass of the whole tree and its Jacobian ∂x₀/∂q (3×n doubles, column-major,
- * n = dof; world components) at the coordinates of the last mech_tree_set_state.
- * `system_out` receives the mass properties of the whole system in world components (total
- * mass, centre, central inertia). `bodies` as in mech_tree_mass_matrix.
+ * The centre of mass x₀ of the whole tree and its Jacobian ∂x₀/∂q (3×n doubles into
+ * `jacobian_out`, column-major, n = dof; world components) at the coordinates of the last
+ * mech_tree_set_state. `system_out` receives the mass properties of the whole system in world
+ * components (total mass, centre, central inertia). `bodies` as in mech_tree_mass_matrix.
  *
- * Errors: as mech_tree_mass_matrix, and INVALID_ARGUMENT when the total mass is 0.
+ * Errors: as mech_tree_mass_matrix, and MECH_STATUS_INVALID_ARGUMENT when the total mass is 0.
  *
  * # Safety
  * `tree` must be a live handle; `bodies` must point to `body_count` readable entries;
@@ -2921,15 +3124,16 @@ mech_status_t mech_tree_center_of_mass(struct mech_tree_t *tree,
 
 #if defined(MECH_FEATURE_MASS)
 /**
- * The split T = T₀ + T₁ + T₂ (syllabus 9.7–9.10) of a tree whose base moves with angular
- * velocity `base_omega` and base-origin velocity `base_velocity` (world components; the base
- * pose is the tree's, see mech_tree_set_base, whose ω₀ and v₀ these normally are; taking them
- * here keeps the split available for a base at rest in the tree's frame), so the drag velocity of a point x is ∂x/∂t = v₀ + ω₀ × (x − p₀)), at the
- * state (q, q̇) of the last mech_tree_set_state. Writes the split, b(q, t) = ∂T₁/∂q̇ into
- * `b_out` and the generalized momenta ∂T/∂q̇ = A q̇ + b into `momenta_out` (n = dof doubles
- * each). `bodies` as in mech_tree_mass_matrix.
+ * The split T = T₀ + T₁ + T₂ (J, syllabus 9.7–9.10) of a tree whose base moves with angular
+ * velocity `base_omega` (rad/s) and base-origin velocity `base_velocity` (m/s), both in world
+ * components, so that the drag velocity of a point x is ∂x/∂t = v₀ + ω₀ × (x − p₀), at the
+ * state (q, q̇) of the last mech_tree_set_state. The base pose p₀, R₀ is the tree's (see
+ * mech_tree_set_base, whose ω₀ and v₀ these normally are; taking them here keeps the split
+ * available for a base at rest in the tree's frame). Writes the split to `split_out`,
+ * b(q, t) = ∂T₁/∂q̇ to `b_out` and the generalized momenta ∂T/∂q̇ = A q̇ + b to `momenta_out`
+ * (n = dof doubles each). `bodies` as in mech_tree_mass_matrix.
  *
- * Errors: as mech_tree_kinetic_energy, and NULL_POINTER / NON_FINITE for the base vectors.
+ * Errors: as mech_tree_kinetic_energy, and MECH_STATUS_NON_FINITE for the base vectors.
  *
  * # Safety
  * `tree` must be a live handle; `bodies` must point to `body_count` readable entries;
@@ -2947,10 +3151,59 @@ mech_status_t mech_tree_energy_split(struct mech_tree_t *tree,
                                      size_t n);
 #endif
 
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Checks whether `properties` could belong to a real body and writes the verdict to
+ * `validity_out`: every problem found as a flag, the class of a valid body and the moments
+ * (the call itself succeeds whether or not the properties are valid). `relative_tolerance`
+ * (≥ 0; 0 selects the default 1e-9) is relative to the trace of the tensor and decides
+ * symmetry, semidefiniteness, the triangle inequality and the class (rods and laminae have
+ * exact equalities, which the tolerance accepts).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite `relative_tolerance`;
+ * MECH_STATUS_INVALID_ARGUMENT for a negative one.
+ *
+ * # Safety
+ * `properties` must be readable and `validity_out` writable.
+ */
+mech_status_t mech_mass_check(const struct mech_mass_properties_t *properties,
+                              double relative_tolerance,
+                              struct mech_mass_validity_t *validity_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * Repairs the tensor of `properties` when mech_mass_check finds it invalid, writing the result
+ * to `out`: symmetrises it, clamps its principal second moments σ_k = (I_i + I_j − I_k)/2 to
+ * ≥ 0 and rebuilds I_k = σ_i + σ_j (which restores semidefiniteness and the triangle
+ * inequality). Valid input is copied unchanged. `relative_change_out` (may be NULL) receives
+ * the size of the repair ‖ΔJ‖_F/‖J‖_F. `relative_tolerance` as in mech_mass_check.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input, which cannot be repaired;
+ * MECH_STATUS_INVALID_ARGUMENT for a negative mass or `relative_tolerance`.
+ *
+ * # Safety
+ * `properties` must be readable, `out` writable, `relative_change_out` NULL or writable.
+ */
+mech_status_t mech_mass_repair(const struct mech_mass_properties_t *properties,
+                               double relative_tolerance,
+                               struct mech_mass_properties_t *out,
+                               double *relative_change_out);
+#endif
+
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * Creates a mechanism from a finalized tree (copied: later changes to the tree do not affect
- * it) and one mass-properties value per body (in the body's frame, in body order).
+ * Creates a mechanism from a finalized tree (copied: later changes to the tree, or its
+ * destruction, do not affect it) and one mass-properties value per body (`n_bodies` of them,
+ * each in the body's frame, in body order), and writes its handle to `*mechanism_out`. The
+ * caller owns the handle and frees it with mech_mechanism_destroy. The mechanism starts
+ * without loads.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when the tree is not finalized or a body's properties
+ * are not those of a real body (mass ≤ 0 or an invalid tensor; the message names the body),
+ * except MECH_STATUS_NOT_POSITIVE_DEFINITE for a tensor that is not positive semidefinite or
+ * breaks the triangle inequality and MECH_STATUS_NON_FINITE for a NaN or infinite entry;
+ * MECH_STATUS_BAD_DIMENSION when `n_bodies` is not the tree's body count.
  *
  * # Safety
  * `tree` must be a live tree handle, `bodies` must point to `n_bodies` readable values and
@@ -2967,14 +3220,16 @@ mech_status_t mech_mechanism_create(struct mech_tree_t *tree,
  * Frees a mechanism. NULL is accepted and ignored.
  *
  * # Safety
- * `mechanism` must be NULL or a live handle, not used afterwards.
+ * `mechanism` must be NULL or a live handle from mech_mechanism_create, not used afterwards.
  */
 void mech_mechanism_destroy(struct mech_mechanism_t *mechanism);
 #endif
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * Number of coordinates of the mechanism into `*dof_out`.
+ * Writes the number of coordinates of the mechanism (the tree's dof) to `*dof_out`.
+ *
+ * Errors: none beyond the pointer checks.
  *
  * # Safety
  * `mechanism` must be a live handle and `dof_out` writable.
@@ -2985,90 +3240,14 @@ mech_status_t mech_mechanism_dof(struct mech_mechanism_t *mechanism,
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * Sets uniform gravity g (m/s², base-frame components).
+ * U*(q) (J) into `*potential_out`, its gradient ∂(U*)/∂q into `gradient_out` (n values) and,
+ * unless `hessian_out` is NULL, its Hessian B = ∂²(U*)/∂q∂q (n×n, column-major), all exact
+ * (8.79), at the coordinates q (n values; n = the mechanism's dof).
  *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_set_gravity(struct mech_mechanism_t *mechanism,
-                                         struct mech_vec3_t gravity);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Makes the base frame turn at `rate` rad/s about the unit `axis` through its origin (§8e);
- * rate 0 removes the rotation. Gravity must be along the axis.
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_set_rotating_frame(struct mech_mechanism_t *mechanism,
-                                                struct mech_vec3_t axis,
-                                                double rate);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Adds U = ½ k (q_i − rest)² on coordinate `coordinate` (not on spherical/free rotation vectors).
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_add_joint_spring(struct mech_mechanism_t *mechanism,
-                                              size_t coordinate,
-                                              double stiffness,
-                                              double rest);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Adds a spring U = ½ k (|x_a − x_b| − rest_length)² between the point `point_a` of body
- * `body_a` and `point_b` of `body_b` (body coordinates; MECH_GROUND and world coordinates for
- * the ground).
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_add_point_spring(struct mech_mechanism_t *mechanism,
-                                              int64_t body_a,
-                                              struct mech_vec3_t point_a,
-                                              int64_t body_b,
-                                              struct mech_vec3_t point_b,
-                                              double stiffness,
-                                              double rest_length);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Adds a constant world force `force` (N) at the point `point` of body `body` (U = −F·x).
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_add_force(struct mech_mechanism_t *mechanism,
-                                       size_t body,
-                                       struct mech_vec3_t point,
-                                       struct mech_vec3_t force);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * Limits coordinate `coordinate` to [lower, upper] in equilibrium searches.
- *
- * # Safety
- * `mechanism` must be a live handle.
- */
-mech_status_t mech_mechanism_set_limits(struct mech_mechanism_t *mechanism,
-                                        size_t coordinate,
-                                        double lower,
-                                        double upper);
-#endif
-
-#if defined(MECH_FEATURE_MECHANISM)
-/**
- * U*(q) into `*potential_out`, its gradient into `gradient_out` (n values) and, unless
- * `hessian_out` is NULL, its Hessian B = ∂²(U*)/∂q∂q (n×n, column-major; spherical and free
- * joints need φ = 0, else MECH_STATUS_INVALID_ARGUMENT). All exact (8.79).
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_NON_FINITE for a NaN or
+ * infinite coordinate; MECH_STATUS_INVALID_ARGUMENT when a Hessian is asked at a non-zero
+ * rotation vector of a spherical or free joint (its Hessian is exact only at φ = 0);
+ * MECH_STATUS_SINGULAR for a spring of rest length > 0 whose ends coincide.
  *
  * # Safety
  * `mechanism` must be a live handle; `q` and `gradient_out` must hold n doubles,
@@ -3084,12 +3263,17 @@ mech_status_t mech_mechanism_potential(struct mech_mechanism_t *mechanism,
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * Searches an equilibrium from `q0` (n values) and writes it to `q_out` (n values) with its
- * report. `max_iterations` 0 means the default (100); `tolerance` ≤ 0 means the default
- * derived from rounding. Spherical and free joints are re-centred during the search: the
- * result is in the mechanism's new chart (bodies do not move). When the search fails
- * (MECH_STATUS_NOT_CONVERGED), `q_out` still receives the best point found and
- * `report_out` its gradient norm, so the caller can inspect it.
+ * Searches an equilibrium (grad U* = 0, or a minimum of U* per `seek`, a mech_seek_t) from
+ * `q0` (n values) and writes it to `q_out` (n values) with its report (U*, ‖grad U*‖ and the
+ * tolerance it met, iterations, last step) to `report_out`. `max_iterations` 0 means the
+ * default (100); `tolerance` ≤ 0 means the default derived from rounding. Spherical and free
+ * joints are re-centred during the search: the result is in the mechanism's new chart (bodies
+ * do not move).
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_BAD_ENUM for an unknown
+ * `seek`; MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_NOT_CONVERGED when
+ * the search fails, in which case `q_out` still receives the best point found and
+ * `report_out` its gradient norm (potential and last step NaN), so the caller can inspect it.
  *
  * # Safety
  * `mechanism` must be a live handle; `q0` and `q_out` must hold n doubles; `report_out`
@@ -3107,11 +3291,124 @@ mech_status_t mech_mechanism_equilibrium(struct mech_mechanism_t *mechanism,
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * The stability and the lowest `count` modes (count 0: all) of the mechanism about q (n
- * values): ω² into `omega_sq_out`, their error bounds into `error_bounds_out`, their kinds
- * (MECH_MODAL_KIND_*) into `kinds_out` (each `count` long, or n for all), the A-normalised
- * shapes into `shapes_out` (n × count column-major, may be NULL) and the verdict into
- * `stability_out`. The number of modes written goes to `*modes_out`.
+ * Sets uniform gravity g (m/s², base-frame components); it replaces any earlier value.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite component; MECH_STATUS_INVALID_ARGUMENT
+ * when the base frame rotates (mech_mechanism_set_rotating_frame) about an axis that g is not
+ * parallel to.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_set_gravity(struct mech_mechanism_t *mechanism,
+                                         struct mech_vec3_t gravity);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Makes the base frame turn at `rate` rad/s about the unit `axis` (base-frame components)
+ * through its origin, so that U* includes the centrifugal potential and the modes the
+ * Coriolis coupling (§8e); rate 0 removes the rotation.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * an axis that is not a unit vector (|‖a‖ − 1| > 1e-9) or gravity that is not along the axis.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_set_rotating_frame(struct mech_mechanism_t *mechanism,
+                                                struct mech_vec3_t axis,
+                                                double rate);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Adds the potential U = ½ k (q_i − rest)² on coordinate i = `coordinate`, with stiffness k =
+ * `stiffness` (N/m or N·m/rad per the coordinate) and rest value `rest`. Not allowed on the
+ * rotation-vector coordinates of spherical and free joints.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a coordinate out of range or of a rotation vector, or a negative stiffness.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_add_joint_spring(struct mech_mechanism_t *mechanism,
+                                              size_t coordinate,
+                                              double stiffness,
+                                              double rest);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Adds a spring U = ½ k (|x_a − x_b| − rest_length)² (k = `stiffness` in N/m, `rest_length`
+ * in m) between the point `point_a` of body `body_a` and `point_b` of `body_b` (body
+ * coordinates, m; MECH_GROUND and base-frame coordinates for the ground).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a body index below MECH_GROUND or out of range, a negative stiffness or rest length.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_add_point_spring(struct mech_mechanism_t *mechanism,
+                                              int64_t body_a,
+                                              struct mech_vec3_t point_a,
+                                              int64_t body_b,
+                                              struct mech_vec3_t point_b,
+                                              double stiffness,
+                                              double rest_length);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Adds a constant force `force` (N, base-frame components) at the point `point` (m, body
+ * coordinates) of body `body`: U = −F·x.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a body out of range.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_add_force(struct mech_mechanism_t *mechanism,
+                                       size_t body,
+                                       struct mech_vec3_t point,
+                                       struct mech_vec3_t force);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * Limits coordinate `coordinate` to [lower, upper] (infinite bounds allowed) in equilibrium
+ * searches; the coordinates resting on a limit are counted in
+ * mech_equilibrium_report_t::at_limit. Not allowed on the rotation-vector coordinates of
+ * spherical and free joints.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT for a coordinate out of range or of a rotation vector,
+ * a NaN bound or lower > upper.
+ *
+ * # Safety
+ * `mechanism` must be a live handle.
+ */
+mech_status_t mech_mechanism_set_limits(struct mech_mechanism_t *mechanism,
+                                        size_t coordinate,
+                                        double lower,
+                                        double upper);
+#endif
+
+#if defined(MECH_FEATURE_MECHANISM)
+/**
+ * The stability and the lowest `count` modes (count 0: all n) of det(λA + B) = 0 for the
+ * mechanism about q (n values, normally an equilibrium), A the mass matrix and B the Hessian
+ * of U*: ω² (rad²/s²) into `omega_sq_out`, their error bounds into `error_bounds_out`, their
+ * kinds (MECH_MODAL_KIND_*) into `kinds_out` (each `count` long, or n for all; entries past
+ * the modes found are 0, 0 and MECH_MODAL_KIND_INFINITE), the A-normalised shapes into
+ * `shapes_out` (n × count column-major, may be NULL) and the verdict into `stability_out`.
+ * The number of modes written goes to `*modes_out`.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof or count > n;
+ * MECH_STATUS_NON_FINITE for a NaN or infinite coordinate; the modal solve's errors
+ * (mech_modal_solve), e.g. MECH_STATUS_NOT_POSITIVE_DEFINITE for an indefinite mass matrix.
  *
  * # Safety
  * `mechanism` must be a live handle; the buffers must have the lengths above.
@@ -3130,8 +3427,24 @@ mech_status_t mech_mechanism_modes(struct mech_mechanism_t *mechanism,
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * Writes the default options of mech_modal_solve to `options_out`: MECH_MODAL_SELECTION_ALL
+ * (count, lower and upper 0), vectors = 1, MECH_MODAL_REFINEMENT_AUTO.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `options_out` must point to a writable mech_modal_options_t.
+ */
+mech_status_t mech_modal_options_default(struct mech_modal_options_t *options_out);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * Checks that the n×n column-major matrices `a` (mass) and `b` (stiffness) form a valid
  * symmetric pencil for det(λA + B) = 0: finite, and symmetric within 64 ulps of max|entry|.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION for n = 0 or n·n overflowing; MECH_STATUS_NON_FINITE for
+ * a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT for an asymmetric matrix.
  *
  * # Safety
  * `a` and `b` must each point to n·n readable doubles.
@@ -3144,10 +3457,18 @@ mech_status_t mech_modal_check_pencil(size_t n,
 #if defined(MECH_FEATURE_MODAL)
 /**
  * Solves det(λA + B) = 0 (8.89) for the n×n column-major mass matrix `a` (symmetric positive
- * semidefinite) and stiffness matrix `b` (symmetric), with the given options, and stores a new
- * result handle in `*out`. Errors: MECH_STATUS_NOT_POSITIVE_DEFINITE when A is indefinite,
- * MECH_STATUS_SINGULAR when det(λA + B) ≡ 0, MECH_STATUS_INVALID_ARGUMENT for an asymmetric
- * matrix, a bad interval, `vectors` not 0/1 or more modes than exist.
+ * semidefinite) and stiffness matrix `b` (symmetric), with the given options, and writes a new
+ * result handle to `*out`; the caller owns it and frees it with mech_modal_result_destroy. The
+ * result carries its accuracy report (mech_modal_result_accuracy): backward errors,
+ * A-orthogonality, per-mode error bounds and a Sturm inertia check; the residuals are measured
+ * exactly (see mech_modal_solve_with_residuals).
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION for n = 0 or n·n overflowing; MECH_STATUS_BAD_ENUM for an
+ * unknown selection or refinement; MECH_STATUS_NON_FINITE for a NaN or infinite entry or
+ * interval end; MECH_STATUS_NOT_POSITIVE_DEFINITE when A is indefinite; MECH_STATUS_SINGULAR
+ * when det(λA + B) ≡ 0; MECH_STATUS_INVALID_ARGUMENT for an asymmetric matrix, a bad interval,
+ * `vectors` not 0/1 or more modes than exist; MECH_STATUS_NOT_CONVERGED when the eigensolver
+ * fails to converge.
  *
  * # Safety
  * `a` and `b` must each point to n·n readable doubles; `options` to a readable
@@ -3164,8 +3485,9 @@ mech_status_t mech_modal_solve(size_t n,
 /**
  * mech_modal_solve with a choice of how the accuracy report measures residuals:
  * MECH_MODAL_RESIDUALS_EXACT (what mech_modal_solve does) or MECH_MODAL_RESIDUALS_SKETCHED
- * (probabilistic upper bounds at O(n²) cost, for large all-pairs solves). Errors as
- * mech_modal_solve, and MECH_STATUS_BAD_ENUM for an unknown `residuals`.
+ * (probabilistic upper bounds at O(n²) cost, for large all-pairs solves).
+ *
+ * Errors: as mech_modal_solve, and MECH_STATUS_BAD_ENUM for an unknown `residuals`.
  *
  * # Safety
  * As mech_modal_solve.
@@ -3180,16 +3502,6 @@ mech_status_t mech_modal_solve_with_residuals(size_t n,
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * Frees a result of mech_modal_solve. NULL is accepted and ignored.
- *
- * # Safety
- * `result` must be NULL or a handle from mech_modal_solve not yet destroyed.
- */
-void mech_modal_result_destroy(struct mech_modal_result_t *result);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
  * Returns to the system the working matrices that dense solves keep for the next solve (up to
  * five n×n matrices of the largest recent order; see the README's known limits). The next
  * dense solve allocates afresh. Safe to call at any time, from any thread.
@@ -3199,71 +3511,11 @@ void mech_modal_release_scratch(void);
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * Stores the number of modes in `*modes` and the order n of the pencil in `*dim`.
+ * Writes to `*below` the number of modes with ω² < `shift` (rad²/s²), certified by the inertia
+ * of an LBLᵀ factorization of B − shift·A (Sylvester's law; A must be positive definite for the
+ * count to equal the number of modes). The n×n matrices are column-major.
  *
- * # Safety
- * `result` must be a live handle; `modes` and `dim` writable.
- */
-mech_status_t mech_modal_result_size(const struct mech_modal_result_t *result,
-                                     size_t *modes,
-                                     size_t *dim);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Copies λ_k (= −ω²_k) of every mode, ascending in ω², into `lambda` (capacity ≥ number of
- * modes, else MECH_STATUS_BUFFER_TOO_SMALL and nothing written).
- *
- * # Safety
- * `result` must be a live handle; `lambda` must have `capacity` writable doubles.
- */
-mech_status_t mech_modal_result_eigenvalues(const struct mech_modal_result_t *result,
-                                            double *lambda,
-                                            size_t capacity);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Copies the scalar data of every mode into `modes` (capacity ≥ number of modes).
- *
- * # Safety
- * `result` must be a live handle; `modes` must have `capacity` writable elements.
- */
-mech_status_t mech_modal_result_modes(const struct mech_modal_result_t *result,
-                                      struct mech_modal_mode_t *modes,
-                                      size_t capacity);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Copies the mode shapes as an n × (number of modes) column-major matrix into `x`
- * (capacity ≥ n·modes). Finite modes are A-orthonormal; infinite ones are unit null vectors
- * of A. MECH_STATUS_INVALID_ARGUMENT if the solve was values only.
- *
- * # Safety
- * `result` must be a live handle; `x` must have `capacity` writable doubles.
- */
-mech_status_t mech_modal_result_vectors(const struct mech_modal_result_t *result,
-                                        double *x,
-                                        size_t capacity);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Copies the accuracy summary of the solve into `*accuracy`.
- *
- * # Safety
- * `result` must be a live handle; `accuracy` writable.
- */
-mech_status_t mech_modal_result_accuracy(const struct mech_modal_result_t *result,
-                                         struct mech_modal_accuracy_t *accuracy);
-#endif
-
-#if defined(MECH_FEATURE_MODAL)
-/**
- * Stores in `*below` the number of modes with ω² < `shift`, certified by the inertia of an
- * LBLᵀ factorization of B − shift·A (Sylvester's law; A must be positive definite for the
- * count to equal the number of modes).
+ * Errors: as mech_modal_check_pencil, and MECH_STATUS_NON_FINITE for a NaN or infinite shift.
  *
  * # Safety
  * `a` and `b` must each point to n·n readable doubles; `below` writable.
@@ -3278,14 +3530,19 @@ mech_status_t mech_modal_count_below(size_t n,
 #if defined(MECH_FEATURE_MODAL)
 /**
  * The free response of A δ̈ + B δ = 0 (8.91) from δ(0) = `delta0` and δ̇(0) = `delta_dot0`
- * (n each) at `time_count` times `times` (s, any sign): δ(t_j) = Σ_k q_k(t_j) x_k with
- * q = q₀ cos ωt + (q̇₀/ω) sin ωt for oscillatory modes, q₀ + q̇₀t for zero (rigid-body) modes
- * and q₀ cosh γt + (q̇₀/γ) sinh γt for unstable ones; massless coordinates follow statically.
- * `result` must come from mech_modal_solve with MECH_MODAL_SELECTION_ALL and vectors = 1
- * (else MECH_STATUS_INVALID_ARGUMENT). Writes δ(t_j) as column j of the n × time_count
- * column-major `delta_out` (capacity ≥ n·time_count), δ̇(t_j) likewise into `velocity_out`
- * (may be NULL), and the fit summary into `fit_out` (may be NULL). An unstable mode that
- * overflows a double at some t_j gives MECH_STATUS_INVALID_ARGUMENT; nothing is written then.
+ * (n each, in the coordinates of the pencil) at `time_count` times `times` (s, any sign):
+ * δ(t_j) = Σ_k q_k(t_j) x_k with q = q₀ cos ωt + (q̇₀/ω) sin ωt for oscillatory modes,
+ * q₀ + q̇₀t for zero (rigid-body) modes and q₀ cosh γt + (q̇₀/γ) sinh γt for unstable ones;
+ * massless coordinates follow statically. Writes δ(t_j) as column j of the n × time_count
+ * column-major `delta_out`, δ̇(t_j) likewise into `velocity_out` (may be NULL), and the fit
+ * summary with the response's error bound into `fit_out` (may be NULL).
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when `result` does not come from mech_modal_solve with
+ * MECH_MODAL_SELECTION_ALL and vectors = 1, or when an unstable mode overflows a double at
+ * some t_j; MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_BAD_DIMENSION when
+ * n·time_count overflows; MECH_STATUS_BUFFER_TOO_SMALL when `delta_capacity` (or, for a
+ * non-NULL `velocity_out`, `velocity_capacity`) is below n·time_count. Nothing is written on
+ * error.
  *
  * # Safety
  * `result` must be a live handle; `delta0`, `delta_dot0` must point to n readable doubles,
@@ -3306,22 +3563,111 @@ mech_status_t mech_modal_free_response(const struct mech_modal_result_t *result,
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * Frees a result of mech_modal_solve. NULL is accepted and ignored.
+ *
+ * # Safety
+ * `result` must be NULL or a handle from mech_modal_solve not yet destroyed; it is invalid
+ * afterwards.
+ */
+void mech_modal_result_destroy(struct mech_modal_result_t *result);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Writes the number of modes of the result to `*modes` and the order n of the pencil to `*dim`.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `result` must be a live handle; `modes` and `dim` writable.
+ */
+mech_status_t mech_modal_result_size(const struct mech_modal_result_t *result,
+                                     size_t *modes,
+                                     size_t *dim);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies λ_k = −ω²_k (rad²/s²) of every mode, ascending in ω², into `lambda`; exactly the
+ * number of modes (mech_modal_result_size) is written.
+ *
+ * Errors: MECH_STATUS_BUFFER_TOO_SMALL when `capacity` is below the number of modes.
+ *
+ * # Safety
+ * `result` must be a live handle; `lambda` must have `capacity` writable doubles.
+ */
+mech_status_t mech_modal_result_eigenvalues(const struct mech_modal_result_t *result,
+                                            double *lambda,
+                                            size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies the scalar record of every mode (λ, ω², rate, error bound, backward error, kind,
+ * group and multiplicity), ascending in ω², into `modes`.
+ *
+ * Errors: MECH_STATUS_BUFFER_TOO_SMALL when `capacity` is below the number of modes.
+ *
+ * # Safety
+ * `result` must be a live handle; `modes` must have `capacity` writable elements.
+ */
+mech_status_t mech_modal_result_modes(const struct mech_modal_result_t *result,
+                                      struct mech_modal_mode_t *modes,
+                                      size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies the mode shapes as an n × (number of modes) column-major matrix into `x`, column k
+ * belonging to mode k. Finite modes are A-orthonormal (XᵀAX = I to the reported
+ * orthogonality error); infinite ones are unit null vectors of A.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT when the solve computed values only;
+ * MECH_STATUS_BUFFER_TOO_SMALL when `capacity` < n·modes.
+ *
+ * # Safety
+ * `result` must be a live handle; `x` must have `capacity` writable doubles.
+ */
+mech_status_t mech_modal_result_vectors(const struct mech_modal_result_t *result,
+                                        double *x,
+                                        size_t capacity);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * Copies the accuracy summary of the solve into `*accuracy`: norms, the largest backward
+ * error and error bound, the A-orthogonality error, the refined modes and the Sturm inertia
+ * check that certifies no mode below its shift was missed.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `result` must be a live handle; `accuracy` writable.
+ */
+mech_status_t mech_modal_result_accuracy(const struct mech_modal_result_t *result,
+                                         struct mech_modal_accuracy_t *accuracy);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * The `count` lowest modes of det(λA + B) = 0 for sparse n×n A (mass, positive semidefinite)
  * and B (stiffness) in compressed sparse columns (0-based, both triangles stored; duplicates are
  * summed): shift-invert block Lanczos on a sparse Cholesky factorization, certified by a sparse
- * inertia count. Writes ω²_k ascending into `omega_sq_out` (count), their error bounds into
- * `error_bound_out` (count, may be NULL), the A-orthonormal shapes as an n × count column-major
- * matrix into `vectors_out` (may be NULL) and the summary into `report_out` (may be NULL).
- * Exactly `count` modes are returned: when `count` cuts through a repeated eigenvalue, only
- * part of its eigenspace is (ask for more to get the whole group). Copies of a repeated
- * eigenvalue missed by the first Lanczos run are found by the inertia count and recovered by
- * deflated reruns; a result is never returned uncertified. Each pair converges until its
- * Ritz residual ‖K⁻¹Ax − θx‖_A ≤ 1e-12·θ (K = B − σA, θ = 1/(ω² − σ)), so its backward
- * error is at most about 1e-12·√κ(A)·‖K‖₂/‖B‖_F (κ(A) the condition number of A); the
- * eigenvalue errors are quadratic in that residual.
- * Errors: BAD_DIMENSION for an index ≥ n, NON_FINITE, INVALID_ARGUMENT for asymmetry, bad
- * column pointers or count ∉ [1, n]; NOT_POSITIVE_DEFINITE when no shift below the spectrum
- * was found (A indefinite); NOT_CONVERGED (also when the reruns run out).
+ * inertia count. Writes ω²_k (rad²/s²) ascending into `omega_sq_out` (count), their error
+ * bounds into `error_bound_out` (count, may be NULL), the A-orthonormal shapes as an n × count
+ * column-major matrix into `vectors_out` (may be NULL) and the accuracy summary into
+ * `report_out` (may be NULL). Exactly `count` modes are returned: when `count` cuts through a
+ * repeated eigenvalue, only part of its eigenspace is (ask for more to get the whole group).
+ * Copies of a repeated eigenvalue missed by the first Lanczos run are found by the inertia
+ * count and recovered by deflated reruns; a result is never returned uncertified. Each pair
+ * converges until its Ritz residual ‖K⁻¹Ax − θx‖_A ≤ 1e-12·θ (K = B − σA, θ = 1/(ω² − σ)), so
+ * its backward error is at most about 1e-12·√κ(A)·‖K‖₂/‖B‖_F (κ(A) the condition number of
+ * A); the eigenvalue errors are quadratic in that residual.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION for n = 0 or an index ≥ n; MECH_STATUS_NON_FINITE;
+ * MECH_STATUS_INVALID_ARGUMENT for asymmetry, bad column pointers or count ∉ [1, n];
+ * MECH_STATUS_NOT_POSITIVE_DEFINITE when no shift below the spectrum was found (A indefinite);
+ * MECH_STATUS_NOT_CONVERGED (also when the reruns run out). Nothing is written on error.
  *
  * # Safety
  * Each `*_col_ptr` must point to n + 1 readable size_t, each `*_row_idx` / `*_values` to
@@ -3343,15 +3689,31 @@ mech_status_t mech_modal_sparse_lowest(size_t n,
 
 #if defined(MECH_FEATURE_MODAL)
 /**
+ * Writes the default options of mech_modal_sparse_solve to `options_out`: count 10, tolerance
+ * 1e-12, block size 2, 6 Lanczos runs, automatic shift (shift_given = 0, shift = 0). Set
+ * `count` to the number of modes wanted before solving.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `options_out` must point to a writable mech_modal_sparse_options_t.
+ */
+mech_status_t mech_modal_sparse_options_default(struct mech_modal_sparse_options_t *options_out);
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
  * The `options->count` lowest modes of det(λA + B) = 0 for sparse A and B in compressed sparse
  * columns, as mech_modal_sparse_lowest, with options (tolerance, block size, runs, shift) and
  * the full record of each mode: `modes_out` (count) receives λ, ω², the rate, the error bound,
  * the backward error, the MECH_MODAL_KIND_* classification (zero when |ω²| is within its
  * bound or within what the rounding of A and B can change), the group index and the group's
- * multiplicity. `vectors_out` (n × count, column-major, may be NULL), `report_out` and
- * `details_out` (may be NULL) as named. Errors as mech_modal_sparse_lowest, plus
- * INVALID_ARGUMENT for a tolerance outside [0, 1) or shift_given ∉ {0, 1}, NON_FINITE for a
- * non-finite tolerance or given shift; nothing is written on error.
+ * multiplicity. `vectors_out` (n × count, column-major, may be NULL), `report_out` (the
+ * accuracy summary) and `details_out` (may be NULL) as named.
+ *
+ * Errors: as mech_modal_sparse_lowest, plus MECH_STATUS_INVALID_ARGUMENT for a tolerance
+ * outside [0, 1) or shift_given ∉ {0, 1}, MECH_STATUS_NON_FINITE for a non-finite tolerance or
+ * given shift. Nothing is written on error.
  *
  * # Safety
  * As mech_modal_sparse_lowest; `options` must point to a readable struct.

@@ -443,10 +443,57 @@ static void test_mechanisms(void) {
     mech_tree_destroy(open);
 }
 
+/* mech_multi_contact_options_default writes the options a NULL pointer selects: a rough double
+ * contact (the simultaneous model) gives the same impact, bit for bit, with either. */
+static void test_multi_contact_options_default(void) {
+    mech_multi_contact_options_t o;
+    FILL_SENTINEL(&o, sizeof o);
+    CHECK_STATUS(mech_multi_contact_options_default(&o), MECH_STATUS_OK);
+    CHECK(o.tolerance == 1e-10 && o.max_iterations == 10000 && o.process_tolerance == 1e-10);
+    CHECK_STATUS(mech_multi_contact_options_default(NULL), MECH_STATUS_NULL_POINTER);
+
+    const double m = 2.0, l = 0.8, ic = 0.05, omega = 1.5;
+    mech_mass_properties_t bob;
+    memset(&bob, 0, sizeof bob);
+    bob.mass = m;
+    bob.center_of_mass = v3(0.0, -l, 0.0);
+    bob.inertia_about_com = diag3(ic, ic, ic);
+    mech_tree_t *tree = pendulum_tree(omega);
+    mech_mechanism_contact_t two[2];
+    memset(two, 0, sizeof two);
+    for (int k = 0; k < 2; ++k) {
+        two[k].body = 0;
+        two[k].point = v3(0.0, -l, 0.0);
+        two[k].other_body = -1;
+        two[k].normal = v3(-1.0, 0.0, 0.0);
+        two[k].restitution = 0.5;
+        two[k].friction = 0.4;
+        two[k].law = MECH_RESTITUTION_POISSON;
+    }
+    mech_mechanism_contact_result_t by_null[2], by_default[2];
+    mech_mechanism_impact_t imp_null, imp_default;
+    double dq_null = 0.0, dq_default = 1.0;
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, two, 2, NULL, by_null, &dq_null, 1, &imp_null),
+                 MECH_STATUS_OK);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, two, 2, &o, by_default, &dq_default, 1, &imp_default),
+                 MECH_STATUS_OK);
+    CHECK(imp_null.simultaneous == 1 && imp_null.converged == 1);
+    CHECK(dq_null == dq_default);
+    CHECK(imp_null.energy_change == imp_default.energy_change && imp_null.iterations == imp_default.iterations);
+    CHECK(imp_null.complementarity_residual == imp_default.complementarity_residual);
+    for (int k = 0; k < 2; ++k) {
+        CHECK(by_null[k].normal_impulse == by_default[k].normal_impulse);
+        CHECK(by_null[k].impulse.x == by_default[k].impulse.x && by_null[k].impulse.y == by_default[k].impulse.y);
+        CHECK(by_null[k].mode == by_default[k].mode);
+    }
+    mech_tree_destroy(tree);
+}
+
 int main(void) {
     test_points();
     test_bodies();
     test_contacts();
     test_mechanisms();
+    test_multi_contact_options_default();
     return CHECK_DONE();
 }

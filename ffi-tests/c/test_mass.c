@@ -406,6 +406,34 @@ static void meshes(void) {
     CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, NULL, &rs), MECH_STATUS_NULL_POINTER);
 }
 
+/* mech_mesh_options_default writes the options a NULL pointer selects: the same properties and
+ * report, bit for bit, for an inside-out box far from the origin (flipped by default). */
+static void mesh_options_default(void) {
+    mech_mesh_options_t o;
+    FILL_SENTINEL(&o, sizeof o);
+    CHECK_STATUS(mech_mesh_options_default(&o), MECH_STATUS_OK);
+    CHECK(o.model == MECH_MESH_SOLID && o.open_mesh == MECH_OPEN_MESH_REJECT);
+    CHECK(o.inside_out == MECH_INSIDE_OUT_FLIP && o.degenerate == MECH_DEGENERATE_SKIP);
+    CHECK_STATUS(mech_mesh_options_default(NULL), MECH_STATUS_NULL_POINTER);
+
+    double v[24];
+    uint32_t tri[36], inv[36];
+    box_mesh(1e6, v, tri);
+    for (int k = 0; k < 12; ++k) {
+        inv[3 * k] = tri[3 * k];
+        inv[3 * k + 1] = tri[3 * k + 2];
+        inv[3 * k + 2] = tri[3 * k + 1];
+    }
+    mech_mass_properties_t by_null, by_default;
+    mech_mesh_report_t rep_null, rep_default;
+    CHECK_STATUS(mech_mass_mesh(v, 8, inv, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &by_null, &rep_null), MECH_STATUS_OK);
+    CHECK_STATUS(mech_mass_mesh(v, 8, inv, 12, MECH_AMOUNT_DENSITY, 2.0, &o, &by_default, &rep_default),
+                 MECH_STATUS_OK);
+    CHECK(rep_null.flipped == 1 && rep_default.flipped == 1);
+    CHECK(memcmp(&by_null, &by_default, sizeof by_null) == 0);
+    CHECK(memcmp(&rep_null, &rep_default, sizeof rep_null) == 0);
+}
+
 /* A deforming box: the report of the first call carries the topology to later calls on the same
  * triangles, whose results equal a fresh mech_mass_mesh bit for bit and the closed form. */
 static void deforming_mesh(void) {
@@ -689,6 +717,7 @@ int main(void) {
     validity_and_repair();
     momenta_and_energy();
     meshes();
+    mesh_options_default();
     deforming_mesh();
     tree_mechanism();
     return CHECK_DONE();

@@ -918,6 +918,68 @@ static void rigid_body_modes(void) {
     }
 }
 
+/* The options_default functions write what the documented defaults select: the dense defaults
+ * solve as default_options() does, the sparse defaults (count set) as a zero-initialised struct,
+ * bit for bit. The sparse problem is a fixed–fixed chain of NC unit springs and masses,
+ * ω²_k = 4 sin²(kπ/(2(NC+1))). */
+#define NC 40
+static void options_defaults(void) {
+    mech_modal_options_t o;
+    FILL_SENTINEL(&o, sizeof o);
+    CHECK_STATUS(mech_modal_options_default(&o), MECH_STATUS_OK);
+    CHECK(o.selection == MECH_MODAL_SELECTION_ALL && o.count == 0 && o.lower == 0.0 && o.upper == 0.0);
+    CHECK(o.vectors == 1 && o.refinement == MECH_MODAL_REFINEMENT_AUTO);
+    CHECK_STATUS(mech_modal_options_default(NULL), MECH_STATUS_NULL_POINTER);
+    double a[N * N], b[N * N];
+    fixed_chain(a, b);
+    mech_modal_options_t by_hand = default_options();
+    mech_modal_result_t *r1 = NULL, *r2 = NULL;
+    CHECK_STATUS(mech_modal_solve(N, a, b, &o, &r1), MECH_STATUS_OK);
+    CHECK_STATUS(mech_modal_solve(N, a, b, &by_hand, &r2), MECH_STATUS_OK);
+    double l1[N], l2[N];
+    CHECK_STATUS(mech_modal_result_eigenvalues(r1, l1, N), MECH_STATUS_OK);
+    CHECK_STATUS(mech_modal_result_eigenvalues(r2, l2, N), MECH_STATUS_OK);
+    CHECK(memcmp(l1, l2, sizeof l1) == 0);
+    mech_modal_result_destroy(r1);
+    mech_modal_result_destroy(r2);
+
+    mech_modal_sparse_options_t so;
+    FILL_SENTINEL(&so, sizeof so);
+    CHECK_STATUS(mech_modal_sparse_options_default(&so), MECH_STATUS_OK);
+    CHECK(so.count == 10 && so.tolerance == 1e-12 && so.block_size == 2 && so.max_runs == 6);
+    CHECK(so.shift_given == 0 && so.shift == 0.0);
+    CHECK_STATUS(mech_modal_sparse_options_default(NULL), MECH_STATUS_NULL_POINTER);
+    size_t acp[NC + 1], arow[NC], bcp[NC + 1], brow[3 * NC];
+    double aval[NC], bval[3 * NC];
+    size_t nb = 0;
+    for (size_t c = 0; c < NC; ++c) {
+        acp[c] = c;
+        arow[c] = c;
+        aval[c] = 1.0;
+        bcp[c] = nb;
+        if (c > 0) { brow[nb] = c - 1; bval[nb++] = -1.0; }
+        brow[nb] = c; bval[nb++] = 2.0;
+        if (c + 1 < NC) { brow[nb] = c + 1; bval[nb++] = -1.0; }
+    }
+    acp[NC] = NC;
+    bcp[NC] = nb;
+    so.count = 3;
+    mech_modal_sparse_options_t zero;
+    memset(&zero, 0, sizeof zero);
+    zero.count = 3;
+    mech_modal_mode_t by_default[3], by_zero[3];
+    CHECK_STATUS(mech_modal_sparse_solve(NC, acp, arow, aval, bcp, brow, bval, &so, by_default, NULL, NULL, NULL),
+                 MECH_STATUS_OK);
+    CHECK_STATUS(mech_modal_sparse_solve(NC, acp, arow, aval, bcp, brow, bval, &zero, by_zero, NULL, NULL, NULL),
+                 MECH_STATUS_OK);
+    const double pi = 3.14159265358979323846;
+    for (int k = 0; k < 3; ++k) {
+        CHECK(by_default[k].omega_sq == by_zero[k].omega_sq && by_default[k].error_bound == by_zero[k].error_bound);
+        double s = sin((k + 1) * pi / (2.0 * (NC + 1)));
+        CHECK_NEAR(by_default[k].omega_sq, 4.0 * s * s, by_default[k].error_bound + 4.0 * 2.2e-16 * 4.0 * s * s);
+    }
+}
+
 int main(void) {
     all_pairs();
     dense_blocked_path();
@@ -932,5 +994,6 @@ int main(void) {
     massless_coordinate();
     stiff_massless_series();
     error_paths();
+    options_defaults();
     return CHECK_DONE();
 }

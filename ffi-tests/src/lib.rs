@@ -1,6 +1,6 @@
 //! Drives the C/C++ ffi-tests and the header checks from `cargo test`.
 //!
-//! The tests in `tests/ffi.rs` build the `mechanica` library (static and shared) with cargo,
+//! The tests in `tests/programs.rs` build the `mechanica` library (static and shared) with cargo,
 //! compile every program in `ffi-tests/c` (C11) and `ffi-tests/cpp` (C++17) with
 //! `-Wall -Wextra -Werror -pedantic` under AddressSanitizer and UndefinedBehaviorSanitizer,
 //! link each once against each library kind, and run them. A failing C assertion exits

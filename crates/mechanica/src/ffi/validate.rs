@@ -1,5 +1,5 @@
-//! Validation of C arguments: pointers, numbers, sizes and enum integers, each failure
-//! with its own status and a message naming the argument.
+//! Validation of C arguments: pointers, numbers, sizes and caller buffers, each failure with
+//! its own status and a message naming the argument. Enum integers are checked in `c_enum`.
 
 use super::boundary::FfiError;
 use super::status::*;
@@ -7,7 +7,7 @@ use super::types::*;
 use std::ptr::NonNull;
 
 /// Fails with NULL_POINTER or MISALIGNED_POINTER unless `ptr` can be dereferenced as a `T`.
-fn check_pointer<T>(ptr: *const T, what: &str) -> Result<(), FfiError> {
+pub(crate) fn check_pointer<T>(ptr: *const T, what: &str) -> Result<(), FfiError> {
     if ptr.is_null() {
         return Err(FfiError::new(MECH_STATUS_NULL_POINTER, format!("{what} is NULL")));
     }
@@ -106,6 +106,22 @@ impl<T: Copy> OutSlice<T> {
         }
     }
 
+    /// Checks a required caller buffer of `capacity` elements that must hold `len`:
+    /// BUFFER_TOO_SMALL when it cannot, before the pointer itself is checked.
+    pub fn buffer(ptr: *mut T, capacity: usize, len: usize, what: &str) -> Result<Self, FfiError> {
+        check_capacity(capacity, len, what)?;
+        Self::new(ptr, len, what)
+    }
+
+    /// As [`OutSlice::buffer`] for an optional buffer: None for NULL, whatever its capacity.
+    pub fn optional_buffer(ptr: *mut T, capacity: usize, len: usize, what: &str) -> Result<Option<Self>, FfiError> {
+        if ptr.is_null() {
+            Ok(None)
+        } else {
+            Self::buffer(ptr, capacity, len, what).map(Some)
+        }
+    }
+
     /// Copies `values` (exactly `len` of them) into the array.
     ///
     /// # Safety
@@ -124,6 +140,24 @@ fn byte_length<T>(len: usize, what: &str) -> Result<usize, FfiError> {
     len.checked_mul(std::mem::size_of::<T>())
         .filter(|&bytes| bytes <= isize::MAX as usize)
         .ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, format!("{what}: length {len} is too large")))
+}
+
+/// Fails with BUFFER_TOO_SMALL when a caller buffer of `capacity` elements cannot hold `needed`.
+pub(crate) fn check_capacity(capacity: usize, needed: usize, what: &str) -> Result<(), FfiError> {
+    if capacity < needed {
+        return Err(FfiError::new(
+            MECH_STATUS_BUFFER_TOO_SMALL,
+            format!("{what}: capacity {capacity} < {needed} needed"),
+        ));
+    }
+    Ok(())
+}
+
+/// The element count a·b of a buffer (e.g. n rows × count columns), failing with BAD_DIMENSION
+/// on overflow.
+pub(crate) fn product(a: usize, b: usize, what: &str) -> Result<usize, FfiError> {
+    a.checked_mul(b)
+        .ok_or_else(|| FfiError::new(MECH_STATUS_BAD_DIMENSION, format!("{what}: {a}·{b} overflows")))
 }
 
 /// The element count n·n of a square matrix, failing with BAD_DIMENSION for n = 0 or overflow.
@@ -178,17 +212,6 @@ pub(crate) fn finite<T: Finite + ?Sized>(value: &T, what: &str) -> Result<(), Ff
     }
 }
 
-/// A Rust enum that C passes as a plain integer (never as the Rust enum itself).
-pub(crate) trait CEnum: Sized {
-    /// The enum value of a C integer, or None for an integer that names no value.
-    fn from_c(raw: i32) -> Option<Self>;
-}
-
-/// Converts a C enum integer into its Rust enum, failing with BAD_ENUM for unknown values.
-pub(crate) fn enum_value<E: CEnum>(raw: i32, what: &str) -> Result<E, FfiError> {
-    E::from_c(raw).ok_or_else(|| FfiError::new(MECH_STATUS_BAD_ENUM, format!("{what}: unknown value {raw}")))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -212,16 +235,14 @@ mod tests {
             square_len(usize::MAX, "A").map_err(|e| e.status),
             Err(MECH_STATUS_BAD_DIMENSION)
         );
-        struct Only7;
-        impl CEnum for Only7 {
-            fn from_c(raw: i32) -> Option<Self> {
-                (raw == 7).then_some(Only7)
-            }
-        }
-        assert!(enum_value::<Only7>(7, "mode").is_ok());
         assert_eq!(
-            enum_value::<Only7>(-3, "mode").map(|_| ()).map_err(|e| e.status),
-            Err(MECH_STATUS_BAD_ENUM)
+            check_capacity(2, 3, "x").map_err(|e| e.status),
+            Err(MECH_STATUS_BUFFER_TOO_SMALL)
         );
+        assert_eq!(
+            product(usize::MAX, 3, "n").map_err(|e| e.status),
+            Err(MECH_STATUS_BAD_DIMENSION)
+        );
+        assert_eq!(product(4, 3, "n"), Ok(12));
     }
 }

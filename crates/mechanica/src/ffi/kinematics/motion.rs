@@ -1,0 +1,175 @@
+//! Rigid motion x = R X + c of a body and the motion of a point relative to a moving frame:
+//! velocity and acceleration fields, and the drag / Coriolis / relative decomposition.
+
+use crate::ffi::boundary::{FfiError, boundary};
+use crate::ffi::spatial::read_vec3;
+use crate::ffi::status::*;
+use crate::ffi::types::*;
+use crate::ffi::validate::*;
+use mechanica_kinematics::nalgebra::Matrix3;
+use mechanica_kinematics::relative_motion::{self, RelativeMotion};
+use mechanica_kinematics::rigid_motion::RigidMotion;
+use mechanica_kinematics::rotation;
+
+/// The state of a rigid motion x = R X + c (syllabus 1.5) at one instant, all in fixed (world)
+/// components, SI units.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_rigid_motion_t {
+    /// Orientation R (body → world), column-major; must be a rotation.
+    pub rotation: mech_mat3_t,
+    /// Position c of the reference point.
+    pub c: mech_vec3_t,
+    /// Velocity ċ of the reference point.
+    pub c_dot: mech_vec3_t,
+    /// Acceleration c̈ of the reference point.
+    pub c_ddot: mech_vec3_t,
+    /// Angular velocity ω.
+    pub omega: mech_vec3_t,
+    /// Angular acceleration ω̇.
+    pub omega_dot: mech_vec3_t,
+}
+
+/// Reads and validates a rigid motion: every entry finite (NON_FINITE) and a rotation within
+/// ‖RᵀR − I‖_F ≤ 1e-12 (INVALID_ARGUMENT).
+///
+/// # Safety
+/// A non-NULL, aligned `ptr` must point to a readable mech_rigid_motion_t.
+unsafe fn read_motion(ptr: *const mech_rigid_motion_t, what: &str) -> Result<RigidMotion, FfiError> {
+    // SAFETY: caller's contract.
+    let m = unsafe { read(ptr, what) }?;
+    finite(&m.rotation, "motion rotation")?;
+    let rotation = rotation::rotation_from_matrix(&Matrix3::from(m.rotation))?;
+    for (v, name) in [
+        (&m.c, "motion c"),
+        (&m.c_dot, "motion c_dot"),
+        (&m.c_ddot, "motion c_ddot"),
+        (&m.omega, "motion omega"),
+        (&m.omega_dot, "motion omega_dot"),
+    ] {
+        finite(v, name)?;
+    }
+    Ok(RigidMotion::new(
+        rotation,
+        m.c.into(),
+        m.c_dot.into(),
+        m.c_ddot.into(),
+        m.omega.into(),
+        m.omega_dot.into(),
+    )?)
+}
+
+/// The velocity v = ω × (x − c) + ċ (m/s, syllabus 2.13) of the body point at world position
+/// `x` (m) in the rigid motion `motion`, written to `velocity_out` (world components).
+///
+/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
+/// `motion->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+///
+/// # Safety
+/// `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
+/// `velocity_out` to a writable mech_vec3_t.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_velocity_field(
+    motion: *const mech_rigid_motion_t,
+    x: *const mech_vec3_t,
+    velocity_out: *mut mech_vec3_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let (m, x) = unsafe { (read_motion(motion, "motion")?, read_vec3(x, "x")?) };
+        let out = Out::new(velocity_out, "velocity_out")?;
+        // SAFETY: caller's contract.
+        unsafe { out.write(m.velocity_at(&x).into()) };
+        Ok(())
+    })
+}
+
+/// The acceleration a = ω̇ × (x − c) + ω × (ω × (x − c)) + c̈ (m/s², syllabus 2.18) of the body
+/// point at world position `x` (m) in the rigid motion `motion`, written to `acceleration_out`
+/// (world components).
+///
+/// Errors: as mech_velocity_field.
+///
+/// # Safety
+/// `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
+/// `acceleration_out` to a writable mech_vec3_t.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_acceleration_field(
+    motion: *const mech_rigid_motion_t,
+    x: *const mech_vec3_t,
+    acceleration_out: *mut mech_vec3_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let (m, x) = unsafe { (read_motion(motion, "motion")?, read_vec3(x, "x")?) };
+        let out = Out::new(acceleration_out, "acceleration_out")?;
+        // SAFETY: caller's contract.
+        unsafe { out.write(m.acceleration_at(&x).into()) };
+        Ok(())
+    })
+}
+
+/// A point's absolute motion decomposed relative to a moving frame (world components, SI units,
+/// syllabus 2.22–2.32): v = v_drag + v_rel, a = a_drag + a_coriolis + a_rel.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_relative_decomposition_t {
+    /// Position x = R ξ + c.
+    pub position: mech_vec3_t,
+    /// Drag velocity ω × (x − c) + ċ.
+    pub v_drag: mech_vec3_t,
+    /// Relative velocity R ξ̇.
+    pub v_rel: mech_vec3_t,
+    /// Drag acceleration ω̇ × (x − c) + ω × (ω × (x − c)) + c̈.
+    pub a_drag: mech_vec3_t,
+    /// Coriolis acceleration 2 ω × v_rel.
+    pub a_coriolis: mech_vec3_t,
+    /// Relative acceleration R ξ̈.
+    pub a_rel: mech_vec3_t,
+}
+
+/// Decomposes the motion of a point with relative position, velocity and acceleration `xi`,
+/// `xi_dot`, `xi_ddot` (moving-frame components, SI units) in the moving frame `frame` into drag,
+/// Coriolis and relative parts (syllabus 2.22–2.32), written to `decomposition_out`.
+///
+/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
+/// `frame->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+///
+/// # Safety
+/// `frame` must point to a readable mech_rigid_motion_t, `xi`, `xi_dot`, `xi_ddot` to readable
+/// mech_vec3_t values and `decomposition_out` to a writable mech_relative_decomposition_t.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_relative_motion_decompose(
+    frame: *const mech_rigid_motion_t,
+    xi: *const mech_vec3_t,
+    xi_dot: *const mech_vec3_t,
+    xi_ddot: *const mech_vec3_t,
+    decomposition_out: *mut mech_relative_decomposition_t,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let (m, rel) = unsafe {
+            (
+                read_motion(frame, "frame")?,
+                RelativeMotion {
+                    xi: read_vec3(xi, "xi")?,
+                    xi_dot: read_vec3(xi_dot, "xi_dot")?,
+                    xi_ddot: read_vec3(xi_ddot, "xi_ddot")?,
+                },
+            )
+        };
+        let out = Out::new(decomposition_out, "decomposition_out")?;
+        let d = relative_motion::decompose(&m, &rel)?;
+        let value = mech_relative_decomposition_t {
+            position: d.position.into(),
+            v_drag: d.v_drag.into(),
+            v_rel: d.v_rel.into(),
+            a_drag: d.a_drag.into(),
+            a_coriolis: d.a_coriolis.into(),
+            a_rel: d.a_rel.into(),
+        };
+        // SAFETY: caller's contract.
+        unsafe { out.write(value) };
+        Ok(())
+    })
+}
