@@ -3242,7 +3242,7 @@ mech_status_t mech_mechanism_dof(struct mech_mechanism_t *mechanism,
 /**
  * U*(q) (J) into `*potential_out`, its gradient ∂(U*)/∂q into `gradient_out` (n values) and,
  * unless `hessian_out` is NULL, its Hessian B = ∂²(U*)/∂q∂q (n×n, column-major), all exact
- * (8.79), at the coordinates q (n values; n = the mechanism's dof).
+ * (8.74, 8.85), at the coordinates q (n values; n = the mechanism's dof).
  *
  * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_NON_FINITE for a NaN or
  * infinite coordinate; MECH_STATUS_INVALID_ARGUMENT when a Hessian is asked at a non-zero
