@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// What was wrong with which impact input.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum ImpulseError {
     /// A number that must be finite was NaN or infinite.
     #[error("{what} is not finite: {value}")]

@@ -5,6 +5,7 @@ use thiserror::Error;
 
 /// What was wrong with which mass-properties input.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum MassError {
     /// A number that must be finite was NaN or infinite.
     #[error("{what} is not finite: {value}")]

@@ -20,6 +20,7 @@ use faer::{Mat, Side};
 
 /// Which equilibria a search heads for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Seek {
     /// Any equilibrium (stable or not): Newton on grad U* = 0, line search on ‖grad U*‖.
     Stationary,

@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Everything that can go wrong while building or analysing a mechanism.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum MechanismError {
     /// A kinematic computation failed (bad coordinates, wrong lengths, ...).
     #[error(transparent)]

@@ -50,6 +50,8 @@ impl From<ImpulseError> for FfiError {
             ImpulseError::Singular { .. } => MECH_STATUS_SINGULAR,
             ImpulseError::NotConverged { .. } => MECH_STATUS_NOT_CONVERGED,
             ImpulseError::DimensionMismatch { .. } => MECH_STATUS_BAD_DIMENSION,
+            // A variant added after this layer was written: its message still says what was wrong.
+            _ => MECH_STATUS_INVALID_ARGUMENT,
         };
         FfiError::new(status, error.to_string())
     }

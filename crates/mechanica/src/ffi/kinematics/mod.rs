@@ -36,6 +36,8 @@ impl From<KinematicsError> for FfiError {
             | KinematicsError::Cycle { .. }
             | KinematicsError::BodyOutOfRange { .. }
             | KinematicsError::WorkspaceNotReady { .. } => MECH_STATUS_INVALID_ARGUMENT,
+            // A variant added after this layer was written: its message still says what was wrong.
+            _ => MECH_STATUS_INVALID_ARGUMENT,
         };
         FfiError::new(status, error.to_string())
     }

@@ -74,6 +74,8 @@ impl From<MassError> for FfiError {
             | MassError::InconsistentOrientation { .. }
             | MassError::InsideOut { .. }
             | MassError::ZeroVolume { .. } => MECH_STATUS_INVALID_ARGUMENT,
+            // A variant added after this layer was written: its message still says what was wrong.
+            _ => MECH_STATUS_INVALID_ARGUMENT,
         };
         FfiError::new(status, error.to_string())
     }

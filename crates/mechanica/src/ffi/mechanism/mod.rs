@@ -37,6 +37,8 @@ impl From<MechanismError> for FfiError {
             | MechanismError::GravityNotAlongAxis { .. }
             | MechanismError::BadLimits { .. }
             | MechanismError::Potential { .. } => MECH_STATUS_INVALID_ARGUMENT,
+            // A variant added after this layer was written: its message still says what was wrong.
+            _ => MECH_STATUS_INVALID_ARGUMENT,
         };
         FfiError::new(status, error.to_string())
     }
