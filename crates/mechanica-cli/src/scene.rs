@@ -412,37 +412,79 @@ impl Scene {
     /// Checks what the schema cannot: unique names, resolvable references, one parent per body,
     /// no cycles, one mass source per body, finite numbers and unit axes.
     fn validate(&self, text: &str, file: &Path) -> Result<(), SceneError> {
-        let error = |span: Option<std::ops::Range<usize>>, field: String, message: String| SceneError {
-            file: file.to_path_buf(),
+        let validator = Validator {
+            scene: self,
+            text,
+            file,
+        };
+        let index_of = validator.body_indices()?;
+        let parent_of = validator.parent_indices(&index_of)?;
+        validator.check_acyclic(&parent_of)?;
+        validator.check_references(&index_of)?;
+        if let Some(frame) = &self.rotating_frame {
+            validator.check_unit_axis(&frame.axis, "rotating_frame.axis".into())?;
+        }
+        validator.check_option_names()?;
+        validator.check_response_needs_modes()
+    }
+}
+
+/// The checks of [`Scene::validate`], with what every error needs to be located.
+struct Validator<'a> {
+    /// The scene being checked.
+    scene: &'a Scene,
+    /// The scene's source text; empty for a scene built in memory.
+    text: &'a str,
+    /// The scene file, named in every error.
+    file: &'a Path,
+}
+
+/// Index of each body, by name.
+type BodyIndex<'a> = HashMap<&'a str, usize>;
+
+impl<'a> Validator<'a> {
+    /// A located error: the span becomes a line and column when there is source text.
+    fn error(&self, span: Option<std::ops::Range<usize>>, field: String, message: String) -> SceneError {
+        SceneError {
+            file: self.file.to_path_buf(),
             // A scene built in memory (no source text) has no positions to report.
-            position: span.filter(|_| !text.is_empty()).map(|s| line_column(text, s.start)),
+            position: span
+                .filter(|_| !self.text.is_empty())
+                .map(|s| line_column(self.text, s.start)),
             field,
             message,
-        };
-        let check_unit_axis = |axis: &Spanned<[f64; 3]>, field: String| {
-            let norm = axis.get_ref().iter().map(|a| a * a).sum::<f64>().sqrt();
-            if norm.is_finite() && (norm - 1.0).abs() <= 1e-9 {
-                Ok(())
-            } else {
-                Err(error(
-                    Some(axis.span()),
-                    field,
-                    format!("axis must be a unit vector, |axis| = {norm}"),
-                ))
-            }
-        };
-        let mut index_of: HashMap<&str, usize> = HashMap::new();
-        for (i, body) in self.bodies.iter().enumerate() {
+        }
+    }
+
+    /// Ok when `axis` is finite and has unit length within 1e-9; else an error on `field`.
+    fn check_unit_axis(&self, axis: &Spanned<[f64; 3]>, field: String) -> Result<(), SceneError> {
+        let norm = axis.get_ref().iter().map(|a| a * a).sum::<f64>().sqrt();
+        if norm.is_finite() && (norm - 1.0).abs() <= 1e-9 {
+            Ok(())
+        } else {
+            Err(self.error(
+                Some(axis.span()),
+                field,
+                format!("axis must be a unit vector, |axis| = {norm}"),
+            ))
+        }
+    }
+
+    /// The index of each body by name, checking that names are unique and not "ground" and that
+    /// each body has exactly one mass source.
+    fn body_indices(&self) -> Result<BodyIndex<'a>, SceneError> {
+        let mut index_of: BodyIndex<'a> = HashMap::new();
+        for (i, body) in self.scene.bodies.iter().enumerate() {
             let name = body.name.get_ref().as_str();
             if name == "ground" {
-                return Err(error(
+                return Err(self.error(
                     Some(body.name.span()),
                     format!("body[{i}].name"),
                     "\"ground\" is reserved".into(),
                 ));
             }
             if index_of.insert(name, i).is_some() {
-                return Err(error(
+                return Err(self.error(
                     Some(body.name.span()),
                     format!("body[{i}].name"),
                     format!("duplicate body name \"{name}\""),
@@ -454,136 +496,182 @@ impl Scene {
                 body.mesh.is_some(),
             ];
             if sources.iter().filter(|&&s| s).count() != 1 {
-                return Err(error(
+                return Err(self.error(
                     Some(body.name.span()),
                     format!("body[{i}]"),
                     "give exactly one of mass_properties, primitive, mesh".into(),
                 ));
             }
         }
-        let mut parent_of: Vec<Option<usize>> = vec![None; self.bodies.len()];
-        let mut has_parent = vec![false; self.bodies.len()];
-        for (j, joint) in self.joints.iter().enumerate() {
-            let child_name = joint.child.get_ref().as_str();
-            let child = *index_of.get(child_name).ok_or_else(|| {
-                error(
-                    Some(joint.child.span()),
-                    format!("joint[{j}].child"),
-                    format!("no body named \"{child_name}\""),
-                )
-            })?;
-            let parent_name = joint.parent.get_ref().as_str();
-            let parent = if parent_name == "ground" {
-                None
-            } else {
-                Some(*index_of.get(parent_name).ok_or_else(|| {
-                    error(
-                        Some(joint.parent.span()),
-                        format!("joint[{j}].parent"),
-                        format!("no body named \"{parent_name}\""),
-                    )
-                })?)
-            };
+        Ok(index_of)
+    }
+
+    /// The parent of each body (`None`: the ground), checking that every joint names existing
+    /// bodies, has the axis its type needs, and that every body has exactly one parent joint.
+    fn parent_indices(&self, index_of: &BodyIndex<'a>) -> Result<Vec<Option<usize>>, SceneError> {
+        let bodies = &self.scene.bodies;
+        let mut parent_of: Vec<Option<usize>> = vec![None; bodies.len()];
+        let mut has_parent = vec![false; bodies.len()];
+        for (j, joint) in self.scene.joints.iter().enumerate() {
+            let (child, parent) = self.joint_ends(j, joint, index_of)?;
             if has_parent[child] {
-                return Err(error(
+                return Err(self.error(
                     Some(joint.child.span()),
                     format!("joint[{j}].child"),
-                    format!("body \"{child_name}\" already has a parent joint (a tree gives each body one)"),
+                    format!(
+                        "body \"{}\" already has a parent joint (a tree gives each body one)",
+                        joint.child.get_ref()
+                    ),
                 ));
             }
             has_parent[child] = true;
             parent_of[child] = parent;
-            let needs_axis = matches!(
-                joint.kind.get_ref(),
-                JointKind::Revolute | JointKind::Prismatic | JointKind::Planar
-            );
-            match (&joint.axis, needs_axis) {
-                (None, true) => {
-                    return Err(error(
-                        Some(joint.kind.span()),
-                        format!("joint[{j}].axis"),
-                        "this joint type needs an axis".into(),
-                    ));
-                }
-                (Some(axis), _) => check_unit_axis(axis, format!("joint[{j}].axis"))?,
-                (None, false) => {}
-            }
+            self.check_joint_axis(j, joint)?;
         }
         if let Some((i, _)) = has_parent.iter().enumerate().find(|(_, has)| !**has) {
-            return Err(error(
-                Some(self.bodies[i].name.span()),
+            return Err(self.error(
+                Some(bodies[i].name.span()),
                 format!("body[{i}]"),
                 format!(
                     "body \"{}\" is connected by no joint (give it a parent, e.g. \"ground\")",
-                    self.bodies[i].name.get_ref()
+                    bodies[i].name.get_ref()
                 ),
             ));
         }
-        for start in 0..self.bodies.len() {
+        Ok(parent_of)
+    }
+
+    /// The (child, parent) body indices of joint `j` (parent `None`: the ground), child first.
+    fn joint_ends(
+        &self,
+        j: usize,
+        joint: &JointSpec,
+        index_of: &BodyIndex<'a>,
+    ) -> Result<(usize, Option<usize>), SceneError> {
+        let child_name = joint.child.get_ref().as_str();
+        let child = *index_of.get(child_name).ok_or_else(|| {
+            self.error(
+                Some(joint.child.span()),
+                format!("joint[{j}].child"),
+                format!("no body named \"{child_name}\""),
+            )
+        })?;
+        let parent_name = joint.parent.get_ref().as_str();
+        let parent = if parent_name == "ground" {
+            None
+        } else {
+            Some(*index_of.get(parent_name).ok_or_else(|| {
+                self.error(
+                    Some(joint.parent.span()),
+                    format!("joint[{j}].parent"),
+                    format!("no body named \"{parent_name}\""),
+                )
+            })?)
+        };
+        Ok((child, parent))
+    }
+
+    /// Ok when joint `j` has an axis if its type needs one, and any axis given is a unit vector.
+    fn check_joint_axis(&self, j: usize, joint: &JointSpec) -> Result<(), SceneError> {
+        let needs_axis = matches!(
+            joint.kind.get_ref(),
+            JointKind::Revolute | JointKind::Prismatic | JointKind::Planar
+        );
+        match (&joint.axis, needs_axis) {
+            (None, true) => Err(self.error(
+                Some(joint.kind.span()),
+                format!("joint[{j}].axis"),
+                "this joint type needs an axis".into(),
+            )),
+            (Some(axis), _) => self.check_unit_axis(axis, format!("joint[{j}].axis")),
+            (None, false) => Ok(()),
+        }
+    }
+
+    /// Ok when following parents from every body reaches the ground within `bodies.len()` steps.
+    fn check_acyclic(&self, parent_of: &[Option<usize>]) -> Result<(), SceneError> {
+        let bodies = &self.scene.bodies;
+        for start in 0..bodies.len() {
             let mut steps = 0;
             let mut at = Some(start);
             while let Some(b) = at {
                 steps += 1;
-                if steps > self.bodies.len() {
-                    return Err(error(
-                        Some(self.bodies[start].name.span()),
+                if steps > bodies.len() {
+                    return Err(self.error(
+                        Some(bodies[start].name.span()),
                         format!("body[{start}]"),
                         format!(
                             "the joints form a cycle through body \"{}\"",
-                            self.bodies[start].name.get_ref()
+                            bodies[start].name.get_ref()
                         ),
                     ));
                 }
                 at = parent_of[b];
             }
         }
-        let body_or_ground = |name: &Spanned<String>, field: String| {
-            let n = name.get_ref().as_str();
-            if n == "ground" || index_of.contains_key(n) {
-                Ok(())
-            } else {
-                Err(error(Some(name.span()), field, format!("no body named \"{n}\"")))
-            }
-        };
-        let body_only = |name: &Spanned<String>, field: String| {
-            let n = name.get_ref().as_str();
-            if index_of.contains_key(n) {
-                Ok(())
-            } else {
-                Err(error(Some(name.span()), field, format!("no body named \"{n}\"")))
-            }
-        };
-        for (i, spring) in self.springs.iter().enumerate() {
-            body_or_ground(&spring.a, format!("spring[{i}].a"))?;
-            body_or_ground(&spring.b, format!("spring[{i}].b"))?;
+        Ok(())
+    }
+
+    /// Ok when every spring, force, impact and joint spring names a body (or joint) that exists.
+    fn check_references(&self, index_of: &BodyIndex<'a>) -> Result<(), SceneError> {
+        for (i, spring) in self.scene.springs.iter().enumerate() {
+            self.check_body_or_ground(&spring.a, format!("spring[{i}].a"), index_of)?;
+            self.check_body_or_ground(&spring.b, format!("spring[{i}].b"), index_of)?;
         }
-        for (i, force) in self.forces.iter().enumerate() {
-            body_only(&force.body, format!("force[{i}].body"))?;
+        for (i, force) in self.scene.forces.iter().enumerate() {
+            self.check_body(&force.body, format!("force[{i}].body"), index_of)?;
         }
-        if let Some(impact) = &self.analyses.impact {
-            body_only(&impact.body, "analyses.impact.body".into())?;
+        if let Some(impact) = &self.scene.analyses.impact {
+            self.check_body(&impact.body, "analyses.impact.body".into(), index_of)?;
         }
-        for (i, spring) in self.joint_springs.iter().enumerate() {
+        for (i, spring) in self.scene.joint_springs.iter().enumerate() {
             let name = spring.joint.get_ref();
-            if !self.joints.iter().any(|j| &j.name == name) {
-                return Err(error(
+            if !self.scene.joints.iter().any(|j| &j.name == name) {
+                return Err(self.error(
                     Some(spring.joint.span()),
                     format!("joint_spring[{i}].joint"),
                     format!("no joint named \"{name}\""),
                 ));
             }
         }
-        if let Some(frame) = &self.rotating_frame {
-            check_unit_axis(&frame.axis, "rotating_frame.axis".into())?;
+        Ok(())
+    }
+
+    /// Ok when `name` is "ground" or a body's name; else an error on `field`.
+    fn check_body_or_ground(
+        &self,
+        name: &Spanned<String>,
+        field: String,
+        index_of: &BodyIndex<'a>,
+    ) -> Result<(), SceneError> {
+        if name.get_ref() == "ground" {
+            Ok(())
+        } else {
+            self.check_body(name, field, index_of)
         }
+    }
+
+    /// Ok when `name` is a body's name; else an error on `field`.
+    fn check_body(&self, name: &Spanned<String>, field: String, index_of: &BodyIndex<'a>) -> Result<(), SceneError> {
+        let n = name.get_ref().as_str();
+        if index_of.contains_key(n) {
+            Ok(())
+        } else {
+            Err(self.error(Some(name.span()), field, format!("no body named \"{n}\"")))
+        }
+    }
+
+    /// Ok when the equilibrium's `seek` and the impact's `law`, if given, are known names.
+    fn check_option_names(&self) -> Result<(), SceneError> {
+        let analyses = &self.scene.analyses;
         for (label, name) in [
             (
                 "analyses.equilibrium.seek",
-                self.analyses.equilibrium.as_ref().and_then(|e| e.seek.as_ref()),
+                analyses.equilibrium.as_ref().and_then(|e| e.seek.as_ref()),
             ),
             (
                 "analyses.impact.law",
-                self.analyses.impact.as_ref().and_then(|i| i.law.as_ref()),
+                analyses.impact.as_ref().and_then(|i| i.law.as_ref()),
             ),
         ] {
             let allowed: &[&str] = if label.ends_with("seek") {
@@ -594,15 +682,20 @@ impl Scene {
             if let Some(name) = name
                 && !allowed.contains(&name.get_ref().as_str())
             {
-                return Err(error(
+                return Err(self.error(
                     Some(name.span()),
                     label.into(),
                     format!("\"{}\" is not one of {allowed:?}", name.get_ref()),
                 ));
             }
         }
-        if self.analyses.response.is_some() && self.analyses.modes.is_none() {
-            return Err(error(
+        Ok(())
+    }
+
+    /// Ok unless a free response is asked for without `modes`.
+    fn check_response_needs_modes(&self) -> Result<(), SceneError> {
+        if self.scene.analyses.response.is_some() && self.scene.analyses.modes.is_none() {
+            return Err(self.error(
                 None,
                 "analyses.response".into(),
                 "the free response needs `modes`".into(),
