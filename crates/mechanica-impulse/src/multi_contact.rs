@@ -158,6 +158,19 @@ impl Sweeper<'_> {
     }
 }
 
+/// The outcome of one phase of the Gauss–Seidel solve.
+struct PhaseSolution {
+    /// The phase's impulses, 3 rows per contact (tangential x, y, then normal).
+    impulses: Vec<f64>,
+    /// Its complementarity residual, m/s (0 for a restitution phase that did not run).
+    residual: f64,
+    /// The sweeps it took.
+    iterations: usize,
+    /// Whether its residual reached the target (true for a restitution phase that did not run).
+    converged: bool,
+}
+
+/// Two or more contacts: the two-phase, energy-guarded model of the module docs.
 fn simultaneous(
     space: &ContactSpace,
     inertia: &MechanismInertia,
@@ -169,8 +182,39 @@ fn simultaneous(
     let rows = 3 * m;
     let w = space.delassus();
     let u = space.u_before();
+    let blocks = contact_blocks(w, u, contacts)?;
+    let speed = u.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+    let target = options.tolerance * speed;
+    let mut sweeper = Sweeper { rows, w, v: u.to_vec() };
+    let mut compression = compression_phase(&blocks, &mut sweeper, target, options.max_iterations);
+    check_no_drift(w, rows, &compression.impulses, speed)?;
+    if scale_back_energy_gain(space, u, &mut compression.impulses, &mut sweeper) {
+        compression.converged = false;
+    }
+    let p1 = &compression.impulses;
+    let restitution = restitution_phase(&blocks, p1, &mut sweeper, target, options.max_iterations);
+    let p2 = &restitution.impulses;
+    let scale = restitution_scale(space, u, p1, p2);
+    let p: Vec<f64> = p1.iter().zip(p2).map(|(a, b)| a + scale * b).collect();
+    check_no_drift(w, rows, &p, speed)?;
+    let modes = contact_modes(&blocks, &p);
+    let normal_compression: Vec<f64> = (0..m).map(|i| p1[3 * i + 2]).collect();
+    let mut impact = assemble_impact(space, inertia, q_dot, &p, &modes, &normal_compression)?;
+    impact.complementarity_residual = compression.residual.max(restitution.residual);
+    impact.iterations = compression.iterations + restitution.iterations;
+    impact.converged = compression.converged && restitution.converged;
+    impact.restitution_scale = scale;
+    impact.model = ImpactModel::Simultaneous;
+    Ok(impact)
+}
+
+/// The per-contact constants of the block updates, from the Delassus matrix `w` (column-major,
+/// 3 rows per contact) and the approach velocities `u`; a contact whose W_nn is not positive
+/// (relative to the largest diagonal entry) is inactive, and an error when it approaches.
+fn contact_blocks(w: &[f64], u: &[f64], contacts: &[MechanismContact]) -> Result<Vec<Block>, ImpulseError> {
+    let rows = 3 * contacts.len();
     let max_diag = (0..rows).map(|r| w[r + rows * r]).fold(0.0, f64::max);
-    let mut blocks = Vec::with_capacity(m);
+    let mut blocks = Vec::with_capacity(contacts.len());
     for (i, contact) in contacts.iter().enumerate() {
         let n = 3 * i + 2;
         let w_nn = w[n + rows * n];
@@ -198,14 +242,16 @@ fn simultaneous(
             l_t: eig_values.max(),
         });
     }
-    let speed = u.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
-    let target = options.tolerance * speed;
-    let mut sweeper = Sweeper { rows, w, v: u.to_vec() };
-    // Phase 1: compression, the inelastic Signorini–Coulomb problem.
-    let mut p1 = vec![0.0; rows];
+    Ok(blocks)
+}
+
+/// Phase 1, the inelastic Signorini–Coulomb problem: Gauss–Seidel sweeps from zero impulses
+/// until the residual is ≤ `target` or `max_iterations` sweeps; `sweeper.v` ends at u⁻ + W P_c.
+fn compression_phase(blocks: &[Block], sweeper: &mut Sweeper<'_>, target: f64, max_iterations: usize) -> PhaseSolution {
+    let mut p1 = vec![0.0; sweeper.rows];
     let mut iterations = 0;
-    let mut residual1 = residual(&blocks, &p1, &p1, &sweeper, Phase::Compression);
-    while residual1 > target && iterations < options.max_iterations {
+    let mut residual1 = residual(blocks, &p1, &p1, sweeper, Phase::Compression);
+    while residual1 > target && iterations < max_iterations {
         iterations += 1;
         for (i, b) in blocks.iter().enumerate() {
             if !b.active {
@@ -217,15 +263,24 @@ fn simultaneous(
             p1[n] = p_new;
             if b.friction > 0.0 {
                 let radius = disk_radius(b.friction, p1[n]);
-                tangential_update(b, i, radius, &mut p1, &mut sweeper);
+                tangential_update(b, i, radius, &mut p1, sweeper);
             }
         }
-        residual1 = residual(&blocks, &p1, &p1, &sweeper, Phase::Compression);
+        residual1 = residual(blocks, &p1, &p1, sweeper, Phase::Compression);
     }
-    check_no_drift(w, rows, &p1, speed)?;
-    let mut converged = residual1 <= target;
-    // Energy safeguard for an unconverged compression phase (a converged one dissipates).
-    let e1 = space.energy_change(&p1);
+    PhaseSolution {
+        impulses: p1,
+        residual: residual1,
+        iterations,
+        converged: residual1 <= target,
+    }
+}
+
+/// Energy safeguard for an unconverged compression phase (a converged one dissipates): when
+/// the impulses `p1` would gain energy they are scaled down (to zero if need be) so that they
+/// do not, `sweeper.v` is recomputed from u⁻, and the result is true.
+fn scale_back_energy_gain(space: &ContactSpace, u: &[f64], p1: &mut [f64], sweeper: &mut Sweeper<'_>) -> bool {
+    let e1 = space.energy_change(p1);
     if e1 > 0.0 {
         let a: f64 = p1.iter().zip(u).map(|(p, u)| p * u).sum();
         let c = 2.0 * (e1 - a);
@@ -236,16 +291,29 @@ fn simultaneous(
         };
         p1.iter_mut().for_each(|p| *p *= s);
         sweeper.v = u.to_vec();
-        for r in 0..rows {
-            let value = p1[r];
+        for (r, &value) in p1.iter().enumerate() {
             sweeper.push(r, value);
         }
-        converged = false;
+        true
+    } else {
+        false
     }
-    // Phase 2: restitution, Poisson normal impulses e p_c with friction acting.
-    let mut p2 = vec![0.0; rows];
+}
+
+/// Phase 2, Poisson restitution: normal impulses e p_c on top of the compression impulses
+/// `p1`, with friction sweeps until the residual is ≤ `target` or `max_iterations` sweeps.
+/// Skipped (zero impulses) when no contact has both e > 0 and a compression impulse.
+fn restitution_phase(
+    blocks: &[Block],
+    p1: &[f64],
+    sweeper: &mut Sweeper<'_>,
+    target: f64,
+    max_iterations: usize,
+) -> PhaseSolution {
+    let mut p2 = vec![0.0; sweeper.rows];
     let mut residual2 = 0.0;
     let mut iterations2 = 0;
+    let mut converged = true;
     if blocks
         .iter()
         .enumerate()
@@ -256,26 +324,37 @@ fn simultaneous(
             p2[n] = b.restitution * p1[n];
             sweeper.push(n, p2[n]);
         }
-        residual2 = residual(&blocks, &p1, &p2, &sweeper, Phase::Restitution);
-        while residual2 > target && iterations2 < options.max_iterations {
+        residual2 = residual(blocks, p1, &p2, sweeper, Phase::Restitution);
+        while residual2 > target && iterations2 < max_iterations {
             iterations2 += 1;
             for (i, b) in blocks.iter().enumerate() {
                 if b.active && b.friction > 0.0 && p2[3 * i + 2] > 0.0 {
                     let radius = disk_radius(b.friction, p2[3 * i + 2]);
-                    tangential_update(b, i, radius, &mut p2, &mut sweeper);
+                    tangential_update(b, i, radius, &mut p2, sweeper);
                 }
             }
-            residual2 = residual(&blocks, &p1, &p2, &sweeper, Phase::Restitution);
+            residual2 = residual(blocks, p1, &p2, sweeper, Phase::Restitution);
         }
-        converged &= residual2 <= target;
+        converged = residual2 <= target;
     }
-    // Energy guard: ΔT(s) = ΔT(P₁ + s P₂) = c₀ + c₁ s + c₂ s², c₀ ≤ 0.
-    let c0 = space.energy_change(&p1);
-    let total: Vec<f64> = p1.iter().zip(&p2).map(|(a, b)| a + b).collect();
+    PhaseSolution {
+        impulses: p2,
+        residual: residual2,
+        iterations: iterations2,
+        converged,
+    }
+}
+
+/// The energy guard: the largest s ∈ [0, 1] with ΔT(P₁ + s P₂) ≤ 0, 1 when the full
+/// restitution impulses `p2` gain no energy.
+fn restitution_scale(space: &ContactSpace, u: &[f64], p1: &[f64], p2: &[f64]) -> f64 {
+    // ΔT(s) = ΔT(P₁ + s P₂) = c₀ + c₁ s + c₂ s², c₀ ≤ 0.
+    let c0 = space.energy_change(p1);
+    let total: Vec<f64> = p1.iter().zip(p2).map(|(a, b)| a + b).collect();
     let e_total = space.energy_change(&total);
     let mut scale = 1.0;
     if e_total > 0.0 {
-        let e_p2 = space.energy_change(&p2);
+        let e_p2 = space.energy_change(p2);
         // P₂·u⁻ + ½P₂ᵀWP₂ = e_p2; P₂ᵀWP₂ = 2 c₂; the cross term gives c₁.
         let p2u: f64 = p2.iter().zip(u).map(|(p, u)| p * u).sum();
         let c2 = e_p2 - p2u;
@@ -289,17 +368,21 @@ fn simultaneous(
             1.0
         };
         // Round-off in the root can leave ΔT a few ulps above 0: step down until it is not.
-        let mut trial: Vec<f64> = p1.iter().zip(&p2).map(|(a, b)| a + scale * b).collect();
+        let mut trial: Vec<f64> = p1.iter().zip(p2).map(|(a, b)| a + scale * b).collect();
         let mut guard = 0;
         while space.energy_change(&trial) > 0.0 && guard < 60 {
             scale *= 1.0 - 1e-12 * 2f64.powi(guard);
-            trial = p1.iter().zip(&p2).map(|(a, b)| a + scale * b).collect();
+            trial = p1.iter().zip(p2).map(|(a, b)| a + scale * b).collect();
             guard += 1;
         }
     }
-    let p: Vec<f64> = p1.iter().zip(&p2).map(|(a, b)| a + scale * b).collect();
-    check_no_drift(w, rows, &p, speed)?;
-    let modes: Vec<ContactMode> = blocks
+    scale
+}
+
+/// The mode of each contact under the total impulses `p`: no impact, frictionless, stick
+/// (tangential impulse inside the friction disk by a relative 1e-9) or slip.
+fn contact_modes(blocks: &[Block], p: &[f64]) -> Vec<ContactMode> {
+    blocks
         .iter()
         .enumerate()
         .map(|(i, b)| {
@@ -315,15 +398,7 @@ fn simultaneous(
                 ContactMode::Slip
             }
         })
-        .collect();
-    let compression: Vec<f64> = (0..m).map(|i| p1[3 * i + 2]).collect();
-    let mut impact = assemble_impact(space, inertia, q_dot, &p, &modes, &compression)?;
-    impact.complementarity_residual = residual1.max(residual2);
-    impact.iterations = iterations + iterations2;
-    impact.converged = converged;
-    impact.restitution_scale = scale;
-    impact.model = ImpactModel::Simultaneous;
-    Ok(impact)
+        .collect()
 }
 
 /// Redundant contacts (more impulse rows than the mechanism has freedoms) make W singular, and
