@@ -158,12 +158,37 @@ fn read(path: &Path) -> Result<mechanica::modal::MatrixMarket, String> {
 
 /// Runs the command.
 pub fn run(args: &ModesArgs) -> Result<Report, String> {
-    let refinement = match args.refinement.as_str() {
-        "auto" => Refinement::Auto,
-        "off" => Refinement::Off,
-        "always" => Refinement::Always,
-        other => return Err(format!("--refinement must be auto, off or always, got {other}")),
-    };
+    let refinement = parse_refinement(&args.refinement)?;
+    let (read_step, a, b) = read_pencil(args)?;
+    let n = a.nrows;
+    let mut steps = vec![read_step];
+    let sparse = matches!(args.lowest, Some(k) if n > DENSE_LIMIT && k < n) && !args.dense && !args.values_only;
+    if sparse {
+        steps.extend(sparse_steps(args, &a, &b)?);
+    } else {
+        steps.extend(dense_steps(args, refinement, &a, &b)?);
+    }
+    Ok(Report {
+        title: format!("modes of ({}, {})", args.mass.display(), args.stiffness.display()),
+        version: env!("CARGO_PKG_VERSION").into(),
+        steps,
+    })
+}
+
+/// The refinement policy named by `--refinement` (auto, off or always).
+fn parse_refinement(name: &str) -> Result<Refinement, String> {
+    match name {
+        "auto" => Ok(Refinement::Auto),
+        "off" => Ok(Refinement::Off),
+        "always" => Ok(Refinement::Always),
+        other => Err(format!("--refinement must be auto, off or always, got {other}")),
+    }
+}
+
+/// Reads A and B, checks that they are square and of one order, and reports the timed step.
+fn read_pencil(
+    args: &ModesArgs,
+) -> Result<(Step, mechanica::modal::MatrixMarket, mechanica::modal::MatrixMarket), String> {
     let mut files = None;
     let read_step = timed_step("read Matrix Market files", || -> Result<Vec<Quantity>, String> {
         let (a, b) = (read(&args.mass)?, read(&args.stiffness)?);
@@ -188,134 +213,158 @@ pub fn run(args: &ModesArgs) -> Result<Report, String> {
     let Some((a, b)) = files else {
         return Err("the Matrix Market files were not read".into());
     };
-    let n = a.nrows;
-    let mut steps = vec![read_step];
-    let sparse = matches!(args.lowest, Some(k) if n > DENSE_LIMIT && k < n) && !args.dense && !args.values_only;
-    if sparse {
-        let count = args.lowest.unwrap_or(0);
-        let pencil = SparsePencil::from_triplets(n, &a.entries, &b.entries).map_err(|e| e.to_string())?;
-        let sol = solve_sparse(
-            &pencil,
-            &SparseOptions {
-                count,
-                ..SparseOptions::default()
-            },
-        )
-        .map_err(|e| e.to_string())?;
-        let r = &sol.report;
-        let t = r.timings;
-        steps.push(stage(
-            "factor B − σA (sparse Cholesky)",
-            t.factor,
-            vec![
-                quantity("shift σ", vec![r.shift], "rad²/s²", None),
-                quantity("stored entries of the factor", vec![r.factor_nnz as f64], "", None),
-            ],
-        ));
-        let mut quantities = mode_quantities(&sol.modes, &sol.groups);
-        quantities.push(quantity(
-            "max backward error, A-orthogonality error",
-            vec![r.max_backward_error, r.orthogonality_error],
-            "",
-            None,
-        ));
-        quantities.push(quantity(
-            "Sturm check: shift, count below, computed below",
-            vec![
-                r.inertia.map_or(f64::NAN, |c| c.count.shift),
-                r.inertia.map_or(f64::NAN, |c| c.count.below as f64),
-                r.computed_below as f64,
-            ],
-            "",
-            Some(if r.consistent { "consistent" } else { "INCONSISTENT" }.into()),
-        ));
-        if args.shapes {
-            quantities.push(shapes(&sol.vectors));
-        }
-        steps.push(stage("solve (shift-invert block Lanczos)", t.lanczos, quantities));
-        steps.push(stage(
-            "refine (Rayleigh–Ritz, double-double residuals)",
-            t.refine,
-            Vec::new(),
-        ));
-        steps.push(stage("Sturm check (inertia of B − τA)", t.inertia, Vec::new()));
-    } else {
-        let dense = |t: &[mechanica::modal::faer::sparse::Triplet<usize, usize, f64>]| {
-            let mut m = Mat::<f64>::zeros(n, n);
-            for e in t {
-                m[(e.row, e.col)] += e.val;
-            }
-            m
-        };
-        let problem =
-            PencilProblem::new(dense(&a.entries).as_ref(), dense(&b.entries).as_ref()).map_err(|e| e.to_string())?;
-        let options = SolveOptions {
-            selection: args.lowest.map_or(Selection::All, Selection::Lowest),
-            vectors: !args.values_only,
-            refinement,
-            residuals: if args.sketched {
-                Residuals::Sketched
-            } else {
-                Residuals::Exact
-            },
-        };
-        let sol = solve(&problem, &options).map_err(|e| e.to_string())?;
-        let t = sol.timings;
-        steps.push(stage(
-            "factor (Cholesky of A, reduction C = L⁻¹BL⁻ᵀ)",
-            t.factor,
-            Vec::new(),
-        ));
-        let mut quantities = mode_quantities(&sol.modes, &sol.groups);
-        if let Some(x) = sol.vectors.as_ref().filter(|_| args.shapes) {
-            quantities.push(shapes(x));
-        }
-        steps.push(stage(
-            "solve (eigen-decomposition, back-transformation)",
-            t.eigen,
-            quantities,
-        ));
-        let acc = &sol.accuracy;
-        steps.push(stage(
-            "accuracy report",
-            t.accuracy,
-            vec![quantity(
-                "max backward error, A-orthogonality error",
-                vec![
-                    acc.max_backward_error.unwrap_or(f64::NAN),
-                    acc.orthogonality_error.unwrap_or(f64::NAN),
-                ],
-                "",
-                Some(format!("{:?} residuals", acc.residuals)),
-            )],
-        ));
-        let refined = acc.refinement_steps.iter().filter(|&&s| s > 0).count();
-        steps.push(stage(
-            "refine (Newton, double-double residuals)",
-            t.refine,
-            vec![quantity("refined modes", vec![refined as f64], "", None)],
-        ));
-        let check = acc.inertia_check;
-        steps.push(stage(
-            "Sturm check (inertia of B − sA)",
-            t.inertia,
-            vec![quantity(
-                "shift, count below, computed below",
-                check.map_or(vec![], |c| {
-                    vec![c.count.shift, c.count.below as f64, c.computed_below as f64]
-                }),
-                "",
-                Some(match check {
-                    Some(c) if c.consistent => "consistent".into(),
-                    Some(_) => "INCONSISTENT".into(),
-                    None => "not run (no finite mode)".into(),
-                }),
-            )],
-        ));
+    Ok((read_step, a, b))
+}
+
+/// The `--lowest k` modes by sparse shift-invert Lanczos: the factor, solve, refine and Sturm
+/// check steps.
+fn sparse_steps(
+    args: &ModesArgs,
+    a: &mechanica::modal::MatrixMarket,
+    b: &mechanica::modal::MatrixMarket,
+) -> Result<Vec<Step>, String> {
+    let count = args.lowest.unwrap_or(0);
+    let pencil = SparsePencil::from_triplets(a.nrows, &a.entries, &b.entries).map_err(|e| e.to_string())?;
+    let sol = solve_sparse(
+        &pencil,
+        &SparseOptions {
+            count,
+            ..SparseOptions::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let r = &sol.report;
+    let t = r.timings;
+    let mut steps = Vec::new();
+    steps.push(stage(
+        "factor B − σA (sparse Cholesky)",
+        t.factor,
+        vec![
+            quantity("shift σ", vec![r.shift], "rad²/s²", None),
+            quantity("stored entries of the factor", vec![r.factor_nnz as f64], "", None),
+        ],
+    ));
+    let mut quantities = mode_quantities(&sol.modes, &sol.groups);
+    quantities.push(quantity(
+        "max backward error, A-orthogonality error",
+        vec![r.max_backward_error, r.orthogonality_error],
+        "",
+        None,
+    ));
+    quantities.push(quantity(
+        "Sturm check: shift, count below, computed below",
+        vec![
+            r.inertia.map_or(f64::NAN, |c| c.count.shift),
+            r.inertia.map_or(f64::NAN, |c| c.count.below as f64),
+            r.computed_below as f64,
+        ],
+        "",
+        Some(if r.consistent { "consistent" } else { "INCONSISTENT" }.into()),
+    ));
+    if args.shapes {
+        quantities.push(shapes(&sol.vectors));
     }
-    Ok(Report {
-        title: format!("modes of ({}, {})", args.mass.display(), args.stiffness.display()),
-        version: env!("CARGO_PKG_VERSION").into(),
-        steps,
-    })
+    steps.push(stage("solve (shift-invert block Lanczos)", t.lanczos, quantities));
+    steps.push(stage(
+        "refine (Rayleigh–Ritz, double-double residuals)",
+        t.refine,
+        Vec::new(),
+    ));
+    steps.push(stage("Sturm check (inertia of B − τA)", t.inertia, Vec::new()));
+    Ok(steps)
+}
+
+/// The dense n × n matrix summing the triplets `t` (duplicates add up).
+fn dense_matrix(n: usize, t: &[mechanica::modal::faer::sparse::Triplet<usize, usize, f64>]) -> Mat<f64> {
+    let mut m = Mat::<f64>::zeros(n, n);
+    for e in t {
+        m[(e.row, e.col)] += e.val;
+    }
+    m
+}
+
+/// All modes (or the k lowest) by the dense solver: the factor, solve, accuracy, refine and
+/// Sturm check steps.
+fn dense_steps(
+    args: &ModesArgs,
+    refinement: Refinement,
+    a: &mechanica::modal::MatrixMarket,
+    b: &mechanica::modal::MatrixMarket,
+) -> Result<Vec<Step>, String> {
+    let n = a.nrows;
+    let problem = PencilProblem::new(
+        dense_matrix(n, &a.entries).as_ref(),
+        dense_matrix(n, &b.entries).as_ref(),
+    )
+    .map_err(|e| e.to_string())?;
+    let options = SolveOptions {
+        selection: args.lowest.map_or(Selection::All, Selection::Lowest),
+        vectors: !args.values_only,
+        refinement,
+        residuals: if args.sketched {
+            Residuals::Sketched
+        } else {
+            Residuals::Exact
+        },
+    };
+    let sol = solve(&problem, &options).map_err(|e| e.to_string())?;
+    let t = sol.timings;
+    let mut steps = Vec::new();
+    steps.push(stage(
+        "factor (Cholesky of A, reduction C = L⁻¹BL⁻ᵀ)",
+        t.factor,
+        Vec::new(),
+    ));
+    let mut quantities = mode_quantities(&sol.modes, &sol.groups);
+    if let Some(x) = sol.vectors.as_ref().filter(|_| args.shapes) {
+        quantities.push(shapes(x));
+    }
+    steps.push(stage(
+        "solve (eigen-decomposition, back-transformation)",
+        t.eigen,
+        quantities,
+    ));
+    steps.extend(dense_accuracy_steps(&sol.accuracy, &t));
+    Ok(steps)
+}
+
+/// The accuracy report, refinement and Sturm check steps of a dense solution.
+fn dense_accuracy_steps(acc: &mechanica::modal::AccuracyReport, t: &mechanica::modal::DenseTimings) -> [Step; 3] {
+    let accuracy = stage(
+        "accuracy report",
+        t.accuracy,
+        vec![quantity(
+            "max backward error, A-orthogonality error",
+            vec![
+                acc.max_backward_error.unwrap_or(f64::NAN),
+                acc.orthogonality_error.unwrap_or(f64::NAN),
+            ],
+            "",
+            Some(format!("{:?} residuals", acc.residuals)),
+        )],
+    );
+    let refined = acc.refinement_steps.iter().filter(|&&s| s > 0).count();
+    let refine = stage(
+        "refine (Newton, double-double residuals)",
+        t.refine,
+        vec![quantity("refined modes", vec![refined as f64], "", None)],
+    );
+    let check = acc.inertia_check;
+    let sturm = stage(
+        "Sturm check (inertia of B − sA)",
+        t.inertia,
+        vec![quantity(
+            "shift, count below, computed below",
+            check.map_or(vec![], |c| {
+                vec![c.count.shift, c.count.below as f64, c.computed_below as f64]
+            }),
+            "",
+            Some(match check {
+                Some(c) if c.consistent => "consistent".into(),
+                Some(_) => "INCONSISTENT".into(),
+                None => "not run (no finite mode)".into(),
+            }),
+        )],
+    );
+    [accuracy, refine, sturm]
 }
