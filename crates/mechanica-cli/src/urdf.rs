@@ -43,89 +43,14 @@ fn rotation(rpy: [f64; 3]) -> Rotation3<f64> {
 /// repairs listed in the returned notes); otherwise they are an error naming every such link.
 pub fn load(path: &Path, repair_inertia: bool) -> Result<(Scene, Vec<String>), String> {
     let robot = urdf_rs::read_file(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let located = |what: String| format!("{}: {what}", path.display());
     let mut notes = Vec::new();
-    let mut problems = Vec::new();
-    let mut bodies = Vec::new();
-    for link in &robot.links {
-        if link.name == "ground" {
-            return Err(located(
-                "a link named \"ground\" clashes with the scene's name for the world".into(),
-            ));
-        }
-        let inertial = &link.inertial;
-        let r = rotation(inertial.origin.rpy.0);
-        let i = &inertial.inertia;
-        let tensor = Matrix3::new(i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz);
-        let mut props = MassProperties {
-            mass: inertial.mass.value,
-            p_oc: Vector3::from(inertial.origin.xyz.0),
-            inertia_c: r.matrix() * tensor * r.matrix().transpose(),
-        };
-        if props.mass == 0.0
-            && let Some((mesh_props, file)) = mesh_mass(path, link)
-        {
-            notes.push(format!(
-                "link \"{}\": no <inertial>; mass properties from mesh {file} at {MESH_DENSITY} kg/m³",
-                link.name
-            ));
-            props = mesh_props;
-        }
-        if props.mass < 0.0 || !props.mass.is_finite() {
-            problems.push(format!(
-                "link \"{}\": mass {} is not a physical mass",
-                link.name, props.mass
-            ));
-        } else if props.mass > 0.0 {
-            match check(&props, &ValidityTolerance::default()) {
-                Ok(_) => {}
-                Err(error) if repair_inertia => match repair(&props, &ValidityTolerance::default()) {
-                    Ok((fixed, report)) => {
-                        notes.push(format!(
-                            "link \"{}\": inertia repaired (relative change {:.2e}): {error}",
-                            link.name, report.relative_change
-                        ));
-                        props = fixed;
-                    }
-                    Err(e) => problems.push(format!("link \"{}\": {e}", link.name)),
-                },
-                Err(error) => problems.push(format!("link \"{}\": {error}", link.name)),
-            }
-        }
-        let c = props.inertia_c;
-        bodies.push(BodySpec {
-            name: spanned(link.name.clone()),
-            mass_properties: Some(ExplicitMass {
-                mass: props.mass,
-                com: props.p_oc.into(),
-                inertia: [c[(0, 0)], c[(1, 1)], c[(2, 2)], c[(0, 1)], c[(0, 2)], c[(1, 2)]],
-            }),
-            primitive: None,
-            mesh: None,
-            offset: [0.0; 3],
-        });
-    }
-    if !problems.is_empty() {
-        return Err(located(format!(
-            "invalid inertias (run with --repair-inertia to replace them by the nearest physical tensors):\n  {}",
-            problems.join("\n  ")
-        )));
-    }
-    let children: Vec<&str> = robot.joints.iter().map(|j| j.child.link.as_str()).collect();
-    let roots: Vec<&str> = robot
-        .links
-        .iter()
-        .map(|l| l.name.as_str())
-        .filter(|name| !children.contains(name))
-        .collect();
-    let [root] = roots.as_slice() else {
-        return Err(located(format!("a URDF tree has one root link, found {roots:?}")));
-    };
+    let bodies = link_bodies(path, &robot.links, repair_inertia, &mut notes)?;
+    let root = root_link(path, &robot)?;
     let mut joints = vec![JointSpec {
         name: "base (fixed to ground)".into(),
         kind: spanned(JointKind::Fixed),
         parent: spanned("ground".into()),
-        child: spanned((*root).to_string()),
+        child: spanned(root.to_string()),
         axis: None,
         origin: [0.0; 3],
         rpy: [0.0; 3],
@@ -134,48 +59,7 @@ pub fn load(path: &Path, repair_inertia: bool) -> Result<(Scene, Vec<String>), S
         limits: None,
     }];
     for joint in &robot.joints {
-        use urdf_rs::JointType as T;
-        let kind = match joint.joint_type {
-            T::Revolute | T::Continuous => JointKind::Revolute,
-            T::Prismatic => JointKind::Prismatic,
-            T::Fixed => JointKind::Fixed,
-            T::Floating => JointKind::Free,
-            T::Spherical => JointKind::Spherical,
-            T::Planar => JointKind::Planar,
-        };
-        let axis = Vector3::from(joint.axis.xyz.0);
-        let norm = axis.norm();
-        if matches!(kind, JointKind::Revolute | JointKind::Prismatic) && !(norm > 0.0 && norm.is_finite()) {
-            return Err(located(format!("joint \"{}\": zero or non-finite axis", joint.name)));
-        }
-        if kind == JointKind::Planar && (axis / norm - Vector3::z()).norm() > 1e-12 {
-            return Err(located(format!(
-                "joint \"{}\": planar joints are supported with their normal along the joint's z axis only",
-                joint.name
-            )));
-        }
-        let limited = matches!(joint.joint_type, T::Revolute | T::Prismatic)
-            && joint.limit.lower.is_finite()
-            && joint.limit.upper.is_finite()
-            && joint.limit.lower < joint.limit.upper;
-        let q0 = if limited && !(joint.limit.lower..=joint.limit.upper).contains(&0.0) {
-            Some(spanned(vec![0.5 * (joint.limit.lower + joint.limit.upper)]))
-        } else {
-            None
-        };
-        joints.push(JointSpec {
-            name: joint.name.clone(),
-            kind: spanned(kind),
-            parent: spanned(joint.parent.link.clone()),
-            child: spanned(joint.child.link.clone()),
-            axis: matches!(kind, JointKind::Revolute | JointKind::Prismatic | JointKind::Planar)
-                .then(|| spanned((axis / norm).into())),
-            origin: joint.origin.xyz.0,
-            rpy: joint.origin.rpy.0,
-            q0,
-            qd0: None,
-            limits: limited.then(|| spanned([joint.limit.lower, joint.limit.upper])),
-        });
+        joints.push(joint_spec(path, joint)?);
     }
     let scene = Scene {
         title: format!("URDF robot \"{}\" ({})", robot.name, path.display()),
@@ -200,6 +84,172 @@ pub fn load(path: &Path, repair_inertia: bool) -> Result<(Scene, Vec<String>), S
     };
     scene.check(path)?;
     Ok((scene, notes))
+}
+
+/// `what`, prefixed by the URDF file's path.
+fn located(path: &Path, what: String) -> String {
+    format!("{}: {what}", path.display())
+}
+
+/// One body per link, with explicit mass properties (see the module docs); mesh fallbacks and
+/// repairs are added to `notes`, and every invalid link is named in one error.
+fn link_bodies(
+    path: &Path,
+    links: &[urdf_rs::Link],
+    repair_inertia: bool,
+    notes: &mut Vec<String>,
+) -> Result<Vec<BodySpec>, String> {
+    let mut problems = Vec::new();
+    let mut bodies = Vec::new();
+    for link in links {
+        if link.name == "ground" {
+            return Err(located(
+                path,
+                "a link named \"ground\" clashes with the scene's name for the world".into(),
+            ));
+        }
+        let mut props = link_mass_properties(path, link, notes);
+        if props.mass < 0.0 || !props.mass.is_finite() {
+            problems.push(format!(
+                "link \"{}\": mass {} is not a physical mass",
+                link.name, props.mass
+            ));
+        } else if props.mass > 0.0 {
+            match check(&props, &ValidityTolerance::default()) {
+                Ok(_) => {}
+                Err(error) if repair_inertia => match repair(&props, &ValidityTolerance::default()) {
+                    Ok((fixed, report)) => {
+                        notes.push(format!(
+                            "link \"{}\": inertia repaired (relative change {:.2e}): {error}",
+                            link.name, report.relative_change
+                        ));
+                        props = fixed;
+                    }
+                    Err(e) => problems.push(format!("link \"{}\": {e}", link.name)),
+                },
+                Err(error) => problems.push(format!("link \"{}\": {error}", link.name)),
+            }
+        }
+        bodies.push(explicit_body(&link.name, &props));
+    }
+    if !problems.is_empty() {
+        return Err(located(
+            path,
+            format!(
+                "invalid inertias (run with --repair-inertia to replace them by the nearest physical tensors):\n  {}",
+                problems.join("\n  ")
+            ),
+        ));
+    }
+    Ok(bodies)
+}
+
+/// A link's mass properties in the link frame: from `<inertial>` (tensor rotated by its rpy),
+/// or, for a massless one, from its mesh at [`MESH_DENSITY`] when there is one (noted in `notes`).
+fn link_mass_properties(path: &Path, link: &urdf_rs::Link, notes: &mut Vec<String>) -> MassProperties {
+    let inertial = &link.inertial;
+    let r = rotation(inertial.origin.rpy.0);
+    let i = &inertial.inertia;
+    let tensor = Matrix3::new(i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz);
+    let mut props = MassProperties {
+        mass: inertial.mass.value,
+        p_oc: Vector3::from(inertial.origin.xyz.0),
+        inertia_c: r.matrix() * tensor * r.matrix().transpose(),
+    };
+    if props.mass == 0.0
+        && let Some((mesh_props, file)) = mesh_mass(path, link)
+    {
+        notes.push(format!(
+            "link \"{}\": no <inertial>; mass properties from mesh {file} at {MESH_DENSITY} kg/m³",
+            link.name
+        ));
+        props = mesh_props;
+    }
+    props
+}
+
+/// A scene body named `name` with the explicit mass properties `props` (central inertia).
+fn explicit_body(name: &str, props: &MassProperties) -> BodySpec {
+    let c = props.inertia_c;
+    BodySpec {
+        name: spanned(name.to_string()),
+        mass_properties: Some(ExplicitMass {
+            mass: props.mass,
+            com: props.p_oc.into(),
+            inertia: [c[(0, 0)], c[(1, 1)], c[(2, 2)], c[(0, 1)], c[(0, 2)], c[(1, 2)]],
+        }),
+        primitive: None,
+        mesh: None,
+        offset: [0.0; 3],
+    }
+}
+
+/// The one link that is no joint's child; an error when there is not exactly one.
+fn root_link<'r>(path: &Path, robot: &'r urdf_rs::Robot) -> Result<&'r str, String> {
+    let children: Vec<&str> = robot.joints.iter().map(|j| j.child.link.as_str()).collect();
+    let roots: Vec<&str> = robot
+        .links
+        .iter()
+        .map(|l| l.name.as_str())
+        .filter(|name| !children.contains(name))
+        .collect();
+    let [root] = roots.as_slice() else {
+        return Err(located(path, format!("a URDF tree has one root link, found {roots:?}")));
+    };
+    Ok(root)
+}
+
+/// The scene joint of a URDF joint (see the module docs for the mapping); an error for a
+/// revolute or prismatic joint without a usable axis or a planar joint whose normal is not z.
+fn joint_spec(path: &Path, joint: &urdf_rs::Joint) -> Result<JointSpec, String> {
+    use urdf_rs::JointType as T;
+    let kind = match joint.joint_type {
+        T::Revolute | T::Continuous => JointKind::Revolute,
+        T::Prismatic => JointKind::Prismatic,
+        T::Fixed => JointKind::Fixed,
+        T::Floating => JointKind::Free,
+        T::Spherical => JointKind::Spherical,
+        T::Planar => JointKind::Planar,
+    };
+    let axis = Vector3::from(joint.axis.xyz.0);
+    let norm = axis.norm();
+    if matches!(kind, JointKind::Revolute | JointKind::Prismatic) && !(norm > 0.0 && norm.is_finite()) {
+        return Err(located(
+            path,
+            format!("joint \"{}\": zero or non-finite axis", joint.name),
+        ));
+    }
+    if kind == JointKind::Planar && (axis / norm - Vector3::z()).norm() > 1e-12 {
+        return Err(located(
+            path,
+            format!(
+                "joint \"{}\": planar joints are supported with their normal along the joint's z axis only",
+                joint.name
+            ),
+        ));
+    }
+    let limited = matches!(joint.joint_type, T::Revolute | T::Prismatic)
+        && joint.limit.lower.is_finite()
+        && joint.limit.upper.is_finite()
+        && joint.limit.lower < joint.limit.upper;
+    let q0 = if limited && !(joint.limit.lower..=joint.limit.upper).contains(&0.0) {
+        Some(spanned(vec![0.5 * (joint.limit.lower + joint.limit.upper)]))
+    } else {
+        None
+    };
+    Ok(JointSpec {
+        name: joint.name.clone(),
+        kind: spanned(kind),
+        parent: spanned(joint.parent.link.clone()),
+        child: spanned(joint.child.link.clone()),
+        axis: matches!(kind, JointKind::Revolute | JointKind::Prismatic | JointKind::Planar)
+            .then(|| spanned((axis / norm).into())),
+        origin: joint.origin.xyz.0,
+        rpy: joint.origin.rpy.0,
+        q0,
+        qd0: None,
+        limits: limited.then(|| spanned([joint.limit.lower, joint.limit.upper])),
+    })
 }
 
 /// The mass properties of a link's first mesh geometry (collision, else visual), when its
