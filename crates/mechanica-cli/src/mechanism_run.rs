@@ -112,19 +112,8 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     if analyses.equilibrium.is_none() && analyses.modes.is_none() {
         return Ok(());
     }
-    let mut built = None;
-    steps.push(timed_step("build: mechanism (potentials, frame)", || {
-        let mechanism = build_mechanism(scene, model)?;
-        let quantities = vec![quantity(
-            "potentials",
-            vec![mechanism.potentials().len() as f64],
-            "",
-            None,
-        )];
-        built = Some(mechanism);
-        Ok::<_, String>(quantities)
-    })?);
-    let mut mechanism = built.ok_or("internal: mechanism not built")?;
+    let (build, mut mechanism) = build_step(scene, model)?;
+    steps.push(build);
     let mut q = model.q0.clone();
     let mut locked: Vec<usize> = Vec::new();
     if let Some(spec) = &analyses.equilibrium {
@@ -136,80 +125,139 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
             max_iterations: spec.max_iterations.unwrap_or(100),
             ..EquilibriumOptions::default()
         };
-        let recentred = mechanism.has_rotation_vectors();
-        let mut notes = Vec::new();
-        let mut step = timed_step("equilibrium: Newton on grad U* (8.74)", || {
-            let eq = find_equilibrium(&mut mechanism, &q, &options).map_err(|e| e.to_string())?;
-            let quantities = vec![
-                quantity("q at equilibrium", eq.q.clone(), "rad | m", None),
-                quantity(
-                    "|grad U*| at equilibrium",
-                    vec![eq.gradient_norm],
-                    "J",
-                    Some(format!(
-                        "tolerance {:.1e}, {} Newton iterations, last step {:.1e}",
-                        eq.tolerance, eq.iterations, eq.last_step
-                    )),
-                ),
-                quantity("U* at equilibrium", vec![eq.potential], "J", None),
-            ];
-            q = eq.q;
-            locked = eq.at_limit;
-            if recentred {
-                notes.push(
-                    "spherical/free joints were re-centred on the equilibrium: their rotation vectors read 0 in the new chart; bodies did not move"
-                        .to_string(),
-                );
-            }
-            Ok::<_, String>(quantities)
-        })?;
-        step.notes.append(&mut notes);
+        let mut step = equilibrium_step(&mut mechanism, &mut q, &mut locked, &options)?;
         if !spec.starts.is_empty() {
-            let mut starts = spec.starts.clone();
-            starts.insert(0, q.clone());
-            let progress = crate::progress::bar(starts.len() as u64, "equilibria from several starts");
-            let mut found = Vec::new();
-            let mut failed = 0;
-            for start in &starts {
-                let (eqs, f) = find_equilibria(&mut mechanism, std::slice::from_ref(start), &options)
-                    .map_err(|e| e.to_string())?;
-                failed += f;
-                for eq in eqs {
-                    let fresh = found.iter().all(|other: &Vec<f64>| {
-                        other.iter().zip(&eq.q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) > 1e-8
-                    });
-                    if fresh {
-                        found.push(eq.q);
-                    }
-                }
-                progress.inc(1);
-            }
-            progress.finish_and_clear();
-            step.notes.push(format!(
-                "{} distinct equilibria from {} starts ({} did not converge)",
-                found.len(),
-                starts.len(),
-                failed
-            ));
-            for (i, eq) in found.iter().enumerate() {
-                step.quantities
-                    .push(quantity(&format!("equilibrium {i}"), eq.clone(), "rad | m", None));
-                let verdict = mechanism_modes(&mut mechanism.clone(), eq, &SolveOptions::default())
-                    .map(|m| stability_note(&m.stability))
-                    .unwrap_or_else(|e| format!("stability unknown: {e}"));
-                step.notes.push(format!("equilibrium {i}: {verdict}"));
-            }
+            add_equilibria_from_starts(&mut step, &mut mechanism, &q, &spec.starts, &options)?;
         }
         steps.push(step);
     }
     let Some(spec) = &analyses.modes else { return Ok(()) };
+    let (step, modes) = modes_step(&mut mechanism, &q, &locked, spec)?;
+    steps.push(step);
+    record_mode_plots(&modes, plots);
+    if let Some(response) = &analyses.response {
+        steps.push(response_step(&modes, response, plots)?);
+    }
+    Ok(())
+}
+
+/// The timed step building the scene's mechanism, and the mechanism.
+fn build_step(scene: &Scene, model: &Model) -> Result<(Step, Mechanism), String> {
+    let mut built = None;
+    let step = timed_step("build: mechanism (potentials, frame)", || {
+        let mechanism = build_mechanism(scene, model)?;
+        let quantities = vec![quantity(
+            "potentials",
+            vec![mechanism.potentials().len() as f64],
+            "",
+            None,
+        )];
+        built = Some(mechanism);
+        Ok::<_, String>(quantities)
+    })?;
+    let mechanism = built.ok_or("internal: mechanism not built")?;
+    Ok((step, mechanism))
+}
+
+/// The timed equilibrium search from `q`: on success `q` becomes the equilibrium and `locked`
+/// the coordinates resting on a joint limit there.
+fn equilibrium_step(
+    mechanism: &mut Mechanism,
+    q: &mut Vec<f64>,
+    locked: &mut Vec<usize>,
+    options: &EquilibriumOptions,
+) -> Result<Step, String> {
+    let recentred = mechanism.has_rotation_vectors();
+    let mut notes = Vec::new();
+    let mut step = timed_step("equilibrium: Newton on grad U* (8.74)", || {
+        let eq = find_equilibrium(mechanism, q, options).map_err(|e| e.to_string())?;
+        let quantities = vec![
+            quantity("q at equilibrium", eq.q.clone(), "rad | m", None),
+            quantity(
+                "|grad U*| at equilibrium",
+                vec![eq.gradient_norm],
+                "J",
+                Some(format!(
+                    "tolerance {:.1e}, {} Newton iterations, last step {:.1e}",
+                    eq.tolerance, eq.iterations, eq.last_step
+                )),
+            ),
+            quantity("U* at equilibrium", vec![eq.potential], "J", None),
+        ];
+        *q = eq.q;
+        *locked = eq.at_limit;
+        if recentred {
+            notes.push(
+                "spherical/free joints were re-centred on the equilibrium: their rotation vectors read 0 in the new chart; bodies did not move"
+                    .to_string(),
+            );
+        }
+        Ok::<_, String>(quantities)
+    })?;
+    step.notes.append(&mut notes);
+    Ok(step)
+}
+
+/// Searches from `q` and every further start, and adds to `step` each distinct equilibrium
+/// found (apart by more than 1e-8 in some coordinate) with its stability.
+fn add_equilibria_from_starts(
+    step: &mut Step,
+    mechanism: &mut Mechanism,
+    q: &[f64],
+    further_starts: &[Vec<f64>],
+    options: &EquilibriumOptions,
+) -> Result<(), String> {
+    let mut starts = further_starts.to_vec();
+    starts.insert(0, q.to_vec());
+    let progress = crate::progress::bar(starts.len() as u64, "equilibria from several starts");
+    let mut found = Vec::new();
+    let mut failed = 0;
+    for start in &starts {
+        let (eqs, f) = find_equilibria(mechanism, std::slice::from_ref(start), options).map_err(|e| e.to_string())?;
+        failed += f;
+        for eq in eqs {
+            let fresh = found
+                .iter()
+                .all(|other: &Vec<f64>| other.iter().zip(&eq.q).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) > 1e-8);
+            if fresh {
+                found.push(eq.q);
+            }
+        }
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    step.notes.push(format!(
+        "{} distinct equilibria from {} starts ({} did not converge)",
+        found.len(),
+        starts.len(),
+        failed
+    ));
+    for (i, eq) in found.iter().enumerate() {
+        step.quantities
+            .push(quantity(&format!("equilibrium {i}"), eq.clone(), "rad | m", None));
+        let verdict = mechanism_modes(&mut mechanism.clone(), eq, &SolveOptions::default())
+            .map(|m| stability_note(&m.stability))
+            .unwrap_or_else(|e| format!("stability unknown: {e}"));
+        step.notes.push(format!("equilibrium {i}: {verdict}"));
+    }
+    Ok(())
+}
+
+/// The timed modes at `q` with the `locked` coordinates held fixed, with notes on stability,
+/// the gyroscopic problem, a non-equilibrium `q` and the locks; and the modes.
+fn modes_step(
+    mechanism: &mut Mechanism,
+    q: &[f64],
+    locked: &[usize],
+    spec: &crate::scene::ModesSpec,
+) -> Result<(Step, MechanismModes), String> {
     let options = SolveOptions {
         selection: spec.lowest.map_or(Selection::All, Selection::Lowest),
         ..SolveOptions::default()
     };
     let mut modes: Option<MechanismModes> = None;
     let mut step = timed_step("modes: det(λA + B) = 0 at the equilibrium (8.84–8.92)", || {
-        let m = mechanism_modes_with_locks(&mut mechanism, &q, &locked, &options).map_err(|e| e.to_string())?;
+        let m = mechanism_modes_with_locks(mechanism, q, locked, &options).map_err(|e| e.to_string())?;
         let quantities = mode_quantities(&m);
         modes = Some(m);
         Ok::<_, String>(quantities)
@@ -239,7 +287,11 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
             "coordinates {locked:?} rest on joint limits at the equilibrium and are held fixed for the modes"
         ));
     }
-    steps.push(step);
+    Ok((step, modes))
+}
+
+/// Puts the spectrum and the first six mode shapes into the plot data.
+fn record_mode_plots(modes: &MechanismModes, plots: &mut PlotData) {
     plots.spectrum = modes
         .solution
         .modes
@@ -249,15 +301,11 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     if let Some(x) = &modes.solution.vectors {
         plots.shapes = (0..x.ncols().min(6))
             .map(|k| ModeShape {
-                label: mode_label(&modes, k),
+                label: mode_label(modes, k),
                 values: (0..x.nrows()).map(|r| x[(r, k)]).collect(),
             })
             .collect();
     }
-    if let Some(response) = &analyses.response {
-        steps.push(response_step(&modes, response, plots)?);
-    }
-    Ok(())
 }
 
 fn mode_label(modes: &MechanismModes, k: usize) -> String {
