@@ -104,6 +104,33 @@ impl TreeBuilder {
         if n == 0 {
             return Err(KinematicsError::EmptyTree);
         }
+        let root = self.checked_root()?;
+        let order = self.depth_first_order(root)?;
+        let (dof_start, dof_body, nv) = self.dof_layout();
+        let depth = self.depths(&order);
+        Ok(KinematicTree {
+            parent: self.bodies.iter().map(|b| b.parent).collect(),
+            joint: self.bodies.iter().map(|b| normalized_joint(b.joint)).collect(),
+            r_pj: self
+                .bodies
+                .iter()
+                .map(|b| *b.placement.rotation.to_rotation_matrix().matrix())
+                .collect(),
+            p_pj: self.bodies.iter().map(|b| b.placement.translation.vector).collect(),
+            r_ref: vec![Matrix3::identity(); n],
+            rev_terms: self.bodies.iter().map(revolute_terms).collect(),
+            order,
+            dof_start,
+            dof_body,
+            depth,
+            nv,
+        })
+    }
+
+    /// The root (the one body without a parent), checking every body on the way: parent index
+    /// in range, finite placement, finite unit joint axis.
+    fn checked_root(&self) -> Result<usize, KinematicsError> {
+        let n = self.bodies.len();
         let mut root = None;
         for (body, spec) in self.bodies.iter().enumerate() {
             match spec.parent {
@@ -120,32 +147,16 @@ impl TreeBuilder {
                 }
                 Some(_) => {}
             }
-            let iso = &spec.placement;
-            let values = iso.translation.vector.iter().chain(iso.rotation.coords.iter()).copied();
-            if let Some(value) = values.clone().find(|v| !v.is_finite()) {
-                return Err(KinematicsError::NonFiniteEntry {
-                    what: "body placement",
-                    index: body,
-                    value,
-                });
-            }
-            if let Joint::Revolute { axis } | Joint::Prismatic { axis } = spec.joint {
-                if let Some(value) = axis.iter().copied().find(|v| !v.is_finite()) {
-                    return Err(KinematicsError::NonFiniteEntry {
-                        what: "joint axis",
-                        index: body,
-                        value,
-                    });
-                }
-                let norm = axis.norm();
-                if (norm - 1.0).abs() > crate::rotation::AXIS_TOLERANCE {
-                    return Err(KinematicsError::JointAxisNotUnit { body, norm });
-                }
-            }
+            check_placement_and_axis(body, spec)?;
         }
-        let root = root.ok_or(KinematicsError::NoRoot)?;
-        // Children lists, then a depth-first order from the root; unvisited bodies are on or
-        // below a cycle.
+        root.ok_or(KinematicsError::NoRoot)
+    }
+
+    /// The bodies in depth-first order from `root` (children in index order), each parent
+    /// before its children; a body never reached lies on or below a cycle, which is an error.
+    fn depth_first_order(&self, root: usize) -> Result<Vec<usize>, KinematicsError> {
+        let n = self.bodies.len();
+        // Children lists (compressed: the children of b are children[child_start[b]..child_start[b + 1]]).
         let mut child_start = vec![0usize; n + 1];
         for spec in &self.bodies {
             if let Some(p) = spec.parent {
@@ -179,7 +190,13 @@ impl TreeBuilder {
         if let Some(body) = visited.iter().position(|v| !v) {
             return Err(KinematicsError::Cycle { body });
         }
-        let mut dof_start = Vec::with_capacity(n + 1);
+        Ok(order)
+    }
+
+    /// The coordinate layout, body by body in index order: the first coordinate of each body
+    /// (n + 1 entries, the last = dof), the body owning each coordinate, and the dof.
+    fn dof_layout(&self) -> (Vec<usize>, Vec<usize>, usize) {
+        let mut dof_start = Vec::with_capacity(self.bodies.len() + 1);
         let mut dof_body = Vec::new();
         let mut nv = 0;
         for (body, spec) in self.bodies.iter().enumerate() {
@@ -188,50 +205,68 @@ impl TreeBuilder {
             dof_body.extend(std::iter::repeat_n(body, spec.joint.dof()));
         }
         dof_start.push(nv);
-        let mut depth = vec![0usize; n];
-        for &b in &order {
+        (dof_start, dof_body, nv)
+    }
+
+    /// The number of joints between each body and the base, from a parents-first `order`.
+    fn depths(&self, order: &[usize]) -> Vec<usize> {
+        let mut depth = vec![0usize; self.bodies.len()];
+        for &b in order {
             if let Some(p) = self.bodies[b].parent {
                 depth[b] = depth[p] + 1;
             }
         }
-        Ok(KinematicTree {
-            parent: self.bodies.iter().map(|b| b.parent).collect(),
-            joint: self
-                .bodies
-                .iter()
-                .map(|b| match b.joint {
-                    Joint::Revolute { axis } => Joint::Revolute { axis: axis.normalize() },
-                    Joint::Prismatic { axis } => Joint::Prismatic { axis: axis.normalize() },
-                    other => other,
-                })
-                .collect(),
-            r_pj: self
-                .bodies
-                .iter()
-                .map(|b| *b.placement.rotation.to_rotation_matrix().matrix())
-                .collect(),
-            p_pj: self.bodies.iter().map(|b| b.placement.translation.vector).collect(),
-            r_ref: vec![Matrix3::identity(); n],
-            rev_terms: self
-                .bodies
-                .iter()
-                .map(|b| {
-                    let r = *b.placement.rotation.to_rotation_matrix().matrix();
-                    match b.joint {
-                        Joint::Revolute { axis } => {
-                            let k = crate::rotation::skew(&axis.normalize());
-                            (r * k, r * k * k, r * axis.normalize())
-                        }
-                        _ => (Matrix3::zeros(), Matrix3::zeros(), Vector3::zeros()),
-                    }
-                })
-                .collect(),
-            order,
-            dof_start,
-            dof_body,
-            depth,
-            nv,
-        })
+        depth
+    }
+}
+
+/// Ok when body `body`'s placement is finite and its revolute or prismatic axis is finite and
+/// of unit length within [`crate::rotation::AXIS_TOLERANCE`].
+fn check_placement_and_axis(body: usize, spec: &BodySpec) -> Result<(), KinematicsError> {
+    let iso = &spec.placement;
+    let values = iso.translation.vector.iter().chain(iso.rotation.coords.iter()).copied();
+    if let Some(value) = values.clone().find(|v| !v.is_finite()) {
+        return Err(KinematicsError::NonFiniteEntry {
+            what: "body placement",
+            index: body,
+            value,
+        });
+    }
+    if let Joint::Revolute { axis } | Joint::Prismatic { axis } = spec.joint {
+        if let Some(value) = axis.iter().copied().find(|v| !v.is_finite()) {
+            return Err(KinematicsError::NonFiniteEntry {
+                what: "joint axis",
+                index: body,
+                value,
+            });
+        }
+        let norm = axis.norm();
+        if (norm - 1.0).abs() > crate::rotation::AXIS_TOLERANCE {
+            return Err(KinematicsError::JointAxisNotUnit { body, norm });
+        }
+    }
+    Ok(())
+}
+
+/// The joint with its revolute or prismatic axis normalised exactly.
+fn normalized_joint(joint: Joint) -> Joint {
+    match joint {
+        Joint::Revolute { axis } => Joint::Revolute { axis: axis.normalize() },
+        Joint::Prismatic { axis } => Joint::Prismatic { axis: axis.normalize() },
+        other => other,
+    }
+}
+
+/// For a revolute joint, (R_PJ [a]×, R_PJ [a]×², R_PJ a) with the normalised axis a; zeros
+/// for every other joint (see [`KinematicTree`]'s `rev_terms`).
+fn revolute_terms(b: &BodySpec) -> (Matrix3<f64>, Matrix3<f64>, Vector3<f64>) {
+    let r = *b.placement.rotation.to_rotation_matrix().matrix();
+    match b.joint {
+        Joint::Revolute { axis } => {
+            let k = crate::rotation::skew(&axis.normalize());
+            (r * k, r * k * k, r * axis.normalize())
+        }
+        _ => (Matrix3::zeros(), Matrix3::zeros(), Vector3::zeros()),
     }
 }
 
