@@ -19,7 +19,7 @@ use crate::{MassError, MassProperties};
 use nalgebra::{Matrix3, Vector3};
 
 pub use crate::mesh_integrals::BLOCK;
-use crate::mesh_integrals::{Integrand, SOLID_DIVISORS, integrate};
+use crate::mesh_integrals::{Integrand, SOLID_DIVISORS, Sums, integrate};
 pub use crate::parallel::PARALLEL_MIN_TRIANGLES;
 use crate::topology::check_indices;
 pub use crate::topology::{MeshTopology, mesh_topology};
@@ -208,6 +208,28 @@ pub fn mesh_mass_properties(
             known
         }
     };
+    let model = model_for_topology(options, &topology)?;
+    let mut sums = scaled_sums(vertices, triangles, &r, model, options.degenerate)?;
+    let flipped = check_measure(&mut sums, model, triangles.len(), diag, options.inside_out)?;
+    let measure = sums.v[0];
+    let properties = properties_from_sums(&sums, &r, amount)?;
+    Ok(MeshMassProperties {
+        properties,
+        model,
+        measure,
+        diagnostics: MeshDiagnostics {
+            triangles: triangles.len(),
+            degenerate_triangles: sums.degenerate,
+            topology,
+            flipped,
+        },
+        relative_error_bound: relative_error_bound(triangles.len(), sums.abs_measure, measure),
+    })
+}
+
+/// The model to integrate: the requested one, or a shell for an open mesh under
+/// [`OpenMeshPolicy::Shell`]; an error for an open (policy Reject) or misoriented solid.
+fn model_for_topology(options: &MeshOptions, topology: &MeshTopology) -> Result<MeshModel, MassError> {
     let mut model = options.model;
     if model == MeshModel::Solid && !topology.is_closed() {
         match options.open_mesh {
@@ -225,11 +247,23 @@ pub fn mesh_mass_properties(
             misoriented_edges: topology.misoriented_edges,
         });
     }
+    Ok(model)
+}
+
+/// The integrals of 1, x, x², xy relative to `r` under `model`, scaled to volume moments for a
+/// solid; an error when degenerate triangles are rejected or every triangle is degenerate.
+fn scaled_sums(
+    vertices: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    r: &[f64; 3],
+    model: MeshModel,
+    degenerate: DegeneratePolicy,
+) -> Result<Sums, MassError> {
     let mut sums = match model {
-        MeshModel::Solid => integrate(vertices, triangles, &r, Integrand::Solid),
-        MeshModel::Shell => integrate(vertices, triangles, &r, Integrand::Shell),
+        MeshModel::Solid => integrate(vertices, triangles, r, Integrand::Solid),
+        MeshModel::Shell => integrate(vertices, triangles, r, Integrand::Shell),
     };
-    if let (DegeneratePolicy::Reject, Some(first)) = (options.degenerate, sums.first_degenerate) {
+    if let (DegeneratePolicy::Reject, Some(first)) = (degenerate, sums.first_degenerate) {
         return Err(MassError::DegenerateTriangles {
             count: sums.degenerate,
             first,
@@ -244,20 +278,36 @@ pub fn mesh_mass_properties(
         }
         sums.abs_measure /= 6.0;
     }
-    // Recursive summation within a block (at most min(n, BLOCK) terms), then over the blocks,
-    // plus a few roundings per term.
-    let n = triangles.len();
+    Ok(sums)
+}
+
+/// The bound (min(n, BLOCK) + ⌈n/BLOCK⌉ + 16)·ε·`abs_measure`/|`measure`| on the relative
+/// rounding error of a measure summed over `n` triangles: recursive summation within a block
+/// (at most min(n, BLOCK) terms), then over the blocks, plus a few roundings per term.
+fn relative_error_bound(n: usize, abs_measure: f64, measure: f64) -> f64 {
     let terms = (n.min(BLOCK) + n.div_ceil(BLOCK) + 16) as f64;
-    let relative_error_bound = |measure: f64| terms * f64::EPSILON * sums.abs_measure / measure.abs();
+    terms * f64::EPSILON * abs_measure / measure.abs()
+}
+
+/// Checks the measure: a solid's volume must exceed both 1e-12·`diag`³ and four times its
+/// rounding bound, and a negative one is reversed (returning true) or rejected by
+/// `inside_out`; a shell's area must be positive.
+fn check_measure(
+    sums: &mut Sums,
+    model: MeshModel,
+    n: usize,
+    diag: f64,
+    inside_out: InsideOutPolicy,
+) -> Result<bool, MassError> {
     let mut flipped = false;
     if model == MeshModel::Solid {
         let volume = sums.v[0];
         let cube = diag * diag * diag;
-        if volume.abs() <= 1e-12 * cube || volume.abs() <= 4.0 * relative_error_bound(1.0) {
+        if volume.abs() <= 1e-12 * cube || volume.abs() <= 4.0 * relative_error_bound(n, sums.abs_measure, 1.0) {
             return Err(MassError::ZeroVolume { volume, scale: cube });
         }
         if volume < 0.0 {
-            match options.inside_out {
+            match inside_out {
                 InsideOutPolicy::Reject => return Err(MassError::InsideOut { volume }),
                 InsideOutPolicy::Flip => {
                     for v in &mut sums.v {
@@ -270,6 +320,12 @@ pub fn mesh_mass_properties(
     } else if sums.v[0].is_nan() || sums.v[0] <= 0.0 {
         return Err(MassError::EmptyMesh);
     }
+    Ok(flipped)
+}
+
+/// Mass, centre of mass and central inertia J = tr(S)·I − S (3.17–3.18) from the checked sums
+/// relative to `r`; an error when the amount does not fit the measure or a result overflows.
+fn properties_from_sums(sums: &Sums, r: &[f64; 3], amount: Amount) -> Result<MassProperties, MassError> {
     let measure = sums.v[0];
     let mass = amount.mass_for(measure)?;
     let rho = mass / measure;
@@ -295,16 +351,5 @@ pub fn mesh_mass_properties(
             value,
         });
     }
-    Ok(MeshMassProperties {
-        properties,
-        model,
-        measure,
-        diagnostics: MeshDiagnostics {
-            triangles: triangles.len(),
-            degenerate_triangles: sums.degenerate,
-            topology,
-            flipped,
-        },
-        relative_error_bound: relative_error_bound(measure),
-    })
+    Ok(properties)
 }
