@@ -15,7 +15,7 @@
 //! default: the size of the rounding error of g near q₀. The report gives ‖g‖ and the last
 //! Newton step, an estimate of the distance to the exact equilibrium.
 
-use crate::{Mechanism, MechanismError};
+use crate::{Mechanism, MechanismError, PotentialSum};
 use faer::{Mat, Side};
 
 /// Which equilibria a search heads for.
@@ -140,36 +140,14 @@ pub fn find_equilibrium(
 ) -> Result<Equilibrium, MechanismError> {
     let limits = mechanism.limits().to_vec();
     let mut q = q0.to_vec();
-    if q.len() != mechanism.dof() {
-        return Err(MechanismError::WrongLength {
-            what: "q0",
-            expected: mechanism.dof(),
-            got: q.len(),
-        });
-    }
-    crate::error::check_all_finite(&q, "q0")?;
-    if options.max_step.is_nan() || options.max_step <= 0.0 {
-        return Err(MechanismError::OutOfRange {
-            what: "maximum equilibrium step",
-            requirement: "> 0",
-            value: options.max_step,
-        });
-    }
+    check_start(mechanism.dof(), &q, options)?;
     clamp(&mut q, &limits);
     let rebase = mechanism.has_rotation_vectors();
     if rebase {
         mechanism.rebase(&mut q)?;
     }
     let start = mechanism.potential(&q, true)?;
-    let start_hessian_norm = start.hessian.as_ref().map_or(0.0, |h| h.norm_l2());
-    let n = q.len().max(1) as f64;
-    let tolerance = match options.tolerance {
-        Some(t) => crate::error::check_finite(t, "equilibrium tolerance")?,
-        None => {
-            64.0 * n * f64::EPSILON * (start_hessian_norm * norm(&q).max(1.0) + norm(&start.gradient))
-                + f64::MIN_POSITIVE
-        }
-    };
+    let tolerance = gradient_tolerance(options.tolerance, &q, &start)?;
     let mut current = start;
     let mut last_step = f64::INFINITY;
     for iteration in 0..=options.max_iterations {
@@ -193,37 +171,16 @@ pub fn find_equilibrium(
             .hessian
             .as_ref()
             .ok_or(MechanismError::Numerical("Hessian missing"))?;
-        // Projected Newton: coordinates held by a limit are frozen, the rest take the Newton
-        // step of the reduced problem.
-        let moving: Vec<usize> = (0..q.len()).filter(|k| !at_limit.contains(k)).collect();
-        let reduced = Mat::from_fn(moving.len(), moving.len(), |i, j| hessian[(moving[i], moving[j])]);
-        let reduced_gradient: Vec<f64> = moving.iter().map(|&k| free[k]).collect();
-        let reduced_step = newton_step(&reduced, &reduced_gradient, options.seek, options.max_step)?;
-        let mut direction = vec![0.0; q.len()];
-        for (&k, d) in moving.iter().zip(&reduced_step) {
-            direction[k] = *d;
-        }
-        let slope: f64 = free.iter().zip(&direction).map(|(g, d)| g * d).sum();
-        let mut alpha = 1.0;
-        let mut accepted = None;
-        for _ in 0..40 {
-            let mut trial: Vec<f64> = q.iter().zip(&direction).map(|(x, d)| x + alpha * d).collect();
-            clamp(&mut trial, &limits);
-            let evaluation = mechanism.potential(&trial, false)?;
-            let (trial_free, _) = free_gradient(&evaluation.gradient, &trial, &limits);
-            let sufficient = match options.seek {
-                Seek::Stationary => norm(&trial_free) < (1.0 - 1e-4 * alpha) * gradient_norm,
-                Seek::Minimum => {
-                    evaluation.value <= current.value + 1e-4 * alpha * slope || norm(&trial_free) < 1e-3 * gradient_norm
-                }
-            };
-            if sufficient {
-                accepted = Some(trial);
-                break;
-            }
-            alpha *= 0.5;
-        }
-        let Some(mut next) = accepted else { break };
+        let direction = projected_newton_direction(hessian, &free, &at_limit, options)?;
+        let from = Iterate {
+            q: &q,
+            value: current.value,
+            free: &free,
+            gradient_norm,
+        };
+        let Some(mut next) = line_search(mechanism, &limits, options.seek, &from, &direction)? else {
+            break;
+        };
         last_step = q.iter().zip(&next).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
         if rebase {
             mechanism.rebase(&mut next)?;
@@ -238,6 +195,102 @@ pub fn find_equilibrium(
         tolerance,
         best_q: q,
     })
+}
+
+/// Ok when `q0` has `dof` finite entries and the maximum step is positive.
+fn check_start(dof: usize, q0: &[f64], options: &EquilibriumOptions) -> Result<(), MechanismError> {
+    if q0.len() != dof {
+        return Err(MechanismError::WrongLength {
+            what: "q0",
+            expected: dof,
+            got: q0.len(),
+        });
+    }
+    crate::error::check_all_finite(q0, "q0")?;
+    if options.max_step.is_nan() || options.max_step <= 0.0 {
+        return Err(MechanismError::OutOfRange {
+            what: "maximum equilibrium step",
+            requirement: "> 0",
+            value: options.max_step,
+        });
+    }
+    Ok(())
+}
+
+/// The gradient-norm tolerance τ: the `given` one (checked finite), else the rounding-level
+/// default of the module docs from the start point `q` and its potential `start`.
+fn gradient_tolerance(given: Option<f64>, q: &[f64], start: &PotentialSum) -> Result<f64, MechanismError> {
+    let start_hessian_norm = start.hessian.as_ref().map_or(0.0, |h| h.norm_l2());
+    let n = q.len().max(1) as f64;
+    Ok(match given {
+        Some(t) => crate::error::check_finite(t, "equilibrium tolerance")?,
+        None => {
+            64.0 * n * f64::EPSILON * (start_hessian_norm * norm(q).max(1.0) + norm(&start.gradient))
+                + f64::MIN_POSITIVE
+        }
+    })
+}
+
+/// The projected Newton direction: coordinates held by a limit (`at_limit`) are frozen, the
+/// rest take the Newton step of the reduced problem on the `free` gradient.
+fn projected_newton_direction(
+    hessian: &Mat<f64>,
+    free: &[f64],
+    at_limit: &[usize],
+    options: &EquilibriumOptions,
+) -> Result<Vec<f64>, MechanismError> {
+    let moving: Vec<usize> = (0..free.len()).filter(|k| !at_limit.contains(k)).collect();
+    let reduced = Mat::from_fn(moving.len(), moving.len(), |i, j| hessian[(moving[i], moving[j])]);
+    let reduced_gradient: Vec<f64> = moving.iter().map(|&k| free[k]).collect();
+    let reduced_step = newton_step(&reduced, &reduced_gradient, options.seek, options.max_step)?;
+    let mut direction = vec![0.0; free.len()];
+    for (&k, d) in moving.iter().zip(&reduced_step) {
+        direction[k] = *d;
+    }
+    Ok(direction)
+}
+
+/// The current point of the Newton iteration, as the line search needs it.
+struct Iterate<'a> {
+    /// The coordinates.
+    q: &'a [f64],
+    /// U* at `q`.
+    value: f64,
+    /// The gradient at `q` without the components carried by a limit.
+    free: &'a [f64],
+    /// ‖`free`‖.
+    gradient_norm: f64,
+}
+
+/// Backtracking along `direction` from `from` (steps 1, ½, ¼, … at most 40 halvings, trial
+/// points clipped to the limits): the first trial point with a sufficient decrease of ‖grad U*‖
+/// (stationary) or of U* (Armijo, minimum), or None when none is found.
+fn line_search(
+    mechanism: &Mechanism,
+    limits: &[(f64, f64)],
+    seek: Seek,
+    from: &Iterate<'_>,
+    direction: &[f64],
+) -> Result<Option<Vec<f64>>, MechanismError> {
+    let slope: f64 = from.free.iter().zip(direction).map(|(g, d)| g * d).sum();
+    let mut alpha = 1.0;
+    for _ in 0..40 {
+        let mut trial: Vec<f64> = from.q.iter().zip(direction).map(|(x, d)| x + alpha * d).collect();
+        clamp(&mut trial, limits);
+        let evaluation = mechanism.potential(&trial, false)?;
+        let (trial_free, _) = free_gradient(&evaluation.gradient, &trial, limits);
+        let sufficient = match seek {
+            Seek::Stationary => norm(&trial_free) < (1.0 - 1e-4 * alpha) * from.gradient_norm,
+            Seek::Minimum => {
+                evaluation.value <= from.value + 1e-4 * alpha * slope || norm(&trial_free) < 1e-3 * from.gradient_norm
+            }
+        };
+        if sufficient {
+            return Ok(Some(trial));
+        }
+        alpha *= 0.5;
+    }
+    Ok(None)
 }
 
 /// Equilibria from several starting points, duplicates (within 1e-8·(1 + ‖q‖)) removed.
