@@ -38,7 +38,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use mechanica::modal::faer::Par;
 use mechanica::modal::reduce::{cholesky_and_reduce, reduce_two_solves};
-use mechanica::modal::{PencilProblem, SolveOptions, SparseOptions, SparsePencil, families, solve, solve_sparse};
+use mechanica::modal::{PencilProblem, SolveOptions, SparseOptions, SparsePencil, testing, solve, solve_sparse};
 use mechanica_benches::lapack;
 use mechanica_benches::modal::{nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra};
 use std::hint::black_box;
@@ -109,7 +109,7 @@ fn sparse(c: &mut Criterion) {
     let mut group = c.benchmark_group("modal_sparse");
     group.sample_size(10);
     let side = 300;
-    let (a, b) = families::grid_laplacian(side, side);
+    let (a, b) = testing::grid_laplacian(side, side);
     let pencil = match SparsePencil::from_triplets(side * side, &a, &b) {
         Ok(p) => p,
         Err(e) => panic!("benchmark grid is valid: {e}"),
@@ -130,7 +130,7 @@ fn stiff(c: &mut Criterion) {
     let mut group = c.benchmark_group("modal_stiff");
     group.sample_size(10);
     let n = 500;
-    let (a, b) = families::spring_chain(&families::graded_exponents(n, 12), &vec![0; n]);
+    let (a, b) = testing::spring_chain(&testing::graded_exponents(n, 12), &vec![0; n]);
     let problem = match PencilProblem::new(a.as_ref(), b.as_ref()) {
         Ok(p) => p,
         Err(e) => panic!("benchmark pencil is valid: {e}"),

@@ -1,6 +1,6 @@
 //! Times the sparse solver on an N×N grid Laplacian (default 300: n = 90 000, 10 lowest modes)
 //! and prints the report. `cargo run --release -p mechanica-modal --example sparse_grid -- 300 10`
-use mechanica_modal::{SparseOptions, SparsePencil, families, solve_sparse};
+use mechanica_modal::{SparseOptions, SparsePencil, testing, solve_sparse};
 use std::time::Instant;
 
 fn main() {
@@ -10,7 +10,7 @@ fn main() {
     if std::env::var("SEQ").is_ok() {
         mechanica_modal::faer::set_global_parallelism(mechanica_modal::faer::Par::Seq);
     }
-    let (a, b) = families::grid_laplacian(side, side);
+    let (a, b) = testing::grid_laplacian(side, side);
     let clock = Instant::now();
     let p = match SparsePencil::from_triplets(side * side, &a, &b) {
         Ok(p) => p,
@@ -34,7 +34,7 @@ fn main() {
         Err(e) => return eprintln!("{e}"),
     };
     let solved = clock.elapsed();
-    let exact = families::grid_omega_sq(side, side, k);
+    let exact = testing::grid_omega_sq(side, side, k);
     let worst = sol
         .modes
         .iter()

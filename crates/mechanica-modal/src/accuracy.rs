@@ -777,7 +777,7 @@ pub(crate) fn residual_bounds(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::families;
+    use crate::testing;
     use crate::reduce::{Cholesky, cholesky};
 
     /// The sketched ‖XᵀAX − I‖_F bound follows columns changed after it was formed: two
@@ -855,13 +855,13 @@ mod tests {
     #[test]
     fn a_inverse_bound_holds_and_is_tight() {
         let n = 200;
-        let q = families::random_orthogonal(n, 5);
+        let q = testing::random_orthogonal(n, 5);
         for decades in [0.0, 6.0, 12.0] {
             let lambda: Vec<f64> = (0..n)
                 .map(|i| 10f64.powf(-decades * i as f64 / (n - 1) as f64))
                 .collect();
             let d = Mat::from_fn(n, n, |i, j| if i == j { lambda[i] } else { 0.0 });
-            let (a, _) = families::rotate(&d, &d, &q);
+            let (a, _) = testing::rotate(&d, &d, &q);
             let Cholesky::Factor(l) = cholesky(a.as_ref(), Par::Seq) else {
                 panic!("positive definite");
             };

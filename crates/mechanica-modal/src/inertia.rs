@@ -115,15 +115,15 @@ pub(crate) fn inertia_of(k: &Mat<f64>) -> (usize, usize, usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::families;
+    use crate::testing;
 
     #[test]
     fn fixed_chain_counts_match_the_closed_form() {
         // Unit chain fixed at both ends: ω²_k = 4 sin²(kπ / (2(n+1))), k = 1..n.
         let n = 40;
-        let (a, b) = families::fixed_chain(n);
+        let (a, b) = testing::fixed_chain(n);
         let p = PencilProblem::new(a.as_ref(), b.as_ref()).expect("valid pencil");
-        let exact = families::fixed_chain_omega_sq(n);
+        let exact = testing::fixed_chain_omega_sq(n);
         for s in [-1.0, 0.0, 0.3, 1.7, 2.0, 3.99, 5.0] {
             let c = count_below(&p, s).expect("finite shift");
             let expected = exact.iter().filter(|&&w| w < s).count();

@@ -47,7 +47,8 @@ pub mod accuracy;
 mod condense;
 mod dd;
 pub mod error;
-pub mod families;
+#[cfg(feature = "testing")]
+pub mod testing;
 mod fork_join;
 mod idle_certificate;
 mod idle_task;

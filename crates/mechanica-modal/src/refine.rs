@@ -893,7 +893,7 @@ fn finish_pair(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::families;
+    use crate::testing;
     use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
 
     /// A, B, L, Y, ω² and X = L⁻ᵀY.
@@ -901,8 +901,8 @@ mod tests {
 
     /// The graded 1e12 chain: L, the reduced spectrum and the back-transformed modes.
     fn graded() -> Reduced {
-        let stiffness = families::graded_exponents(16, 12);
-        let (a, b) = families::spring_chain(&stiffness, &[0; 16]);
+        let stiffness = testing::graded_exponents(16, 12);
+        let (a, b) = testing::spring_chain(&stiffness, &[0; 16]);
         reduced_modes(a, b)
     }
 
@@ -1000,7 +1000,7 @@ mod tests {
     #[test]
     fn sparse_and_dense_bordered_steps_agree_on_banded_pencils() {
         let n = 64;
-        let (lumped, b) = families::spring_chain(&families::graded_exponents(n, 12), &vec![0; n]);
+        let (lumped, b) = testing::spring_chain(&testing::graded_exponents(n, 12), &vec![0; n]);
         let consistent = Mat::from_fn(n, n, |i, j| match i.abs_diff(j) {
             0 => 4.0 / 6.0,
             1 => 1.0 / 6.0,

@@ -174,7 +174,7 @@ pub(crate) fn inertia_with(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{PencilProblem, count_below, families};
+    use crate::{PencilProblem, count_below, testing};
     use faer::sparse::Triplet;
 
     fn sparse_of(m: &faer::Mat<f64>) -> Vec<Triplet<usize, usize, f64>> {
@@ -192,8 +192,8 @@ mod tests {
     #[test]
     fn sparse_count_agrees_with_dense_count_and_closed_form() {
         // A ring has double eigenvalues; the rotated chain is dense (one supernode).
-        let (a, b) = families::ring(40);
-        let exact = families::ring_omega_sq(40);
+        let (a, b) = testing::ring(40);
+        let exact = testing::ring_omega_sq(40);
         let sparse = SparsePencil::from_triplets(40, &sparse_of(&a), &sparse_of(&b)).expect("valid");
         let dense = PencilProblem::new(a.as_ref(), b.as_ref()).expect("valid");
         for shift in [-1.0, 0.05, 0.5, 1.3, 2.1, 3.9, 5.0] {

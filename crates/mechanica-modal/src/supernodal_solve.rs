@@ -195,7 +195,7 @@ impl<'a> SupernodalSolver<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::families;
+    use crate::testing;
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::sparse::linalg::SupernodalThreshold;
     use faer::sparse::linalg::cholesky::{
@@ -219,7 +219,7 @@ mod tests {
     /// dense block coupling the first `dense` unknowns (one wide supernode).
     fn test_matrix(side: usize, dense: usize) -> (usize, Vec<Triplet<usize, usize, f64>>) {
         let n = side * side;
-        let (_, mut entries) = families::grid_laplacian(side, side);
+        let (_, mut entries) = testing::grid_laplacian(side, side);
         for i in 0..n {
             entries.push(Triplet::new(i, i, 0.1 + (i % 7) as f64 * 0.3));
         }
