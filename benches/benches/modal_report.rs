@@ -36,7 +36,7 @@
 
 use mechanica::modal::faer::sparse::Triplet;
 use mechanica::modal::faer::{Mat, MatRef, Side, get_global_parallelism};
-use mechanica::modal::reduce::{back_transform, cholesky_lower, reduce};
+use mechanica::modal::linalg::reduce::{back_transform, cholesky_lower, reduce};
 use mechanica::modal::{
     ModalSolution, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparseOptions, SparsePencil,
     count_below, testing, solve, solve_sparse,

@@ -5,7 +5,7 @@
 //! B = D^½ Qᵀ T Q D^½ (same ω²), the lumped-mass case.
 //! `cargo run --release -p mechanica-modal --example dense_timing -- 2000 [auto|off|always] [values] [sketched] [lumped]`
 use mechanica_modal::faer::Mat;
-use mechanica_modal::{PencilProblem, Refinement, Residuals, SolveOptions, testing, solve};
+use mechanica_modal::{PencilProblem, Refinement, Residuals, SolveOptions, solve, testing};
 use std::time::Instant;
 
 fn main() {

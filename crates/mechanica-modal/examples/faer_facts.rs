@@ -9,7 +9,7 @@ use mechanica_modal::faer::matrix_free::eigen::{
     PartialEigenParams, partial_self_adjoint_eigen, partial_self_adjoint_eigen_scratch,
 };
 use mechanica_modal::faer::{Col, Mat, Par};
-use mechanica_modal::{PencilProblem, SolveOptions, testing, solve};
+use mechanica_modal::{PencilProblem, SolveOptions, solve, testing};
 use std::time::Instant;
 
 fn main() {

@@ -2,7 +2,7 @@
 //! over 12 decades, `testing::graded_exponents`), where Auto refinement certifies the weakly
 //! bounded low half of the spectrum, and prints the modes refined and the stage timings.
 //! `cargo run --release -p mechanica-modal --example graded_timing -- 1000`
-use mechanica_modal::{PencilProblem, SolveOptions, testing, solve};
+use mechanica_modal::{PencilProblem, SolveOptions, solve, testing};
 
 fn main() {
     let n: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(1000);

@@ -4,7 +4,7 @@
 //! Prints the wall time, the lowest ω² against that closed form and the stage times.
 //! `cargo run --release -p mechanica-modal --example massless_timing -- 1000`
 use mechanica_modal::faer::Mat;
-use mechanica_modal::{PencilProblem, Residuals, SolveOptions, testing, solve};
+use mechanica_modal::{PencilProblem, Residuals, SolveOptions, solve, testing};
 use std::time::Instant;
 
 fn main() {

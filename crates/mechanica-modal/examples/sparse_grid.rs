@@ -1,6 +1,6 @@
 //! Times the sparse solver on an N×N grid Laplacian (default 300: n = 90 000, 10 lowest modes)
 //! and prints the report. `cargo run --release -p mechanica-modal --example sparse_grid -- 300 10`
-use mechanica_modal::{SparseOptions, SparsePencil, testing, solve_sparse};
+use mechanica_modal::{SparseOptions, SparsePencil, solve_sparse, testing};
 use std::time::Instant;
 
 fn main() {

@@ -177,7 +177,7 @@ pub(crate) enum PairProducts {
 /// out = A X; a diagonal A (lumped masses) scales the rows in O(nm) instead of the 2n²m of a
 /// matrix product.
 fn mass_product(mut out: MatMut<'_, f64>, a: MatRef<'_, f64>, x: MatRef<'_, f64>, par: Par) {
-    if crate::reduce::is_diagonal(a) {
+    if crate::linalg::reduce::is_diagonal(a) {
         for j in 0..x.ncols() {
             for i in 0..x.nrows() {
                 out[(i, j)] = a[(i, i)] * x[(i, j)];
@@ -489,7 +489,7 @@ pub(crate) fn a_inverse_norm_bound(l: MatRef<'_, f64>, par: Par) -> f64 {
     if n == 0 {
         return 0.0;
     }
-    if crate::reduce::is_diagonal(l) {
+    if crate::linalg::reduce::is_diagonal(l) {
         return (0..n).map(|i| (l[(i, i)] * l[(i, i)]).recip()).fold(0.0, f64::max);
     }
     let mut v = crate::sketch::gaussian(n, NORM_PROBES, probe_seed(l));
@@ -777,8 +777,8 @@ pub(crate) fn residual_bounds(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::reduce::{Cholesky, cholesky};
     use crate::testing;
-    use crate::reduce::{Cholesky, cholesky};
 
     /// The sketched ‖XᵀAX − I‖_F bound follows columns changed after it was formed: two
     /// columns of an A-orthonormal X are spoiled (one mixed with another mode, one scaled), and

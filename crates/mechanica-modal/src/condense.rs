@@ -12,9 +12,9 @@
 //! decomposition of A and the 4n³ flops of QᵀBQ by O(n²), and the condensed pencil's A₁ is
 //! diagonal again (the reduction then scales, module `reduce`).
 
+use crate::linalg::eigen::symmetric_eigen;
 use crate::refine::ReducedCorrection;
 use crate::solve::{Finish, Method, ModalSolution, SolveOptions, solve_definite};
-use crate::symmetric_eigen::symmetric_eigen;
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par, Side};
 
@@ -247,7 +247,7 @@ enum MassBasis {
 /// Eigenvalues of A ascending and their eigenvectors; a diagonal A is sorted, not decomposed.
 fn mass_eigen(a: MatRef<'_, f64>, par: Par) -> Result<(Vec<f64>, MassBasis), ModalError> {
     let n = a.nrows();
-    if crate::reduce::is_diagonal(a) {
+    if crate::linalg::reduce::is_diagonal(a) {
         let mut order: Vec<usize> = (0..n).collect();
         order.sort_by(|&i, &j| a[(i, i)].total_cmp(&a[(j, j)]));
         let values = order.iter().map(|&i| a[(i, i)]).collect();

@@ -2,6 +2,8 @@
 //! that must survive cancellation, built on the error-free transformations TwoSum and TwoProd
 //! (Ogita, Rump & Oishi, "Accurate sum and dot product", SIAM J. Sci. Comput. 26, 2005).
 
+#[cfg(target_arch = "x86_64")]
+use crate::runtime::cpu::fused_available;
 use faer::MatRef;
 
 /// An unevaluated sum hi + lo with |lo| ≤ ½ ulp(hi).
@@ -57,13 +59,6 @@ fn two_prod(a: f64, b: f64) -> (f64, f64) {
 #[inline(always)]
 fn two_prod_as<const FUSED: bool>(a: f64, b: f64) -> (f64, f64) {
     if FUSED { two_prod_fused(a, b) } else { two_prod(a, b) }
-}
-
-/// Whether this CPU runs the FMA and AVX2 variants of the kernels below (detected once, cached
-/// by the standard library).
-#[cfg(target_arch = "x86_64")]
-pub(crate) fn fused_available() -> bool {
-    std::arch::is_x86_feature_detected!("fma") && std::arch::is_x86_feature_detected!("avx2")
 }
 
 /// Veltkamp's split a = hi + lo, each half with at most 26 significant bits.
@@ -193,14 +188,15 @@ impl<'a> Operand<'a> {
     /// Wraps `matrix`: one scan of its entries, stopping once it holds more nonzeros than a
     /// sparse operand may (a dense matrix costs n²/16 reads).
     pub(crate) fn new(matrix: MatRef<'a, f64>) -> Self {
-        let structure = if crate::reduce::is_diagonal(matrix) && crate::reduce::is_diagonal(matrix.transpose()) {
-            Structure::Diagonal
-        } else {
-            match sparse_columns(matrix) {
-                Some(sparse) => Structure::Sparse(sparse),
-                None => Structure::Dense,
-            }
-        };
+        let structure =
+            if crate::linalg::reduce::is_diagonal(matrix) && crate::linalg::reduce::is_diagonal(matrix.transpose()) {
+                Structure::Diagonal
+            } else {
+                match sparse_columns(matrix) {
+                    Some(sparse) => Structure::Sparse(sparse),
+                    None => Structure::Dense,
+                }
+            };
         Self { matrix, structure }
     }
 

@@ -1,6 +1,6 @@
 //! The bottom-of-spectrum certificate of a dense all-modes solve (the Cholesky factorization of
 //! B − sA that proves no mode lies below s, module `solve`'s inertia check), factored on idle
-//! core time ([`crate::idle_task`]) while the eigenvectors are formed.
+//! core time ([`crate::runtime::idle_task`]) while the eigenvectors are formed.
 //!
 //! The task starts when T (the tridiagonal form) is known: the solve takes the shift s = ½λ₁
 //! from T's lowest eigenvalue λ₁ (bisection on Sturm counts), and the thread forms the lower
@@ -17,10 +17,10 @@
 //! 15 ms) the stage went from 0.47–0.53 s to 0.16 s.
 
 use crate::PencilProblem;
-use crate::idle_task::IdleTask;
 use crate::inertia::shifted_lower;
-use crate::reduce::{check_pivots, factor_block_step, factor_trailing, max_diagonal};
-use crate::tridiagonal_values::lowest_eigenvalue;
+use crate::linalg::eigen::ql_values::lowest_eigenvalue;
+use crate::linalg::reduce::{check_pivots, factor_block_step, factor_trailing, max_diagonal};
+use crate::runtime::idle_task::IdleTask;
 use faer::{Mat, Par};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -58,7 +58,7 @@ impl PartialFactor {
     /// Factors the remaining columns on `par`'s threads: whether B − sA is positive definite.
     pub(crate) fn finish(mut self, par: Par) -> bool {
         let positive = factor_trailing(self.factor.as_mut(), self.factored, self.max_diag, par).is_ok();
-        crate::scratch::give_back(self.factor);
+        crate::runtime::scratch::give_back(self.factor);
         positive
     }
 }
@@ -136,14 +136,14 @@ fn factor_shifted(problem: &PencilProblem, shift: f64, stop: &AtomicBool, factor
         }
         let width = BLOCK.min(n - done);
         if factor_block_step(factor.as_mut(), done, width).is_err() {
-            crate::scratch::give_back(factor);
+            crate::runtime::scratch::give_back(factor);
             return Some(Outcome::Decided { positive: false });
         }
         done += width;
         factored.store(done, Ordering::Release);
     }
     let positive = check_pivots(factor.as_ref(), max_diag).is_ok();
-    crate::scratch::give_back(factor);
+    crate::runtime::scratch::give_back(factor);
     Some(Outcome::Decided { positive })
 }
 

@@ -47,8 +47,8 @@ pub fn count_below(problem: &PencilProblem, shift: f64) -> Result<InertiaCount, 
 /// The factorization works in kept storage (module `scratch`), given back afterwards.
 pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> bool {
     let mut k = shifted_lower(problem, shift);
-    let positive = crate::reduce::factor_in_place(k.as_mut(), par).is_ok();
-    crate::scratch::give_back(k);
+    let positive = crate::linalg::reduce::factor_in_place(k.as_mut(), par).is_ok();
+    crate::runtime::scratch::give_back(k);
     positive
 }
 
@@ -57,7 +57,7 @@ pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> 
 pub(crate) fn shifted_lower(problem: &PencilProblem, shift: f64) -> Mat<f64> {
     let (a, b) = (problem.a(), problem.b());
     let n = problem.dim();
-    let mut k = crate::scratch::empty(n, n);
+    let mut k = crate::runtime::scratch::empty(n, n);
     k.resize_with(n, n, |i, j| if i >= j { b[(i, j)] - shift * a[(i, j)] } else { 0.0 });
     k
 }

@@ -47,29 +47,23 @@ pub mod accuracy;
 mod condense;
 mod dd;
 pub mod error;
-#[cfg(feature = "testing")]
-pub mod testing;
-mod fork_join;
 mod idle_certificate;
-mod idle_task;
 pub mod inertia;
 pub mod lanczos;
+#[doc(hidden)]
+pub mod linalg;
 pub mod matrix_market;
 pub mod problem;
-pub mod reduce;
 mod refine;
 pub mod response;
-pub mod scratch;
+mod runtime;
 pub mod sketch;
 pub mod solve;
 pub mod sparse_inertia;
 pub mod sparse_pencil;
 mod supernodal_solve;
-pub mod symmetric_eigen;
-mod symv_team;
-mod tridiagonal_divide;
-mod tridiagonal_values;
-mod tridiagonal_vectors;
+#[cfg(feature = "testing")]
+pub mod testing;
 mod values_only;
 
 pub use accuracy::{AccuracyReport, BoundKind, Residuals};
@@ -80,7 +74,7 @@ pub use lanczos::{DENSE_LIMIT, SparseModalSolution, SparseOptions, SparseReport,
 pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use problem::PencilProblem;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
-pub use scratch::release as release_scratch;
+pub use runtime::scratch::release as release_scratch;
 pub use solve::{
     DenseTimings, InertiaCheck, Method, ModalSolution, Mode, ModeGroup, ModeKind, Refinement, Selection, SolveOptions,
     classify, solve,

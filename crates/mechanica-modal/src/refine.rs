@@ -29,10 +29,10 @@
 
 use crate::condense::Condensation;
 use crate::dd::{Dd, Operand, SplitVector, dot, dot_split};
-use crate::fork_join::map_items;
-use crate::reduce::LowerFactor;
-use crate::symmetric_eigen::TridiagonalForm;
-use crate::tridiagonal_vectors::{ShiftedTridiagonal, one_norm};
+use crate::linalg::eigen::TridiagonalForm;
+use crate::linalg::eigen::inverse_iteration::{ShiftedTridiagonal, one_norm};
+use crate::linalg::reduce::LowerFactor;
+use crate::runtime::fork_join::map_items;
 use faer::linalg::matmul::matmul;
 use faer::linalg::solvers::Solve;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
@@ -893,8 +893,8 @@ fn finish_pair(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::reduce::{Cholesky, back_transform, cholesky, reduce};
     use crate::testing;
-    use crate::reduce::{Cholesky, back_transform, cholesky, reduce};
 
     /// A, B, L, Y, ω² and X = L⁻ᵀY.
     type Reduced = (Mat<f64>, Mat<f64>, Mat<f64>, Mat<f64>, Vec<f64>, Mat<f64>);
@@ -1077,7 +1077,7 @@ mod tests {
         let (a, b, l, _, _, _) = graded();
         let c = reduce(l.as_ref(), b.as_ref(), Par::Seq);
         let (values, mut form) =
-            crate::symmetric_eigen::symmetric_values_keeping_form(c, Par::Seq, None).expect("values converge");
+            crate::linalg::eigen::symmetric_values_keeping_form(c, Par::Seq, None).expect("values converge");
         let (mut x, z) = form.eigenvectors(&values[..4]).expect("inverse iteration converges");
         back_transform(l.as_ref(), x.as_mut(), Par::Seq);
         for i in 0..4 {

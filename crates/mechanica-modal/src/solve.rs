@@ -1,5 +1,5 @@
 //! The dense solver of det(λA + B) = 0 (8.89): Cholesky reduction to a standard symmetric
-//! problem, its eigen-decomposition ([`crate::symmetric_eigen`]), back-transformation, an accuracy report, mode
+//! problem, its eigen-decomposition ([`crate::linalg::eigen`]), back-transformation, an accuracy report, mode
 //! classification, grouping of repeated frequencies, static condensation of massless
 //! coordinates, and refinement of the low modes of stiff problems.
 //!
@@ -10,19 +10,19 @@
 use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
 use crate::condense::Condensation;
 use crate::dd::Operand;
-use crate::fork_join::{join, map_items};
 use crate::idle_certificate::{BottomCertificate, IdleCertificate, Outcome};
-use crate::idle_task::IdleTask;
 use crate::inertia::{InertiaCount, all_above, count_below};
-use crate::reduce::{Cholesky, back_transform_into, cholesky_owned, lower_entry, reduce_owned};
+use crate::linalg::eigen::{
+    OnTridiagonal, TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form,
+};
+use crate::linalg::reduce::{Cholesky, back_transform_into, cholesky_owned, lower_entry, reduce_owned};
 use crate::refine::{
     Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts, polish_simple_mode,
     refine_cluster, refine_simple_modes,
 };
+use crate::runtime::fork_join::{join, map_items};
+use crate::runtime::idle_task::IdleTask;
 use crate::sketch::SketchRows;
-use crate::symmetric_eigen::{
-    OnTridiagonal, TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form,
-};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
 use std::ops::Range;
@@ -160,7 +160,7 @@ pub struct ModeGroup {
 /// How the modes were computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
-    /// Cholesky A = LLᵀ, C = L⁻¹BL⁻ᵀ, C = Y Λ Yᵀ ([`crate::symmetric_eigen`]), X = L⁻ᵀY.
+    /// Cholesky A = LLᵀ, C = L⁻¹BL⁻ᵀ, C = Y Λ Yᵀ ([`crate::linalg::eigen`]), X = L⁻ᵀY.
     CholeskyReduction,
     /// Massless coordinates condensed out first (A semidefinite), then the reduction.
     CondensedReduction {
@@ -363,7 +363,10 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     // every page, and faults on two cores proceed in parallel (6.5 ms per 8 MB on one core of
     // the Zen 3 host). Only the lower triangles are read (the factorization and the reduction
     // use no other entry); the upper ones are zeroed, as L's must be.
-    let (mut a_copy, mut b_copy) = (crate::scratch::empty(n, n), crate::scratch::empty(n, n));
+    let (mut a_copy, mut b_copy) = (
+        crate::runtime::scratch::empty(n, n),
+        crate::runtime::scratch::empty(n, n),
+    );
     join(
         || a_copy.resize_with(n, n, |i, j| lower_entry(a, i, j)),
         || b_copy.resize_with(n, n, |i, j| lower_entry(b, i, j)),
@@ -417,7 +420,7 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 sketch_rows: early.and_then(|inputs| inputs.sketch_rows),
             };
             let solution = finish.run(def, Vec::new(), None, Method::CholeskyReduction, idle);
-            crate::scratch::give_back(l);
+            crate::runtime::scratch::give_back(l);
             solution
         }
         Cholesky::Failed { pivot } => {
@@ -581,7 +584,7 @@ impl Finish<'_> {
         // condensed pencil is refined when its condensation is exact (diagonal A), in the metric
         // of the condensed pencil.
         let metric = match (lift.is_none(), self.condensation) {
-            (true, _) => Some(Metric::Cholesky(crate::reduce::LowerFactor::new(self.l))),
+            (true, _) => Some(Metric::Cholesky(crate::linalg::reduce::LowerFactor::new(self.l))),
             (false, Some(c)) => Some(Metric::Condensed(c)),
             (false, None) => None,
         };
@@ -733,7 +736,7 @@ impl Finish<'_> {
         // The reduced eigenvectors are no longer needed: their storage takes the certificate's
         // matrix (a fresh n×n allocation costs its page faults).
         if let Some(storage) = def.reduced.or_else(|| form.map(TridiagonalForm::into_storage)) {
-            crate::scratch::give_back(storage);
+            crate::runtime::scratch::give_back(storage);
         }
         report.inertia_check = inertia_check(
             self.problem,

@@ -8,7 +8,7 @@
 //! mode above [`crate::solve::AUTO_REFINE_RELATIVE_BOUND`]·|ω²|:
 //!
 //! 1. its eigenvector z of the tridiagonal form T of C = L⁻¹BL⁻ᵀ is computed by inverse
-//!    iteration ([`crate::tridiagonal_vectors`], O(n) per mode), and x = L⁻ᵀQz (O(n²));
+//!    iteration ([`crate::linalg::eigen::inverse_iteration`], O(n) per mode), and x = L⁻ᵀQz (O(n²));
 //! 2. its backward error is measured and the bound becomes the first-order η·κ
 //!    ([`crate::BoundKind::FirstOrder`]); the measured η is usually far below n·u;
 //! 3. a mode still above the threshold (stiff and graded problems) is refined as in an
@@ -21,10 +21,10 @@
 //! (before, a values-only solve with a flagged mode was solved again with all vectors).
 
 use crate::accuracy::{self, AccuracyReport, BoundKind, PairProducts, RefinedResidual, Residuals};
-use crate::reduce::back_transform;
+use crate::linalg::eigen::TridiagonalForm;
+use crate::linalg::reduce::back_transform;
 use crate::refine::{Metric, TridiagonalCorrection, refine_cluster};
 use crate::solve::{clusters, refinable, weakly_bounded};
-use crate::symmetric_eigen::TridiagonalForm;
 use faer::{MatRef, Par};
 
 /// The pencil and its factor, as the refinement needs them.
@@ -84,7 +84,7 @@ pub(crate) fn sharpen(
         .collect();
     let mass = crate::dd::Operand::new(a);
     let stiffness = crate::dd::Operand::new(b);
-    let factor = crate::reduce::LowerFactor::new(pencil.l);
+    let factor = crate::linalg::reduce::LowerFactor::new(pencil.l);
     let shifts = crate::refine::SparseShifts::new(&mass, &stiffness);
     for g in clusters(omega, &separable) {
         // A block needs the vectors of all its members: consecutive flagged columns.

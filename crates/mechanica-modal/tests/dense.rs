@@ -3,7 +3,7 @@
 use mechanica_modal::faer::Mat;
 use mechanica_modal::{
     BoundKind, Method, ModalError, ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions,
-    count_below, testing, solve,
+    count_below, solve, testing,
 };
 use proptest::prelude::*;
 

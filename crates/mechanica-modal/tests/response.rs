@@ -10,7 +10,7 @@
 use mechanica_modal::faer::prelude::Solve;
 use mechanica_modal::faer::{Mat, Side};
 use mechanica_modal::{
-    CoordinateLaw, FreeResponse, ModalError, PencilProblem, Selection, SolveOptions, testing, solve,
+    CoordinateLaw, FreeResponse, ModalError, PencilProblem, Selection, SolveOptions, solve, testing,
 };
 use proptest::prelude::*;
 

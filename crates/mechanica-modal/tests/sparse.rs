@@ -2,7 +2,7 @@
 //! eigenvalues), the dense solver, and bad input.
 
 use mechanica_modal::faer::sparse::Triplet;
-use mechanica_modal::{ModalError, SparseOptions, SparsePencil, count_below_sparse, testing, solve_sparse};
+use mechanica_modal::{ModalError, SparseOptions, SparsePencil, count_below_sparse, solve_sparse, testing};
 
 const U: f64 = f64::EPSILON;
 

@@ -3,7 +3,7 @@
 //! bit for bit. Alone in its test binary, because that setting is process-wide.
 
 use mechanica_modal::faer::{self, Par};
-use mechanica_modal::{SparseOptions, SparsePencil, testing, solve_sparse};
+use mechanica_modal::{SparseOptions, SparsePencil, solve_sparse, testing};
 
 #[test]
 fn two_threads_and_one_give_the_same_modes() {

@@ -1,7 +1,7 @@
 //! Graded stiff chains (stiffness or stiffness/mass ratios up to 1e12) against 60-digit mpmath
 //! references (tools/modal_reference.py → tools/modal_reference.txt, committed).
 
-use mechanica_modal::{BoundKind, PencilProblem, Refinement, Residuals, SolveOptions, testing, solve};
+use mechanica_modal::{BoundKind, PencilProblem, Refinement, Residuals, SolveOptions, solve, testing};
 
 const U: f64 = f64::EPSILON;
 

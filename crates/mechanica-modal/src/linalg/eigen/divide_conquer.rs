@@ -26,7 +26,7 @@
 //! blocks, and its root finder is scalar; at n = 2000 it took 0.27 s, of which about two
 //! thirds outside the matrix products (measured with `perf`).
 
-use crate::fork_join::join;
+use crate::runtime::fork_join::join;
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
@@ -76,9 +76,9 @@ pub(crate) fn tridiagonal_divide_and_conquer(diag: &[f64], offdiag: &[f64], par:
     // skipped when the top merge deflates nothing, this stage's min / q1 / median over 29 solves
     // at n = 1000 went from 32.9 / 36.6 / 42.9 to 29.8 / 34.1 / 36.8 ms.
     let (mut u, mut work, mut secular) = (
-        crate::scratch::stale(n, n),
-        crate::scratch::stale(n, n),
-        crate::scratch::stale(n, n),
+        crate::runtime::scratch::stale(n, n),
+        crate::runtime::scratch::stale(n, n),
+        crate::runtime::scratch::stale(n, n),
     );
     let fill_fresh = |m: &mut Mat<f64>| {
         if m.nrows() != n {
@@ -106,16 +106,16 @@ pub(crate) fn tridiagonal_divide_and_conquer(diag: &[f64], offdiag: &[f64], par:
     if values.iter().any(|v| !v.is_finite()) {
         return None;
     }
-    crate::scratch::give_back(secular);
+    crate::runtime::scratch::give_back(secular);
     // Without deflation at the top merge its columns are already ascending.
     if order.iter().enumerate().all(|(j, &c)| j == c) {
-        crate::scratch::give_back(work);
+        crate::runtime::scratch::give_back(work);
         return Some((values, u));
     }
     for (j, &c) in order.iter().enumerate() {
         work.col_mut(j).copy_from(u.col(c));
     }
-    crate::scratch::give_back(u);
+    crate::runtime::scratch::give_back(u);
     Some((values, work))
 }
 
@@ -599,7 +599,7 @@ fn shift_poles(poles: &[f64], origin: f64, shifted: &mut [f64]) {
 /// below `below_limit` count as below); `delta` receives (d_i − origin) − τ.
 fn evaluate(shifted: &[f64], z_sq: &[f64], below_limit: f64, tau: f64, delta: &mut [f64]) -> SecularSums {
     #[cfg(target_arch = "x86_64")]
-    if crate::dd::fused_available() {
+    if crate::runtime::cpu::fused_available() {
         // SAFETY: the running CPU supports FMA and AVX2, checked just above.
         return unsafe { evaluate_avx2(shifted, z_sq, below_limit, tau, delta) };
     }
@@ -845,7 +845,7 @@ fn solve_leaf(d: &mut [f64], e: &[f64], mut u: MatMut<'_, f64>, order: &mut [usi
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tridiagonal_values::tridiagonal_eigenvalues;
+    use crate::linalg::eigen::ql_values::tridiagonal_eigenvalues;
 
     /// max_j ‖T z_j − λ_j z_j‖ / ‖T‖_max and max |ZᵀZ − I|.
     fn errors(d: &[f64], e: &[f64], values: &[f64], z: &Mat<f64>) -> (f64, f64) {
@@ -1045,7 +1045,7 @@ mod tests {
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn vector_secular_sums_equal_the_scalar_ones_bit_for_bit() {
-        if !crate::dd::fused_available() {
+        if !crate::runtime::cpu::fused_available() {
             return;
         }
         // Orders with and without a tail past the last 8-term chunk; the split between poles

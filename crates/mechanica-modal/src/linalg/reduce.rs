@@ -12,7 +12,7 @@
 //! (SciPy's `eigh(B, A)`) does the dense work whatever A is. The test is exact (every
 //! off-diagonal entry of the symmetrised A is zero); a nearly diagonal A takes the dense path.
 
-use crate::fork_join::{by_column_chunks, by_column_chunks_at};
+use crate::runtime::fork_join::{by_column_chunks, by_column_chunks_at};
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{BlockStructure, matmul as tri_matmul};
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};

@@ -1,4 +1,4 @@
-//! A second thread for one tridiagonalization ([`crate::symmetric_eigen`]): the panel reduction
+//! A second thread for one tridiagonalization ([`crate::linalg::eigen`]): the panel reduction
 //! needs one symmetric matrix-vector product per column, each a few tens of microseconds at
 //! orders 1000–2000, and a pool thread that has gone to sleep between them takes about as long
 //! to wake. The team's helper waits for the next job by spinning (then parking), and takes one

@@ -128,7 +128,7 @@ pub(crate) fn one_norm(diag: &[f64], offdiag: &[f64]) -> f64 {
 }
 
 /// Unit eigenvectors of T (diagonal `diag`, off-diagonal `offdiag`) for the ascending
-/// eigenvalues `values` (computed, e.g., by [`crate::tridiagonal_values`]), one column-major
+/// eigenvalues `values` (computed, e.g., by [`crate::linalg::eigen::ql_values`]), one column-major
 /// n-vector after another. Err(i) when the iteration for `values[i]` did not converge.
 pub(crate) fn tridiagonal_eigenvectors(diag: &[f64], offdiag: &[f64], values: &[f64]) -> Result<Vec<f64>, usize> {
     let n = diag.len();
@@ -263,7 +263,7 @@ impl StartVector {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tridiagonal_values::tridiagonal_eigenvalues;
+    use crate::linalg::eigen::ql_values::tridiagonal_eigenvalues;
 
     /// ‖T z − θ z‖₂ / ‖T‖₁ for a unit z (formed on T/‖T‖₁, so that squares cannot overflow).
     fn relative_residual(d: &[f64], e: &[f64], theta: f64, z: &[f64]) -> f64 {
