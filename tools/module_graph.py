@@ -207,20 +207,48 @@ INLINE = re.compile(r"(?<![\w:])((?:crate|super|self)(?:::\w+)+)")
 DEFINITION = re.compile(r"\b(?:fn|struct|enum|trait|type|const|static|mod|union)\s+(\w+)")
 
 
+INLINE_MODULE = re.compile(r"\bmod\s+(\w+)\s*\{")
+
+
+def inline_modules(text: str) -> list[tuple[int, int, str]]:
+    """(start, end, name) of every inline `mod name { ... }` block."""
+    spans = []
+    for m in INLINE_MODULE.finditer(text):
+        spans.append((m.start(), item_end(text, m.start()), m.group(1)))
+    return spans
+
+
+def scope_at(module: Module, spans: list[tuple[int, int, str]], position: int) -> Module:
+    """`module`, or the inline module (as a child scope) that encloses `position`."""
+    path = list(module.path)
+    for start, end, name in spans:
+        if start <= position < end:
+            path.append(name)
+    if path == module.path:
+        return module
+    scope = Module(path, module.file, "")
+    scope.children = module.children
+    return scope
+
+
 def collect(modules: dict[tuple[str, ...], Module]) -> None:
     for module in modules.values():
         module.defined = set(DEFINITION.findall(module.text))
-        without_uses = module.text
+        spans = inline_modules(module.text)
+        without_uses = list(module.text)
         for m in USE.finditer(module.text):
+            scope = scope_at(module, spans, m.start())
             for segments, name in expand_use_tree(m.group(1)):
-                target = absolute(module, segments)
+                target = absolute(scope, segments)
                 if target is None:
                     continue
-                module.imports[name] = target
+                if scope is module:
+                    module.imports[name] = target
                 module.references.append(target)
-            without_uses = without_uses.replace(m.group(0), " ")
-        for m in INLINE.finditer(without_uses):
-            target = absolute(module, m.group(1).split("::"))
+            without_uses[m.start() : m.end()] = " " * (m.end() - m.start())
+        text = "".join(without_uses)
+        for m in INLINE.finditer(text):
+            target = absolute(scope_at(module, spans, m.start()), m.group(1).split("::"))
             if target is not None:
                 module.references.append(target)
 

@@ -97,7 +97,7 @@ pub(crate) fn solve_semidefinite(
 /// (S − ρA₁)z = r₁ − B₁₀B₀₀⁻¹r₀ for any x = Q[w; z] and its residual r = (B − ρA)x, with
 /// S = B₁₁ − B₁₀B₀₀⁻¹B₀₁ the condensed stiffness. A residual measured in double-double on the
 /// stored A and B thus becomes the residual of the condensed definite pencil (S, A₁), whose
-/// residual bounds ([`crate::accuracy::residual_bounds`]) then hold for the stored data, however
+/// residual bounds ([`crate::certify::residual_bounds::residual_bounds`]) then hold for the stored data, however
 /// much the condensation's own rounding (stiff springs to massless nodes: the subtraction in S
 /// loses u·‖B₁₀‖‖B₀₀⁻¹‖‖B₀₁‖) changed S.
 pub(crate) struct Condensation {
@@ -140,7 +140,8 @@ impl Condensation {
         let dmin = d.iter().fold(f64::INFINITY, |m, v| m.min(v.abs()));
         let dmax = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let rounding =
-            4.0 * r as f64 * f64::EPSILON * (dmax / dmin + 2.0) * crate::accuracy::frobenius_norm(b10.as_ref()) / dmin;
+            4.0 * r as f64 * f64::EPSILON * (dmax / dmin + 2.0) * crate::linalg::norms::frobenius_norm(b10.as_ref())
+                / dmin;
         Self {
             order,
             massless: r,

@@ -42,9 +42,9 @@
 //!   rounding of the Rayleigh quotient.
 
 use crate::dd::{self, Dd};
-use crate::solve::{Mode, ModeGroup, classify, group_modes};
 use crate::sparse_inertia::{SparseInertia, inertia_with, symbolic_supernodal};
 use crate::sparse_pencil::{Csc, SparsePencil, abs_quadratic, frobenius, mul};
+use crate::spectrum::{Mode, ModeGroup, classify, group_modes};
 use crate::supernodal_solve::SupernodalSolver;
 use crate::{ModalError, PencilProblem, Refinement, Selection, SolveOptions, solve};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -1038,7 +1038,7 @@ fn rayleigh_ritz(
 
 /// What the bounds of the refined pairs need: each Rayleigh quotient and its rounding, θ, the
 /// first-order θ bound δ and the backward error η; and what the classification needs, the
-/// data resolution of each ω² ([`crate::accuracy::data_resolution`]).
+/// data resolution of each ω² ([`crate::certify::resolution::data_resolution`]).
 struct PairResiduals {
     omega_sq: Vec<f64>,
     theta: Vec<f64>,

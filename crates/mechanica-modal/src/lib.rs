@@ -43,12 +43,10 @@
 //! - **Free response** ([`FreeResponse`]): δ(t) = Σ q_k(t) x_k from δ(0), δ̇(0) (8.91), with
 //!   zero (q + q̇t), unstable (cosh/sinh), repeated and massless (static) modes.
 
-pub mod accuracy;
+pub mod certify;
 mod condense;
 mod dd;
 pub mod error;
-mod idle_certificate;
-pub mod inertia;
 pub mod lanczos;
 #[doc(hidden)]
 pub mod linalg;
@@ -57,27 +55,24 @@ pub mod problem;
 mod refine;
 pub mod response;
 mod runtime;
-pub mod sketch;
 pub mod solve;
 pub mod sparse_inertia;
 pub mod sparse_pencil;
+pub mod spectrum;
 mod supernodal_solve;
 #[cfg(feature = "testing")]
 pub mod testing;
 mod values_only;
 
-pub use accuracy::{AccuracyReport, BoundKind, Residuals};
+pub use certify::{AccuracyReport, BoundKind, InertiaCheck, InertiaCount, Residuals, count_below};
 pub use error::ModalError;
 pub use faer;
-pub use inertia::{InertiaCount, count_below};
 pub use lanczos::{DENSE_LIMIT, SparseModalSolution, SparseOptions, SparseReport, SparseTimings, solve_sparse};
 pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use problem::PencilProblem;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use runtime::scratch::release as release_scratch;
-pub use solve::{
-    DenseTimings, InertiaCheck, Method, ModalSolution, Mode, ModeGroup, ModeKind, Refinement, Selection, SolveOptions,
-    classify, solve,
-};
+pub use solve::{DenseTimings, Method, ModalSolution, Refinement, Selection, SolveOptions, solve};
 pub use sparse_inertia::{SparseInertia, count_below_sparse};
 pub use sparse_pencil::SparsePencil;
+pub use spectrum::{Mode, ModeGroup, ModeKind, classify};

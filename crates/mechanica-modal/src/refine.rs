@@ -757,7 +757,7 @@ fn refine_members(
         .map(|p| p.residual_a_inv + f64::EPSILON * p.omega_sq.abs())
         .collect();
     let ascending = omega.windows(2).all(|w| w[0] < w[1]);
-    if !ascending || crate::solve::clusters(&omega, &reach).len() != pairs.len() {
+    if !ascending || crate::spectrum::clusters(&omega, &reach).len() != pairs.len() {
         return None;
     }
     let mut orthogonality = 0.0_f64;
@@ -1032,7 +1032,7 @@ mod tests {
                 );
             }
         }
-        let dense = crate::sketch::gaussian(n, n, 3);
+        let dense = crate::certify::sketch::gaussian(n, n, 3);
         let dense_b = Mat::from_fn(n, n, |i, j| dense[(i, j)] + dense[(j, i)]);
         let identity = Mat::<f64>::identity(n, n);
         assert!(SparseShifts::new(&Operand::new(identity.as_ref()), &Operand::new(dense_b.as_ref())).is_none());

@@ -6,15 +6,20 @@
 //! Sign convention: the syllabus writes det(λA + B) = 0, so an oscillatory mode has λ = −ω² < 0
 //! (8.90). Internally and in every ordering the solver uses ω² = −λ, ascending: unstable modes
 //! (ω² < 0) first, then rigid-body modes, then oscillatory modes, then infinite ones.
-
-use crate::accuracy::{self, AccuracyReport, RefinedResidual, Residuals};
+use crate::certify::a_priori::APrioriModel;
+use crate::certify::idle_certificate::BottomCertificate;
+use crate::certify::products::{PairProducts, Residuals};
+use crate::certify::report::AccuracyReport;
+use crate::certify::residual_bounds::{ModeBasis, RefinedResidual, residual_bounds, split_refined_clusters};
+use crate::certify::resolution::zero_resolution;
+use crate::certify::sketch::SketchRows;
+use crate::certify::sturm::inertia_check;
 use crate::condense::Condensation;
 use crate::dd::Operand;
-use crate::idle_certificate::{BottomCertificate, IdleCertificate, Outcome};
-use crate::inertia::{InertiaCount, all_above, count_below};
 use crate::linalg::eigen::{
     OnTridiagonal, TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form,
 };
+use crate::linalg::norms::frobenius_norm;
 use crate::linalg::reduce::{Cholesky, back_transform_into, cholesky_owned, lower_entry, reduce_owned};
 use crate::refine::{
     Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts, polish_simple_mode,
@@ -22,7 +27,7 @@ use crate::refine::{
 };
 use crate::runtime::fork_join::{join, map_items};
 use crate::runtime::idle_task::IdleTask;
-use crate::sketch::SketchRows;
+use crate::spectrum::{Mode, ModeGroup, ModeKind, classify, clusters, group_modes, refinable};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, MatRef, Par};
 use std::ops::Range;
@@ -109,54 +114,6 @@ impl Default for SolveOptions {
     }
 }
 
-/// What a mode is physically (§8g: δ(t) ∝ x e^{±iωt} for λ = −ω² < 0).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ModeKind {
-    /// λ < 0 beyond its error bound: δ(t) = x (a cos ωt + b sin ωt), ω = √(−λ) rad/s.
-    Oscillatory {
-        /// Angular frequency ω (rad/s).
-        omega: f64,
-    },
-    /// |λ| within its error bound: a rigid-body (zero-frequency) mode, δ(t) = x (a + b t).
-    Zero,
-    /// λ > 0 beyond its error bound: the equilibrium is unstable, δ(t) ∝ x e^{±γt}.
-    Unstable {
-        /// Growth rate γ = √λ (1/s).
-        growth_rate: f64,
-    },
-    /// A massless direction (A x = 0, A semidefinite): λ = −∞, infinite frequency.
-    Infinite,
-}
-
-/// One eigenpair's scalar data.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Mode {
-    /// λ of det(λA + B) = 0 (= −ω²); −∞ for an infinite mode.
-    pub lambda: f64,
-    /// ω² = −λ (rad²/s²); +∞ for an infinite mode.
-    pub omega_sq: f64,
-    /// Classification.
-    pub kind: ModeKind,
-    /// Bound on |ω²_computed − ω²_exact| (first-order condition bound or residual bound, see
-    /// [`AccuracyReport::bound_kinds`]); 0 for infinite modes, which are exact by construction.
-    pub error_bound: f64,
-    /// Backward error η of the pair (None when values only were computed or the mode is infinite).
-    pub backward_error: Option<f64>,
-    /// Index of this mode's group of (numerically) equal frequencies in [`ModalSolution::groups`].
-    pub group: usize,
-}
-
-/// A set of modes whose ω² cannot be told apart within their error bounds.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ModeGroup {
-    /// Index of the first mode of the group in [`ModalSolution::modes`].
-    pub first: usize,
-    /// Multiplicity (number of modes in the group).
-    pub multiplicity: usize,
-    /// Mean ω² of the group.
-    pub omega_sq: f64,
-}
-
 /// How the modes were computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
@@ -217,7 +174,7 @@ pub(crate) struct Definite {
     /// of the few modes whose a-priori bound is too weak.
     pub form: Option<TridiagonalForm>,
     /// Values only: the a-priori error model, when already computed.
-    pub a_priori: Option<accuracy::APrioriModel>,
+    pub a_priori: Option<APrioriModel>,
     /// The reduction's time (as `factor`) and the eigensolver's (as `eigen`).
     pub timings: DenseTimings,
 }
@@ -377,21 +334,22 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
             let cholesky_time = clock.elapsed();
             // The bottom certificate is factored on idle time once T is known.
             let mut certificate = None;
-            let mut start_certificate =
-                |diag: &[f64], subdiag: &[f64]| certificate = crate::idle_certificate::start(problem, diag, subdiag);
+            let mut start_certificate = |diag: &[f64], subdiag: &[f64]| {
+                certificate = crate::certify::idle_certificate::start(problem, diag, subdiag)
+            };
             let hook: Option<OnTridiagonal<'_>> = if idle_time { Some(&mut start_certificate) } else { None };
             let mut def = solve_definite_owned(l.as_ref(), b_copy, options.selection, want_vectors, par, hook)?;
             let early = early_inputs.and_then(IdleTask::finished);
             let (norm_a, norm_b) = match &early {
                 Some(inputs) => inputs.norms,
-                None => (accuracy::frobenius_norm(a), accuracy::frobenius_norm(b)),
+                None => (frobenius_norm(a), frobenius_norm(b)),
             };
             if !want_vectors && options.refinement == Refinement::Auto {
                 // Values only: the modes whose a-priori bound is too weak get their vectors
                 // (crate::values_only), unless they are so many that all vectors cost less.
                 let clock = Instant::now();
                 let selected = &def.omega_sq[def.first..def.end];
-                let model = accuracy::APrioriModel::new(l.as_ref(), norm_a, norm_b, par);
+                let model = APrioriModel::new(l.as_ref(), norm_a, norm_b, par);
                 def.timings.accuracy = clock.elapsed();
                 let flagged = selected.iter().filter(|&&w| weakly_bounded(model.bound(w), w)).count();
                 if flagged > FLAGGED_VECTORS_UP_TO.max(n / 4) {
@@ -424,7 +382,7 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
             solution
         }
         Cholesky::Failed { pivot } => {
-            let (norm_a, norm_b) = (accuracy::frobenius_norm(a), accuracy::frobenius_norm(b));
+            let (norm_a, norm_b) = (frobenius_norm(a), frobenius_norm(b));
             crate::condense::solve_semidefinite(problem, pivot, options, norm_a, norm_b, par)
         }
     }
@@ -443,7 +401,7 @@ impl EarlyInputs {
         let problem = problem.clone();
         IdleTask::spawn("mechanica-idle-inputs", move |stop| {
             let (a, b) = (problem.a(), problem.b());
-            let norms = (accuracy::frobenius_norm(a), accuracy::frobenius_norm(b));
+            let norms = (frobenius_norm(a), frobenius_norm(b));
             if stop.load(std::sync::atomic::Ordering::Acquire) {
                 return None;
             }
@@ -496,7 +454,7 @@ pub(crate) struct Finish<'a> {
 }
 
 impl Finish<'_> {
-    /// The refined modes' residual bounds ([`accuracy::residual_bounds`]), in the definite
+    /// The refined modes' residual bounds ([`crate::certify::residual_bounds::residual_bounds`]), in the definite
     /// pencil the residuals belong to: (B, A) itself, or the condensed (S, A₁) with the modes'
     /// rows at the coordinates with mass.
     fn residual_bounds(
@@ -514,14 +472,14 @@ impl Finish<'_> {
             Some((a1, z)) => (a1.as_ref(), z.as_ref()),
             None => (self.problem.a(), x),
         };
-        let basis = accuracy::ModeBasis {
+        let basis = ModeBasis {
             a: basis_a,
             l: self.l,
             x: basis_x,
             modes: &all,
             unselected: None,
         };
-        accuracy::residual_bounds(report, omega, omega_all, first, residuals, &basis, self.par);
+        residual_bounds(report, omega, omega_all, first, residuals, &basis, self.par);
     }
 
     /// `def` holds the finite spectrum of the (possibly condensed) pencil; `lift` maps its
@@ -549,7 +507,7 @@ impl Finish<'_> {
         let clock = Instant::now();
         let mut products = x
             .as_ref()
-            .map(|x| accuracy::PairProducts::new(a, b, x.as_ref(), self.options.residuals, idle.sketch_rows, self.par));
+            .map(|x| PairProducts::new(a, b, x.as_ref(), self.options.residuals, idle.sketch_rows, self.par));
         // Values only: the a-priori error model (computed once, here or by `solve`).
         let mut a_priori = None;
         let mut report = match (&x, &products) {
@@ -557,7 +515,7 @@ impl Finish<'_> {
             _ => {
                 let model = def
                     .a_priori
-                    .unwrap_or_else(|| accuracy::APrioriModel::new(self.l, self.norm_a, self.norm_b, self.par));
+                    .unwrap_or_else(|| APrioriModel::new(self.l, self.norm_a, self.norm_b, self.par));
                 a_priori = Some(model);
                 AccuracyReport::a_priori(self.norm_a, self.norm_b, model.bounds(&omega))
             }
@@ -751,9 +709,7 @@ impl Finish<'_> {
         // What the data resolve: the zero classification allows for the rounding of A and B.
         let mut resolution: Vec<f64> = (0..m)
             .map(|i| match (&x, &a_priori) {
-                (Some(x), _) => {
-                    accuracy::zero_resolution(a, b, x.col_as_slice(i), omega[i], (self.norm_a, self.norm_b))
-                }
+                (Some(x), _) => zero_resolution(a, b, x.col_as_slice(i), omega[i], (self.norm_a, self.norm_b)),
                 (None, Some(model)) => model.data_resolution(omega[i]),
                 (None, None) => 0.0,
             })
@@ -807,265 +763,5 @@ impl Finish<'_> {
             method,
             timings,
         })
-    }
-}
-
-/// The largest cluster of nearly equal ω² that refinement treats as one block; larger ones
-/// keep the bounds of the reduction (a block step costs 4p double-double matrix-vector
-/// products).
-pub const MAX_REFINED_CLUSTER: usize = 16;
-
-/// Whether the bound intervals of two modes overlap (with a factor 2 of margin): refinement
-/// cannot tell them apart, so it treats them as one cluster.
-fn overlapping(omega_i: f64, bound_i: f64, omega_j: f64, bound_j: f64) -> bool {
-    (omega_i - omega_j).abs() <= 2.0 * (bound_i + bound_j)
-}
-
-/// The selected modes split into clusters: maximal runs of consecutive modes whose bound
-/// intervals overlap, chained (a simple mode is a cluster of one). Refinement treats each
-/// cluster as one block ([`crate::refine::refine_cluster_projected`]).
-pub(crate) fn clusters(omega: &[f64], bounds: &[f64]) -> Vec<Range<usize>> {
-    let mut out: Vec<Range<usize>> = Vec::new();
-    for i in 0..omega.len() {
-        match out.last_mut() {
-            Some(g) if overlapping(omega[i - 1], bounds[i - 1], omega[i], bounds[i]) => g.end = i + 1,
-            _ => out.push(i..i + 1),
-        }
-    }
-    out
-}
-
-/// Narrows the clusters of refined modes to what their refined residuals can tell apart.
-/// Clusters are formed from the reduction's bounds, which on stiff problems are wide enough to
-/// chain modes that are far apart (the lowest ten of a 1e12 chain); the block's bound then
-/// carries its Rayleigh–Ritz defect at the block's largest ω². After refinement each member's
-/// residual places an eigenvalue within e_i = ‖r_i‖_{A⁻¹} of ω²_i, so the clusters of the
-/// intervals ω²_i ± e_i ([`clusters`]) are separated from one another: each keeps the block's
-/// A-orthogonality defect (a maximum over more pairs) and its members' residuals, and a member
-/// alone keeps none (its ω² is its own Rayleigh quotient, not a mixture).
-fn split_refined_clusters(residuals: &mut [RefinedResidual], omega: &[f64], residual_norms: &[Option<f64>]) {
-    let mut start = 0;
-    while start < residuals.len() {
-        let block = residuals[start].cluster.clone();
-        let members = residuals[start..].iter().take_while(|r| r.cluster == block).count();
-        let complete = members == block.len();
-        let sharp: Option<Vec<f64>> = block
-            .clone()
-            .map(|i| residual_norms[i].map(|e| e + f64::EPSILON * omega[i].abs()))
-            .collect();
-        if let (true, Some(sharp)) = (complete && block.len() > 1, sharp) {
-            for sub in clusters(&omega[block.clone()], &sharp) {
-                let sub = block.start + sub.start..block.start + sub.end;
-                for record in residuals[start..start + members]
-                    .iter_mut()
-                    .filter(|r| sub.contains(&r.mode))
-                {
-                    record.cluster = sub.clone();
-                    if sub.len() == 1 {
-                        record.orthogonality = 0.0;
-                    }
-                }
-            }
-        }
-        start += members;
-    }
-}
-
-/// Whether the cluster `g` of the selection (entries `first..` of the ascending spectrum
-/// `omega_all`) can be refined: at most [`MAX_REFINED_CLUSTER`] modes, and not cut by the
-/// selection (an unselected mode within its bounds would be a missing member of the block,
-/// which makes the correction singular).
-pub(crate) fn refinable(g: &Range<usize>, omega: &[f64], bounds: &[f64], omega_all: &[f64], first: usize) -> bool {
-    let cut_below = g.start == 0 && first > 0 && overlapping(omega[0], bounds[0], omega_all[first - 1], bounds[0]);
-    let last = g.end - 1;
-    let cut_above = g.end == omega.len()
-        && first + omega.len() < omega_all.len()
-        && overlapping(omega[last], bounds[last], omega_all[first + omega.len()], bounds[last]);
-    g.len() <= MAX_REFINED_CLUSTER && !cut_below && !cut_above
-}
-
-/// Zero when |ω²| is within `bound`; otherwise oscillatory or unstable by its sign. The solvers
-/// pass the larger of the mode's error bound and its [`crate::accuracy::data_resolution`]: a mode
-/// is zero when the computation cannot tell it from zero, or the data cannot.
-pub fn classify(omega_sq: f64, bound: f64) -> ModeKind {
-    if omega_sq.is_infinite() {
-        ModeKind::Infinite
-    } else if omega_sq.abs() <= bound {
-        ModeKind::Zero
-    } else if omega_sq > 0.0 {
-        ModeKind::Oscillatory { omega: omega_sq.sqrt() }
-    } else {
-        ModeKind::Unstable {
-            growth_rate: (-omega_sq).sqrt(),
-        }
-    }
-}
-
-/// Groups consecutive modes whose ω² differ by at most the sum of their bounds, or that are
-/// both zero (the rigid-body modes form one group), and stores each mode's group index.
-pub(crate) fn group_modes(modes: &mut [Mode]) -> Vec<ModeGroup> {
-    let mut groups: Vec<ModeGroup> = Vec::new();
-    for i in 0..modes.len() {
-        let joins = i > 0 && {
-            let (p, q) = (&modes[i - 1], &modes[i]);
-            (p.omega_sq.is_infinite() && q.omega_sq.is_infinite())
-                || (p.kind == ModeKind::Zero && q.kind == ModeKind::Zero)
-                || (q.omega_sq - p.omega_sq).abs() <= p.error_bound + q.error_bound
-        };
-        if joins && let Some(g) = groups.last_mut() {
-            g.multiplicity += 1;
-        } else {
-            groups.push(ModeGroup {
-                first: i,
-                multiplicity: 1,
-                omega_sq: 0.0,
-            });
-        }
-        modes[i].group = groups.len() - 1;
-    }
-    for g in &mut groups {
-        let sum: f64 = modes[g.first..g.first + g.multiplicity]
-            .iter()
-            .map(|m| m.omega_sq)
-            .sum();
-        g.omega_sq = sum / g.multiplicity as f64;
-    }
-    groups
-}
-
-/// The Sturm check of a solve (`spare`: an unused matrix whose storage it may take). With every
-/// mode selected it first tries the cheap certificate
-/// that B − sA is positive definite for s just below the lowest computed ω² (by half its size or
-/// twice its bound): nothing was missed at the bottom of the spectrum, where stability is
-/// decided (the `idle_certificate`'s decision, when it has one at that shift). Otherwise, or
-/// when that Cholesky fails, it places a shift in the first real gap
-/// (wider than twice the largest bound) at or beyond the selection's edge, so never inside a
-/// cluster the selection cut, or in the widest gap of the whole spectrum, and compares the LBLᵀ
-/// inertia count with the number of computed ω² below it.
-fn inertia_check(
-    problem: &PencilProblem,
-    omega_all: &[f64],
-    (first, end): (usize, usize),
-    bounds: &[f64],
-    condensed_stiffness_negatives: Option<usize>,
-    bottom: Option<BottomCertificate>,
-    par: Par,
-) -> Result<Option<InertiaCheck>, ModalError> {
-    if omega_all.is_empty() {
-        return Ok(None);
-    }
-    let n = omega_all.len();
-    // A condensed pencil: the count of the full B − sA includes B₀₀'s negative eigenvalues.
-    let offset = condensed_stiffness_negatives.unwrap_or(0);
-    if first == 0 && end == n && !bounds.is_empty() && offset == 0 {
-        // Every mode selected: certify the bottom of the spectrum (no mode, and so no
-        // instability, below the lowest computed ω²) with a Cholesky factorization.
-        let lowest = omega_all[0];
-        let rule = lowest - (0.5 * lowest.abs()).max(2.0 * bounds[0]);
-        // Half of T's lowest eigenvalue (the shift the idle thread factors at) is taken when it
-        // is the rule's to 8 digits, or higher and still below the lowest ω² by more than twice
-        // its bound: then the certified shift does not depend on whether the thread finished.
-        let usable = |s: f64| s >= rule - 1e-8 * rule.abs() && s < lowest - 2.0 * bounds[0];
-        let (shift, idle) = match bottom {
-            Some(b) if usable(b.shift) => (b.shift, b.idle),
-            _ => (rule, None),
-        };
-        // A factor the thread had begun is finished here on every thread.
-        let from_idle = match idle.and_then(IdleCertificate::collect) {
-            Some(Outcome::Decided { positive: true }) => Some(shift),
-            Some(Outcome::Partial(partial)) => partial.finish(par).then_some(shift),
-            _ => None,
-        };
-        let certified = from_idle.or_else(|| (shift < lowest && all_above(problem, shift, par)).then_some(shift));
-        if let Some(shift) = certified {
-            return Ok(Some(InertiaCheck {
-                count: InertiaCount {
-                    shift,
-                    below: 0,
-                    zero: 0,
-                    above: problem.dim(),
-                },
-                computed_below: 0,
-                consistent: true,
-            }));
-        }
-    }
-    let margin = bounds.iter().copied().fold(0.0, f64::max);
-    // A gap between i − 1 and i that is real (wider than the bounds), so that the shift does
-    // not fall inside a cluster the selection cut (its count would split the cluster).
-    let real_gap = |i: &usize| omega_all[*i] - omega_all[*i - 1] > 2.0 * margin;
-    let midpoint = |i: usize| 0.5 * (omega_all[i - 1] + omega_all[i]);
-    let shift = if end < n && end > 0 {
-        midpoint((end..n).find(real_gap).unwrap_or(end))
-    } else if first > 0 && first < n {
-        midpoint((1..=first).rev().find(real_gap).unwrap_or(first))
-    } else {
-        // All modes selected: the widest gap, or above the top of the spectrum.
-        let widest =
-            (1..n).max_by(|&i, &j| (omega_all[i] - omega_all[i - 1]).total_cmp(&(omega_all[j] - omega_all[j - 1])));
-        match widest {
-            Some(i) if omega_all[i] - omega_all[i - 1] > 2.0 * margin => 0.5 * (omega_all[i] + omega_all[i - 1]),
-            _ => omega_all[n - 1] + omega_all[n - 1].abs().max(1.0),
-        }
-    };
-    let raw = count_below(problem, shift)?;
-    // In modes: B₀₀'s negative eigenvalues leave `below`; its positive ones are the infinite
-    // modes, above every shift, as `above` already counts them.
-    let count = InertiaCount {
-        below: raw.below.saturating_sub(offset),
-        above: raw.above + offset.min(raw.below),
-        ..raw
-    };
-    let expected = omega_all.partition_point(|&w| w < shift);
-    Ok(Some(InertiaCheck {
-        count,
-        computed_below: expected,
-        consistent: raw.below == expected + offset && raw.zero == 0,
-    }))
-}
-
-/// The Sturm check attached to a solve: no mode below the shift was missed or invented.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct InertiaCheck {
-    /// The inertia of B − sA at the chosen shift, in modes: for a condensed pencil (semidefinite
-    /// A) the negative eigenvalues of the massless directions' stiffness B₀₀ are taken out of
-    /// `below` (Haynsworth: In(B − sA) = In(B₀₀) + In(S − sA₁)), and the infinite modes are
-    /// `above`.
-    pub count: InertiaCount,
-    /// How many computed ω² lie below the shift.
-    pub computed_below: usize,
-    /// Whether the two counts agree (and s is not numerically an eigenvalue).
-    pub consistent: bool,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn record(mode: usize, cluster: Range<usize>) -> RefinedResidual {
-        RefinedResidual {
-            mode,
-            cluster,
-            orthogonality: 1e-15,
-            residual: Vec::new(),
-        }
-    }
-
-    /// A block of four refined together: modes 0 and 1 are a pair within their refined
-    /// residuals, 2 and 3 stand apart; a block with a member lacking its residual norm, and a
-    /// block cut short (a member not refined), keep their clusters.
-    #[test]
-    fn refined_blocks_split_where_their_residuals_separate_the_modes() {
-        let omega = [1.0, 1.0 + 2e-15, 2.0, 3.0, 5.0, 5.5, 7.0, 7.5];
-        let mut norms = vec![Some(1e-15); omega.len()];
-        norms[5] = None;
-        let mut residuals: Vec<RefinedResidual> = (0..4).map(|i| record(i, 0..4)).collect();
-        residuals.extend((4..6).map(|i| record(i, 4..6)));
-        residuals.push(record(6, 6..8));
-        split_refined_clusters(&mut residuals, &omega, &norms);
-        let clusters: Vec<Range<usize>> = residuals.iter().map(|r| r.cluster.clone()).collect();
-        assert_eq!(clusters, vec![0..2, 0..2, 2..3, 3..4, 4..6, 4..6, 6..8]);
-        let orthogonality: Vec<f64> = residuals.iter().map(|r| r.orthogonality).collect();
-        assert_eq!(orthogonality, vec![1e-15, 1e-15, 0.0, 0.0, 1e-15, 1e-15, 1e-15]);
     }
 }

@@ -3,7 +3,7 @@
 //! still too weak, refined.
 //!
 //! Without vectors a dense solve can only bound an eigenvalue a priori, by an assumed backward
-//! error of n·u: n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ (`accuracy::APrioriModel`), which
+//! error of n·u: n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ (`crate::certify::a_priori::APrioriModel`), which
 //! relative to a small |ω²| is weak (the lowest modes of a long chain, stiff problems). For each
 //! mode above [`crate::solve::AUTO_REFINE_RELATIVE_BOUND`]·|ω²|:
 //!
@@ -20,11 +20,14 @@
 //! The cost is O(n²) per flagged mode, against the n³ of the vectors that a full solve forms
 //! (before, a values-only solve with a flagged mode was solved again with all vectors).
 
-use crate::accuracy::{self, AccuracyReport, BoundKind, PairProducts, RefinedResidual, Residuals};
+use crate::certify::products::{PairProducts, Residuals};
+use crate::certify::report::{AccuracyReport, BoundKind};
+use crate::certify::residual_bounds::RefinedResidual;
 use crate::linalg::eigen::TridiagonalForm;
 use crate::linalg::reduce::back_transform;
 use crate::refine::{Metric, TridiagonalCorrection, refine_cluster};
-use crate::solve::{clusters, refinable, weakly_bounded};
+use crate::solve::weakly_bounded;
+use crate::spectrum::{clusters, refinable};
 use faer::{MatRef, Par};
 
 /// The pencil and its factor, as the refinement needs them.
@@ -42,11 +45,11 @@ pub(crate) struct Pencil<'a> {
 /// ascending spectrum `omega_all`, the eigenvalues of `form`'s T): measured first-order bounds
 /// for the flagged modes, refinement and residual bounds for those still flagged. `omega` is
 /// updated where refinement moved a value. When inverse iteration fails, the report keeps its
-/// a-priori bounds. Returns the data resolution ([`accuracy::zero_resolution`]) of every mode
+/// a-priori bounds. Returns the data resolution ([`crate::certify::resolution::zero_resolution`]) of every mode
 /// whose vector was formed, for the zero classification.
 pub(crate) fn sharpen(
     pencil: &Pencil<'_>,
-    a_priori: accuracy::APrioriModel,
+    a_priori: crate::certify::a_priori::APrioriModel,
     form: &mut TridiagonalForm,
     report: &mut AccuracyReport,
     omega: &mut [f64],
@@ -128,18 +131,23 @@ pub(crate) fn sharpen(
         }
     }
     // Unselected values were never measured: the gaps to them allow for their a-priori error.
-    let basis = accuracy::ModeBasis {
+    let basis = crate::certify::residual_bounds::ModeBasis {
         a,
         l: pencil.l,
         x: x.as_ref(),
         modes: &flagged,
         unselected: Some(a_priori),
     };
-    accuracy::residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
+    crate::certify::residual_bounds::residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
     let norms = (report.norm_a, report.norm_b);
     flagged
         .iter()
         .enumerate()
-        .map(|(col, &i)| (i, accuracy::zero_resolution(a, b, x.col_as_slice(col), omega[i], norms)))
+        .map(|(col, &i)| {
+            (
+                i,
+                crate::certify::resolution::zero_resolution(a, b, x.col_as_slice(col), omega[i], norms),
+            )
+        })
         .collect()
 }

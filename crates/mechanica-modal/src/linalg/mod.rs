@@ -1,6 +1,6 @@
 //! Dense linear-algebra kernels of the modal solvers, below every solver and certificate: the
 //! Cholesky factorization, the reduction C = L⁻¹BL⁻ᵀ and the back-transformation ([`reduce`]),
-//! and the symmetric eigensolver with its tridiagonal stages ([`eigen`]).
+//! the symmetric eigensolver with its tridiagonal stages ([`eigen`]), and one-pass norms.
 //!
 //! They form their own layer, not part of the dense solver, because the certificates (the
 //! bottom-of-spectrum Cholesky, the a-priori bound's ‖A⁻¹‖) and the refinement (corrections
@@ -8,4 +8,5 @@
 //! the refinement all depend on these kernels, and the kernels on none of them.
 
 pub mod eigen;
+pub(crate) mod norms;
 pub mod reduce;

@@ -17,7 +17,7 @@
 //! 15 ms) the stage went from 0.47–0.53 s to 0.16 s.
 
 use crate::PencilProblem;
-use crate::inertia::shifted_lower;
+use crate::certify::inertia::shifted_lower;
 use crate::linalg::eigen::ql_values::lowest_eigenvalue;
 use crate::linalg::reduce::{check_pivots, factor_block_step, factor_trailing, max_diagonal};
 use crate::runtime::idle_task::IdleTask;
