@@ -108,6 +108,8 @@ def drop_test_items(text: str) -> tuple[str, list[str]]:
 
 def expand_use_tree(tree: str) -> list[tuple[list[str], str]]:
     """`a::{b, c::{d as e}}` → [(['a','b'], 'b'), (['a','c','d'], 'e')]."""
+    # Spaces matter only around `as`: mark it, then drop the rest.
+    tree = re.sub(r"\s+as\s+", "@", tree.strip())
     tree = re.sub(r"\s+", "", tree)
 
     def split_top(s: str) -> list[str]:
@@ -133,8 +135,8 @@ def expand_use_tree(tree: str) -> list[tuple[list[str], str]]:
                 out.extend(walk(prefix + head, part))
             return out
         alias = None
-        if "as" in s and re.search(r"as[A-Za-z_]", s):
-            s, alias = re.split(r"(?<=[A-Za-z0-9_])as(?=[A-Za-z_])", s, maxsplit=1)
+        if "@" in s:
+            s, alias = s.split("@", 1)
         segments = [p for p in s.split("::") if p]
         if segments and segments[-1] == "self":
             segments = segments[:-1]

@@ -44,8 +44,8 @@
 //!   zero (q + q̇t), unstable (cosh/sinh), repeated and massless (static) modes.
 
 pub mod certify;
-mod condense;
 mod dd;
+pub mod dense;
 pub mod error;
 pub mod lanczos;
 #[doc(hidden)]
@@ -55,16 +55,15 @@ pub mod problem;
 mod refine;
 pub mod response;
 mod runtime;
-pub mod solve;
 pub mod sparse_inertia;
 pub mod sparse_pencil;
 pub mod spectrum;
 mod supernodal_solve;
 #[cfg(feature = "testing")]
 pub mod testing;
-mod values_only;
 
 pub use certify::{AccuracyReport, BoundKind, InertiaCheck, InertiaCount, Residuals, count_below};
+pub use dense::{DenseTimings, Method, ModalSolution, Refinement, Selection, SolveOptions, solve};
 pub use error::ModalError;
 pub use faer;
 pub use lanczos::{DENSE_LIMIT, SparseModalSolution, SparseOptions, SparseReport, SparseTimings, solve_sparse};
@@ -72,7 +71,6 @@ pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use problem::PencilProblem;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use runtime::scratch::release as release_scratch;
-pub use solve::{DenseTimings, Method, ModalSolution, Refinement, Selection, SolveOptions, solve};
 pub use sparse_inertia::{SparseInertia, count_below_sparse};
 pub use sparse_pencil::SparsePencil;
 pub use spectrum::{Mode, ModeGroup, ModeKind, classify};

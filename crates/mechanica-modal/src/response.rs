@@ -28,7 +28,7 @@
 //! order). A zero mode is integrated as q + q̇t; its true ω² may be anything within its bound e,
 //! which its rate bound √e expresses.
 
-use crate::solve::{ModalSolution, SolveOptions, solve};
+use crate::dense::{ModalSolution, SolveOptions, solve};
 use crate::spectrum::ModeKind;
 use crate::{ModalError, PencilProblem};
 use faer::Mat;

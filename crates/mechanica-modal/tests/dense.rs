@@ -300,10 +300,10 @@ fn values_only_with_many_weak_modes_computes_all_vectors() {
     let weak = assumed
         .modes
         .iter()
-        .filter(|m| m.error_bound > mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * m.omega_sq.abs())
+        .filter(|m| m.error_bound > mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * m.omega_sq.abs())
         .count();
     assert!(
-        weak > mechanica_modal::solve::FLAGGED_VECTORS_UP_TO.max(n / 4),
+        weak > mechanica_modal::dense::FLAGGED_VECTORS_UP_TO.max(n / 4),
         "{weak} weak modes"
     );
     let measured = solve(&p, &values_only).expect("solve");

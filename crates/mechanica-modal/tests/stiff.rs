@@ -101,7 +101,7 @@ fn refined_modes_are_correct_to_their_bounds() {
                     c.name,
                     m.error_bound
                 );
-                assert!(m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w);
+                assert!(m.error_bound <= mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * w);
                 let refined = sol.accuracy.bound_kinds[i] == BoundKind::Residual;
                 // Values only, the bound is weaker (crate::values_only): the refined value is
                 // as accurate as with all vectors, but the residual's components along modes
@@ -176,7 +176,7 @@ fn values_only_subsets_are_correct_to_their_bounds() {
                 c.name,
                 m.error_bound
             );
-            assert!(m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w);
+            assert!(m.error_bound <= mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * w);
         }
         assert_eq!(sol.accuracy.bound_kinds[0], BoundKind::Residual, "{}", c.name);
     }
@@ -226,7 +226,7 @@ fn repeated_stiff_modes_are_refined_as_one_block() {
                     m.error_bound
                 );
                 assert!(
-                    m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w,
+                    m.error_bound <= mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * w,
                     "{} {options:?} mode {i}: bound {:e} relative",
                     c.name,
                     m.error_bound / w
@@ -439,7 +439,7 @@ fn a_densely_turned_long_chain_is_certified_to_its_references() {
                     m.error_bound
                 );
                 assert!(
-                    m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w,
+                    m.error_bound <= mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * w,
                     "{options:?} mode {i}: bound {:e} relative",
                     m.error_bound / w
                 );

@@ -23,10 +23,10 @@
 use crate::certify::products::{PairProducts, Residuals};
 use crate::certify::report::{AccuracyReport, BoundKind};
 use crate::certify::residual_bounds::RefinedResidual;
+use crate::dense::options::weakly_bounded;
 use crate::linalg::eigen::TridiagonalForm;
 use crate::linalg::reduce::back_transform;
 use crate::refine::{Metric, TridiagonalCorrection, refine_cluster};
-use crate::solve::weakly_bounded;
 use crate::spectrum::{clusters, refinable};
 use faer::{MatRef, Par};
 
