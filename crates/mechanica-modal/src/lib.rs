@@ -47,18 +47,14 @@ pub mod certify;
 mod dd;
 pub mod dense;
 pub mod error;
-pub mod lanczos;
 #[doc(hidden)]
 pub mod linalg;
-pub mod matrix_market;
 pub mod problem;
 mod refine;
 pub mod response;
 mod runtime;
-pub mod sparse_inertia;
-pub mod sparse_pencil;
+pub mod sparse;
 pub mod spectrum;
-mod supernodal_solve;
 #[cfg(feature = "testing")]
 pub mod testing;
 
@@ -66,11 +62,11 @@ pub use certify::{AccuracyReport, BoundKind, InertiaCheck, InertiaCount, Residua
 pub use dense::{DenseTimings, Method, ModalSolution, Refinement, Selection, SolveOptions, solve};
 pub use error::ModalError;
 pub use faer;
-pub use lanczos::{DENSE_LIMIT, SparseModalSolution, SparseOptions, SparseReport, SparseTimings, solve_sparse};
-pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use problem::PencilProblem;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use runtime::scratch::release as release_scratch;
-pub use sparse_inertia::{SparseInertia, count_below_sparse};
-pub use sparse_pencil::SparsePencil;
+pub use sparse::SparsePencil;
+pub use sparse::{DENSE_LIMIT, SparseModalSolution, SparseOptions, SparseReport, SparseTimings, solve_sparse};
+pub use sparse::{MatrixMarket, parse_matrix_market, read_matrix_market};
+pub use sparse::{SparseInertia, count_below_sparse};
 pub use spectrum::{Mode, ModeGroup, ModeKind, classify};

@@ -180,9 +180,9 @@ fn matrix_market_files_feed_the_solver() {
     let (nx, ny) = (22, 21);
     let (a, b) = testing::grid_laplacian(nx, ny);
     let n = nx * ny;
-    let ma = mechanica_modal::parse_matrix_market(&mechanica_modal::matrix_market::symmetric_to_string(n, &a))
+    let ma = mechanica_modal::parse_matrix_market(&mechanica_modal::sparse::matrix_market::symmetric_to_string(n, &a))
         .expect("A parses");
-    let mb = mechanica_modal::parse_matrix_market(&mechanica_modal::matrix_market::symmetric_to_string(n, &b))
+    let mb = mechanica_modal::parse_matrix_market(&mechanica_modal::sparse::matrix_market::symmetric_to_string(n, &b))
         .expect("B parses");
     let p = SparsePencil::from_triplets(n, &ma.entries, &mb.entries).expect("valid");
     let sol = solve_sparse(&p, &lowest(3)).expect("solve");

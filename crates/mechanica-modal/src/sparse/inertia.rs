@@ -10,7 +10,7 @@
 //! supernodes is not backward stable in the worst case: the smallest and largest |pivot| are
 //! reported so that a suspicious factorization (tiny pivots, growth) can be recognised.
 
-use crate::sparse_pencil::{Csc, SparsePencil};
+use crate::sparse::pencil::{Csc, SparsePencil};
 use crate::{InertiaCount, ModalError};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::SupernodalThreshold;
