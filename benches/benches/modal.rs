@@ -38,7 +38,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use mechanica::modal::faer::Par;
 use mechanica::modal::linalg::reduce::{cholesky_and_reduce, reduce_two_solves};
-use mechanica::modal::{PencilProblem, SolveOptions, SparseOptions, SparsePencil, testing, solve, solve_sparse};
+use mechanica::modal::{PencilProblem, SolveOptions, SparseOptions, SparsePencil, solve, solve_sparse, testing};
 use mechanica_benches::lapack;
 use mechanica_benches::modal::{nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra};
 use std::hint::black_box;

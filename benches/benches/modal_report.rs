@@ -39,7 +39,7 @@ use mechanica::modal::faer::{Mat, MatRef, Side, get_global_parallelism};
 use mechanica::modal::linalg::reduce::{back_transform, cholesky_lower, reduce};
 use mechanica::modal::{
     ModalSolution, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparseOptions, SparsePencil,
-    count_below, testing, solve, solve_sparse,
+    count_below, solve, solve_sparse, testing,
 };
 use mechanica_benches::modal::{
     from_col_major, from_nalgebra, from_triplets, lumped_fixed_chain, max_backward_error, max_eigenvalue_error,

@@ -2,14 +2,14 @@
 //! of a pencil read from Matrix Market files, det(λA + B) = 0 (8.89), with the accuracy report
 //! and the wall time of each stage (read, factor, solve, accuracy, refine, Sturm check).
 //!
-//! Which solver: `--lowest k` on a pencil larger than [`DENSE_LIMIT`] uses the sparse
+//! Which solver: `--lowest k` on a pencil larger than [`Tuning::dense_limit`] uses the sparse
 //! shift-invert Lanczos solver (memory O(nnz + n·k)); everything else is solved densely
 //! (all modes, or the k lowest). `--dense` forces the dense solver.
 
 use crate::report::{Quantity, Report, Step, timed_step};
 use mechanica::modal::faer::Mat;
 use mechanica::modal::{
-    DENSE_LIMIT, ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparseOptions, SparsePencil,
+    ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparseOptions, SparsePencil, Tuning,
     read_matrix_market, solve, solve_sparse,
 };
 use std::path::{Path, PathBuf};
@@ -190,7 +190,8 @@ pub fn run(args: &ModesArgs) -> Result<Report, String> {
     };
     let n = a.nrows;
     let mut steps = vec![read_step];
-    let sparse = matches!(args.lowest, Some(k) if n > DENSE_LIMIT && k < n) && !args.dense && !args.values_only;
+    let sparse =
+        matches!(args.lowest, Some(k) if n > Tuning::DEFAULT.dense_limit && k < n) && !args.dense && !args.values_only;
     if sparse {
         let count = args.lowest.unwrap_or(0);
         let pencil = SparsePencil::from_triplets(n, &a.entries, &b.entries).map_err(|e| e.to_string())?;

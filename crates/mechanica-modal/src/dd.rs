@@ -4,6 +4,7 @@
 
 #[cfg(target_arch = "x86_64")]
 use crate::runtime::cpu::fused_available;
+use crate::tuning::Tuning;
 use faer::MatRef;
 
 /// An unevaluated sum hi + lo with |lo| ≤ ½ ulp(hi).
@@ -130,7 +131,7 @@ impl Dd {
 /// the working precision, then kept unrounded). Accumulated column by column into separate
 /// high and low parts, which vectorises; on CPUs with FMA and AVX2 the same operations run four
 /// rows per instruction (both products are exact, so results are identical). From
-/// [`PARALLEL_ROWS_FROM`] rows, when faer's global parallelism allows two threads, the two
+/// [`crate::Tuning::parallel_rows_from`] rows, when faer's global parallelism allows two threads, the two
 /// halves of the rows are accumulated on two threads (each row's sum is unchanged, so the
 /// result is bitwise the same).
 pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
@@ -138,7 +139,7 @@ pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     let (mut hi, mut lo) = (vec![0.0; n], vec![0.0; n]);
     // Inside a pool thread (refinement runs clusters in parallel) the other threads are busy.
     let nested = rayon::current_thread_index().is_some();
-    if n >= PARALLEL_ROWS_FROM && !nested && faer::get_global_parallelism().degree() >= 2 {
+    if n >= Tuning::DEFAULT.parallel_rows_from && !nested && faer::get_global_parallelism().degree() >= 2 {
         let half = n / 2;
         let (hi_top, hi_bottom) = hi.split_at_mut(half);
         let (lo_top, lo_bottom) = lo.split_at_mut(half);
@@ -178,11 +179,6 @@ enum Structure {
     /// The nonzero entries by columns.
     Sparse(faer::sparse::SparseColMat<usize, f64>),
 }
-
-/// An operand with at most n²/`SPARSE_FRACTION` nonzeros is stored by columns: the sparse
-/// product touches scattered accumulators one term at a time, where the dense kernel runs four
-/// rows per instruction, so it wins only well below full density.
-const SPARSE_FRACTION: usize = 16;
 
 impl<'a> Operand<'a> {
     /// Wraps `matrix`: one scan of its entries, stopping once it holds more nonzeros than a
@@ -237,10 +233,10 @@ impl<'a> Operand<'a> {
     }
 }
 
-/// The nonzero entries of `m` by columns when it has at most n²/[`SPARSE_FRACTION`] of them
+/// The nonzero entries of `m` by columns when it has at most n²/[`crate::Tuning::sparse_fraction`] of them
 /// (one scan, stopping past that many), else None.
 pub(crate) fn sparse_columns(m: MatRef<'_, f64>) -> Option<faer::sparse::SparseColMat<usize, f64>> {
-    nonzeros_by_columns(m, m.nrows() * m.ncols() / SPARSE_FRACTION)
+    nonzeros_by_columns(m, m.nrows() * m.ncols() / Tuning::DEFAULT.sparse_fraction)
 }
 
 /// The nonzero entries of `m` by columns (rows ascending), or None past `limit` nonzeros.
@@ -263,10 +259,6 @@ fn nonzeros_by_columns(m: MatRef<'_, f64>, limit: usize) -> Option<faer::sparse:
     let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(m.nrows(), m.ncols(), column_starts, None, rows);
     Some(faer::sparse::SparseColMat::new(symbolic, values))
 }
-
-/// Orders from which [`mat_vec`] splits its rows between two threads (a thread costs tens of
-/// microseconds; the product of an order-1000 matrix takes milliseconds).
-const PARALLEL_ROWS_FROM: usize = 1000;
 
 /// hi + lo += M x with the fastest exact kernel the CPU has.
 fn accumulate_rows(m: MatRef<'_, f64>, x: &[f64], hi: &mut [f64], lo: &mut [f64]) {
@@ -629,7 +621,7 @@ mod tests {
 
     #[test]
     fn rows_on_two_threads_change_no_bit() {
-        let n = PARALLEL_ROWS_FROM + 37;
+        let n = Tuning::DEFAULT.parallel_rows_from + 37;
         let m = faer::Mat::from_fn(n, n, |i, j| {
             ((i * 31 + j * 17) % 97) as f64 / 7.0 - 6.0 + 1e-9 * j as f64
         });

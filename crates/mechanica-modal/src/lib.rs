@@ -57,6 +57,7 @@ pub mod sparse;
 pub mod spectrum;
 #[cfg(feature = "testing")]
 pub mod testing;
+pub mod tuning;
 
 pub use certify::{AccuracyReport, BoundKind, InertiaCheck, InertiaCount, Residuals, count_below};
 pub use dense::{DenseTimings, Method, ModalSolution, Refinement, Selection, SolveOptions, solve};
@@ -66,7 +67,8 @@ pub use problem::PencilProblem;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use runtime::scratch::release as release_scratch;
 pub use sparse::SparsePencil;
-pub use sparse::{DENSE_LIMIT, SparseModalSolution, SparseOptions, SparseReport, SparseTimings, solve_sparse};
 pub use sparse::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use sparse::{SparseInertia, count_below_sparse};
+pub use sparse::{SparseModalSolution, SparseOptions, SparseReport, SparseTimings, solve_sparse};
 pub use spectrum::{Mode, ModeGroup, ModeKind, classify};
+pub use tuning::Tuning;

@@ -7,6 +7,7 @@
 //! (8.90, see docs/theory.md). Every ordering uses ω² = −λ, ascending: unstable modes (ω² < 0)
 //! first, then rigid-body modes, then oscillatory modes, then infinite ones.
 
+use crate::tuning::Tuning;
 use std::ops::Range;
 
 /// What a mode is physically (§8g: δ(t) ∝ x e^{±iωt} for λ = −ω² < 0).
@@ -106,11 +107,6 @@ pub(crate) fn group_modes(modes: &mut [Mode]) -> Vec<ModeGroup> {
     groups
 }
 
-/// The largest cluster of nearly equal ω² that refinement treats as one block; larger ones
-/// keep the bounds of the reduction (a block step costs 4p double-double matrix-vector
-/// products).
-pub const MAX_REFINED_CLUSTER: usize = 16;
-
 /// Whether the bound intervals of two modes overlap (with a factor 2 of margin): refinement
 /// cannot tell them apart, so it treats them as one cluster.
 fn overlapping(omega_i: f64, bound_i: f64, omega_j: f64, bound_j: f64) -> bool {
@@ -132,7 +128,7 @@ pub(crate) fn clusters(omega: &[f64], bounds: &[f64]) -> Vec<Range<usize>> {
 }
 
 /// Whether the cluster `g` of the selection (entries `first..` of the ascending spectrum
-/// `omega_all`) can be refined: at most [`MAX_REFINED_CLUSTER`] modes, and not cut by the
+/// `omega_all`) can be refined: at most [`crate::Tuning::max_refined_cluster`] modes, and not cut by the
 /// selection (an unselected mode within its bounds would be a missing member of the block,
 /// which makes the correction singular).
 pub(crate) fn refinable(g: &Range<usize>, omega: &[f64], bounds: &[f64], omega_all: &[f64], first: usize) -> bool {
@@ -141,5 +137,5 @@ pub(crate) fn refinable(g: &Range<usize>, omega: &[f64], bounds: &[f64], omega_a
     let cut_above = g.end == omega.len()
         && first + omega.len() < omega_all.len()
         && overlapping(omega[last], bounds[last], omega_all[first + omega.len()], bounds[last]);
-    g.len() <= MAX_REFINED_CLUSTER && !cut_below && !cut_above
+    g.len() <= Tuning::DEFAULT.max_refined_cluster && !cut_below && !cut_above
 }

@@ -273,7 +273,7 @@ fn values_only_solves_measure_their_weakly_bounded_modes() {
     assert!(mult[1..mult.len() - 1].iter().all(|&m| m == 2), "{mult:?}");
 }
 
-/// Values only with more weakly bounded modes than `FLAGGED_VECTORS_UP_TO` (masses graded over
+/// Values only with more weakly bounded modes than `Tuning::flagged_vectors_up_to` (masses graded over
 /// six decades make ‖A⁻¹‖ large): all vectors are computed instead, and every mode agrees with
 /// the all-pairs solve within the two bounds, with measured (not assumed) bounds.
 #[test]
@@ -303,7 +303,7 @@ fn values_only_with_many_weak_modes_computes_all_vectors() {
         .filter(|m| m.error_bound > mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * m.omega_sq.abs())
         .count();
     assert!(
-        weak > mechanica_modal::dense::FLAGGED_VECTORS_UP_TO.max(n / 4),
+        weak > mechanica_modal::Tuning::DEFAULT.flagged_vectors_up_to.max(n / 4),
         "{weak} weak modes"
     );
     let measured = solve(&p, &values_only).expect("solve");

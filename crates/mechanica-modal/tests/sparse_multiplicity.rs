@@ -246,7 +246,7 @@ fn count_cutting_a_repeated_eigenvalue_is_reported() {
     let sol = solve_sparse(&p, &options(9, 2)).expect("solve");
     check_against_closed_form(&p, &sol, 6, 100, 9);
     assert_eq!(sol.report.kth_group_multiplicity, 6);
-    // The dense path (n ≤ DENSE_LIMIT) reports the cut the same way.
+    // The dense path (n ≤ `Tuning::dense_limit`) reports the cut the same way.
     let p = chains(4, 50);
     let sol = solve_sparse(&p, &options(2, 2)).expect("solve");
     assert!(sol.report.dense_fallback);

@@ -21,21 +21,11 @@ use crate::certify::inertia::shifted_lower;
 use crate::linalg::eigen::ql_values::lowest_eigenvalue;
 use crate::linalg::reduce::{check_pivots, factor_block_step, factor_trailing, max_diagonal};
 use crate::runtime::idle_task::IdleTask;
+use crate::tuning::Tuning;
 use faer::{Mat, Par};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Duration;
-
-/// Columns per sequential block (between two looks at the stop flag).
-const BLOCK: usize = 64;
-
-/// The slowest rate (flops per second) at which the report expects the thread to finish its
-/// current block once asked: the wait for the hand-over is one block step at this rate.
-const SLOWEST_BLOCK_RATE: f64 = 2e9;
-
-/// The fraction of the columns the thread must have factored for the report to wait for its
-/// hand-over (an eighth: a third of the flops done); before that the report factors alone.
-const HANDOVER_FROM: f64 = 0.125;
 
 /// What the thread decided or had done.
 pub(crate) enum Outcome {
@@ -76,11 +66,13 @@ impl IdleCertificate {
     /// partial factor, after waiting at most one block step for it to stop.
     pub(crate) fn collect(self) -> Option<Outcome> {
         let factored = self.factored.load(Ordering::Acquire).min(self.n);
-        if (factored as f64) < HANDOVER_FROM * self.n as f64 {
+        if (factored as f64) < Tuning::DEFAULT.handover_from * self.n as f64 {
             return self.task.finished();
         }
         let rest = (self.n - factored) as f64;
-        let patience = Duration::from_secs_f64(BLOCK as f64 * rest * rest / SLOWEST_BLOCK_RATE);
+        let patience = Duration::from_secs_f64(
+            Tuning::DEFAULT.certificate_block as f64 * rest * rest / Tuning::DEFAULT.slowest_block_rate,
+        );
         self.task.collect(patience)
     }
 }
@@ -134,7 +126,7 @@ fn factor_shifted(problem: &PencilProblem, shift: f64, stop: &AtomicBool, factor
                 max_diag,
             }));
         }
-        let width = BLOCK.min(n - done);
+        let width = Tuning::DEFAULT.certificate_block.min(n - done);
         if factor_block_step(factor.as_mut(), done, width).is_err() {
             crate::runtime::scratch::give_back(factor);
             return Some(Outcome::Decided { positive: false });
@@ -226,12 +218,13 @@ mod tests {
         for (shift, positive) in [(0.5 * lowest, true), (0.5 * (lowest + second), false)] {
             let mut factor = shifted_lower(&problem, shift);
             let max_diag = max_diagonal(factor.as_ref());
-            for start in [0, BLOCK] {
-                factor_block_step(factor.as_mut(), start, BLOCK).expect("the leading blocks are definite");
+            for start in [0, Tuning::DEFAULT.certificate_block] {
+                factor_block_step(factor.as_mut(), start, Tuning::DEFAULT.certificate_block)
+                    .expect("the leading blocks are definite");
             }
             let partial = PartialFactor {
                 factor,
-                factored: 2 * BLOCK,
+                factored: 2 * Tuning::DEFAULT.certificate_block,
                 max_diag,
             };
             assert_eq!(partial.finish(Par::rayon(2)), positive, "shift {shift}");

@@ -15,7 +15,7 @@ mod options;
 mod solution;
 mod values_only;
 
-pub use options::{AUTO_REFINE_RELATIVE_BOUND, FLAGGED_VECTORS_UP_TO, Refinement, Selection, SolveOptions};
+pub use options::{AUTO_REFINE_RELATIVE_BOUND, Refinement, Selection, SolveOptions};
 pub use solution::{DenseTimings, Method, ModalSolution};
 
 use crate::certify::a_priori::APrioriModel;
@@ -35,20 +35,9 @@ use crate::problem::PencilProblem;
 use crate::runtime::fork_join::join;
 use crate::runtime::idle_task::IdleTask;
 use crate::runtime::scratch;
+use crate::tuning::Tuning;
 use faer::{MatRef, Par};
 use std::time::Instant;
-
-/// Dense problems smaller than this are solved on one thread.
-pub const SEQUENTIAL_BELOW: usize = 192;
-
-/// From this order an all-modes solve puts work off its critical path on idle core time (module
-/// `idle_task`: the norms, the sketch's rows, the bottom certificate): from the first order
-/// solved on two threads. Measured (rotated chain, sketched report, medians of 15 solves in two
-/// alternations, against the earlier threshold of 640): n = 250 18.4 / 17.6 → 14.8 / 13.6 ms,
-/// n = 350 29.8 / 31.7 → 28.7 / 26.3 ms, n = 500 (threshold 300) 57.5 / 55.8 / 54.0 → 51.3 /
-/// 50.2 / 50.0 ms; below the factorization's own threshold one core is idle while the other
-/// factors A.
-const IDLE_TIME_FROM: usize = SEQUENTIAL_BELOW;
 
 /// Solves det(λA + B) = 0 (8.89) for the selected modes, with a full accuracy report.
 ///
@@ -60,7 +49,7 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     let (a, b) = (problem.a(), problem.b());
     let n = problem.dim();
     // Below a few hundred unknowns thread start-up costs more than it saves (mechanisms).
-    let par = if n < SEQUENTIAL_BELOW {
+    let par = if n < Tuning::DEFAULT.sequential_below {
         Par::Seq
     } else {
         faer::get_global_parallelism()
@@ -71,7 +60,8 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
     // The refinement and the residual bounds need the vectors even when the caller does not.
     let want_vectors = options.vectors || options.refinement == Refinement::Always;
     // All modes of a large pencil: work off the critical path goes to idle core time.
-    let idle_time = matches!(options.selection, Selection::All) && n >= IDLE_TIME_FROM && par.degree() > 1;
+    let idle_time =
+        matches!(options.selection, Selection::All) && n >= Tuning::DEFAULT.idle_time_from && par.degree() > 1;
     let early_inputs = idle_time
         .then(|| EarlyInputs::start(problem, want_vectors && options.residuals == Residuals::Sketched))
         .flatten();
@@ -109,7 +99,7 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 let model = APrioriModel::new(l.as_ref(), norm_a, norm_b, par);
                 def.timings.accuracy = clock.elapsed();
                 let flagged = selected.iter().filter(|&&w| weakly_bounded(model.bound(w), w)).count();
-                if flagged > FLAGGED_VECTORS_UP_TO.max(n / 4) {
+                if flagged > Tuning::DEFAULT.flagged_vectors_up_to.max(n / 4) {
                     let first_try = def.timings;
                     def = solve_definite(l.as_ref(), b, options.selection, true, par)?;
                     def.timings.factor += first_try.factor;

@@ -21,7 +21,7 @@ pub enum Selection {
 }
 
 /// Whether to refine low modes with extended-precision residuals (module `refine`). Clusters of
-/// nearly equal ω² (up to [`MAX_REFINED_CLUSTER`] modes) are refined as blocks; a semidefinite A
+/// nearly equal ω² (up to [`crate::Tuning::max_refined_cluster`] modes) are refined as blocks; a semidefinite A
 /// is refined when it is diagonal with exactly zero massless entries (the condensation is then
 /// exact), and otherwise keeps its first-order bounds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -42,12 +42,6 @@ pub const AUTO_REFINE_RELATIVE_BOUND: f64 = 1e-8;
 pub(crate) fn weakly_bounded(bound: f64, omega_sq: f64) -> bool {
     bound > AUTO_REFINE_RELATIVE_BOUND * omega_sq.abs()
 }
-
-/// A values-only solve with [`Refinement::Auto`] forms the vectors of its poorly bounded modes
-/// one by one (inverse iteration, module `values_only`) when there are at most this many or
-/// n/4 of them; beyond that it computes all vectors, which then costs less (the clustered
-/// inverse iteration orthogonalises in O(k²n), and all vectors cost about n³ more than values).
-pub const FLAGGED_VECTORS_UP_TO: usize = 32;
 
 /// Options of [`solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]

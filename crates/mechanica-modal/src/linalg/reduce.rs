@@ -13,34 +13,20 @@
 //! off-diagonal entry of the symmetrised A is zero); a nearly diagonal A takes the dense path.
 
 use crate::runtime::fork_join::{by_column_chunks, by_column_chunks_at};
+use crate::tuning::Tuning;
 use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{BlockStructure, matmul as tri_matmul};
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
-/// Below this order the reduction uses two plain triangular solves (cheap at that size).
-const BASE_CASE: usize = 48;
-
-/// Below this order the Cholesky factorization is faer's blocked one (measured: 128–256 are
-/// equally fast at orders 1000–4000).
-const CHOLESKY_BASE_CASE: usize = 128;
-
-/// Width of the leading block split off by each step of the reduction. Halving instead
-/// (n1 = n/2) does the ½L21C11 products on large square blocks, n³/2 flops at the top level
-/// alone (4n³/3 in all); a block of fixed width keeps the total at n³, as in `dsygst`
-/// (measured: 0.12 → 0.11 s at n = 2000, 0.93 → 0.80 s at n = 4000; widths 192–384 equal).
-const REDUCE_BLOCK: usize = 256;
-
-/// Below this order the factorization and the reduction run on one thread: their blocks are
-/// too small for the pool's wake-ups to pay (measured, best of 8 solves of the rotated chain,
-/// factor stage one thread against two: 0.97 against 2.4 ms at n = 250, 6.6 against 11.4 ms
-/// at 500, 26 against 18 ms at 750).
-const PARALLEL_FACTOR_FROM: usize = 640;
-
-/// `par` for a factorization or reduction of order `n` ([`PARALLEL_FACTOR_FROM`]).
+/// `par` for a factorization or reduction of order `n` ([`crate::Tuning::parallel_factor_from`]).
 fn factor_parallelism(n: usize, par: Par) -> Par {
-    if n < PARALLEL_FACTOR_FROM { Par::Seq } else { par }
+    if n < Tuning::DEFAULT.parallel_factor_from {
+        Par::Seq
+    } else {
+        par
+    }
 }
 
 /// The outcome of a Cholesky attempt on the mass matrix A.
@@ -185,7 +171,7 @@ pub(crate) fn subtract_lower_product(target: MatMut<'_, f64>, lhs: MatRef<'_, f6
 /// 1000–4000 (measured). Err(pivot) at the first pivot that is not positive.
 fn factor_recursive(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
     let n = l.nrows();
-    if n <= CHOLESKY_BASE_CASE {
+    if n <= Tuning::DEFAULT.cholesky_base_case {
         let mut mem = faer::dyn_stack::MemBuffer::new(
             faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(n, par, Default::default()),
         );
@@ -256,14 +242,14 @@ fn mirror_lower(mut c: MatMut<'_, f64>) {
     }
 }
 
-/// Blocked sygst, one leading block of [`REDUCE_BLOCK`] columns per step (the block itself is
+/// Blocked sygst, one leading block of [`crate::Tuning::reduce_block`] columns per step (the block itself is
 /// reduced by the same recursion): with L = [L11 0; L21 L22] and B split alike, L C Lᵀ = B gives
 /// C11 = L11⁻¹ B11 L11⁻ᵀ, H = ½ L21 C11, W = B21 L11⁻ᵀ − H, B22' = B22 − (W L21ᵀ + L21 Wᵀ),
 /// C21 = L22⁻¹ (W − H), C22 = L22⁻¹ B22' L22⁻ᵀ. H is formed once per step (LAPACK `dsygst`
 /// forms it twice, by two `dsymm`): a sixth of the flops fewer.
 fn reduce_in_place(l: MatRef<'_, f64>, c: MatMut<'_, f64>, par: Par) {
     let n = c.nrows();
-    let mut half_product = Mat::<f64>::zeros(n, REDUCE_BLOCK.min(n / 2));
+    let mut half_product = Mat::<f64>::zeros(n, Tuning::DEFAULT.reduce_block.min(n / 2));
     reduce_blocks(l, c, half_product.as_mut(), par);
 }
 
@@ -271,18 +257,18 @@ fn reduce_in_place(l: MatRef<'_, f64>, c: MatMut<'_, f64>, par: Par) {
 /// n − n1 rows and n1 columns).
 fn reduce_blocks(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>, mut scratch: MatMut<'_, f64>, par: Par) {
     let n = c.nrows();
-    if n <= BASE_CASE {
+    if n <= Tuning::DEFAULT.reduce_base_case {
         mirror_lower(c.as_mut());
         solve_lower_triangular_in_place(l, c.as_mut(), par);
         solve_lower_triangular_in_place(l, c.as_mut().transpose_mut(), par);
         return;
     }
-    let n1 = REDUCE_BLOCK.min(n / 2);
+    let n1 = Tuning::DEFAULT.reduce_block.min(n / 2);
     let (l11, _, l21, l22) = l.split_at(n1, n1);
     let (mut c11, _, mut c21, mut c22) = c.split_at_mut(n1, n1);
     reduce_blocks(l11, c11.as_mut(), scratch.rb_mut(), par);
     mirror_lower(c11.as_mut());
-    if n - n1 <= SPLIT_STEP_UP_TO && par.degree() == 2 {
+    if n - n1 <= Tuning::DEFAULT.split_step_up_to && par.degree() == 2 {
         let half = scratch.rb_mut().submatrix_mut(0, 0, n - n1, n1);
         let step = StepBlocks {
             l11,
@@ -311,17 +297,6 @@ fn reduce_blocks(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>, mut scratch: MatMut
     });
     reduce_blocks(l22, c22, scratch, par);
 }
-
-/// Trailing orders up to which a step of the reduction runs as three two-thread phases of
-/// sequential kernels instead of faer's parallel kernels, whose every call synchronizes the
-/// threads. Measured on the rotated chain: the reduction alone at n = 1000 (medians of 12) 35
-/// against 39.5 ms, but every step in phases at n = 2000 197 against 169 ms (large products
-/// gain from faer's shared packing); with this threshold the factor stage (copies, Cholesky,
-/// reduction; 80 alternated solves) at n = 1000 took q1 / median / q3 39.5 / 44.8 / 49.6
-/// against 41.0 / 47.9 / 53.4 ms, and at n = 2000 (12 solves) a median of 216 against 237 ms.
-/// Only with exactly two threads (the measured case): with more, faer's parallel kernels use
-/// them all, where the phases would use two.
-const SPLIT_STEP_UP_TO: usize = 1024;
 
 /// The blocks of L and C11 that one step of the reduction reads.
 struct StepBlocks<'a> {
@@ -537,9 +512,9 @@ mod tests {
 
     #[test]
     fn symmetric_reduction_matches_two_triangular_solves() {
-        // 700: several blocks of REDUCE_BLOCK, each step's H in the shared scratch, on two threads
+        // 700: several blocks of `Tuning::reduce_block`, each step's H in the shared scratch, on two threads
         // (every step as two-thread phases); 1300: the first steps with faer's parallel kernels
-        // (trailing order above SPLIT_STEP_UP_TO), the later ones in phases.
+        // (trailing order above `Tuning::split_step_up_to`), the later ones in phases.
         for n in [1, 5, 48, 49, 130, 257, 700, 1300] {
             let a = spd(n, 1);
             let b = spd(n, 2);

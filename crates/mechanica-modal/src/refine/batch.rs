@@ -5,9 +5,8 @@ use crate::dd::{Operand, SplitVector, dot};
 use crate::linalg::reduce::LowerFactor;
 use crate::refine::metric::Metric;
 use crate::refine::pair::{RefinedPair, finish_pair};
-use crate::refine::projected::MAX_PROJECTED_STEPS;
-use crate::refine::projected::STAGNATION_ULPS;
 use crate::runtime::fork_join::map_items;
+use crate::tuning::Tuning;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par};
 
@@ -41,7 +40,7 @@ pub(crate) fn refine_simple_modes(
     let mut x = x0.to_owned();
     let mut state = vec![State::Iterating; k];
     let mut previous = vec![f64::INFINITY; k];
-    for step in 1..=MAX_PROJECTED_STEPS {
+    for step in 1..=Tuning::DEFAULT.max_projected_steps {
         let active: Vec<usize> = (0..k).filter(|&c| state[c] == State::Iterating).collect();
         if active.is_empty() {
             break;
@@ -86,7 +85,7 @@ pub(crate) fn refine_simple_modes(
             }
             let xmax = x.col_as_slice(mode).iter().fold(0.0_f64, |m, v| m.max(v.abs()));
             let dmax = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-            let at_rounding = dmax <= STAGNATION_ULPS * f64::EPSILON * xmax;
+            let at_rounding = dmax <= Tuning::DEFAULT.stagnation_ulps * f64::EPSILON * xmax;
             let contracting = dmax <= 0.5 * previous[mode];
             if !dmax.is_finite() || !(contracting || at_rounding) {
                 state[mode] = State::Failed;

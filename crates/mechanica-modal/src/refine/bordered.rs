@@ -5,11 +5,9 @@
 use crate::dd::{Dd, Operand, SplitVector, dot};
 use crate::refine::metric::Metric;
 use crate::refine::pair::{RefinedPair, finish_pair};
+use crate::tuning::Tuning;
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
-
-/// Maximum Newton steps per pair.
-pub const MAX_STEPS: usize = 12;
 
 /// Refines (ω₀², x₀) by Newton steps on the bordered matrix [B − ω₀²A, −Ax₀; −(Ax₀)ᵀ, 0]
 /// (nonsingular for a simple finite eigenvalue, also when A is singular), factored densely,
@@ -121,7 +119,7 @@ fn newton_steps(
     let mut omega = Dd::of(omega0);
     let mut converged = false;
     let mut previous = f64::INFINITY;
-    for step in 1..=MAX_STEPS {
+    for step in 1..=Tuning::DEFAULT.max_newton_steps {
         let bx = b.product_split(&x);
         let axd = a.product_split(&x);
         let residual: Vec<f64> = (0..n).map(|i| -(bx[i].minus(omega.times(axd[i]))).to_f64()).collect();
@@ -138,7 +136,7 @@ fn newton_steps(
         }
         previous = dmax;
     }
-    Some((x, MAX_STEPS, converged))
+    Some((x, Tuning::DEFAULT.max_newton_steps, converged))
 }
 
 /// The Jacobian [K, −a; −aᵀ, 0] of [`refine_pair`] with K = B − ω₀²A and a = A x₀, factored

@@ -6,15 +6,9 @@ use crate::dd::{Dd, Operand, SplitVector, dot, dot_split};
 use crate::refine::correction::ReducedCorrection;
 use crate::refine::metric::Metric;
 use crate::refine::pair::{RefinedCluster, RefinedPair, finish_pair};
+use crate::tuning::Tuning;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
 use faer::{Mat, MatRef, Par, Side};
-
-/// Maximum steps of [`refine_pair_projected`] before it gives up.
-pub const MAX_PROJECTED_STEPS: usize = 8;
-
-/// A correction below this many ulps of x that no longer halves has reached rounding level:
-/// the iteration stops there (the bound comes from the final residual either way).
-pub(crate) const STAGNATION_ULPS: f64 = 16.0;
 
 /// Refines the simple pair (ω²_i, x₀): [`refine_cluster_projected`] for one mode.
 #[cfg(test)]
@@ -58,7 +52,7 @@ pub(crate) fn refine_cluster_projected(
     }
     let mut x = x0.to_owned();
     let mut previous = f64::INFINITY;
-    for step in 1..=MAX_PROJECTED_STEPS {
+    for step in 1..=Tuning::DEFAULT.max_projected_steps {
         let ax: Vec<Vec<Dd>> = (0..p).map(|k| a.product(x.col_as_slice(k))).collect();
         let bx: Vec<Vec<Dd>> = (0..p).map(|k| b.product(x.col_as_slice(k))).collect();
         let m = rayleigh_quotient_matrix(&x, &ax, &bx)?;
@@ -76,7 +70,7 @@ pub(crate) fn refine_cluster_projected(
             .col_iter()
             .flat_map(|c| c.iter())
             .fold(0.0_f64, |m, v| m.max(v.abs()));
-        let at_rounding = dmax <= STAGNATION_ULPS * f64::EPSILON * xmax;
+        let at_rounding = dmax <= Tuning::DEFAULT.stagnation_ulps * f64::EPSILON * xmax;
         let contracting = dmax <= 0.5 * previous;
         if !dmax.is_finite() || !(contracting || at_rounding) {
             return None;
@@ -111,7 +105,7 @@ pub(crate) fn polish_simple_mode(
     let mut x = SplitVector::of(x0.to_vec());
     let mut previous = f64::INFINITY;
     let mut taken = 0;
-    for _ in 0..MAX_PROJECTED_STEPS {
+    for _ in 0..Tuning::DEFAULT.max_projected_steps {
         let ax = a.product_split(&x);
         let bx = b.product_split(&x);
         let rho = dot_split(&x, &bx).over(dot_split(&x, &ax));

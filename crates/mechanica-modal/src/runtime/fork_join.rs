@@ -1,6 +1,7 @@
 //! Fork–join helpers that respect a [`Par`]: two closures, or column chunks of a matrix, on the
 //! threads of Rayon's global pool when `par` allows more than one, else in turn.
 
+use crate::tuning::Tuning;
 use faer::{MatMut, Par};
 
 /// Runs two closures, on two threads of Rayon's global pool when `par` allows more than one
@@ -25,9 +26,6 @@ pub(crate) fn map_items<T: Sync, R: Send>(items: &[T], par: Par, f: impl Fn(&T) 
     }
 }
 
-/// The fewest columns a chunk of [`by_column_chunks`] gets: fewer columns run as one chunk.
-pub(crate) const COLUMNS_PER_CHUNK: usize = 64;
-
 /// Runs `solve` on column chunks of `rhs`, one chunk per thread of `par` (each chunk solved
 /// sequentially). For triangular solves with many right-hand sides this keeps both threads on
 /// whole columns; faer's parallel triangular solve was measured 1.1–1.4× slower on a
@@ -39,7 +37,10 @@ pub(crate) fn by_column_chunks(rhs: MatMut<'_, f64>, par: Par, solve: &(dyn Fn(M
 /// [`by_column_chunks`], telling `solve` the index in `rhs` of its chunk's first column.
 pub(crate) fn by_column_chunks_at(rhs: MatMut<'_, f64>, par: Par, solve: &(dyn Fn(usize, MatMut<'_, f64>) + Sync)) {
     let threads = match par {
-        Par::Rayon(threads) => threads.get().min(rhs.ncols() / COLUMNS_PER_CHUNK).max(1),
+        Par::Rayon(threads) => threads
+            .get()
+            .min(rhs.ncols() / Tuning::DEFAULT.columns_per_chunk)
+            .max(1),
         Par::Seq => 1,
     };
     split_columns(rhs, 0, threads, solve);

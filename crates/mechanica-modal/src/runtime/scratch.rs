@@ -4,8 +4,8 @@
 //! divide and conquer, and the bottom certificate's), of which the caller keeps one (the mode
 //! shapes). Fresh memory costs a page fault per 4 KiB on its first write, and the allocator
 //! returns large blocks to the system when they are freed, so every solve faulted its working
-//! set anew. Freed working matrices of at least [`KEPT_FROM_BYTES`] are kept here, at most
-//! [`KEPT`] of them, and the next solve takes them instead of allocating. Measured at n = 2000
+//! set anew. Freed working matrices of at least [`crate::Tuning::kept_from_bytes`] are kept here, at most
+//! [`crate::Tuning::kept_matrices`] of them, and the next solve takes them instead of allocating. Measured at n = 2000
 //! on the 2-core Zen 3 host, six solves in a row: 32 thousand page faults and 0.19 s of system
 //! time per solve before, 14 thousand and 0.08 s after (the wall time, about 1.5 s, moved by
 //! less than the host's spread).
@@ -14,14 +14,9 @@
 //! the solve's own peak), as optimised BLAS libraries keep their buffers; [`release`] (C:
 //! `mech_modal_release_scratch`) gives it back to the system.
 
+use crate::tuning::Tuning;
 use faer::Mat;
 use std::sync::Mutex;
-
-/// Matrices kept at most.
-pub const KEPT: usize = 5;
-
-/// Matrices smaller than this are not kept (the allocator reuses small blocks itself).
-pub const KEPT_FROM_BYTES: usize = 1 << 20;
 
 /// Kept matrices with the shape they were given back in (their storage holds at least that).
 #[derive(Default)]
@@ -42,13 +37,13 @@ impl Pool {
         Some(self.kept.swap_remove(fitting))
     }
 
-    /// Keeps `matrix` when it is large enough, dropping the smallest one beyond [`KEPT`].
+    /// Keeps `matrix` when it is large enough, dropping the smallest one beyond [`crate::Tuning::kept_matrices`].
     fn give_back(&mut self, matrix: Mat<f64>) {
-        if matrix.nrows() * matrix.ncols() * size_of::<f64>() < KEPT_FROM_BYTES {
+        if matrix.nrows() * matrix.ncols() * size_of::<f64>() < Tuning::DEFAULT.kept_from_bytes {
             return;
         }
         self.kept.push(matrix);
-        if self.kept.len() > KEPT
+        if self.kept.len() > Tuning::DEFAULT.kept_matrices
             && let Some((smallest, _)) = self.kept.iter().enumerate().min_by_key(|(_, m)| m.nrows() * m.ncols())
         {
             self.kept.swap_remove(smallest);
@@ -145,16 +140,16 @@ mod tests {
         assert_eq!(small_first.take(380, 380).map(|m| m.as_ptr()), Some(small_storage));
     }
 
-    /// Small matrices are not kept, and at most KEPT large ones (the smallest goes).
+    /// Small matrices are not kept, and at most `Tuning::kept_matrices` large ones (the smallest goes).
     #[test]
     fn the_pool_is_bounded() {
         let mut pool = Pool::default();
         pool.give_back(large(100, 0.0));
         assert!(pool.kept.is_empty());
-        for k in 0..KEPT + 2 {
+        for k in 0..Tuning::DEFAULT.kept_matrices + 2 {
             pool.give_back(large(400 + k, 0.0));
         }
-        assert_eq!(pool.kept.len(), KEPT);
+        assert_eq!(pool.kept.len(), Tuning::DEFAULT.kept_matrices);
         let smallest = pool.kept.iter().map(|m| m.nrows()).min();
         assert_eq!(smallest, Some(402));
     }

@@ -5,6 +5,7 @@
 
 use crate::error::ModalError;
 use crate::sparse::operator::{Mass, Operator, dot, product, product_into};
+use crate::tuning::Tuning;
 use faer::{Mat, MatMut, MatRef, Par, Side};
 
 /// Pseudo-random numbers in [−1, 1).
@@ -178,22 +179,12 @@ fn normalise_block(
 /// Called once with roughly converged θ (see [`lanczos_run`]).
 type RoughHook<'a> = &'a mut dyn FnMut(&[f64]);
 
-/// Relative Ritz residual to which the buffer modes above the k-th converge. They serve only to
-/// place the inertia shift τ in a real gap (relative width ≥ √u); after Rayleigh–Ritz their ω²
-/// err by about the square of this, far inside such a gap.
-const BUFFER_TOLERANCE: f64 = 1e-8;
-
-/// Relative Ritz residual at which the first run's θ are good enough to place the inertia shift
-/// τ (their ω² then err by about 1e-12 relative): the inertia count starts on a second thread
-/// while Lanczos converges the rest of the way.
-const ROUGH_TOLERANCE: f64 = 1e-6;
-
 /// One block thick-restart Lanczos run for the `nev` largest θ of T restricted to the
 /// A-orthogonal complement of `locked`, from the n × b column-major `start` block when given
 /// with that size (tests), else from a pseudo-random block. The first `strict` of them converge
 /// to `tolerance`, the rest (a buffer that only has to show where the spectrum has a gap) to
-/// [`BUFFER_TOLERANCE`]. `rough`, when given, is called once with the nev θ (descending) as
-/// soon as all of them have converged to [`ROUGH_TOLERANCE`] (not when they converge fully at
+/// [`crate::Tuning::buffer_tolerance`]. `rough`, when given, is called once with the nev θ (descending) as
+/// soon as all of them have converged to [`crate::Tuning::rough_tolerance`] (not when they converge fully at
 /// the first check). Returns (θ descending, n × nev Ritz vectors, restarts).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn lanczos_run(
@@ -217,7 +208,7 @@ pub(crate) fn lanczos_run(
     // 2·nev + 4b: with convergence checked after every block step, a larger basis saves no
     // operator application on the 300×300 grid (k = 10, b = 2: 72 for every m from 32 to 56),
     // only orthogonalisation work; 2·nev + 2b needed more.
-    let wanted_m = (2 * nev + 4 * b).max(24);
+    let wanted_m = (2 * nev + 4 * b).max(Tuning::DEFAULT.lanczos_min_basis);
     let m = (wanted_m.div_ceil(b) * b).min((room.saturating_sub(b) / b) * b);
     if m < 2 * b || nev >= m {
         return Err(ModalError::TooManyModes {
@@ -300,7 +291,7 @@ pub(crate) fn lanczos_run(
                 let goal = if r < strict {
                     tolerance
                 } else {
-                    tolerance.max(BUFFER_TOLERANCE)
+                    tolerance.max(Tuning::DEFAULT.buffer_tolerance)
                 };
                 ritz.residual(c) <= goal * ritz.theta[c].abs()
             })
@@ -308,7 +299,7 @@ pub(crate) fn lanczos_run(
         if converged < nev
             && wanted
                 .iter()
-                .all(|&c| ritz.residual(c) <= ROUGH_TOLERANCE * ritz.theta[c].abs())
+                .all(|&c| ritz.residual(c) <= Tuning::DEFAULT.rough_tolerance * ritz.theta[c].abs())
             && let Some(hook) = rough.take()
         {
             hook(&wanted.iter().map(|&c| ritz.theta[c]).collect::<Vec<_>>());

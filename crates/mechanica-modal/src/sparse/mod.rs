@@ -57,7 +57,7 @@ pub use inertia::{SparseInertia, count_below_sparse};
 pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use options::SparseOptions;
 pub use pencil::SparsePencil;
-pub use solution::{DENSE_LIMIT, SparseModalSolution, SparseReport, SparseTimings};
+pub use solution::{SparseModalSolution, SparseReport, SparseTimings};
 
 use crate::error::ModalError;
 use crate::sparse::bounds::{finish, pair_residuals};
@@ -67,6 +67,7 @@ use crate::sparse::lanczos::{Lcg, lanczos_run};
 use crate::sparse::operator::{Mass, Operator, factor_llt};
 use crate::sparse::pencil::{Csc, frobenius};
 use crate::sparse::rayleigh_ritz::rayleigh_ritz;
+use crate::tuning::Tuning;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
 };
@@ -116,7 +117,7 @@ fn solve_sparse_from(
     let (a, b) = (pencil.a(), pencil.b());
     let norm_a = frobenius(a);
     let norm_b = frobenius(b);
-    if n <= DENSE_LIMIT {
+    if n <= Tuning::DEFAULT.dense_limit {
         return dense_fallback(pencil, k, norm_a, norm_b);
     }
     let mut timings = SparseTimings::default();
@@ -147,7 +148,7 @@ fn solve_sparse_from(
         match factor_llt(&symbolic, &Csc::combine(1.0, &cb, -sigma, &ca))? {
             Ok(values) => break values,
             Err(pivot) => {
-                if options.shift.is_some() || attempts >= 6 {
+                if options.shift.is_some() || attempts >= Tuning::DEFAULT.shift_attempts {
                     return Err(ModalError::NoDefiniteShift {
                         lowest_shift: sigma,
                         pivot,
@@ -337,7 +338,7 @@ fn solve_sparse_from(
             });
         }
         // Missed modes (repeated eigenvalues): rerun deflated against everything found. A block
-        // of `missing` vectors (≤ MAX_RERUN_BLOCK) sees every missing copy of an eigenvalue in one
+        // of `missing` vectors (at most `Tuning::max_rerun_block`) sees every missing copy of an eigenvalue in one
         // run, whatever its multiplicity.
         let clock = Instant::now();
         let rerun_nev = (missing + 1).min(n.saturating_sub(cols + 1)).max(1);
@@ -345,7 +346,7 @@ fn solve_sparse_from(
             &mut op,
             rerun_nev,
             rerun_nev,
-            options.block_size.max(missing.min(MAX_RERUN_BLOCK)),
+            options.block_size.max(missing.min(Tuning::DEFAULT.max_rerun_block)),
             &refined.vectors,
             cols,
             options.tolerance,
@@ -361,9 +362,6 @@ fn solve_sparse_from(
         found.extend_from_slice(&more);
     }
 }
-
-/// Largest block size of a deflated rerun.
-const MAX_RERUN_BLOCK: usize = 32;
 
 /// ω²_{j+1} − ω²_j relative to max(|ω²_j|, |ω²_{j+1}|) (0 past the end).
 fn gap(omega: &[f64], j: usize) -> f64 {

@@ -57,7 +57,7 @@ pub struct SparseReport {
     pub computed_below: usize,
     /// Whether the inertia count equals computed_below (no mode below τ missed or invented).
     pub consistent: bool,
-    /// True when the problem was small enough to be solved densely (n ≤ [`DENSE_LIMIT`]).
+    /// True when the problem was small enough to be solved densely (n ≤ [`crate::Tuning::dense_limit`]).
     pub dense_fallback: bool,
     /// Stage timings.
     pub timings: SparseTimings,
@@ -75,6 +75,3 @@ pub struct SparseModalSolution {
     /// Accuracy and cost.
     pub report: SparseReport,
 }
-
-/// At or below this order the sparse solver converts to dense and calls [`crate::solve()`].
-pub const DENSE_LIMIT: usize = 400;

@@ -6,7 +6,7 @@
 //! - T, scaled to unit max-norm, is torn at its middle off-diagonal β into
 //!   T = diag(T₁, T₂) + |β| v vᵀ, v = e_{n₁} + sign(β) e_{n₁+1}, with |β| taken off the two
 //!   diagonal entries beside the tear;
-//! - with T_i = Q_i D_i Q_iᵀ solved recursively (leaves of at most [`LEAF`] rows by the implicit
+//! - with T_i = Q_i D_i Q_iᵀ solved recursively (leaves of at most [`crate::Tuning::leaf`] rows by the implicit
 //!   QL iteration), T = Q (D + ρ z zᵀ) Qᵀ with z = Qᵀv/√2 and ρ = 2|β|;
 //! - deflation: a pair whose ρ|z_i| is below 8u·max(‖D‖, ‖z‖) keeps (d_i, q_i); two close poles
 //!   are rotated so that one of them deflates (`dlaed2`'s tests);
@@ -27,17 +27,13 @@
 //! thirds outside the matrix products (measured with `perf`).
 
 use crate::runtime::fork_join::join;
+use crate::tuning::Tuning;
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, MatMut, MatRef, Par};
 
-/// Leaves of at most this many rows are solved by the implicit QL iteration (LAPACK's SMLSIZ
-/// is 25; here a power of two so that the halves of a power-of-two order are equal).
-pub const LEAF: usize = 32;
 /// Unit roundoff 2⁻⁵³.
 const EPS: f64 = f64::EPSILON / 2.0;
-/// Secular-equation roots per node from which the roots are shared between two threads.
-const PARALLEL_ROOTS_FROM: usize = 128;
 /// Iterations of the secular-equation solver before it bisects only.
 const RATIONAL_STEPS: usize = 30;
 /// Iterations of the secular-equation solver in all (bisection halves the bracket each time).
@@ -136,7 +132,7 @@ struct Node<'a> {
 /// the order of `nodes.u`'s columns and `order` lists the columns by ascending eigenvalue.
 fn solve_node(d: &mut [f64], e: &mut [f64], nodes: Node<'_>, order: &mut [usize], par: Par) -> bool {
     let n = d.len();
-    if n <= LEAF {
+    if n <= Tuning::DEFAULT.leaf {
         return solve_leaf(d, e, nodes.u, order);
     }
     let n1 = n / 2;
@@ -402,7 +398,7 @@ fn secular_roots(
         }
     };
     let split = k / 2;
-    if k >= PARALLEL_ROOTS_FROM && matches!(par, Par::Rayon(t) if t.get() > 1) {
+    if k >= Tuning::DEFAULT.parallel_roots_from && matches!(par, Par::Rayon(t) if t.get() > 1) {
         let (roots1, roots2) = roots.split_at_mut(split);
         let (deltas1, deltas2) = deltas.rb_mut().split_at_col_mut(split);
         join(
@@ -738,7 +734,7 @@ fn secular_vectors(poles: &[f64], z: &[f64], position: &[usize], rho: f64, mut d
             }
         }
     };
-    if k >= PARALLEL_ROOTS_FROM && matches!(par, Par::Rayon(t) if t.get() > 1) {
+    if k >= Tuning::DEFAULT.parallel_roots_from && matches!(par, Par::Rayon(t) if t.get() > 1) {
         let split = k / 2;
         let (first, second) = z_hat.split_at_mut(split);
         join(|| products(0..split, first), || products(split..k, second), par);

@@ -8,9 +8,9 @@
 //! writing the whole trailing matrix once per column (a rank-2 update fused with a
 //! matrix-vector product). Here the panel algorithm of LAPACK `dsytrd`/`dlatrd` (Dongarra,
 //! Hammarling & Sorensen, "Block reduction of matrices to condensed forms for eigenvalue
-//! computations", J. Comput. Appl. Math. 27, 1989) is used: a panel of [`PANEL`] columns is
+//! computations", J. Comput. Appl. Math. 27, 1989) is used: a panel of [`crate::Tuning::panel`] columns is
 //! reduced with one read-only symmetric matrix-vector product per column, and the trailing
-//! matrix is updated once per panel by a symmetric rank-2·[`PANEL`] update (half the flops,
+//! matrix is updated once per panel by a symmetric rank-2·[`crate::Tuning::panel`] update (half the flops,
 //! as matrix products). Only the lower triangle of C is read. From order `PARALLEL_SYMV_FROM` (640)
 //! half of every matrix-vector product runs on a spinning helper thread (module `symv_team`):
 //! with the pool's sleeping threads, woken once per column, the reduction took 41–47 ms at
@@ -24,7 +24,8 @@ use crate::linalg::eigen::divide_conquer::tridiagonal_divide_and_conquer;
 use crate::linalg::eigen::inverse_iteration::tridiagonal_eigenvectors;
 use crate::linalg::eigen::ql_values::tridiagonal_eigenvalues;
 use crate::linalg::eigen::tridiagonalize::{Tridiagonal, tridiagonalize};
-use crate::runtime::fork_join::{COLUMNS_PER_CHUNK, by_column_chunks};
+use crate::runtime::fork_join::by_column_chunks;
+use crate::tuning::Tuning;
 use faer::linalg::evd::{ComputeEigenvectors, self_adjoint_evd_scratch, tridiagonal_self_adjoint_evd};
 use faer::linalg::householder::{
     apply_block_householder_sequence_on_the_left_in_place_scratch,
@@ -260,7 +261,7 @@ fn apply_reflectors(basis: MatRef<'_, f64>, factor: MatRef<'_, f64>, z: MatMut<'
     let bs = factor.nrows();
     // Too few columns for two chunks (the values-only path's few vectors): one chunk, with
     // faer's parallel application inside it.
-    let inside = if z.ncols() < 2 * COLUMNS_PER_CHUNK {
+    let inside = if z.ncols() < 2 * Tuning::DEFAULT.columns_per_chunk {
         par
     } else {
         Par::Seq

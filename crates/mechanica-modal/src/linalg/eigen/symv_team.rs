@@ -6,14 +6,11 @@
 //! it has not claimed yet when the caller's own half is done is run by the caller instead, so a
 //! late helper never delays the reduction.
 
+use crate::tuning::Tuning;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::thread::Thread;
-use std::time::{Duration, Instant};
-
-/// How long the helper spins for the next job before it parks (measured: 20 µs and 2 ms were
-/// no faster at n = 1000–2000, 2 ms slower at 1000).
-const SPIN: Duration = Duration::from_micros(200);
+use std::time::Instant;
 
 /// A closure lent to the helper by [`SymvTeam::beside`], its lifetime erased: `beside` does not
 /// return, nor unwind, before the job is settled (run by the helper, or taken back unstarted).
@@ -63,7 +60,7 @@ impl SymvTeam {
                     break posted;
                 }
                 spins = spins.wrapping_add(1);
-                if spins.is_multiple_of(256) && since.elapsed() > SPIN {
+                if spins.is_multiple_of(256) && since.elapsed() > Tuning::DEFAULT.symv_spin {
                     std::thread::park();
                 } else {
                     std::hint::spin_loop();
@@ -198,6 +195,7 @@ impl Drop for StopOnDrop<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::time::Duration;
 
     /// Runs `body` with a serving helper (stopped when `body` returns or unwinds).
     fn with_helper(body: impl FnOnce(&SymvTeam, &Thread)) {

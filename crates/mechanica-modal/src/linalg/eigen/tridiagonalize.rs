@@ -1,32 +1,20 @@
 //! The blocked Householder tridiagonalization C = Q T Qᵀ of a symmetric matrix (LAPACK
 //! `dsytrd`/`dlatrd`, lower; Dongarra, Hammarling & Sorensen, "Block reduction of matrices to
 //! condensed forms for eigenvalue computations", J. Comput. Appl. Math. 27, 1989): a panel of
-//! [`PANEL`] columns is reduced with one read-only symmetric matrix-vector product per column,
-//! and the trailing matrix is updated once per panel by a symmetric rank-2·[`PANEL`] update (half
+//! [`crate::Tuning::panel`] columns is reduced with one read-only symmetric matrix-vector product per column,
+//! and the trailing matrix is updated once per panel by a symmetric rank-2·[`crate::Tuning::panel`] update (half
 //! the flops, as matrix products). Only the lower triangle of C is read. On large trailing
 //! matrices half of every matrix-vector product, of its panel correction and of each trailing
 //! update runs on a spinning helper thread ([`super::symv_team`]).
 
 use crate::linalg::eigen::symv_team::SymvTeam;
 use crate::linalg::reduce::{columns_holding, subtract_lower_product};
+use crate::tuning::Tuning;
 use faer::linalg::householder::make_householder_in_place;
 use faer::linalg::matmul::matmul;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, ColMut, Mat, Par};
 use std::thread::Thread;
-
-/// Columns reduced per panel before the trailing matrix is updated (LAPACK's `dsytrd` default).
-pub const PANEL: usize = 32;
-
-/// Trailing orders below this use one thread for the symmetric matrix-vector product, and
-/// smaller matrices no helper thread at all (measured: one thread is faster at order 500, two
-/// at order 1000).
-const PARALLEL_SYMV_FROM: usize = 640;
-
-/// From this trailing order the trailing update of a team's tridiagonalization is split between
-/// the caller and the team's helper (each half one sequential product) instead of faer's pool,
-/// whose threads have gone to sleep during the panel and contend with the spinning helper.
-const SPLIT_UPDATE_FROM: usize = 128;
 
 /// T = Qᵀ C Q: the diagonal and subdiagonal of T; Q = H₀ H₁ ⋯ H_{n−2} with H_k = I − v_k v_kᵀ/τ_k
 /// (faer's convention) stored below the subdiagonal of the matrix that was reduced.
@@ -45,7 +33,7 @@ pub(crate) fn tridiagonalize(a: &mut Mat<f64>, par: Par) -> Tridiagonal {
         subdiag: vec![0.0; n],
         tau: vec![f64::INFINITY; n.saturating_sub(1)],
     };
-    if par.degree() < 2 || n <= PARALLEL_SYMV_FROM {
+    if par.degree() < 2 || n <= Tuning::DEFAULT.parallel_symv_from {
         reduce_panels(a, &mut t, None, par);
     } else {
         let team = SymvTeam::new();
@@ -70,15 +58,15 @@ pub(crate) fn tridiagonalize(a: &mut Mat<f64>, par: Par) -> Tridiagonal {
 /// The panel loop of [`tridiagonalize`]; `team` computes half of every large symmetric product.
 fn reduce_panels(a: &mut Mat<f64>, t: &mut Tridiagonal, team: Option<(&SymvTeam, &Thread)>, par: Par) {
     let n = a.nrows();
-    let mut w = Mat::<f64>::zeros(n, PANEL);
+    let mut w = Mat::<f64>::zeros(n, Tuning::DEFAULT.panel);
     // [V W] and [W V] side by side: the trailing update is then one product of inner dimension
     // 2·nb, one pass over the trailing matrix instead of two (measured: tridiagonalization
     // 4–8 % faster at n = 1000, 8–10 % at 2000; panels of 48 or 64 columns were slower).
-    let mut vw = Mat::<f64>::zeros(n, 2 * PANEL);
-    let mut wv = Mat::<f64>::zeros(n, 2 * PANEL);
+    let mut vw = Mat::<f64>::zeros(n, 2 * Tuning::DEFAULT.panel);
+    let mut wv = Mat::<f64>::zeros(n, 2 * Tuning::DEFAULT.panel);
     let mut p = 0;
     while p + 1 < n {
-        let nb = PANEL.min(n - 1 - p);
+        let nb = Tuning::DEFAULT.panel.min(n - 1 - p);
         reduce_panel(a, &mut w, p, nb, t, team);
         // A(q.., q..) −= V Wᵀ + W Vᵀ = [V W][W V]ᵀ on the lower triangle, q = p + nb (the
         // syr2k of dsytrd).
@@ -94,7 +82,7 @@ fn reduce_panels(a: &mut Mat<f64>, t: &mut Tridiagonal, team: Option<(&SymvTeam,
         rhs.rb_mut().subcols_mut(nb, nb).copy_from(v2);
         let trailing = a.as_mut().submatrix_mut(q, q, m, m);
         match team {
-            Some((team, helper)) if m >= SPLIT_UPDATE_FROM => {
+            Some((team, helper)) if m >= Tuning::DEFAULT.split_update_from => {
                 // The helper is awake (between two symmetric products): it takes the lower
                 // right triangle, this thread the columns left of it, half the area each.
                 let split = columns_holding(m, 0.25 * (m * m) as f64);
@@ -189,7 +177,7 @@ fn reduce_panel(
 
 /// dlatrd's y for column k = p + i of a panel: y = S v − V (Wᵀ v) − W (Vᵀ v), with
 /// S = A(k+1.., k+1..) (lower triangle read, not yet updated by the panel), v = A(k+1.., k),
-/// V = A(k+1.., p..k) and W = w(k+1.., 0..i). With a team, from order [`PARALLEL_SYMV_FROM`],
+/// V = A(k+1.., p..k) and W = w(k+1.., 0..i). With a team, from order [`crate::Tuning::parallel_symv_from`],
 /// the helper computes the right-hand columns of S v and the correction into `partial`, this
 /// thread the left-hand columns, so that the two take about the same time.
 fn panel_product(
@@ -205,7 +193,7 @@ fn panel_product(
     let m = y.len();
     let v = &a.col_as_slice(q - 1)[q..];
     match team {
-        Some((team, helper)) if m >= PARALLEL_SYMV_FROM => {
+        Some((team, helper)) if m >= Tuning::DEFAULT.parallel_symv_from => {
             // The caller takes a quarter of m² plus m·i, the estimated cost of the helper's
             // correction (4 passes over the two m×i panels, held in cache).
             let split = columns_holding(m, 0.25 * (m * m) as f64 + (m * i) as f64);
@@ -241,7 +229,7 @@ fn subtract_panel_correction(a: &Mat<f64>, w: &Mat<f64>, p: usize, i: usize, y: 
     let v_panel = a.as_ref().submatrix(k + 1, p, m, i);
     let w_panel = w.as_ref().submatrix(k + 1, 0, m, i);
     let v = a.as_ref().submatrix(k + 1, k, m, 1);
-    let mut coefficients = [0.0; PANEL];
+    let mut coefficients = [0.0; Tuning::DEFAULT.panel];
     let mut c = faer::MatMut::from_column_major_slice_mut(&mut coefficients[..i], i, 1);
     let mut y = faer::MatMut::from_column_major_slice_mut(y, m, 1);
     matmul(c.rb_mut(), Accum::Replace, w_panel.transpose(), v, 1.0, Par::Seq);
@@ -432,7 +420,7 @@ mod tests {
     #[test]
     fn panel_products_subtract_the_pending_update_on_either_thread() {
         // y = S v − V (Wᵀ v) − W (Vᵀ v) against its definition, with the helper taking the
-        // correction (order 700 > PARALLEL_SYMV_FROM) and without a team.
+        // correction (order 700 > `Tuning::parallel_symv_from`) and without a team.
         let n = 700;
         let a = symmetric(n, 3);
         let w = symmetric(n, 4);
