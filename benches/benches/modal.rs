@@ -38,7 +38,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use mechanica::modal::faer::Par;
 use mechanica::modal::linalg::reduce::{cholesky_and_reduce, reduce_two_solves};
-use mechanica::modal::{PencilProblem, SolveOptions, SparseOptions, SparsePencil, solve, solve_sparse, testing};
+use mechanica::modal::{PencilProblem, SolveOptions, SparsePencil, SparseSolveOptions, solve, solve_sparse, testing};
 use mechanica_benches::lapack;
 use mechanica_benches::modal::{nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra};
 use std::hint::black_box;
@@ -114,9 +114,9 @@ fn sparse(c: &mut Criterion) {
         Ok(p) => p,
         Err(e) => panic!("benchmark grid is valid: {e}"),
     };
-    let options = SparseOptions {
+    let options = SparseSolveOptions {
         count: 10,
-        ..SparseOptions::default()
+        ..SparseSolveOptions::default()
     };
     group.bench_with_input(
         BenchmarkId::new("mechanica_lowest10_grid", side * side),

@@ -38,7 +38,7 @@ use mechanica::modal::faer::sparse::Triplet;
 use mechanica::modal::faer::{Mat, MatRef, Side, get_global_parallelism};
 use mechanica::modal::linalg::reduce::{back_transform, cholesky_lower, reduce};
 use mechanica::modal::{
-    ModalSolution, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparseOptions, SparsePencil,
+    ModalSolution, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparsePencil, SparseSolveOptions,
     count_below, solve, solve_sparse, testing,
 };
 use mechanica_benches::modal::{
@@ -191,9 +191,9 @@ fn run(method: Method, case: &Case) -> Option<Row> {
                 Ok(p) => p,
                 Err(e) => return fail(&e),
             };
-            let options = SparseOptions {
+            let options = SparseSolveOptions {
                 count: LOWEST.min(case.n.saturating_sub(1)),
-                ..SparseOptions::default()
+                ..SparseSolveOptions::default()
             };
             let (t, out) = median_seconds(runs, time, || solve_sparse(&pencil, &options));
             let sol = match out {

@@ -9,7 +9,7 @@
 use crate::report::{Quantity, Report, Step, timed_step};
 use mechanica::modal::faer::Mat;
 use mechanica::modal::{
-    ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparseOptions, SparsePencil, Tuning,
+    ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparsePencil, SparseSolveOptions, Tuning,
     read_matrix_market, solve, solve_sparse,
 };
 use std::path::{Path, PathBuf};
@@ -197,9 +197,9 @@ pub fn run(args: &ModesArgs) -> Result<Report, String> {
         let pencil = SparsePencil::from_triplets(n, &a.entries, &b.entries).map_err(|e| e.to_string())?;
         let sol = solve_sparse(
             &pencil,
-            &SparseOptions {
+            &SparseSolveOptions {
                 count,
-                ..SparseOptions::default()
+                ..SparseSolveOptions::default()
             },
         )
         .map_err(|e| e.to_string())?;

@@ -1,6 +1,6 @@
 //! Times the sparse solver on an N×N grid Laplacian (default 300: n = 90 000, 10 lowest modes)
 //! and prints the report. `cargo run --release -p mechanica-modal --example sparse_grid -- 300 10`
-use mechanica_modal::{SparseOptions, SparsePencil, solve_sparse, testing};
+use mechanica_modal::{SparsePencil, SparseSolveOptions, solve_sparse, testing};
 use std::time::Instant;
 
 fn main() {
@@ -20,14 +20,14 @@ fn main() {
     let clock = Instant::now();
     let sol = match solve_sparse(
         &p,
-        &SparseOptions {
+        &SparseSolveOptions {
             count: k,
             block_size: std::env::var("BLOCK")
                 .ok()
                 .and_then(|b| b.parse().ok())
-                .unwrap_or(SparseOptions::default().block_size),
+                .unwrap_or(SparseSolveOptions::default().block_size),
             tolerance: std::env::var("TOL").ok().and_then(|b| b.parse().ok()).unwrap_or(1e-12),
-            ..SparseOptions::default()
+            ..SparseSolveOptions::default()
         },
     ) {
         Ok(s) => s,

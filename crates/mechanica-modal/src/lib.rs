@@ -60,15 +60,19 @@ pub mod testing;
 pub mod tuning;
 
 pub use certify::{AccuracyReport, BoundKind, InertiaCheck, InertiaCount, Residuals, count_below};
-pub use dense::{DenseTimings, Method, ModalSolution, Refinement, Selection, SolveOptions, solve};
+pub use dense::{Method, ModalSolution, Refinement, Selection, SolveOptions, SolveTimings, solve};
 pub use error::ModalError;
 pub use faer;
 pub use problem::PencilProblem;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use runtime::scratch::release as release_scratch;
-pub use sparse::SparsePencil;
-pub use sparse::{MatrixMarket, parse_matrix_market, read_matrix_market};
-pub use sparse::{SparseInertia, count_below_sparse};
-pub use sparse::{SparseModalSolution, SparseOptions, SparseReport, SparseTimings, solve_sparse};
+pub use sparse::{
+    MatrixMarket, SparseAccuracyReport, SparseInertiaCount, SparseModalSolution, SparsePencil, SparseSolveOptions,
+    SparseSolveTimings, count_below_sparse, parse_matrix_market, read_matrix_market, solve_sparse,
+};
 pub use spectrum::{Mode, ModeGroup, ModeKind, classify};
 pub use tuning::Tuning;
+
+// Old name; removed once the C layer uses the new one.
+#[doc(hidden)]
+pub type SparseOptions = SparseSolveOptions;

@@ -2,14 +2,14 @@
 //! eigenvalues), the dense solver, and bad input.
 
 use mechanica_modal::faer::sparse::Triplet;
-use mechanica_modal::{ModalError, SparseOptions, SparsePencil, count_below_sparse, solve_sparse, testing};
+use mechanica_modal::{ModalError, SparsePencil, SparseSolveOptions, count_below_sparse, solve_sparse, testing};
 
 const U: f64 = f64::EPSILON;
 
-fn lowest(k: usize) -> SparseOptions {
-    SparseOptions {
+fn lowest(k: usize) -> SparseSolveOptions {
+    SparseSolveOptions {
         count: k,
-        ..SparseOptions::default()
+        ..SparseSolveOptions::default()
     }
 }
 
@@ -60,10 +60,10 @@ fn inertia_guard_recovers_a_triple_eigenvalue() {
     let p = SparsePencil::from_triplets(n, &a, &b).expect("valid");
     let sol = solve_sparse(
         &p,
-        &SparseOptions {
+        &SparseSolveOptions {
             count: 5,
             block_size: 1,
-            ..SparseOptions::default()
+            ..SparseSolveOptions::default()
         },
     )
     .expect("solve");
@@ -148,7 +148,7 @@ fn bad_sparse_input_is_located() {
     assert!(matches!(
         solve_sparse(
             &p,
-            &SparseOptions {
+            &SparseSolveOptions {
                 shift: Some(f64::NAN),
                 ..lowest(1)
             }
@@ -162,7 +162,7 @@ fn bad_sparse_input_is_located() {
     assert!(matches!(
         solve_sparse(
             &g,
-            &SparseOptions {
+            &SparseSolveOptions {
                 shift: Some(0.5),
                 ..lowest(2)
             }
@@ -215,7 +215,7 @@ fn bad_tolerances_are_refused() {
     let (a, b) = testing::grid_laplacian(25, 25);
     let p = SparsePencil::from_triplets(625, &a, &b).expect("valid pencil");
     for tolerance in [f64::NAN, f64::INFINITY, 0.0, -1e-12, 1.0, 2.0] {
-        let options = SparseOptions { tolerance, ..lowest(3) };
+        let options = SparseSolveOptions { tolerance, ..lowest(3) };
         assert!(
             matches!(solve_sparse(&p, &options), Err(ModalError::BadTolerance(t)) if t.to_bits() == tolerance.to_bits()),
             "{tolerance}"
@@ -224,7 +224,7 @@ fn bad_tolerances_are_refused() {
     assert!(
         solve_sparse(
             &p,
-            &SparseOptions {
+            &SparseSolveOptions {
                 tolerance: 1e-8,
                 ..lowest(3)
             }

@@ -11,7 +11,7 @@
 
 use mechanica_modal::faer::Mat;
 use mechanica_modal::faer::sparse::Triplet;
-use mechanica_modal::{ModalError, SparseModalSolution, SparseOptions, SparsePencil, solve_sparse};
+use mechanica_modal::{ModalError, SparseModalSolution, SparsePencil, SparseSolveOptions, solve_sparse};
 use std::f64::consts::PI;
 
 const U: f64 = f64::EPSILON;
@@ -186,11 +186,11 @@ fn torus(m: usize) -> (SparsePencil, Vec<f64>) {
     (SparsePencil::from_triplets(n, &a, &b).expect("valid"), spectrum)
 }
 
-fn options(k: usize, block: usize) -> SparseOptions {
-    SparseOptions {
+fn options(k: usize, block: usize) -> SparseSolveOptions {
+    SparseSolveOptions {
         count: k,
         block_size: block,
-        ..SparseOptions::default()
+        ..SparseSolveOptions::default()
     }
 }
 
@@ -265,7 +265,7 @@ fn count_cutting_a_repeated_eigenvalue_is_reported() {
 #[test]
 fn exhausted_reruns_are_a_typed_error() {
     let p = chains(16, 100);
-    let single = SparseOptions {
+    let single = SparseSolveOptions {
         max_runs: 1,
         ..options(8, 2)
     };
@@ -277,7 +277,7 @@ fn exhausted_reruns_are_a_typed_error() {
         other => panic!("expected LanczosNoConvergence, got {other:?}"),
     }
     // max_runs = 0 is taken as 1, never as "no run".
-    let zero = SparseOptions { max_runs: 0, ..single };
+    let zero = SparseSolveOptions { max_runs: 0, ..single };
     assert!(matches!(
         solve_sparse(&p, &zero),
         Err(ModalError::LanczosNoConvergence { .. })
@@ -319,7 +319,7 @@ proptest::proptest! {
         let len = len.max(401 / copies + 1);
         let k = 1 + (k_frac * (2 * copies + 1) as f64) as usize;
         let p = chains(copies, len);
-        let sol = solve_sparse(&p, &SparseOptions { seed, ..options(k, block) }).expect("solve");
+        let sol = solve_sparse(&p, &SparseSolveOptions { seed, ..options(k, block) }).expect("solve");
         check_against_closed_form(&p, &sol, copies, len, k);
         proptest::prop_assert_eq!(sol.report.kth_group_multiplicity, copies);
     }

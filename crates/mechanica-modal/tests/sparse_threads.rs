@@ -3,7 +3,7 @@
 //! bit for bit. Alone in its test binary, because that setting is process-wide.
 
 use mechanica_modal::faer::{self, Par};
-use mechanica_modal::{SparseOptions, SparsePencil, solve_sparse, testing};
+use mechanica_modal::{SparsePencil, SparseSolveOptions, solve_sparse, testing};
 
 #[test]
 fn two_threads_and_one_give_the_same_modes() {
@@ -11,9 +11,9 @@ fn two_threads_and_one_give_the_same_modes() {
     let k = 12;
     let (a, b) = testing::grid_laplacian(side, side);
     let pencil = SparsePencil::from_triplets(side * side, &a, &b).expect("a valid pencil");
-    let options = SparseOptions {
+    let options = SparseSolveOptions {
         count: k,
-        ..SparseOptions::default()
+        ..SparseSolveOptions::default()
     };
     faer::set_global_parallelism(Par::rayon(2));
     let parallel = solve_sparse(&pencil, &options).expect("solves on two threads");

@@ -4,7 +4,7 @@
 
 use crate::certify::a_priori::APrioriModel;
 use crate::dense::options::Selection;
-use crate::dense::solution::DenseTimings;
+use crate::dense::solution::SolveTimings;
 use crate::error::ModalError;
 use crate::linalg::eigen::{
     OnTridiagonal, TridiagonalForm, symmetric_eigen_returning_input, symmetric_values_keeping_form,
@@ -29,7 +29,7 @@ pub(crate) struct Definite {
     /// Values only: the a-priori error model, when already computed.
     pub a_priori: Option<APrioriModel>,
     /// The reduction's time (as `factor`) and the eigensolver's (as `eigen`).
-    pub timings: DenseTimings,
+    pub timings: SolveTimings,
 }
 
 pub(crate) fn select(omega_sq: &[f64], selection: Selection) -> Result<(usize, usize), ModalError> {
@@ -81,14 +81,14 @@ pub(crate) fn solve_definite_owned(
             reduced: None,
             form: None,
             a_priori: None,
-            timings: DenseTimings::default(),
+            timings: SolveTimings::default(),
         });
     }
     let clock = Instant::now();
     let c = reduce_owned(l, b, par);
-    let mut timings = DenseTimings {
+    let mut timings = SolveTimings {
         factor: clock.elapsed(),
-        ..DenseTimings::default()
+        ..SolveTimings::default()
     };
     let clock = Instant::now();
     if !vectors {

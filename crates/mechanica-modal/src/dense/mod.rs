@@ -16,7 +16,7 @@ mod solution;
 mod values_only;
 
 pub use options::{AUTO_REFINE_RELATIVE_BOUND, Refinement, Selection, SolveOptions};
-pub use solution::{DenseTimings, Method, ModalSolution};
+pub use solution::{Method, ModalSolution, SolveTimings};
 
 use crate::certify::a_priori::APrioriModel;
 use crate::certify::idle_certificate;

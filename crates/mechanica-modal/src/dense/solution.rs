@@ -34,12 +34,12 @@ pub struct ModalSolution {
     /// Algorithm used.
     pub method: Method,
     /// Wall time of each stage.
-    pub timings: DenseTimings,
+    pub timings: SolveTimings,
 }
 
 /// Wall time of each stage of a dense [`solve`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct DenseTimings {
+pub struct SolveTimings {
     /// Cholesky of A (or the condensation of a semidefinite A) and the reduction C = L⁻¹BL⁻ᵀ.
     pub factor: Duration,
     /// Eigen-decomposition of C and back-transformation X = L⁻ᵀY.
@@ -59,6 +59,6 @@ pub(crate) fn empty_solution() -> ModalSolution {
         groups: Vec::new(),
         accuracy: AccuracyReport::empty(),
         method: Method::CholeskyReduction,
-        timings: DenseTimings::default(),
+        timings: SolveTimings::default(),
     }
 }

@@ -3,11 +3,11 @@
 //! bounds made rigorous by the inertia count at τ.
 
 use crate::dd::{self, Dd};
-use crate::sparse::inertia::SparseInertia;
+use crate::sparse::inertia::SparseInertiaCount;
 use crate::sparse::operator::{Mass, Operator, dot, product, solve_with};
 use crate::sparse::pencil::{SparsePencil, abs_quadratic};
 use crate::sparse::rayleigh_ritz::Refined;
-use crate::sparse::solution::{SparseModalSolution, SparseReport, SparseTimings};
+use crate::sparse::solution::{SparseAccuracyReport, SparseModalSolution, SparseSolveTimings};
 use crate::spectrum::{Mode, classify, group_modes};
 use faer::Mat;
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
@@ -181,7 +181,7 @@ pub(crate) fn finish(
     residuals: PairResiduals,
     k: usize,
     (sigma, tau): (f64, f64),
-    inertia: SparseInertia,
+    inertia: SparseInertiaCount,
     below: usize,
     (norm_a, norm_b): (f64, f64),
 ) -> SparseModalSolution {
@@ -243,7 +243,7 @@ pub(crate) fn finish(
     let vectors = Mat::from_fn(n, take, |i, c| refined.vectors[i + n * c]);
     let orthogonality_error = orthogonality(a, &vectors);
     SparseModalSolution {
-        report: SparseReport {
+        report: SparseAccuracyReport {
             shift: sigma,
             shift_attempts: 0,
             factor_nnz: 0,
@@ -259,7 +259,7 @@ pub(crate) fn finish(
             computed_below: below,
             consistent,
             dense_fallback: false,
-            timings: SparseTimings::default(),
+            timings: SparseSolveTimings::default(),
         },
         modes,
         vectors,

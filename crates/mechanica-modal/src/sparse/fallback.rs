@@ -3,9 +3,9 @@
 use crate::dense::{Refinement, Selection, SolveOptions, solve};
 use crate::error::ModalError;
 use crate::problem::PencilProblem;
-use crate::sparse::inertia::SparseInertia;
+use crate::sparse::inertia::SparseInertiaCount;
 use crate::sparse::pencil::SparsePencil;
-use crate::sparse::solution::{SparseModalSolution, SparseReport, SparseTimings};
+use crate::sparse::solution::{SparseAccuracyReport, SparseModalSolution, SparseSolveTimings};
 use crate::spectrum::group_modes;
 use faer::Mat;
 use std::time::Instant;
@@ -77,7 +77,7 @@ pub(crate) fn dense_fallback(
     };
     let check = sol.accuracy.inertia_check;
     Ok(SparseModalSolution {
-        report: SparseReport {
+        report: SparseAccuracyReport {
             shift: f64::NEG_INFINITY,
             shift_attempts: 0,
             factor_nnz: 0,
@@ -89,7 +89,7 @@ pub(crate) fn dense_fallback(
             kth_group_multiplicity,
             max_backward_error: sol.accuracy.max_backward_error.unwrap_or(0.0),
             orthogonality_error: sol.accuracy.orthogonality_error.unwrap_or(0.0),
-            inertia: check.map(|c| SparseInertia {
+            inertia: check.map(|c| SparseInertiaCount {
                 count: c.count,
                 min_pivot: 0.0,
                 max_pivot: 0.0,
@@ -97,9 +97,9 @@ pub(crate) fn dense_fallback(
             computed_below: check.map_or(0, |c| c.computed_below),
             consistent: check.is_some_and(|c| c.consistent),
             dense_fallback: true,
-            timings: SparseTimings {
+            timings: SparseSolveTimings {
                 refine: clock.elapsed(),
-                ..SparseTimings::default()
+                ..SparseSolveTimings::default()
             },
         },
         modes,

@@ -21,7 +21,7 @@ use faer::{Par, Side};
 
 /// The inertia of B − sA with the pivot sizes of its factorization.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SparseInertia {
+pub struct SparseInertiaCount {
     /// The counts (as for the dense [`crate::count_below`]).
     pub count: InertiaCount,
     /// Smallest |eigenvalue| over the 1×1 and 2×2 pivot blocks (0 when not known: dense path).
@@ -50,7 +50,7 @@ pub(crate) fn symbolic_supernodal(k: &Csc) -> Result<SymbolicCholesky<usize>, Mo
 }
 
 /// Counts the modes of the sparse pencil with ω² below `shift`.
-pub fn count_below_sparse(pencil: &SparsePencil, shift: f64) -> Result<SparseInertia, ModalError> {
+pub fn count_below_sparse(pencil: &SparsePencil, shift: f64) -> Result<SparseInertiaCount, ModalError> {
     if !shift.is_finite() {
         return Err(ModalError::BadShift(shift));
     }
@@ -65,10 +65,10 @@ pub(crate) fn inertia_with(
     symbolic: &SymbolicCholesky<usize>,
     k: &Csc,
     shift: f64,
-) -> Result<SparseInertia, ModalError> {
+) -> Result<SparseInertiaCount, ModalError> {
     let n = k.n;
     if n == 0 {
-        return Ok(SparseInertia {
+        return Ok(SparseInertiaCount {
             count: InertiaCount {
                 shift,
                 below: 0,
@@ -159,7 +159,7 @@ pub(crate) fn inertia_with(
             above += 1;
         }
     }
-    Ok(SparseInertia {
+    Ok(SparseInertiaCount {
         count: InertiaCount {
             shift,
             below,

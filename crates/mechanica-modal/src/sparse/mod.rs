@@ -29,10 +29,10 @@
 //!   eigenspace in exact arithmetic; further copies appear only from rounding, if at all):
 //!   Lanczos is rerun deflated against every found vector, with a block of as many vectors as
 //!   are missing (at most 32), so one rerun sees every missing copy of an eigenvalue. After
-//!   [`SparseOptions::max_runs`] runs without agreement the solve fails with
+//!   [`SparseSolveOptions::max_runs`] runs without agreement the solve fails with
 //!   [`ModalError::LanczosNoConvergence`] (found vs. counted below τ).
 //! - **Repeated eigenvalues at the cut.** Exactly k modes are returned; when the k-th and
-//!   (k+1)-th are equal, [`SparseReport::kth_group_multiplicity`] gives the full multiplicity of
+//!   (k+1)-th are equal, [`SparseAccuracyReport::kth_group_multiplicity`] gives the full multiplicity of
 //!   the k-th mode's eigenvalue (all its copies lie below τ and were computed).
 //! - **Bounds.** For a pair with θ = 1/(ω² − σ) the residual s = Ax − θKx gives
 //!   δ = ‖s‖_{K⁻¹}/‖x‖_K (one solve with K): the pencil (A, K) has an eigenvalue within δ of θ
@@ -53,11 +53,11 @@ mod rayleigh_ritz;
 mod solution;
 mod supernodal;
 
-pub use inertia::{SparseInertia, count_below_sparse};
+pub use inertia::{SparseInertiaCount, count_below_sparse};
 pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
-pub use options::SparseOptions;
+pub use options::SparseSolveOptions;
 pub use pencil::SparsePencil;
-pub use solution::{SparseModalSolution, SparseReport, SparseTimings};
+pub use solution::{SparseAccuracyReport, SparseModalSolution, SparseSolveTimings};
 
 use crate::error::ModalError;
 use crate::sparse::bounds::{finish, pair_residuals};
@@ -78,7 +78,7 @@ use std::time::{Duration, Instant};
 ///
 /// Exactly k = `options.count` modes are returned, ascending. When the k-th and (k+1)-th ω² are
 /// equal (k cuts through a repeated eigenvalue), the last returned group is an A-orthonormal basis
-/// of only part of that eigenspace; [`SparseReport::kth_group_multiplicity`] then exceeds the
+/// of only part of that eigenspace; [`SparseAccuracyReport::kth_group_multiplicity`] then exceeds the
 /// last group's multiplicity and says how many modes the whole eigenspace has.
 ///
 /// Errors: [`ModalError::TooManyModes`] for k = 0 or k > n (or when the deflated reruns would
@@ -87,7 +87,7 @@ use std::time::{Duration, Instant};
 /// converge within `max_restarts`, or when after `max_runs` Lanczos runs the inertia count still
 /// shows modes missing below the check shift τ (then `converged` = modes found below τ, `wanted` =
 /// the inertia count below τ, `restarts` = restarts over all runs).
-pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<SparseModalSolution, ModalError> {
+pub fn solve_sparse(pencil: &SparsePencil, options: &SparseSolveOptions) -> Result<SparseModalSolution, ModalError> {
     solve_sparse_from(pencil, options, None)
 }
 
@@ -95,7 +95,7 @@ pub fn solve_sparse(pencil: &SparsePencil, options: &SparseOptions) -> Result<Sp
 /// start the first run exactly A-orthogonal to an eigenvector, which no rounding can then reach.
 fn solve_sparse_from(
     pencil: &SparsePencil,
-    options: &SparseOptions,
+    options: &SparseSolveOptions,
     start: Option<&[f64]>,
 ) -> Result<SparseModalSolution, ModalError> {
     let n = pencil.dim();
@@ -120,7 +120,7 @@ fn solve_sparse_from(
     if n <= Tuning::DEFAULT.dense_limit {
         return dense_fallback(pencil, k, norm_a, norm_b);
     }
-    let mut timings = SparseTimings::default();
+    let mut timings = SparseSolveTimings::default();
     let (ca, cb) = (pencil.csc_a(), pencil.csc_b());
     // Factor K = B − σA at a shift below the spectrum.
     let clock = Instant::now();
@@ -218,7 +218,7 @@ fn solve_sparse_from(
         let kmat = Csc::combine(1.0, &cb, -tau, &ca);
         (inertia_with(inertia_symbolic, &kmat, tau), clock.elapsed())
     };
-    let joined = |counted: std::thread::Result<(Result<SparseInertia, ModalError>, Duration)>| {
+    let joined = |counted: std::thread::Result<(Result<SparseInertiaCount, ModalError>, Duration)>| {
         counted.unwrap_or_else(|_| {
             let failure = ModalError::Factorization {
                 what: "B − τA",
@@ -433,10 +433,10 @@ mod tests {
     fn modes_invisible_from_the_start_block_are_recovered() {
         let len = 300;
         let (p, exact) = two_chains(len);
-        let options = SparseOptions {
+        let options = SparseSolveOptions {
             count: 6,
             block_size: 1,
-            ..SparseOptions::default()
+            ..SparseSolveOptions::default()
         };
         let mut start = vec![0.0; 2 * len];
         for (i, x) in start[len..].iter_mut().enumerate() {
@@ -447,7 +447,7 @@ mod tests {
         assert_eq!(sol.modes.len(), 6);
         assert_matches(&sol, &exact);
         // With a single run allowed the missed modes are a typed error naming both counts.
-        let single = SparseOptions { max_runs: 1, ..options };
+        let single = SparseSolveOptions { max_runs: 1, ..options };
         match solve_sparse_from(&p, &single, Some(&start)) {
             Err(ModalError::LanczosNoConvergence { converged, wanted, .. }) => {
                 assert!(converged < wanted, "{converged} of {wanted}");
@@ -467,10 +467,10 @@ mod tests {
             *x = scale * (1.0 + (i % 5) as f64);
         }
         for block in [1, 2] {
-            let options = SparseOptions {
+            let options = SparseSolveOptions {
                 count: 8,
                 block_size: block,
-                ..SparseOptions::default()
+                ..SparseSolveOptions::default()
             };
             let mut s = start.clone();
             if block == 2 {

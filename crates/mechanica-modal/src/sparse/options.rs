@@ -3,7 +3,7 @@
 
 /// Options of [`solve_sparse`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SparseOptions {
+pub struct SparseSolveOptions {
     /// Number k of lowest modes wanted (1 ≤ k < n).
     pub count: usize,
     /// Shift σ (rad²/s²) below the lowest mode; None: automatic (see the module documentation).
@@ -24,7 +24,7 @@ pub struct SparseOptions {
     pub max_runs: usize,
 }
 
-impl Default for SparseOptions {
+impl Default for SparseSolveOptions {
     fn default() -> Self {
         Self {
             count: 10,

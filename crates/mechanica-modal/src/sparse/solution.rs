@@ -1,14 +1,14 @@
 //! The result of a sparse solve: the modes, their shapes and groups, and the report of how they
 //! were obtained and how accurate they are.
 
-use crate::sparse::inertia::SparseInertia;
+use crate::sparse::inertia::SparseInertiaCount;
 use crate::spectrum::{Mode, ModeGroup};
 use faer::Mat;
 use std::time::Duration;
 
 /// Wall time of each stage of a sparse solve.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct SparseTimings {
+pub struct SparseSolveTimings {
     /// Symbolic analysis and Cholesky factorization of B − σA (all shifts tried).
     pub factor: Duration,
     /// Lanczos iterations (all rounds).
@@ -24,7 +24,7 @@ pub struct SparseTimings {
 
 /// How the sparse result was obtained and how accurate it is.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SparseReport {
+pub struct SparseAccuracyReport {
     /// The shift σ of the factored operator (every mode lies above it).
     pub shift: f64,
     /// Cholesky factorizations tried to find a positive definite B − σA.
@@ -52,7 +52,7 @@ pub struct SparseReport {
     /// max |(XᵀAX − I)_ij| of the returned vectors.
     pub orthogonality_error: f64,
     /// The inertia check: B − τA at τ in a gap above the k-th mode.
-    pub inertia: Option<SparseInertia>,
+    pub inertia: Option<SparseInertiaCount>,
     /// How many computed modes lie below τ.
     pub computed_below: usize,
     /// Whether the inertia count equals computed_below (no mode below τ missed or invented).
@@ -60,7 +60,7 @@ pub struct SparseReport {
     /// True when the problem was small enough to be solved densely (n ≤ [`crate::Tuning::dense_limit`]).
     pub dense_fallback: bool,
     /// Stage timings.
-    pub timings: SparseTimings,
+    pub timings: SparseSolveTimings,
 }
 
 /// The k lowest modes of a sparse pencil.
@@ -73,5 +73,5 @@ pub struct SparseModalSolution {
     /// Groups of numerically equal frequencies (repeated modes).
     pub groups: Vec<ModeGroup>,
     /// Accuracy and cost.
-    pub report: SparseReport,
+    pub report: SparseAccuracyReport,
 }
