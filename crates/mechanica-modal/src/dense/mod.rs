@@ -12,6 +12,7 @@ mod definite;
 mod finish;
 mod idle_inputs;
 mod options;
+mod refinement;
 mod solution;
 mod values_only;
 

@@ -51,6 +51,7 @@ mod options;
 mod pencil;
 mod rayleigh_ritz;
 mod solution;
+mod sturm;
 mod supernodal;
 
 pub use inertia::{SparseInertiaCount, count_below_sparse};
@@ -60,18 +61,15 @@ pub use pencil::SparsePencil;
 pub use solution::{SparseAccuracyReport, SparseModalSolution, SparseSolveTimings};
 
 use crate::error::ModalError;
-use crate::sparse::bounds::{finish, pair_residuals};
+use crate::sparse::bounds::{PairResiduals, finish, pair_residuals};
 use crate::sparse::fallback::dense_fallback;
-use crate::sparse::inertia::{inertia_with, symbolic_supernodal};
 use crate::sparse::lanczos::{Lcg, lanczos_run};
-use crate::sparse::operator::{Mass, Operator, factor_llt};
-use crate::sparse::pencil::{Csc, frobenius};
-use crate::sparse::rayleigh_ritz::rayleigh_ritz;
+use crate::sparse::operator::{Mass, Operator, factor_below_spectrum};
+use crate::sparse::pencil::frobenius;
+use crate::sparse::rayleigh_ritz::{Refined, rayleigh_ritz};
+use crate::sparse::sturm::{Counted, InertiaCounter, TauChoice, joined};
 use crate::tuning::Tuning;
-use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
-};
-use faer::{Par, Side};
+use faer::Par;
 use std::time::{Duration, Instant};
 
 /// Solves for the `options.count` lowest modes of the sparse pencil. See the module documentation.
@@ -100,20 +98,7 @@ fn solve_sparse_from(
 ) -> Result<SparseModalSolution, ModalError> {
     let n = pencil.dim();
     let k = options.count;
-    if k == 0 || k > n {
-        return Err(ModalError::TooManyModes {
-            requested: k,
-            available: n,
-        });
-    }
-    if let Some(s) = options.shift
-        && !s.is_finite()
-    {
-        return Err(ModalError::BadShift(s));
-    }
-    if !(options.tolerance > 0.0 && options.tolerance < 1.0) {
-        return Err(ModalError::BadTolerance(options.tolerance));
-    }
+    options.check(n)?;
     let (a, b) = (pencil.a(), pencil.b());
     let norm_a = frobenius(a);
     let norm_b = frobenius(b);
@@ -122,47 +107,13 @@ fn solve_sparse_from(
     }
     let mut timings = SparseSolveTimings::default();
     let (ca, cb) = (pencil.csc_a(), pencil.csc_b());
-    // Factor K = B − σA at a shift below the spectrum.
     let clock = Instant::now();
-    let pattern = Csc::combine(1.0, &cb, 1.0, &ca);
-    let symbolic = factorize_symbolic_cholesky(
-        pattern.to_faer().symbolic(),
-        Side::Lower,
-        SymmetricOrdering::Amd,
-        // faer's own choice (supernodal here): a simplicial factor has cheaper solves but on the
-        // 300×300 grid its slower factorization cost more than that saved (idle: 1.63 s against
-        // 1.89 s in all at block size 2).
-        CholeskySymbolicParams::default(),
-    )
-    .map_err(|e| ModalError::Factorization {
-        what: "B − σA (symbolic)",
-        detail: format!("{e:?}"),
-    })?;
     let ratio = if norm_a > 0.0 { norm_b / norm_a } else { 1.0 };
-    let mut sigma = options
-        .shift
-        .unwrap_or(-f64::EPSILON.sqrt() * ratio.max(f64::MIN_POSITIVE));
-    let mut attempts = 0;
-    let values = loop {
-        attempts += 1;
-        match factor_llt(&symbolic, &Csc::combine(1.0, &cb, -sigma, &ca))? {
-            Ok(values) => break values,
-            Err(pivot) => {
-                if options.shift.is_some() || attempts >= Tuning::DEFAULT.shift_attempts {
-                    return Err(ModalError::NoDefiniteShift {
-                        lowest_shift: sigma,
-                        pivot,
-                    });
-                }
-                sigma *= 1e3;
-            }
-        }
-    };
+    let (factor, values) = factor_below_spectrum(&ca, &cb, ratio, options.shift)?;
     timings.factor = clock.elapsed();
-    // Independent work runs on two threads unless faer's global parallelism is sequential.
-    let concurrent = !matches!(faer::get_global_parallelism(), Par::Seq);
+    let sigma = factor.sigma;
     let mut op = Operator {
-        symbolic: &symbolic,
+        symbolic: &factor.symbolic,
         values,
         a: Mass::of(a),
         applications: 0,
@@ -170,92 +121,18 @@ fn solve_sparse_from(
         work: Vec::new(),
     };
     let mut rng = Lcg(options.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x5851_f42d_4c95_7f2d);
-    // Gaps narrower than this (relative, plus an absolute floor at the rounding level of ω²
-    // near zero, e.g. rigid-body modes) may lie inside a numerically repeated eigenvalue: an
-    // inertia shift there could split the group, so τ is never placed in one.
-    let min_gap = f64::EPSILON.sqrt().max(100.0 * options.tolerance);
-    let floor = 100.0 * f64::EPSILON * ratio;
-    let is_real_gap = |below: f64, above: f64| above - below > min_gap * below.abs().max(above.abs()) + floor;
-    let real_gap = |omega: &[f64], j: usize| is_real_gap(omega[j], omega[j + 1]);
-    // τ in the widest real gap between the k-th mode and the last one found (ω² ascending);
-    // above the last one when every gap there is within a cluster.
-    let choose_tau = |omega: &[f64]| -> f64 {
-        let last = omega.len() - 1;
-        let kth = (k - 1).min(last);
-        match (kth..last)
-            .filter(|&j| real_gap(omega, j))
-            .max_by(|&i, &j| gap(omega, i).total_cmp(&gap(omega, j)))
-        {
-            Some(j) => 0.5 * (omega[j] + omega[j + 1]),
-            None => omega[last] + 0.5 * (omega[last] - sigma).abs(),
-        }
+    let solve = LanczosSolve {
+        pencil,
+        options,
+        sigma,
+        norms: (norm_a, norm_b),
+        // Independent work runs on two threads unless faer's global parallelism is sequential.
+        concurrent: !matches!(faer::get_global_parallelism(), Par::Seq),
+        tau: TauChoice::new(k, sigma, options.tolerance, ratio),
+        counter: InertiaCounter::new(&factor.symbolic, &factor.pattern, &ca, &cb)?,
     };
-    // A τ chosen from rough Ritz values still serves for the final ones when it lies above the
-    // k-th of them and in the middle half of a real gap (or, above the last, a real gap away).
-    let tau_is_clear = |omega: &[f64], tau: f64| -> bool {
-        let j = omega.partition_point(|&w| w < tau);
-        if j < k.min(omega.len()) || j == 0 {
-            return false;
-        }
-        match omega.get(j) {
-            Some(&above) => {
-                let below = omega[j - 1];
-                let quarter = 0.25 * (above - below);
-                real_gap(omega, j - 1) && tau - below >= quarter && above - tau >= quarter
-            }
-            None => is_real_gap(omega[j - 1], tau),
-        }
-    };
-    // The inertia count needs a supernodal analysis of the same pattern: the Cholesky one when
-    // faer chose supernodal (as on large problems), else a forced one.
-    let forced_supernodal = match symbolic.raw() {
-        SymbolicCholeskyRaw::Supernodal(_) => None,
-        SymbolicCholeskyRaw::Simplicial(_) => Some(symbolic_supernodal(&pattern)?),
-    };
-    let inertia_symbolic = forced_supernodal.as_ref().unwrap_or(&symbolic);
-    let count_at = |tau: f64| {
-        let clock = Instant::now();
-        let kmat = Csc::combine(1.0, &cb, -tau, &ca);
-        (inertia_with(inertia_symbolic, &kmat, tau), clock.elapsed())
-    };
-    let joined = |counted: std::thread::Result<(Result<SparseInertiaCount, ModalError>, Duration)>| {
-        counted.unwrap_or_else(|_| {
-            let failure = ModalError::Factorization {
-                what: "B − τA",
-                detail: "the inertia count failed".into(),
-            };
-            (Err(failure), Duration::ZERO)
-        })
-    };
-    // First run: k plus a buffer, so that a gap above the k-th mode is seen. Once its θ are
-    // roughly converged the inertia count at a τ chosen from them starts on a second thread.
-    let buffer = (k / 4).clamp(2, 10);
     let clock = Instant::now();
-    let (first, mut early) = std::thread::scope(|scope| {
-        let mut pending = None;
-        let mut start_count = |theta: &[f64]| {
-            let omega: Vec<f64> = theta.iter().map(|t| sigma + 1.0 / t).collect();
-            let tau = choose_tau(&omega);
-            // (Should no thread be creatable, the count is done after the run instead.)
-            let counting = std::thread::Builder::new().spawn_scoped(scope, move || count_at(tau));
-            pending = counting.ok().map(|handle| (tau, handle));
-        };
-        let run = lanczos_run(
-            &mut op,
-            (k + buffer).min(n - 1),
-            k,
-            options.block_size,
-            &[],
-            0,
-            options.tolerance,
-            options.max_restarts,
-            &mut rng,
-            start,
-            if concurrent { Some(&mut start_count) } else { None },
-        );
-        let early = pending.map(|(tau, handle)| (tau, joined(handle.join())));
-        (run, early)
-    });
+    let (first, mut early) = solve.first_run(&mut op, &mut rng, start);
     let (_, mut found, mut restarts) = first?;
     timings.lanczos += clock.elapsed();
     let mut runs = 1;
@@ -274,35 +151,7 @@ fn solve_sparse_from(
             });
         }
         let cols = omega.len();
-        let residuals = |op: &mut Operator<'_>, two_threads: bool| {
-            let clock = Instant::now();
-            (
-                pair_residuals(pencil, op, &refined, sigma, (norm_a, norm_b), two_threads),
-                clock.elapsed(),
-            )
-        };
-        // The early count when its τ still fits the refined modes; else a count now, beside the
-        // residuals of the refined pairs.
-        let (tau, (inertia, inertia_time), (residuals, residual_time)) =
-            match early.take().filter(|(tau, _)| tau_is_clear(omega, *tau)) {
-                Some((tau, counted)) => (tau, counted, residuals(&mut op, concurrent)),
-                None => {
-                    let tau = choose_tau(omega);
-                    if concurrent {
-                        std::thread::scope(|scope| {
-                            match std::thread::Builder::new().spawn_scoped(scope, || count_at(tau)) {
-                                Ok(counting) => {
-                                    let residuals = residuals(&mut op, false);
-                                    (tau, joined(counting.join()), residuals)
-                                }
-                                Err(_) => (tau, count_at(tau), residuals(&mut op, false)),
-                            }
-                        })
-                    } else {
-                        (tau, count_at(tau), residuals(&mut op, false))
-                    }
-                }
-            };
+        let (tau, (inertia, inertia_time), (residuals, residual_time)) = solve.check(&mut op, &refined, early.take());
         let below = omega.partition_point(|&w| w < tau);
         timings.inertia += inertia_time;
         timings.refine += residual_time;
@@ -321,8 +170,8 @@ fn solve_sparse_from(
                 (norm_a, norm_b),
             );
             timings.refine += clock.elapsed();
-            solution.report.shift_attempts = attempts;
-            solution.report.factor_nnz = symbolic.len_val();
+            solution.report.shift_attempts = factor.attempts;
+            solution.report.factor_nnz = factor.symbolic.len_val();
             solution.report.operator_applications = op.applications;
             solution.report.restarts = restarts;
             solution.report.lanczos_runs = runs;
@@ -337,24 +186,8 @@ fn solve_sparse_from(
                 restarts,
             });
         }
-        // Missed modes (repeated eigenvalues): rerun deflated against everything found. A block
-        // of `missing` vectors (at most `Tuning::max_rerun_block`) sees every missing copy of an eigenvalue in one
-        // run, whatever its multiplicity.
         let clock = Instant::now();
-        let rerun_nev = (missing + 1).min(n.saturating_sub(cols + 1)).max(1);
-        let (_, more, r) = lanczos_run(
-            &mut op,
-            rerun_nev,
-            rerun_nev,
-            options.block_size.max(missing.min(Tuning::DEFAULT.max_rerun_block)),
-            &refined.vectors,
-            cols,
-            options.tolerance,
-            options.max_restarts,
-            &mut rng,
-            None,
-            None,
-        )?;
+        let (_, more, r) = solve.rerun(&mut op, &mut rng, missing, &refined.vectors, cols)?;
         timings.lanczos += clock.elapsed();
         restarts += r;
         runs += 1;
@@ -363,13 +196,123 @@ fn solve_sparse_from(
     }
 }
 
-/// ω²_{j+1} − ω²_j relative to max(|ω²_j|, |ω²_{j+1}|) (0 past the end).
-fn gap(omega: &[f64], j: usize) -> f64 {
-    if j + 1 >= omega.len() {
-        return 0.0;
+/// The first run's result, and the inertia count it started early at the τ given.
+type FirstRun = (Result<(Vec<f64>, Vec<f64>, usize), ModalError>, Option<(f64, Counted)>);
+
+/// What the Lanczos runs and Sturm checks of one sparse solve share.
+struct LanczosSolve<'a> {
+    pencil: &'a SparsePencil,
+    options: &'a SparseSolveOptions,
+    /// The operator's shift σ (every mode lies above it).
+    sigma: f64,
+    /// (‖A‖_F, ‖B‖_F).
+    norms: (f64, f64),
+    /// Whether independent work runs on two threads.
+    concurrent: bool,
+    tau: TauChoice,
+    counter: InertiaCounter<'a>,
+}
+
+impl LanczosSolve<'_> {
+    /// The first run: k plus a buffer, so that a gap above the k-th mode is seen. Once its θ
+    /// are roughly converged the inertia count at a τ chosen from them starts on a second thread
+    /// (when no thread can be created, the count is done after the run instead).
+    fn first_run(&self, op: &mut Operator<'_>, rng: &mut Lcg, start: Option<&[f64]>) -> FirstRun {
+        let (n, k) = (self.pencil.dim(), self.options.count);
+        let buffer = (k / 4).clamp(2, 10);
+        let counter = &self.counter;
+        std::thread::scope(|scope| {
+            let mut pending = None;
+            let mut start_count = |theta: &[f64]| {
+                let omega: Vec<f64> = theta.iter().map(|t| self.sigma + 1.0 / t).collect();
+                let tau = self.tau.choose(&omega);
+                let counting = std::thread::Builder::new().spawn_scoped(scope, move || counter.count_at(tau));
+                pending = counting.ok().map(|handle| (tau, handle));
+            };
+            let run = lanczos_run(
+                op,
+                (k + buffer).min(n - 1),
+                k,
+                self.options.block_size,
+                &[],
+                0,
+                self.options.tolerance,
+                self.options.max_restarts,
+                rng,
+                start,
+                if self.concurrent { Some(&mut start_count) } else { None },
+            );
+            let early = pending.map(|(tau, handle)| (tau, joined(handle.join())));
+            (run, early)
+        })
     }
-    let scale = omega[j].abs().max(omega[j + 1].abs()).max(f64::MIN_POSITIVE);
-    (omega[j + 1] - omega[j]) / scale
+
+    /// τ and the inertia count there, with the residuals of the `refined` pairs: the `early`
+    /// count when its τ still fits the refined modes, else a count now, beside the residuals.
+    fn check(
+        &self,
+        op: &mut Operator<'_>,
+        refined: &Refined,
+        early: Option<(f64, Counted)>,
+    ) -> (f64, Counted, (PairResiduals, Duration)) {
+        let omega = &refined.omega_sq;
+        let residuals = |op: &mut Operator<'_>, two_threads: bool| {
+            let clock = Instant::now();
+            (
+                pair_residuals(self.pencil, op, refined, self.sigma, self.norms, two_threads),
+                clock.elapsed(),
+            )
+        };
+        match early.filter(|(tau, _)| self.tau.is_clear(omega, *tau)) {
+            Some((tau, counted)) => (tau, counted, residuals(op, self.concurrent)),
+            None => {
+                let tau = self.tau.choose(omega);
+                if self.concurrent {
+                    std::thread::scope(|scope| {
+                        match std::thread::Builder::new().spawn_scoped(scope, || self.counter.count_at(tau)) {
+                            Ok(counting) => {
+                                let residuals = residuals(op, false);
+                                (tau, joined(counting.join()), residuals)
+                            }
+                            Err(_) => (tau, self.counter.count_at(tau), residuals(op, false)),
+                        }
+                    })
+                } else {
+                    (tau, self.counter.count_at(tau), residuals(op, false))
+                }
+            }
+        }
+    }
+
+    /// Missed modes (repeated eigenvalues): a run deflated against the `cols` vectors `found`.
+    /// A block of `missing` vectors (at most [`Tuning::max_rerun_block`]) sees every missing
+    /// copy of an eigenvalue in one run, whatever its multiplicity.
+    fn rerun(
+        &self,
+        op: &mut Operator<'_>,
+        rng: &mut Lcg,
+        missing: usize,
+        found: &[f64],
+        cols: usize,
+    ) -> Result<(Vec<f64>, Vec<f64>, usize), ModalError> {
+        let n = self.pencil.dim();
+        let rerun_nev = (missing + 1).min(n.saturating_sub(cols + 1)).max(1);
+        lanczos_run(
+            op,
+            rerun_nev,
+            rerun_nev,
+            self.options
+                .block_size
+                .max(missing.min(Tuning::DEFAULT.max_rerun_block)),
+            found,
+            cols,
+            self.options.tolerance,
+            self.options.max_restarts,
+            rng,
+            None,
+            None,
+        )
+    }
 }
 
 #[cfg(test)]

@@ -4,8 +4,12 @@
 use crate::error::ModalError;
 use crate::sparse::pencil::{Csc, mul};
 use crate::sparse::supernodal::SupernodalSolver;
+use crate::tuning::Tuning;
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, SymbolicCholeskyRaw};
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
 use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 use std::time::{Duration, Instant};
 
@@ -158,6 +162,67 @@ fn product_to(target: MatMut<'_, f64>, lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64
 
 pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| a * b).sum()
+}
+
+/// K = B − σA factored at a shift σ below the spectrum.
+pub(crate) struct ShiftedFactor {
+    /// The union of the patterns of A and B (that of every B − sA).
+    pub(crate) pattern: Csc,
+    /// Its symbolic Cholesky analysis (AMD ordering).
+    pub(crate) symbolic: SymbolicCholesky<usize>,
+    /// The shift σ.
+    pub(crate) sigma: f64,
+    /// Cholesky factorizations tried to find it.
+    pub(crate) attempts: usize,
+}
+
+/// Factors K = B − σA (`b`, `a`) at the given shift, or at the automatic σ = −√u·‖B‖_F/‖A‖_F
+/// (`ratio`) lowered by factors of 1000 while K is not positive definite (at most
+/// [`Tuning::shift_attempts`] tries); returns the factor's numeric values beside it.
+/// [`ModalError::NoDefiniteShift`] when no tried shift gives a positive definite K.
+pub(crate) fn factor_below_spectrum(
+    a: &Csc,
+    b: &Csc,
+    ratio: f64,
+    shift: Option<f64>,
+) -> Result<(ShiftedFactor, Vec<f64>), ModalError> {
+    let pattern = Csc::combine(1.0, b, 1.0, a);
+    let symbolic = factorize_symbolic_cholesky(
+        pattern.to_faer().symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Amd,
+        // faer's own choice (supernodal on large grids): a simplicial factor has cheaper solves
+        // but a slower factorization, which costs more than that saves.
+        CholeskySymbolicParams::default(),
+    )
+    .map_err(|e| ModalError::Factorization {
+        what: "B − σA (symbolic)",
+        detail: format!("{e:?}"),
+    })?;
+    let mut sigma = shift.unwrap_or(-f64::EPSILON.sqrt() * ratio.max(f64::MIN_POSITIVE));
+    let mut attempts = 0;
+    let values = loop {
+        attempts += 1;
+        match factor_llt(&symbolic, &Csc::combine(1.0, b, -sigma, a))? {
+            Ok(values) => break values,
+            Err(pivot) => {
+                if shift.is_some() || attempts >= Tuning::DEFAULT.shift_attempts {
+                    return Err(ModalError::NoDefiniteShift {
+                        lowest_shift: sigma,
+                        pivot,
+                    });
+                }
+                sigma *= 1e3;
+            }
+        }
+    };
+    let factor = ShiftedFactor {
+        pattern,
+        symbolic,
+        sigma,
+        attempts,
+    };
+    Ok((factor, values))
 }
 
 #[cfg(test)]

@@ -1,6 +1,8 @@
 //! What a sparse solve is asked for: how many modes, the shift, the tolerance and the limits of
 //! the Lanczos iteration.
 
+use crate::error::ModalError;
+
 /// Options of [`solve_sparse`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SparseSolveOptions {
@@ -35,5 +37,28 @@ impl Default for SparseSolveOptions {
             block_size: 2,
             max_runs: 6,
         }
+    }
+}
+
+impl SparseSolveOptions {
+    /// [`ModalError::TooManyModes`] unless 1 ≤ k ≤ n, [`ModalError::BadShift`] for a shift that
+    /// is not finite, [`ModalError::BadTolerance`] unless 0 < tolerance < 1.
+    pub(crate) fn check(&self, n: usize) -> Result<(), ModalError> {
+        let k = self.count;
+        if k == 0 || k > n {
+            return Err(ModalError::TooManyModes {
+                requested: k,
+                available: n,
+            });
+        }
+        if let Some(s) = self.shift
+            && !s.is_finite()
+        {
+            return Err(ModalError::BadShift(s));
+        }
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return Err(ModalError::BadTolerance(self.tolerance));
+        }
+        Ok(())
     }
 }
