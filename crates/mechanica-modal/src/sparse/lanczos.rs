@@ -183,9 +183,12 @@ type RoughHook<'a> = &'a mut dyn FnMut(&[f64]);
 /// A-orthogonal complement of `locked`, from the n × b column-major `start` block when given
 /// with that size (tests), else from a pseudo-random block. The first `strict` of them converge
 /// to `tolerance`, the rest (a buffer that only has to show where the spectrum has a gap) to
-/// [`crate::Tuning::buffer_tolerance`]. `rough`, when given, is called once with the nev θ (descending) as
-/// soon as all of them have converged to [`crate::Tuning::rough_tolerance`] (not when they converge fully at
-/// the first check). Returns (θ descending, n × nev Ritz vectors, restarts).
+/// [`Tuning::buffer_tolerance`]. `rough`, when given, is called once with the nev θ
+/// (descending) as soon as all of them have converged to [`Tuning::rough_tolerance`] (not when
+/// they converge fully at the first check). Convergence is checked after every block step, not
+/// only when the basis is full: the projected problem is tiny (at most m columns), and a run
+/// then stops at the first block at which every wanted pair has converged instead of finishing
+/// the cycle. Returns (θ descending, n × nev Ritz vectors, restarts).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn lanczos_run(
     op: &mut Operator<'_>,
@@ -200,102 +203,19 @@ pub(crate) fn lanczos_run(
     start: Option<&[f64]>,
     mut rough: Option<RoughHook<'_>>,
 ) -> Result<(Vec<f64>, Vec<f64>, usize), ModalError> {
-    let a = op.a;
-    let n = a.nrows();
-    let room = n.saturating_sub(locked_cols);
-    let b = block.clamp(1, (room / 4).max(1));
-    // m basis columns (a multiple of b) plus one residual block.
-    // 2·nev + 4b: with convergence checked after every block step, a larger basis saves no
-    // operator application on the 300×300 grid (k = 10, b = 2: 72 for every m from 32 to 56),
-    // only orthogonalisation work; 2·nev + 2b needed more.
-    let wanted_m = (2 * nev + 4 * b).max(Tuning::DEFAULT.lanczos_min_basis);
-    let m = (wanted_m.div_ceil(b) * b).min((room.saturating_sub(b) / b) * b);
-    if m < 2 * b || nev >= m {
-        return Err(ModalError::TooManyModes {
-            requested: nev + locked_cols,
-            available: n,
-        });
-    }
-    let mut basis = vec![0.0; n * (m + b)];
-    // Second basis buffer for the restarts (allocated at the first).
-    let mut spare = Vec::new();
-    let mut h = Mat::<f64>::zeros(m + b, m);
-    let mut scratch = vec![0.0; n * b];
-    let mut w = vec![0.0; n * b];
-    // Start block: given or random, A-orthonormal, A-orthogonal to the locked vectors.
-    match start {
-        Some(given) if given.len() == w.len() => w.copy_from_slice(given),
-        _ => w.iter_mut().for_each(|x| *x = rng.next()),
-    }
-    let _ = orthogonalise_block(a, &[], 0, 0, locked, locked_cols, &mut w, &mut scratch);
-    normalise_block(a, &[], 0, locked, locked_cols, &mut w, 1.0, rng, &mut scratch[..n])?;
-    basis[..n * b].copy_from_slice(&w);
-    let mut cols = 0usize;
-    // Columns kept by the last restart (0 before the first).
-    let mut kept = 0usize;
-    let mut restarts = 0usize;
+    let locked = Locked {
+        vectors: locked,
+        cols: locked_cols,
+    };
+    let mut krylov = Krylov::start(op.a, nev, block, locked, rng, start)?;
     loop {
-        // Expand by one block.
-        let current = &basis[n * cols..n * (cols + b)];
-        a.apply_block(current, &mut w);
-        op.solve_block(&mut w, b);
-        // The recurrence couples the block to the previous one, or after a restart (and at the
-        // start) to every kept Ritz vector.
-        let coupled_from = if cols == kept { 0 } else { cols - b };
-        let coefficients = orthogonalise_block(
-            a,
-            &basis,
-            cols + b,
-            coupled_from,
-            locked,
-            locked_cols,
-            &mut w,
-            &mut scratch,
-        );
-        let scale = (0..cols + b)
-            .flat_map(|i| (0..b).map(move |c| (i, c)))
-            .fold(0.0_f64, |s, (i, c)| s.max(coefficients[(i, c)].abs()));
-        let r = normalise_block(
-            a,
-            &basis,
-            cols + b,
-            locked,
-            locked_cols,
-            &mut w,
-            scale,
-            rng,
-            &mut scratch[..n],
-        )?;
-        for c in 0..b {
-            for i in 0..cols + b {
-                h[(i, cols + c)] = coefficients[(i, c)];
-            }
-            for i in 0..b {
-                h[(cols + b + i, cols + c)] = r[(i, c)];
-            }
-        }
-        basis[n * (cols + b)..n * (cols + 2 * b)].copy_from_slice(&w);
-        cols += b;
-        // Convergence is checked after every block step, not only when the basis is full: the
-        // projected problem is tiny (cols ≤ m), and a run then stops at the first block at which
-        // every wanted pair has converged instead of finishing the cycle.
-        if cols < nev + b {
+        krylov.expand(op, locked, rng)?;
+        if krylov.cols < nev + krylov.b {
             continue;
         }
-        let ritz = RitzPairs::of(&h, cols, b)?;
-        let wanted: Vec<usize> = (0..nev).map(|r| cols - 1 - r).collect();
-        let converged = wanted
-            .iter()
-            .enumerate()
-            .filter(|&(r, &c)| {
-                let goal = if r < strict {
-                    tolerance
-                } else {
-                    tolerance.max(Tuning::DEFAULT.buffer_tolerance)
-                };
-                ritz.residual(c) <= goal * ritz.theta[c].abs()
-            })
-            .count();
+        let ritz = RitzPairs::of(&krylov.h, krylov.cols, krylov.b)?;
+        let wanted: Vec<usize> = (0..nev).map(|r| krylov.cols - 1 - r).collect();
+        let converged = converged_count(&ritz, &wanted, strict, tolerance);
         if converged < nev
             && wanted
                 .iter()
@@ -304,44 +224,222 @@ pub(crate) fn lanczos_run(
         {
             hook(&wanted.iter().map(|&c| ritz.theta[c]).collect::<Vec<_>>());
         }
-        let v = MatRef::from_column_major_slice(&basis[..n * cols], n, cols);
         if converged == nev {
-            let ys = Mat::from_fn(cols, nev, |i, r| ritz.y[(i, wanted[r])]);
-            let mut out = vec![0.0; n * nev];
-            product_into(&mut out, v, ys.as_ref());
-            return Ok((wanted.iter().map(|&c| ritz.theta[c]).collect(), out, restarts));
+            let vectors = krylov.ritz_vectors(&ritz, &wanted);
+            return Ok((
+                wanted.iter().map(|&c| ritz.theta[c]).collect(),
+                vectors,
+                krylov.restarts,
+            ));
         }
-        if cols < m {
+        if krylov.cols < krylov.m {
             continue;
         }
-        if restarts >= max_restarts {
+        if krylov.restarts >= max_restarts {
             return Err(ModalError::LanczosNoConvergence {
                 converged,
                 wanted: nev,
-                restarts,
+                restarts: krylov.restarts,
             });
         }
-        restarts += 1;
-        // Thick restart: keep the p largest Ritz vectors and the residual block.
-        // p ≡ m (mod b), so that the expansions fill the basis exactly.
+        krylov.restart(&ritz);
+    }
+}
+
+/// The vectors a run stays A-orthogonal to (n × `cols`, column-major).
+#[derive(Clone, Copy)]
+struct Locked<'a> {
+    vectors: &'a [f64],
+    cols: usize,
+}
+
+/// How many of the `wanted` Ritz pairs have converged: the first `strict` to `tolerance`, the
+/// rest to the larger of it and [`Tuning::buffer_tolerance`], relative to θ.
+fn converged_count(ritz: &RitzPairs, wanted: &[usize], strict: usize, tolerance: f64) -> usize {
+    wanted
+        .iter()
+        .enumerate()
+        .filter(|&(r, &c)| {
+            let goal = if r < strict {
+                tolerance
+            } else {
+                tolerance.max(Tuning::DEFAULT.buffer_tolerance)
+            };
+            ritz.residual(c) <= goal * ritz.theta[c].abs()
+        })
+        .count()
+}
+
+/// The Krylov basis of a run: m columns (a multiple of the block size b) plus one residual
+/// block, the projected matrix H, and the work blocks of an expansion.
+struct Krylov<'a> {
+    a: Mass<'a>,
+    n: usize,
+    /// The number of wanted values.
+    nev: usize,
+    b: usize,
+    m: usize,
+    basis: Vec<f64>,
+    /// Second basis buffer for the restarts (allocated at the first).
+    spare: Vec<f64>,
+    h: Mat<f64>,
+    scratch: Vec<f64>,
+    w: Vec<f64>,
+    /// Columns of the basis filled.
+    cols: usize,
+    /// Columns kept by the last restart (0 before the first).
+    kept: usize,
+    restarts: usize,
+}
+
+impl<'a> Krylov<'a> {
+    /// The basis of a run for `nev` values with block size `block` (clamped to the room left
+    /// beside the locked vectors): m = max(2·nev + 4b, [`Tuning::lanczos_min_basis`]) rounded
+    /// up to a multiple of b, since a larger basis saves no operator application, only
+    /// orthogonalisation work. Its first block is the start block (given or random),
+    /// A-orthonormal and A-orthogonal to the locked vectors.
+    fn start(
+        a: Mass<'a>,
+        nev: usize,
+        block: usize,
+        locked: Locked<'_>,
+        rng: &mut Lcg,
+        start: Option<&[f64]>,
+    ) -> Result<Self, ModalError> {
+        let n = a.nrows();
+        let room = n.saturating_sub(locked.cols);
+        let b = block.clamp(1, (room / 4).max(1));
+        let wanted_m = (2 * nev + 4 * b).max(Tuning::DEFAULT.lanczos_min_basis);
+        let m = (wanted_m.div_ceil(b) * b).min((room.saturating_sub(b) / b) * b);
+        if m < 2 * b || nev >= m {
+            return Err(ModalError::TooManyModes {
+                requested: nev + locked.cols,
+                available: n,
+            });
+        }
+        let mut basis = vec![0.0; n * (m + b)];
+        let h = Mat::<f64>::zeros(m + b, m);
+        let mut scratch = vec![0.0; n * b];
+        let mut w = vec![0.0; n * b];
+        match start {
+            Some(given) if given.len() == w.len() => w.copy_from_slice(given),
+            _ => w.iter_mut().for_each(|x| *x = rng.next()),
+        }
+        let _ = orthogonalise_block(a, &[], 0, 0, locked.vectors, locked.cols, &mut w, &mut scratch);
+        normalise_block(
+            a,
+            &[],
+            0,
+            locked.vectors,
+            locked.cols,
+            &mut w,
+            1.0,
+            rng,
+            &mut scratch[..n],
+        )?;
+        basis[..n * b].copy_from_slice(&w);
+        Ok(Self {
+            a,
+            n,
+            nev,
+            b,
+            m,
+            basis,
+            spare: Vec::new(),
+            h,
+            scratch,
+            w,
+            cols: 0,
+            kept: 0,
+            restarts: 0,
+        })
+    }
+
+    /// Expands the basis by one block: W = K⁻¹A V_last, A-orthogonalised against the basis and
+    /// the locked vectors, A-orthonormalised, its coefficients written into H.
+    fn expand(&mut self, op: &mut Operator<'_>, locked: Locked<'_>, rng: &mut Lcg) -> Result<(), ModalError> {
+        let (a, n, b, cols) = (self.a, self.n, self.b, self.cols);
+        let current = &self.basis[n * cols..n * (cols + b)];
+        a.apply_block(current, &mut self.w);
+        op.solve_block(&mut self.w, b);
+        // The recurrence couples the block to the previous one, or after a restart (and at the
+        // start) to every kept Ritz vector.
+        let coupled_from = if cols == self.kept { 0 } else { cols - b };
+        let coefficients = orthogonalise_block(
+            a,
+            &self.basis,
+            cols + b,
+            coupled_from,
+            locked.vectors,
+            locked.cols,
+            &mut self.w,
+            &mut self.scratch,
+        );
+        let scale = (0..cols + b)
+            .flat_map(|i| (0..b).map(move |c| (i, c)))
+            .fold(0.0_f64, |s, (i, c)| s.max(coefficients[(i, c)].abs()));
+        let r = normalise_block(
+            a,
+            &self.basis,
+            cols + b,
+            locked.vectors,
+            locked.cols,
+            &mut self.w,
+            scale,
+            rng,
+            &mut self.scratch[..n],
+        )?;
+        for c in 0..b {
+            for i in 0..cols + b {
+                self.h[(i, cols + c)] = coefficients[(i, c)];
+            }
+            for i in 0..b {
+                self.h[(cols + b + i, cols + c)] = r[(i, c)];
+            }
+        }
+        self.basis[n * (cols + b)..n * (cols + 2 * b)].copy_from_slice(&self.w);
+        self.cols += b;
+        Ok(())
+    }
+
+    /// The filled columns of the basis.
+    fn filled(&self) -> MatRef<'_, f64> {
+        MatRef::from_column_major_slice(&self.basis[..self.n * self.cols], self.n, self.cols)
+    }
+
+    /// The Ritz vectors V·Y of the `wanted` pairs (n × nev, column-major).
+    fn ritz_vectors(&self, ritz: &RitzPairs, wanted: &[usize]) -> Vec<f64> {
+        let ys = Mat::from_fn(self.cols, wanted.len(), |i, r| ritz.y[(i, wanted[r])]);
+        let mut out = vec![0.0; self.n * wanted.len()];
+        product_into(&mut out, self.filled(), ys.as_ref());
+        out
+    }
+
+    /// Thick restart: keeps the p largest Ritz vectors and the residual block, with
+    /// p ≡ m (mod b) so that the expansions fill the basis exactly. The new basis is formed in
+    /// the spare buffer, which then becomes the basis.
+    fn restart(&mut self, ritz: &RitzPairs) {
+        let (n, b, m) = (self.n, self.b, self.m);
+        self.restarts += 1;
+        let nev = self.nev;
         let p_wanted = (nev + (m - nev) / 2).min(m - b).max(nev);
         let p = m - (m - p_wanted).div_ceil(b) * b;
         let keep: Vec<usize> = (0..p).map(|r| m - 1 - r).collect();
         let ys = Mat::from_fn(m, p, |i, r| ritz.y[(i, keep[r])]);
-        // The new basis is formed in the spare buffer, which then becomes the basis.
-        spare.resize(basis.len(), 0.0);
-        product_into(&mut spare[..n * p], v, ys.as_ref());
-        spare[n * p..n * (p + b)].copy_from_slice(&basis[n * m..n * (m + b)]);
-        std::mem::swap(&mut basis, &mut spare);
-        h.fill(0.0);
+        let mut spare = std::mem::take(&mut self.spare);
+        spare.resize(self.basis.len(), 0.0);
+        product_into(&mut spare[..n * p], self.filled(), ys.as_ref());
+        spare[n * p..n * (p + b)].copy_from_slice(&self.basis[n * m..n * (m + b)]);
+        self.spare = std::mem::replace(&mut self.basis, spare);
+        self.h.fill(0.0);
         for r in 0..p {
-            h[(r, r)] = ritz.theta[keep[r]];
+            self.h[(r, r)] = ritz.theta[keep[r]];
             for i in 0..b {
-                h[(p + i, r)] = ritz.coupling[(i, keep[r])];
+                self.h[(p + i, r)] = ritz.coupling[(i, keep[r])];
             }
         }
-        cols = p;
-        kept = p;
+        self.cols = p;
+        self.kept = p;
     }
 }
 

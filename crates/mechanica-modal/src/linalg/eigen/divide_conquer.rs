@@ -239,105 +239,179 @@ fn merge(d: &mut [f64], beta: f64, n1: usize, nodes: Node<'_>, order: &mut [usiz
         .collect();
     let ascending = merge_orders(d, &order[..n1], &order[n1..], n1);
     let mut rows: Vec<Rows> = (0..n).map(|c| if c < n1 { Rows::Top } else { Rows::Bottom }).collect();
-
-    // Deflation (dlaed2): small components of z, then close poles by a Givens rotation.
-    let d_max = d.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let z_max = z.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let tol = 8.0 * EPS * d_max.max(z_max);
-    let mut kept: Vec<usize> = Vec::with_capacity(n);
-    let mut deflated: Vec<usize> = Vec::with_capacity(n);
-    for &c in &ascending {
-        if rho * z[c].abs() <= tol {
-            deflated.push(c);
-            continue;
-        }
-        if let Some(&j) = kept.last() {
-            let tau = z[j].hypot(z[c]);
-            let (cos, sin) = (z[c] / tau, -z[j] / tau);
-            if ((d[c] - d[j]) * cos * sin).abs() <= tol {
-                // Rotate columns j and c so that z_j = 0: G = [cos sin; −sin cos] on (j, c).
-                let span = if rows[j] == rows[c] { rows[c] } else { Rows::Both };
-                if span == Rows::Both {
-                    write_zero_rows(u.rb_mut(), j, rows[j], n1);
-                    write_zero_rows(u.rb_mut(), c, rows[c], n1);
-                }
-                for r in span.range(n1, n) {
-                    let (uj, uc) = (u[(r, j)], u[(r, c)]);
-                    u[(r, j)] = cos * uj + sin * uc;
-                    u[(r, c)] = cos * uc - sin * uj;
-                }
-                rows[j] = span;
-                rows[c] = span;
-                let (dj, dc) = (d[j], d[c]);
-                d[j] = cos * cos * dj + sin * sin * dc;
-                d[c] = sin * sin * dj + cos * cos * dc;
-                z[c] = tau;
-                z[j] = 0.0;
-                kept.pop();
-                deflated.push(j);
-            }
-        }
-        kept.push(c);
-    }
+    let mut columns = Deflation {
+        d,
+        z: &mut z,
+        u: u.rb_mut(),
+        rows: &mut rows,
+        n1,
+    };
+    let (kept, deflated) = columns.deflate(&ascending, rho);
     let k = kept.len();
-
-    // The kept columns in the order top-only, both, bottom-only (`typed`); `position[m]` is the
-    // place in that order of the m-th smallest pole.
-    let typed: Vec<usize> = [Rows::Top, Rows::Both, Rows::Bottom]
-        .iter()
-        .flat_map(|&part| kept.iter().copied().filter(|&c| rows[c] == part).collect::<Vec<_>>())
-        .collect();
-    let top_count = typed.iter().filter(|&&c| rows[c] == Rows::Top).count();
-    let bottom_count = typed.iter().filter(|&&c| rows[c] == Rows::Bottom).count();
-    let mut place = vec![0; n];
-    for (r, &c) in typed.iter().enumerate() {
-        place[c] = r;
-    }
-    let position: Vec<usize> = kept.iter().map(|&c| place[c]).collect();
-    let poles: Vec<f64> = typed.iter().map(|&c| d[c]).collect();
-    let z_kept: Vec<f64> = typed.iter().map(|&c| z[c]).collect();
+    let typed = TypedColumns::of(&kept, &rows, n);
+    let poles: Vec<f64> = typed.order.iter().map(|&c| d[c]).collect();
+    let z_kept: Vec<f64> = typed.order.iter().map(|&c| z[c]).collect();
 
     let mut deltas = secular_storage.rb_mut().submatrix_mut(0, 0, k, k);
-    let Some(roots) = secular_roots(&poles, &z_kept, &position, rho, deltas.rb_mut(), par) else {
+    let Some(roots) = secular_roots(&poles, &z_kept, &typed.position, rho, deltas.rb_mut(), par) else {
         return false;
     };
-    secular_vectors(&poles, &z_kept, &position, rho, deltas.rb_mut(), par);
+    secular_vectors(&poles, &z_kept, &typed.position, rho, deltas.rb_mut(), par);
+    let product = Product {
+        typed: &typed,
+        deflated: &deflated,
+        rows: &rows,
+        n1,
+    };
+    product.multiply(u.rb_mut(), work.rb_mut(), deltas.rb(), par);
+    reorder(d, &roots, &deflated, order);
+    true
+}
 
-    // Gather the kept columns (typed order; only their nonzero rows, the only ones the products
-    // below read), then the deflated ones with their zero rows written (they become columns of
-    // the node as they are).
-    for (r, &c) in typed.iter().enumerate() {
-        copy_nonzero_rows(work.rb_mut(), r, u.rb(), c, rows[c], n1);
-    }
-    for (r, &c) in deflated.iter().enumerate().map(|(i, c)| (k + i, c)) {
-        copy_nonzero_rows(work.rb_mut(), r, u.rb(), c, rows[c], n1);
-        write_zero_rows(work.rb_mut(), r, rows[c], n1);
-    }
-    let vectors = deltas.rb();
-    let (upper_rows, lower_rows) = (top_count + (k - top_count - bottom_count), k - top_count);
-    matmul(
-        u.rb_mut().submatrix_mut(0, 0, n1, k),
-        Accum::Replace,
-        work.rb().submatrix(0, 0, n1, upper_rows),
-        vectors.submatrix(0, 0, upper_rows, k),
-        1.0,
-        par,
-    );
-    matmul(
-        u.rb_mut().submatrix_mut(n1, 0, n - n1, k),
-        Accum::Replace,
-        work.rb().submatrix(n1, top_count, n - n1, lower_rows),
-        vectors.submatrix(top_count, 0, lower_rows, k),
-        1.0,
-        par,
-    );
-    u.rb_mut()
-        .submatrix_mut(0, k, n, n - k)
-        .copy_from(work.rb().submatrix(0, k, n, n - k));
+/// The columns of a merge being deflated: values `d`, the coupling vector `z`, the eigenvector
+/// columns `u` of the two halves, and which rows of each column may be nonzero.
+struct Deflation<'a, 'u> {
+    d: &'a mut [f64],
+    z: &'a mut [f64],
+    u: MatMut<'u, f64>,
+    rows: &'a mut [Rows],
+    n1: usize,
+}
 
-    // Values in the new column order, and the ascending order of the node.
+impl Deflation<'_, '_> {
+    /// Deflation (`dlaed2`): small components of z, then close poles by a Givens rotation,
+    /// visiting the columns by `ascending` value. Returns the kept and the deflated columns.
+    fn deflate(&mut self, ascending: &[usize], rho: f64) -> (Vec<usize>, Vec<usize>) {
+        let (d, z, n1) = (&mut *self.d, &mut *self.z, self.n1);
+        let n = d.len();
+        let d_max = d.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let z_max = z.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let tol = 8.0 * EPS * d_max.max(z_max);
+        let mut kept: Vec<usize> = Vec::with_capacity(n);
+        let mut deflated: Vec<usize> = Vec::with_capacity(n);
+        for &c in ascending {
+            if rho * z[c].abs() <= tol {
+                deflated.push(c);
+                continue;
+            }
+            if let Some(&j) = kept.last() {
+                let tau = z[j].hypot(z[c]);
+                let (cos, sin) = (z[c] / tau, -z[j] / tau);
+                if ((d[c] - d[j]) * cos * sin).abs() <= tol {
+                    // Rotate columns j and c so that z_j = 0: G = [cos sin; −sin cos] on (j, c).
+                    let rows = &mut *self.rows;
+                    let span = if rows[j] == rows[c] { rows[c] } else { Rows::Both };
+                    if span == Rows::Both {
+                        write_zero_rows(self.u.rb_mut(), j, rows[j], n1);
+                        write_zero_rows(self.u.rb_mut(), c, rows[c], n1);
+                    }
+                    for r in span.range(n1, n) {
+                        let (uj, uc) = (self.u[(r, j)], self.u[(r, c)]);
+                        self.u[(r, j)] = cos * uj + sin * uc;
+                        self.u[(r, c)] = cos * uc - sin * uj;
+                    }
+                    rows[j] = span;
+                    rows[c] = span;
+                    let (dj, dc) = (d[j], d[c]);
+                    d[j] = cos * cos * dj + sin * sin * dc;
+                    d[c] = sin * sin * dj + cos * cos * dc;
+                    z[c] = tau;
+                    z[j] = 0.0;
+                    kept.pop();
+                    deflated.push(j);
+                }
+            }
+            kept.push(c);
+        }
+        (kept, deflated)
+    }
+}
+
+/// The kept columns of a merge in the order top-only, both, bottom-only (`order`), so that the
+/// two products of [`Product::multiply`] skip the zero blocks; `position[m]` is the place in that
+/// order of the m-th smallest pole.
+struct TypedColumns {
+    order: Vec<usize>,
+    top_count: usize,
+    bottom_count: usize,
+    position: Vec<usize>,
+}
+
+impl TypedColumns {
+    fn of(kept: &[usize], rows: &[Rows], n: usize) -> Self {
+        let order: Vec<usize> = [Rows::Top, Rows::Both, Rows::Bottom]
+            .iter()
+            .flat_map(|&part| kept.iter().copied().filter(|&c| rows[c] == part).collect::<Vec<_>>())
+            .collect();
+        let top_count = order.iter().filter(|&&c| rows[c] == Rows::Top).count();
+        let bottom_count = order.iter().filter(|&&c| rows[c] == Rows::Bottom).count();
+        let mut place = vec![0; n];
+        for (r, &c) in order.iter().enumerate() {
+            place[c] = r;
+        }
+        let position: Vec<usize> = kept.iter().map(|&c| place[c]).collect();
+        Self {
+            order,
+            top_count,
+            bottom_count,
+            position,
+        }
+    }
+}
+
+/// The product of a merge: the node's eigenvectors from the halves' and the secular vectors.
+struct Product<'a> {
+    typed: &'a TypedColumns,
+    deflated: &'a [usize],
+    rows: &'a [Rows],
+    n1: usize,
+}
+
+impl Product<'_> {
+    /// Gathers the kept columns of `u` into `work` (typed order; only their nonzero rows, the
+    /// only ones the products read), then the deflated ones with their zero rows written (they
+    /// become columns of the node as they are); the kept columns of the node are then the two
+    /// products of the gathered blocks with the secular `vectors` (k × k).
+    fn multiply(&self, mut u: MatMut<'_, f64>, mut work: MatMut<'_, f64>, vectors: MatRef<'_, f64>, par: Par) {
+        let (n, n1, k) = (u.nrows(), self.n1, vectors.ncols());
+        let (rows, typed) = (self.rows, self.typed);
+        for (r, &c) in typed.order.iter().enumerate() {
+            copy_nonzero_rows(work.rb_mut(), r, u.rb(), c, rows[c], n1);
+        }
+        for (r, &c) in self.deflated.iter().enumerate().map(|(i, c)| (k + i, c)) {
+            copy_nonzero_rows(work.rb_mut(), r, u.rb(), c, rows[c], n1);
+            write_zero_rows(work.rb_mut(), r, rows[c], n1);
+        }
+        let (top_count, bottom_count) = (typed.top_count, typed.bottom_count);
+        let (upper_rows, lower_rows) = (top_count + (k - top_count - bottom_count), k - top_count);
+        matmul(
+            u.rb_mut().submatrix_mut(0, 0, n1, k),
+            Accum::Replace,
+            work.rb().submatrix(0, 0, n1, upper_rows),
+            vectors.submatrix(0, 0, upper_rows, k),
+            1.0,
+            par,
+        );
+        matmul(
+            u.rb_mut().submatrix_mut(n1, 0, n - n1, k),
+            Accum::Replace,
+            work.rb().submatrix(n1, top_count, n - n1, lower_rows),
+            vectors.submatrix(top_count, 0, lower_rows, k),
+            1.0,
+            par,
+        );
+        u.rb_mut()
+            .submatrix_mut(0, k, n, n - k)
+            .copy_from(work.rb().submatrix(0, k, n, n - k));
+    }
+}
+
+/// The node's values in its new column order (the `roots`, then the `deflated` columns'
+/// values) and its ascending `order`.
+fn reorder(d: &mut [f64], roots: &[f64], deflated: &[usize], order: &mut [usize]) {
+    let (n, k) = (d.len(), roots.len());
     let deflated_values: Vec<f64> = deflated.iter().map(|&c| d[c]).collect();
-    d[..k].copy_from_slice(&roots);
+    d[..k].copy_from_slice(roots);
     d[k..].copy_from_slice(&deflated_values);
     let mut deflated_order: Vec<usize> = (k..n).collect();
     deflated_order.sort_by(|&a, &b| d[a].total_cmp(&d[b]));
@@ -351,7 +425,6 @@ fn merge(d: &mut [f64], beta: f64, n1: usize, nodes: Node<'_>, order: &mut [usiz
             j += 1;
         }
     }
-    true
 }
 
 /// Column indices of the node by ascending value: the children's orders (the second one local
@@ -445,6 +518,69 @@ fn secular_root(
     shifted: &mut [f64],
     delta: &mut [f64],
 ) -> Option<f64> {
+    let last = m + 1 == poles.len();
+    let (mut root, mut sums, mut f) = first_guess(m, poles, z_sq, position, rho, shifted, delta);
+    let below_limit = shifted[position[m]];
+    for step in 0..MAX_SECULAR_STEPS {
+        let slope = sums.below_slope + sums.above_slope;
+        let rounding = EPS * (8.0 * (sums.above - sums.below) + 2.0 / rho + 3.0 * root.tau.abs() * slope);
+        if f.abs() <= rounding {
+            return Some(root.origin + root.tau);
+        }
+        if f < 0.0 {
+            root.low = root.low.max(root.tau);
+        } else {
+            root.high = root.high.min(root.tau);
+        }
+        if root.high - root.low <= 2.0 * EPS * root.low.abs().max(root.high.abs()) {
+            return Some(root.origin + root.tau);
+        }
+        let model = Model {
+            m,
+            last,
+            position,
+            z_sq,
+            delta,
+            rho,
+        };
+        let eta = model.step(root.origin_pole, f, slope);
+        let mut next = root.tau + eta;
+        if step >= RATIONAL_STEPS || !(next > root.low && next < root.high) {
+            next = 0.5 * (root.low + root.high);
+        }
+        if next == root.tau {
+            return Some(root.origin + root.tau);
+        }
+        root.tau = next;
+        sums = evaluate(shifted, z_sq, below_limit, root.tau, delta);
+        f = 1.0 / rho + sums.below + sums.above;
+    }
+    None
+}
+
+/// A root being found: λ = origin + τ, with the origin at the pole `origin_pole`, inside the
+/// bisection bracket low < τ < high.
+struct RootIterate {
+    origin: f64,
+    origin_pole: usize,
+    tau: f64,
+    low: f64,
+    high: f64,
+}
+
+/// The first iterate of [`secular_root`] for the m-th root, the sums there and f there:
+/// `dlaed4`'s guess (the two poles beside the root exact, the other terms frozen at the
+/// midpoint), with the origin at the nearer pole; the last root starts at its interval's
+/// midpoint.
+fn first_guess(
+    m: usize,
+    poles: &[f64],
+    z_sq: &[f64],
+    position: &[usize],
+    rho: f64,
+    shifted: &mut [f64],
+    delta: &mut [f64],
+) -> (RootIterate, SecularSums, f64) {
     let k = poles.len();
     let lower = poles[position[m]];
     let last = m + 1 == k;
@@ -489,30 +625,43 @@ fn secular_root(
         sums = evaluate(shifted, z_sq, a, tau, delta);
         f = 1.0 / rho + sums.below + sums.above;
     }
-    let below_limit = shifted[position[m]];
-    for step in 0..MAX_SECULAR_STEPS {
-        let slope = sums.below_slope + sums.above_slope;
-        let rounding = EPS * (8.0 * (sums.above - sums.below) + 2.0 / rho + 3.0 * tau.abs() * slope);
-        if f.abs() <= rounding {
-            return Some(origin + tau);
-        }
-        if f < 0.0 {
-            low = low.max(tau);
-        } else {
-            high = high.min(tau);
-        }
-        if high - low <= 2.0 * EPS * low.abs().max(high.abs()) {
-            return Some(origin + tau);
-        }
+    let iterate = RootIterate {
+        origin,
+        origin_pole,
+        tau,
+        low,
+        high,
+    };
+    (iterate, sums, f)
+}
+
+/// The rational model of one step of [`secular_root`] for the m-th root, from the current
+/// differences `delta` = d_i − λ.
+struct Model<'a> {
+    m: usize,
+    last: bool,
+    position: &'a [usize],
+    z_sq: &'a [f64],
+    delta: &'a [f64],
+    rho: f64,
+}
+
+impl Model<'_> {
+    /// The step η: the root of c + s/(δ_(m) − η) + S/(δ_(m+1) − η) fitted to f and its `slope`,
+    /// the origin pole's own weight exact and the other terms' slope on the far pole (for the
+    /// last root the two poles below it); a Newton step where the model steps away from the
+    /// root.
+    fn step(&self, origin_pole: usize, f: f64, slope: f64) -> f64 {
+        let (m, position, z_sq, delta) = (self.m, self.position, self.z_sq, self.delta);
         // The origin pole's own slope z_o²/δ_o², and the slope of all the other terms.
         let own = z_sq[origin_pole] / (delta[origin_pole] * delta[origin_pole]);
         let others = (slope - own).max(0.0);
-        let model = if last && m > 0 {
+        let model = if self.last && m > 0 {
             // Poles d_(k−1) and d_(k) (the origin): the other terms' slope on d_(k−1).
             let (a, b) = (delta[position[m - 1]], delta[origin_pole]);
             let (s, big_s) = (a * a * others, z_sq[origin_pole]);
             Some((f - s / a - big_s / b, a, b, s, big_s))
-        } else if last {
+        } else if self.last {
             None
         } else {
             let (a, b) = (delta[position[m]], delta[position[m + 1]]);
@@ -524,12 +673,12 @@ fn secular_root(
             Some((f - s / a - big_s / b, a, b, s, big_s))
         };
         let mut eta = match model {
-            Some((c, a, b, s, big_s)) if last => beyond_two_poles_root(c, a, b, s, big_s),
+            Some((c, a, b, s, big_s)) if self.last => beyond_two_poles_root(c, a, b, s, big_s),
             Some((c, a, b, s, big_s)) => two_pole_root(c, a, b, s, big_s),
             None => {
                 // k = 1: f = 1/ρ + z²/(δ − η) exactly.
                 let a = delta[origin_pole];
-                a + z_sq[origin_pole] * rho
+                a + z_sq[origin_pole] * self.rho
             }
         };
         let towards_root = f * eta < 0.0;
@@ -537,18 +686,8 @@ fn secular_root(
             // The model stepped away from the root (or failed): a Newton step instead.
             eta = -f / slope;
         }
-        let mut next = tau + eta;
-        if step >= RATIONAL_STEPS || !(next > low && next < high) {
-            next = 0.5 * (low + high);
-        }
-        if next == tau {
-            return Some(origin + tau);
-        }
-        tau = next;
-        sums = evaluate(shifted, z_sq, below_limit, tau, delta);
-        f = 1.0 / rho + sums.below + sums.above;
+        eta
     }
-    None
 }
 
 /// The root η > b of c + s/(a − η) + S/(b − η) = 0 for two poles a < b below it (the last
