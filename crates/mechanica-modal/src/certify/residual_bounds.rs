@@ -67,9 +67,7 @@ pub(crate) fn residual_bounds(
     par: Par,
 ) {
     let m = omega_sq.len();
-    let n = basis.x.nrows();
-    let k = residuals.len();
-    if k == 0 {
+    if residuals.is_empty() {
         return;
     }
     let others_bound = report.error_bounds.iter().copied().fold(0.0, f64::max);
@@ -78,41 +76,113 @@ pub(crate) fn residual_bounds(
             report.residual_norms_a_inv[i].map_or(report.error_bounds[i], |e| e + f64::EPSILON * omega_sq[i].abs())
         })
         .collect();
-    // All refined residuals at once: C = Xᵀ R, and R_⊥ = L⁻¹(R − A X C) in the A⁻¹-norm.
-    let r = Mat::from_fn(n, k, |row, col| residuals[col].residual[row]);
-    let mut c = Mat::<f64>::zeros(basis.x.ncols(), k);
-    faer::linalg::matmul::matmul(
-        c.as_mut(),
-        faer::Accum::Replace,
-        basis.x.transpose(),
-        r.as_ref(),
-        1.0,
-        par,
-    );
-    let mut xc = Mat::<f64>::zeros(n, k);
-    let mut column_of = vec![None; m];
-    for (col, &mode) in basis.modes.iter().enumerate() {
-        column_of[mode] = Some(col);
-    }
-    let mut residual_of = vec![None; m];
-    for (col, refined) in residuals.iter().enumerate() {
-        residual_of[refined.mode] = Some(col);
-    }
-    faer::linalg::matmul::matmul(xc.as_mut(), faer::Accum::Replace, basis.x, c.as_ref(), 1.0, par);
-    let mut rest = r;
-    faer::linalg::matmul::matmul(rest.as_mut(), faer::Accum::Add, basis.a, xc.as_ref(), -1.0, par);
-    solve_lower_triangular_in_place(basis.l, rest.as_mut(), par);
+    let split = SplitResiduals::of(basis, residuals, m, par);
+    let spectrum = Spectrum {
+        omega_sq,
+        omega_all,
+        first,
+        linear: &linear,
+        others_bound,
+        unselected: basis.unselected,
+    };
     for refined in residuals {
         let i = refined.mode;
         let group = refined.cluster.clone();
         // The block's residual columns; a member without one leaves the linear bound.
         let Some(columns) = group
             .clone()
-            .map(|g| residual_of[g].zip(report.residual_norms_a_inv[g]))
+            .map(|g| split.residual_of[g].zip(report.residual_norms_a_inv[g]))
             .collect::<Option<Vec<(usize, f64)>>>()
         else {
             continue;
         };
+        let bound = split.block_bound(&spectrum, &group, &columns);
+        // Rounding and the block's A-orthogonality defect at the cluster's largest |ω²|: the
+        // Rayleigh–Ritz step in double leaves a mixing of order u between members, which moves a
+        // member's Rayleigh quotient by up to u² times the cluster's spread (a zero mode chained
+        // to soft ones would otherwise get a bound far below its computed ω²).
+        let scale = group.clone().map(|g| omega_sq[g].abs()).fold(0.0, f64::max);
+        let defect = group.len() as f64 * refined.orthogonality * scale;
+        report.error_bounds[i] = bound + defect + f64::EPSILON * scale;
+        report.bound_kinds[i] = BoundKind::Residual;
+    }
+}
+
+/// The spectrum the gaps of [`residual_bounds`] are measured in.
+struct Spectrum<'a> {
+    /// The selected modes' ω².
+    omega_sq: &'a [f64],
+    /// All ω², ascending; the selection is `first..first + omega_sq.len()`.
+    omega_all: &'a [f64],
+    first: usize,
+    /// Each selected mode's linear bound (its residual norm, or its bound before refinement).
+    linear: &'a [f64],
+    /// The largest bound of the selection, the uncertainty of the unselected modes.
+    others_bound: f64,
+    /// Values only: the error model of the unselected modes' values.
+    unselected: Option<APrioriModel>,
+}
+
+/// The refined residuals R split along the computed modes: C = Xᵀ R, and R_⊥ = L⁻¹(R − A X C),
+/// whose column norms are the A⁻¹-norms of the parts outside the basis.
+struct SplitResiduals {
+    c: Mat<f64>,
+    rest: Mat<f64>,
+    /// The basis column of each selected mode (None when not in the basis).
+    column_of: Vec<Option<usize>>,
+    /// The residual column of each selected mode (None when not refined).
+    residual_of: Vec<Option<usize>>,
+}
+
+impl SplitResiduals {
+    /// All refined residuals at once, for a selection of `m` modes.
+    fn of(basis: &ModeBasis<'_>, residuals: &[RefinedResidual], m: usize, par: Par) -> Self {
+        let n = basis.x.nrows();
+        let k = residuals.len();
+        let r = Mat::from_fn(n, k, |row, col| residuals[col].residual[row]);
+        let mut c = Mat::<f64>::zeros(basis.x.ncols(), k);
+        faer::linalg::matmul::matmul(
+            c.as_mut(),
+            faer::Accum::Replace,
+            basis.x.transpose(),
+            r.as_ref(),
+            1.0,
+            par,
+        );
+        let mut xc = Mat::<f64>::zeros(n, k);
+        let mut column_of = vec![None; m];
+        for (col, &mode) in basis.modes.iter().enumerate() {
+            column_of[mode] = Some(col);
+        }
+        let mut residual_of = vec![None; m];
+        for (col, refined) in residuals.iter().enumerate() {
+            residual_of[refined.mode] = Some(col);
+        }
+        faer::linalg::matmul::matmul(xc.as_mut(), faer::Accum::Replace, basis.x, c.as_ref(), 1.0, par);
+        let mut rest = r;
+        faer::linalg::matmul::matmul(rest.as_mut(), faer::Accum::Add, basis.a, xc.as_ref(), -1.0, par);
+        solve_lower_triangular_in_place(basis.l, rest.as_mut(), par);
+        Self {
+            c,
+            rest,
+            column_of,
+            residual_of,
+        }
+    }
+
+    /// The bound of the block `group` (its members' residual columns and residual norms
+    /// `columns`) before its orthogonality defect and rounding: min(ε, ε²/δ, Σ c²/δ_j +
+    /// ‖R_⊥‖²/δ) where the gap δ allows it.
+    fn block_bound(&self, spectrum: &Spectrum<'_>, group: &Range<usize>, columns: &[(usize, f64)]) -> f64 {
+        let Spectrum {
+            omega_sq,
+            omega_all,
+            first,
+            linear,
+            others_bound,
+            unselected,
+        } = *spectrum;
+        let m = omega_sq.len();
         let eps = columns.iter().map(|(_, e)| e * e).sum::<f64>().sqrt();
         let distance = |w: f64| {
             group
@@ -126,9 +196,13 @@ pub(crate) fn residual_bounds(
         for j in (0..m).filter(|j| !group.contains(j)) {
             let d = distance(omega_sq[j]) - linear[j];
             gap = gap.min(d);
-            if let Some(basis_col) = column_of[j] {
+            if let Some(basis_col) = self.column_of[j] {
                 if d > 0.0 {
-                    weighted += columns.iter().map(|&(col, _)| c[(basis_col, col)].powi(2)).sum::<f64>() / d;
+                    weighted += columns
+                        .iter()
+                        .map(|&(col, _)| self.c[(basis_col, col)].powi(2))
+                        .sum::<f64>()
+                        / d;
                 } else {
                     usable = false;
                 }
@@ -136,15 +210,13 @@ pub(crate) fn residual_bounds(
         }
         for (k, &w) in omega_all.iter().enumerate() {
             if k < first || k >= first + m {
-                let uncertainty = basis
-                    .unselected
-                    .map_or(others_bound, |model| model.bound(w).max(others_bound));
+                let uncertainty = unselected.map_or(others_bound, |model| model.bound(w).max(others_bound));
                 gap = gap.min(distance(w) - uncertainty);
             }
         }
         let eps_rest = columns
             .iter()
-            .map(|&(col, _)| vector_norm(rest.col(col)).powi(2))
+            .map(|&(col, _)| vector_norm(self.rest.col(col)).powi(2))
             .sum::<f64>()
             .sqrt();
         let mut bound = eps;
@@ -154,14 +226,7 @@ pub(crate) fn residual_bounds(
                 bound = bound.min(weighted + eps_rest * eps_rest / gap);
             }
         }
-        // Rounding and the block's A-orthogonality defect at the cluster's largest |ω²|: the
-        // Rayleigh–Ritz step in double leaves a mixing of order u between members, which moves a
-        // member's Rayleigh quotient by up to u² times the cluster's spread (found in review: a
-        // zero mode chained to soft ones had ω² = 5e-37 against a bound of 1.7e-40 with |ρ_i|).
-        let scale = group.clone().map(|g| omega_sq[g].abs()).fold(0.0, f64::max);
-        let defect = group.len() as f64 * refined.orthogonality * scale;
-        report.error_bounds[i] = bound + defect + f64::EPSILON * scale;
-        report.bound_kinds[i] = BoundKind::Residual;
+        bound
     }
 }
 

@@ -20,15 +20,18 @@
 //! The cost is O(n²) per flagged mode, against the n³ of the vectors that a full solve forms
 //! (before, a values-only solve with a flagged mode was solved again with all vectors).
 
+use crate::certify::a_priori::APrioriModel;
 use crate::certify::products::{PairProducts, Residuals};
 use crate::certify::report::{AccuracyReport, BoundKind};
-use crate::certify::residual_bounds::RefinedResidual;
+use crate::certify::residual_bounds::{ModeBasis, RefinedResidual, residual_bounds};
+use crate::certify::resolution::zero_resolution;
+use crate::dd::Operand;
 use crate::dense::options::weakly_bounded;
 use crate::linalg::eigen::TridiagonalForm;
-use crate::linalg::reduce::back_transform;
-use crate::refine::{Metric, TridiagonalCorrection, refine_cluster};
+use crate::linalg::reduce::{LowerFactor, back_transform};
+use crate::refine::{Metric, SparseShifts, TridiagonalCorrection, refine_cluster};
 use crate::spectrum::{clusters, refinable};
-use faer::{MatRef, Par};
+use faer::{Mat, MatRef, Par};
 
 /// The pencil and its factor, as the refinement needs them.
 pub(crate) struct Pencil<'a> {
@@ -49,7 +52,7 @@ pub(crate) struct Pencil<'a> {
 /// whose vector was formed, for the zero classification.
 pub(crate) fn sharpen(
     pencil: &Pencil<'_>,
-    a_priori: crate::certify::a_priori::APrioriModel,
+    a_priori: APrioriModel,
     form: &mut TridiagonalForm,
     report: &mut AccuracyReport,
     omega: &mut [f64],
@@ -77,77 +80,109 @@ pub(crate) fn sharpen(
     if let PairProducts::Sketched { .. } = products {
         report.residuals = Residuals::Sketched;
     }
-    let mut residuals: Vec<RefinedResidual> = Vec::new();
     // Clusters for the correction: T's eigenvalues and inverse-iteration vectors are only as
     // accurate as the a-priori model, so modes closer than that cannot be told apart by the
-    // correction through T, however tight their measured bounds (found in review: ω² = 0,
-    // 1e-15 and 1e-13 with ‖C‖ = 1 stalled as {0}, {1e-15, 1e-13}).
+    // correction through T, however tight their measured bounds.
     let separable: Vec<f64> = (0..omega.len())
         .map(|i| report.error_bounds[i].max(a_priori.bound(omega[i])))
         .collect();
-    let mass = crate::dd::Operand::new(a);
-    let stiffness = crate::dd::Operand::new(b);
-    let factor = crate::linalg::reduce::LowerFactor::new(pencil.l);
-    let shifts = crate::refine::SparseShifts::new(&mass, &stiffness);
-    for g in clusters(omega, &separable) {
-        // A block needs the vectors of all its members: consecutive flagged columns.
-        let Some(col) = flagged.iter().position(|&i| i == g.start) else {
-            continue;
-        };
-        let all_flagged = flagged.get(col + g.len() - 1) == Some(&(g.end - 1));
-        let weak = g.clone().any(|i| weakly_bounded(report.error_bounds[i], omega[i]));
-        if !(all_flagged && weak && refinable(&g, omega, &separable, omega_all, first)) {
-            continue;
-        }
-        let x0 = x.as_ref().subcols(col, g.len()).to_owned();
-        let mut correction = TridiagonalCorrection {
-            form,
-            z: z.as_ref().subcols(col, g.len()).to_owned(),
-            purified: false,
-        };
-        let refined = refine_cluster(
-            &mass,
-            &stiffness,
-            shifts.as_ref(),
-            Metric::Cholesky(factor),
-            Some(&mut correction),
-            x0.as_ref(),
-            omega[g.start],
-        );
-        let Some(cluster) = refined else { continue };
-        for (k, p) in cluster.pairs.into_iter().enumerate() {
-            let i = g.start + k;
-            x.col_as_slice_mut(col + k).copy_from_slice(&p.x);
-            omega[i] = p.omega_sq;
-            products.update_column(a, b, x.as_ref(), col + k, pencil.par);
-            report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
-            report.refinement_steps[i] = p.steps;
-            residuals.push(RefinedResidual {
-                mode: i,
-                cluster: g.clone(),
-                orthogonality: cluster.orthogonality,
-                residual: p.residual,
-            });
-        }
-    }
+    let formed = Formed {
+        flagged: &flagged,
+        z: &z,
+        separable: &separable,
+        omega_all,
+        first,
+    };
+    let residuals = formed.refine(pencil, form, &mut x, &mut products, report, omega);
     // Unselected values were never measured: the gaps to them allow for their a-priori error.
-    let basis = crate::certify::residual_bounds::ModeBasis {
+    let basis = ModeBasis {
         a,
         l: pencil.l,
         x: x.as_ref(),
         modes: &flagged,
         unselected: Some(a_priori),
     };
-    crate::certify::residual_bounds::residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
+    residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
     let norms = (report.norm_a, report.norm_b);
     flagged
         .iter()
         .enumerate()
-        .map(|(col, &i)| {
-            (
-                i,
-                crate::certify::resolution::zero_resolution(a, b, x.col_as_slice(col), omega[i], norms),
-            )
-        })
+        .map(|(col, &i)| (i, zero_resolution(a, b, x.col_as_slice(col), omega[i], norms)))
         .collect()
+}
+
+/// The flagged modes whose vectors were formed: column c of X (and of Z, their eigenvectors of
+/// T) belongs to mode `flagged[c]` of the selection.
+struct Formed<'a> {
+    flagged: &'a [usize],
+    z: &'a Mat<f64>,
+    /// Each selected mode's uncertainty for the clusters of the correction through T.
+    separable: &'a [f64],
+    omega_all: &'a [f64],
+    first: usize,
+}
+
+impl Formed<'_> {
+    /// Refines every cluster of still weakly bounded modes whose members all have their vectors
+    /// (consecutive flagged columns), with the correction through Q and T; writes the refined
+    /// pairs into `x`, `omega`, `products` and the report, and returns their residual records.
+    fn refine(
+        &self,
+        pencil: &Pencil<'_>,
+        form: &mut TridiagonalForm,
+        x: &mut Mat<f64>,
+        products: &mut PairProducts,
+        report: &mut AccuracyReport,
+        omega: &mut [f64],
+    ) -> Vec<RefinedResidual> {
+        let (a, b) = (pencil.a, pencil.b);
+        let flagged = self.flagged;
+        let mut residuals: Vec<RefinedResidual> = Vec::new();
+        let mass = Operand::new(a);
+        let stiffness = Operand::new(b);
+        let factor = LowerFactor::new(pencil.l);
+        let shifts = SparseShifts::new(&mass, &stiffness);
+        for g in clusters(omega, self.separable) {
+            // A block needs the vectors of all its members: consecutive flagged columns.
+            let Some(col) = flagged.iter().position(|&i| i == g.start) else {
+                continue;
+            };
+            let all_flagged = flagged.get(col + g.len() - 1) == Some(&(g.end - 1));
+            let weak = g.clone().any(|i| weakly_bounded(report.error_bounds[i], omega[i]));
+            if !(all_flagged && weak && refinable(&g, omega, self.separable, self.omega_all, self.first)) {
+                continue;
+            }
+            let x0 = x.as_ref().subcols(col, g.len()).to_owned();
+            let mut correction = TridiagonalCorrection {
+                form,
+                z: self.z.as_ref().subcols(col, g.len()).to_owned(),
+                purified: false,
+            };
+            let refined = refine_cluster(
+                &mass,
+                &stiffness,
+                shifts.as_ref(),
+                Metric::Cholesky(factor),
+                Some(&mut correction),
+                x0.as_ref(),
+                omega[g.start],
+            );
+            let Some(cluster) = refined else { continue };
+            for (k, p) in cluster.pairs.into_iter().enumerate() {
+                let i = g.start + k;
+                x.col_as_slice_mut(col + k).copy_from_slice(&p.x);
+                omega[i] = p.omega_sq;
+                products.update_column(a, b, x.as_ref(), col + k, pencil.par);
+                report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
+                report.refinement_steps[i] = p.steps;
+                residuals.push(RefinedResidual {
+                    mode: i,
+                    cluster: g.clone(),
+                    orthogonality: cluster.orthogonality,
+                    residual: p.residual,
+                });
+            }
+        }
+        residuals
+    }
 }

@@ -79,6 +79,15 @@ pub(crate) fn inertia_with(
             max_pivot: 0.0,
         });
     }
+    let (values, subdiag) = factor_lblt(symbolic, k)?;
+    let pivots = pivot_eigenvalues(symbolic, &values, &subdiag, n);
+    Ok(count_signs(pivots, shift))
+}
+
+/// The intranode Bunch–Kaufman LBLᵀ factorization of `k` (lower triangle read, sequential): the
+/// factor's values and the subdiagonal of its 2×2 pivot blocks.
+fn factor_lblt(symbolic: &SymbolicCholesky<usize>, k: &Csc) -> Result<(Vec<f64>, Vec<f64>), ModalError> {
+    let n = k.n;
     let m = k.to_faer();
     let par = Par::Seq;
     let params = Default::default();
@@ -103,7 +112,11 @@ pub(crate) fn inertia_with(
         params,
     );
     let _ = lblt;
-    // The eigenvalues of the pivot blocks, in any order.
+    Ok((values, subdiag))
+}
+
+/// The eigenvalues of the pivot blocks of a factor (`values`, `subdiag`), in any order.
+fn pivot_eigenvalues(symbolic: &SymbolicCholesky<usize>, values: &[f64], subdiag: &[f64], n: usize) -> Vec<f64> {
     let mut pivots: Vec<f64> = Vec::with_capacity(n);
     match symbolic.raw() {
         SymbolicCholeskyRaw::Supernodal(supernodal) => {
@@ -143,6 +156,12 @@ pub(crate) fn inertia_with(
             }
         }
     }
+    pivots
+}
+
+/// The inertia at `shift` from the pivot blocks' eigenvalues: a pivot that is zero or not
+/// finite counts as zero.
+fn count_signs(pivots: Vec<f64>, shift: f64) -> SparseInertiaCount {
     let (mut below, mut zero, mut above) = (0, 0, 0);
     let (mut min_pivot, mut max_pivot) = (f64::INFINITY, 0.0_f64);
     for v in pivots {
@@ -159,7 +178,7 @@ pub(crate) fn inertia_with(
             above += 1;
         }
     }
-    Ok(SparseInertiaCount {
+    SparseInertiaCount {
         count: InertiaCount {
             shift,
             below,
@@ -168,7 +187,7 @@ pub(crate) fn inertia_with(
         },
         min_pivot,
         max_pivot,
-    })
+    }
 }
 
 #[cfg(test)]

@@ -41,6 +41,46 @@ pub fn read_matrix_market(path: &Path) -> Result<MatrixMarket, ModalError> {
 pub fn parse_matrix_market(text: &str) -> Result<MatrixMarket, ModalError> {
     let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l));
     let (_, header) = lines.next().ok_or_else(|| bad(1, "empty file"))?;
+    let symmetric = parse_header(header)?;
+    // Size line: the first line that is neither a comment nor blank.
+    let (size_line, size) = lines
+        .by_ref()
+        .find(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('%'))
+        .ok_or_else(|| bad(2, "missing the size line 'rows cols entries'"))?;
+    let (nrows, ncols, nnz) = parse_size(size_line, size, symmetric)?;
+    let mut entries = Vec::with_capacity(if symmetric { 2 * nnz } else { nnz });
+    let mut read = 0usize;
+    let mut last_line = size_line;
+    for (number, line) in lines {
+        last_line = number;
+        let trimmed = line.trim();
+        if trimmed.is_empty() || trimmed.starts_with('%') {
+            continue;
+        }
+        if read == nnz {
+            return Err(bad(number, format!("more entries than the {nnz} declared")));
+        }
+        let (r, c, value) = parse_entry(number, trimmed, (nrows, ncols), symmetric)?;
+        entries.push(Triplet::new(r, c, value));
+        if symmetric && r != c {
+            entries.push(Triplet::new(c, r, value));
+        }
+        read += 1;
+    }
+    if read != nnz {
+        return Err(bad(last_line, format!("{read} entries found, {nnz} declared")));
+    }
+    Ok(MatrixMarket {
+        nrows,
+        ncols,
+        entries,
+        symmetric,
+    })
+}
+
+/// The header `%%MatrixMarket matrix coordinate <real|integer|double> <general|symmetric>`
+/// (case-insensitive): whether the matrix is stored symmetric.
+fn parse_header(header: &str) -> Result<bool, ModalError> {
     let words: Vec<String> = header.split_whitespace().map(str::to_ascii_lowercase).collect();
     if words.first().map(String::as_str) != Some("%%matrixmarket") {
         return Err(bad(1, "missing the %%MatrixMarket header"));
@@ -66,26 +106,25 @@ pub fn parse_matrix_market(text: &str) -> Result<MatrixMarket, ModalError> {
             format!("unsupported field '{}' (need real or integer)", words[3]),
         ));
     }
-    let symmetric = match words[4].as_str() {
-        "general" => false,
-        "symmetric" => true,
-        other => {
-            return Err(bad(
-                1,
-                format!("unsupported symmetry '{other}' (need general or symmetric)"),
-            ));
-        }
-    };
-    // Size line: the first line that is neither a comment nor blank.
-    let (size_line, size) = lines
-        .by_ref()
-        .find(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('%'))
-        .ok_or_else(|| bad(2, "missing the size line 'rows cols entries'"))?;
-    let parse_usize = |line: usize, token: &str, what: &str| -> Result<usize, ModalError> {
-        token
-            .parse::<usize>()
-            .map_err(|_| bad(line, format!("{what} '{token}' is not a non-negative integer")))
-    };
+    match words[4].as_str() {
+        "general" => Ok(false),
+        "symmetric" => Ok(true),
+        other => Err(bad(
+            1,
+            format!("unsupported symmetry '{other}' (need general or symmetric)"),
+        )),
+    }
+}
+
+/// A non-negative integer `token` of line `line` (`what` names it in the error).
+fn parse_usize(line: usize, token: &str, what: &str) -> Result<usize, ModalError> {
+    token
+        .parse::<usize>()
+        .map_err(|_| bad(line, format!("{what} '{token}' is not a non-negative integer")))
+}
+
+/// The size line `rows cols entries` (line `size_line`); a symmetric matrix must be square.
+fn parse_size(size_line: usize, size: &str, symmetric: bool) -> Result<(usize, usize, usize), ModalError> {
     let tokens: Vec<&str> = size.split_whitespace().collect();
     if tokens.len() != 3 {
         return Err(bad(size_line, "size line needs exactly 3 integers: rows cols entries"));
@@ -99,61 +138,46 @@ pub fn parse_matrix_market(text: &str) -> Result<MatrixMarket, ModalError> {
             format!("a symmetric matrix must be square, got {nrows}×{ncols}"),
         ));
     }
-    let mut entries = Vec::with_capacity(if symmetric { 2 * nnz } else { nnz });
-    let mut read = 0usize;
-    let mut last_line = size_line;
-    for (number, line) in lines {
-        last_line = number;
-        let trimmed = line.trim();
-        if trimmed.is_empty() || trimmed.starts_with('%') {
-            continue;
-        }
-        if read == nnz {
-            return Err(bad(number, format!("more entries than the {nnz} declared")));
-        }
-        let t: Vec<&str> = trimmed.split_whitespace().collect();
-        if t.len() != 3 {
-            return Err(bad(
-                number,
-                format!("entry needs 'row col value', got {} tokens", t.len()),
-            ));
-        }
-        let row = parse_usize(number, t[0], "row")?;
-        let col = parse_usize(number, t[1], "col")?;
-        if row == 0 || row > nrows || col == 0 || col > ncols {
-            return Err(bad(
-                number,
-                format!("index ({row}, {col}) outside 1..={nrows} × 1..={ncols}"),
-            ));
-        }
-        let value: f64 = t[2]
-            .parse()
-            .map_err(|_| bad(number, format!("value '{}' is not a number", t[2])))?;
-        if !value.is_finite() {
-            return Err(bad(number, format!("value {value} is not finite")));
-        }
-        let (r, c) = (row - 1, col - 1);
-        if symmetric && r < c {
-            return Err(bad(
-                number,
-                "a symmetric file stores the lower triangle (row ≥ col) only",
-            ));
-        }
-        entries.push(Triplet::new(r, c, value));
-        if symmetric && r != c {
-            entries.push(Triplet::new(c, r, value));
-        }
-        read += 1;
+    Ok((nrows, ncols, nnz))
+}
+
+/// The entry `row col value` of line `number` as zero-based (row, col, value): indices within
+/// the matrix's size, a finite value, and the lower triangle only when the file is symmetric.
+fn parse_entry(
+    number: usize,
+    trimmed: &str,
+    (nrows, ncols): (usize, usize),
+    symmetric: bool,
+) -> Result<(usize, usize, f64), ModalError> {
+    let t: Vec<&str> = trimmed.split_whitespace().collect();
+    if t.len() != 3 {
+        return Err(bad(
+            number,
+            format!("entry needs 'row col value', got {} tokens", t.len()),
+        ));
     }
-    if read != nnz {
-        return Err(bad(last_line, format!("{read} entries found, {nnz} declared")));
+    let row = parse_usize(number, t[0], "row")?;
+    let col = parse_usize(number, t[1], "col")?;
+    if row == 0 || row > nrows || col == 0 || col > ncols {
+        return Err(bad(
+            number,
+            format!("index ({row}, {col}) outside 1..={nrows} × 1..={ncols}"),
+        ));
     }
-    Ok(MatrixMarket {
-        nrows,
-        ncols,
-        entries,
-        symmetric,
-    })
+    let value: f64 = t[2]
+        .parse()
+        .map_err(|_| bad(number, format!("value '{}' is not a number", t[2])))?;
+    if !value.is_finite() {
+        return Err(bad(number, format!("value {value} is not finite")));
+    }
+    let (r, c) = (row - 1, col - 1);
+    if symmetric && r < c {
+        return Err(bad(
+            number,
+            "a symmetric file stores the lower triangle (row ≥ col) only",
+        ));
+    }
+    Ok((r, c, value))
 }
 
 /// The text of a symmetric matrix (lower triangle of `entries`, which must hold both) in
