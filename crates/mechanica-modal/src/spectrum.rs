@@ -39,18 +39,18 @@ pub struct Mode {
     /// Classification.
     pub kind: ModeKind,
     /// Bound on |ω²_computed − ω²_exact| (first-order condition bound or residual bound, see
-    /// [`AccuracyReport::bound_kinds`]); 0 for infinite modes, which are exact by construction.
+    /// [`crate::AccuracyReport::bound_kinds`]); 0 for infinite modes, which are exact by construction.
     pub error_bound: f64,
     /// Backward error η of the pair (None when values only were computed or the mode is infinite).
     pub backward_error: Option<f64>,
-    /// Index of this mode's group of (numerically) equal frequencies in [`ModalSolution::groups`].
+    /// Index of this mode's group of (numerically) equal frequencies in [`crate::ModalSolution::groups`].
     pub group: usize,
 }
 
 /// A set of modes whose ω² cannot be told apart within their error bounds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeGroup {
-    /// Index of the first mode of the group in [`ModalSolution::modes`].
+    /// Index of the first mode of the group in [`crate::ModalSolution::modes`].
     pub first: usize,
     /// Multiplicity (number of modes in the group).
     pub multiplicity: usize,

@@ -12,7 +12,7 @@
 use std::time::Duration;
 
 /// Thresholds, sizes and limits of the modal solvers (see the module documentation). Orders are
-/// matrix orders n; the thread thresholds were chosen on a two-core machine (measured in
+/// matrix orders n; the thread thresholds suit a two-core machine (measured in
 /// docs/benchmarks.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tuning {
@@ -58,12 +58,12 @@ pub struct Tuning {
 
     // Symmetric eigensolver (module `linalg::eigen`).
     /// Columns reduced per panel of the tridiagonalization before the trailing matrix is updated
-    /// (default 32, LAPACK `dsytrd`'s default): wider panels were slower (measured in
+    /// (default 32, LAPACK `dsytrd`'s default): wider panels are slower (measured in
     /// docs/benchmarks.md).
     pub panel: usize,
     /// Trailing orders from which half of each symmetric matrix-vector product of the
     /// tridiagonalization runs on a helper thread; smaller matrices use no helper at all
-    /// (default 640): one thread is faster at order 500, two at order 1000.
+    /// (default 640): below it one thread is faster (measured in docs/benchmarks.md).
     pub parallel_symv_from: usize,
     /// Trailing orders from which the helper thread takes half of each panel's trailing update
     /// (default 128): faer's pool threads have gone to sleep during the panel and would contend

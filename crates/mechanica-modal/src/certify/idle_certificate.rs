@@ -1,6 +1,6 @@
 //! The bottom-of-spectrum certificate of a dense all-modes solve (the Cholesky factorization of
-//! B − sA that proves no mode lies below s, module `solve`'s inertia check), factored on idle
-//! core time ([`crate::runtime::idle_task`]) while the eigenvectors are formed.
+//! B − sA that proves no mode lies below s, the Sturm check of [`super::sturm`]), factored on
+//! idle core time ([`crate::runtime::idle_task`]) while the eigenvectors are formed.
 //!
 //! The task starts when T (the tridiagonal form) is known: the solve takes the shift s = ½λ₁
 //! from T's lowest eigenvalue λ₁ (bisection on Sturm counts), and the thread forms the lower
@@ -11,10 +11,7 @@
 //! When the report needs it before the thread is done, the thread hands over its partial factor
 //! at the end of its current block and the report factors the remaining columns on all
 //! threads: a right-looking factorization past its first third of the columns has done 70 % of
-//! its flops. Measured at n = 1000: the
-//! certificate stage went from 9.6–11 ms to 0 in 18 of 20 solves. At n = 4000 the thread had
-//! reached column 1088–2432 of 4000 when the report needed it; with the hand-over (a wait of
-//! 15 ms) the stage went from 0.47–0.53 s to 0.16 s.
+//! its flops. (What this saves is measured in docs/benchmarks.md.)
 
 use crate::PencilProblem;
 use crate::certify::inertia::shifted_lower;

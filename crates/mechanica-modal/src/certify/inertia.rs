@@ -1,5 +1,5 @@
 //! Sylvester inertia (Sturm) counts of the pencil: how many eigenvalues ω² = −λ of
-//! det(λA + B) = 0 (8.89) lie below a shift s.
+//! det(λA + B) = 0 ((8.89), see docs/theory.md) lie below a shift s.
 //!
 //! With A positive definite, B − sA is congruent to diag(ω²_k − s) (take X A-orthonormal:
 //! Xᵀ(B − sA)X = diag(ω²_k − s)), so by Sylvester's law of inertia the number of negative
@@ -44,7 +44,7 @@ pub fn count_below(problem: &PencilProblem, shift: f64) -> Result<InertiaCount, 
 /// Whether every mode has ω² > `shift`: B − shift·A is positive definite to working precision
 /// (its Cholesky factorization succeeds with no negligible pivot). The count 0 it certifies
 /// costs a third of the LBLᵀ of [`count_below`] (n³/3 flops at Cholesky speed).
-/// The factorization works in kept storage (module `scratch`), given back afterwards.
+/// The factorization works in kept storage ([`crate::runtime::scratch`]), given back afterwards.
 pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> bool {
     let mut k = shifted_lower(problem, shift);
     let positive = crate::linalg::reduce::factor_in_place(k.as_mut(), par).is_ok();
@@ -53,7 +53,7 @@ pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> 
 }
 
 /// The lower triangle of B − shift·A (the strict upper triangle zero), in kept storage when
-/// some fits (module `scratch`).
+/// some fits ([`crate::runtime::scratch`]).
 pub(crate) fn shifted_lower(problem: &PencilProblem, shift: f64) -> Mat<f64> {
     let (a, b) = (problem.a(), problem.b());
     let n = problem.dim();

@@ -15,7 +15,7 @@ pub enum Residuals {
     /// orthogonality error are computed exactly (to rounding).
     #[default]
     Exact,
-    /// Gaussian sketches ([`crate::certify::sketch`], O(k·n²) flops with k = 32): each backward error and
+    /// Gaussian sketches (`crate::certify::sketch`, O(k·n²) flops with k = 32): each backward error and
     /// the orthogonality error (then a bound on ‖XᵀAX − I‖_F) is an upper bound that fails with
     /// probability at most 1e-12; typically 2–4 times the exact value. Where the exact products
     /// cost less (all pairs below n ≈ 200, or a few pairs of any pencil) they are formed
@@ -59,8 +59,8 @@ fn mass_product(mut out: MatMut<'_, f64>, a: MatRef<'_, f64>, x: MatRef<'_, f64>
 /// B X and XᵀAX take 4n²m + 2nm² flops in large products; the sketches 4kn² + 10knm flops in
 /// thin products (counted twice: they run at about half the rate) and k(n + m) Gaussian
 /// numbers (a logarithm and a cosine each, about 1000 flops' time). For all pairs the
-/// crossover is n ≈ 200 (measured: sketched 1.3–5× slower at n = 12–120, 1.2× faster at 250);
-/// for a few pairs of a large pencil the exact products are cheaper at any n.
+/// crossover is n ≈ 200 (measured in docs/benchmarks.md); for a few pairs of a large pencil the
+/// exact products are cheaper at any n.
 pub(crate) fn exact_costs_less(n: usize, m: usize) -> bool {
     let (n, m, k) = (n as f64, m as f64, crate::certify::sketch::SKETCH_SIZE as f64);
     let exact = 4.0 * n * n * m + 2.0 * n * m * m;

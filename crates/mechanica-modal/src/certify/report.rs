@@ -90,7 +90,8 @@ impl AccuracyReport {
         }
     }
 
-    /// Whether every backward error meets the target 10·n·u.
+    /// Whether every backward error is at most 10·n·u (n the order): the level of a backward
+    /// stable solve.
     pub fn meets_backward_error_target(&self, n: usize) -> bool {
         self.max_backward_error
             .is_some_and(|e| e <= 10.0 * n as f64 * f64::EPSILON)

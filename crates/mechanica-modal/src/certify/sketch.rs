@@ -56,7 +56,7 @@ fn product(lhs: MatRef<'_, f64>, rhs: MatRef<'_, f64>, par: Par) -> Mat<f64> {
 }
 
 /// The sketch's rows S·A and S·B (k×n): they do not depend on the modes, so a solve can form
-/// them early (on idle core time, module `idle_task`).
+/// them early (on idle core time, [`crate::runtime::idle_task`]).
 pub(crate) struct SketchRows {
     sa: Mat<f64>,
     sb: Mat<f64>,
@@ -65,7 +65,7 @@ pub(crate) struct SketchRows {
 impl SketchRows {
     /// S·A and S·B for the fixed-seed Gaussian S of every report, formed on one thread: the
     /// same products whether an idle thread or the report forms them, so that the report's
-    /// bounds do not depend on which did (4kn² flops, 4–5 ms at n = 1000).
+    /// bounds do not depend on which did (4kn² flops).
     pub(crate) fn new(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Self {
         let s = gaussian(SKETCH_SIZE, a.nrows(), 1);
         Self {

@@ -25,7 +25,7 @@ pub struct InertiaCheck {
 /// mode selected it first tries the cheap certificate
 /// that B − sA is positive definite for s just below the lowest computed ω² (by half its size or
 /// twice its bound): nothing was missed at the bottom of the spectrum, where stability is
-/// decided (the `idle_certificate`'s decision, when it has one at that shift). Otherwise, or
+/// decided (the idle-time certificate's decision, when it has one at that shift). Otherwise, or
 /// when that Cholesky fails, it places a shift in the first real gap
 /// (wider than twice the largest bound) at or beyond the selection's edge, so never inside a
 /// cluster the selection cut, or in the widest gap of the whole spectrum, and compares the LBLᵀ

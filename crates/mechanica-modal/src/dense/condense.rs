@@ -10,7 +10,7 @@
 //! model) needs no eigen-decomposition: Q is the permutation that sorts its diagonal, so QᵀBQ is
 //! a reordering of B and the lift Q₁z + Q₀w a scatter of rows. That replaces the O(n³) eigen-
 //! decomposition of A and the 4n³ flops of QᵀBQ by O(n²), and the condensed pencil's A₁ is
-//! diagonal again (the reduction then scales, module `reduce`).
+//! diagonal again (the reduction then scales, [`crate::linalg::reduce`]).
 
 use crate::error::ModalError;
 use crate::linalg::eigen::symmetric_eigen;

@@ -7,7 +7,7 @@ use crate::linalg::norms::frobenius_norm;
 use crate::problem::PencilProblem;
 use crate::runtime::idle_task::IdleTask;
 
-/// What an all-modes solve computes on idle core time from its start (module `idle_task`): the
+/// What an all-modes solve computes on idle core time from its start ([`IdleTask`]): the
 /// Frobenius norms of A and B and, for a sketched report, the sketch's rows S·A and S·B.
 pub(crate) struct EarlyInputs {
     pub(crate) norms: (f64, f64),
@@ -34,7 +34,7 @@ impl EarlyInputs {
 #[derive(Default)]
 pub(crate) struct IdleResults {
     /// The bottom certificate's shift and its factorization begun on idle time, module
-    /// `idle_certificate`.
+    /// [`crate::certify::idle_certificate`].
     pub(crate) certificate: Option<BottomCertificate>,
     /// The sketch's S·A and S·B.
     pub(crate) sketch_rows: Option<SketchRows>,

@@ -1,11 +1,16 @@
-//! The dense solver of det(λA + B) = 0 (8.89): Cholesky reduction to a standard symmetric
-//! problem, its eigen-decomposition ([`crate::linalg::eigen`]), back-transformation, an accuracy report, mode
-//! classification, grouping of repeated frequencies, static condensation of massless
-//! coordinates, and refinement of the low modes of stiff problems.
+//! The dense solver of det(λA + B) = 0 ((8.89), see docs/theory.md), [`solve`]: the Cholesky
+//! reduction to a standard symmetric problem C = L⁻¹BL⁻ᵀ ([`crate::linalg`]), its
+//! eigen-decomposition, the back-transformation X = L⁻ᵀY, an accuracy report, classification,
+//! grouping of repeated frequencies, static condensation of massless coordinates, and
+//! refinement of the low modes of stiff problems. Modes are ordered by ω² = −λ ascending
+//! ([`crate::spectrum`]).
 //!
-//! Sign convention: the syllabus writes det(λA + B) = 0, so an oscillatory mode has λ = −ω² < 0
-//! (8.90). Internally and in every ordering the solver uses ω² = −λ, ascending: unstable modes
-//! (ω² < 0) first, then rigid-body modes, then oscillatory modes, then infinite ones.
+//! Files: what is asked ([`SolveOptions`], `options`) and returned ([`ModalSolution`],
+//! `solution`); the definite pencil's spectrum from L (`definite`); the condensation of a
+//! semidefinite A (`condense`, a transform [`solve`] calls before the definite solve); the
+//! report inputs formed on idle core time (`idle_inputs`); the common tail of every solve
+//! (`finish`: report, Sturm check, classification) with its refinement stage (`refinement`) and
+//! the values-only sharpening (`values_only`).
 
 mod condense;
 mod definite;
@@ -68,10 +73,10 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
         .flatten();
     let clock = Instant::now();
     // The copies of A (factored in place) and B (reduced in place) take kept working storage
-    // (module `scratch`) and are written on two threads: the first write of fresh memory faults
-    // every page, and faults on two cores proceed in parallel (6.5 ms per 8 MB on one core of
-    // the Zen 3 host). Only the lower triangles are read (the factorization and the reduction
-    // use no other entry); the upper ones are zeroed, as L's must be.
+    // (`crate::runtime::scratch`) and are written on two threads: the first write of fresh
+    // memory faults every page, and faults on two cores proceed in parallel. Only the lower
+    // triangles are read (the factorization and the reduction use no other entry); the upper
+    // ones are zeroed, as L's must be.
     let (mut a_copy, mut b_copy) = (scratch::empty(n, n), scratch::empty(n, n));
     join(
         || a_copy.resize_with(n, n, |i, j| lower_entry(a, i, j)),

@@ -20,7 +20,7 @@ pub enum Selection {
     },
 }
 
-/// Whether to refine low modes with extended-precision residuals (module `refine`). Clusters of
+/// Whether to refine low modes with extended-precision residuals (`crate::refine`). Clusters of
 /// nearly equal ω² (up to [`crate::Tuning::max_refined_cluster`] modes) are refined as blocks; a semidefinite A
 /// is refined when it is diagonal with exactly zero massless entries (the condensation is then
 /// exact), and otherwise keeps its first-order bounds.
@@ -43,7 +43,7 @@ pub(crate) fn weakly_bounded(bound: f64, omega_sq: f64) -> bool {
     bound > AUTO_REFINE_RELATIVE_BOUND * omega_sq.abs()
 }
 
-/// Options of [`solve`].
+/// Options of [`crate::solve()`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolveOptions {
     /// Which modes.

@@ -18,7 +18,7 @@ pub enum Method {
     },
 }
 
-/// The result of [`solve`]: modes, shapes, groups and the accuracy report.
+/// The result of [`crate::solve()`]: modes, shapes, groups and the accuracy report.
 #[derive(Debug, Clone)]
 pub struct ModalSolution {
     /// Selected modes, ascending in ω².
@@ -37,7 +37,7 @@ pub struct ModalSolution {
     pub timings: SolveTimings,
 }
 
-/// Wall time of each stage of a dense [`solve`].
+/// Wall time of each stage of a dense [`crate::solve()`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SolveTimings {
     /// Cholesky of A (or the condensation of a semidefinite A) and the reduction C = L⁻¹BL⁻ᵀ.

@@ -5,7 +5,7 @@
 //! Without vectors a dense solve can only bound an eigenvalue a priori, by an assumed backward
 //! error of n·u: n·u·(‖B‖ + |ω²|‖A‖)·‖A⁻¹‖ (`crate::certify::a_priori::APrioriModel`), which
 //! relative to a small |ω²| is weak (the lowest modes of a long chain, stiff problems). For each
-//! mode above [`crate::solve::AUTO_REFINE_RELATIVE_BOUND`]·|ω²|:
+//! mode above [`crate::dense::AUTO_REFINE_RELATIVE_BOUND`]·|ω²|:
 //!
 //! 1. its eigenvector z of the tridiagonal form T of C = L⁻¹BL⁻ᵀ is computed by inverse
 //!    iteration ([`crate::linalg::eigen::inverse_iteration`], O(n) per mode), and x = L⁻ᵀQz (O(n²));
@@ -17,8 +17,9 @@
 //!    values-only solve does not have, and gets a residual bound
 //!    ([`crate::BoundKind::Residual`]).
 //!
-//! The cost is O(n²) per flagged mode, against the n³ of the vectors that a full solve forms
-//! (before, a values-only solve with a flagged mode was solved again with all vectors).
+//! The cost is O(n²) per flagged mode, against the n³ of the vectors that a full solve forms;
+//! beyond [`crate::Tuning::flagged_vectors_up_to`] (or n/4) flagged modes the solve forms all
+//! vectors instead.
 
 use crate::certify::a_priori::APrioriModel;
 use crate::certify::products::{PairProducts, Residuals};

@@ -167,8 +167,9 @@ pub(crate) fn subtract_lower_product(target: MatMut<'_, f64>, lhs: MatRef<'_, f6
 /// blocking for dense linear-algebra algorithms", IBM J. Res. Dev. 41, 1997): with
 /// A = [A11 ·; A21 A22], L11 = chol(A11), L21 = A21 L11⁻ᵀ, then chol(A22 − L21 L21ᵀ) with the
 /// update on the lower triangle only. Almost all flops land in two large matrix products, which
-/// faer runs on every thread; faer's own blocked factorization was 1.1–1.6× slower at orders
-/// 1000–4000 (measured). Err(pivot) at the first pivot that is not positive.
+/// faer runs on every thread, so that it is faster than faer's own blocked factorization at
+/// large orders (measured in docs/benchmarks.md). Err(pivot) at the first pivot that is not
+/// positive.
 fn factor_recursive(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
     let n = l.nrows();
     if n <= Tuning::DEFAULT.cholesky_base_case {
@@ -289,9 +290,8 @@ fn reduce_blocks(l: MatRef<'_, f64>, mut c: MatMut<'_, f64>, mut scratch: MatMut
     subtract_lower_product(c22.as_mut(), c21.as_ref(), l21, par);
     subtract_lower_product(c22.as_mut(), l21, c21.as_ref(), par);
     subtract_in_place(c21.as_mut(), half.as_ref());
-    // C21 = L22⁻¹ (W − H) on column chunks, one per thread (faer's parallel solve of the same:
-    // medians 7.0 / 50.8 / 438 ms against 5.9 / 44.5 / 332 ms summed over the steps at
-    // n = 1000 / 2000 / 4000).
+    // C21 = L22⁻¹ (W − H) on column chunks, one per thread (faster than faer's parallel solve
+    // of the same, measured in docs/benchmarks.md).
     by_column_chunks(c21.as_mut(), par, &|rhs| {
         solve_lower_triangular_in_place(l22, rhs, Par::Seq)
     });

@@ -12,7 +12,7 @@ pub(crate) enum Metric<'a> {
     /// A = LLᵀ positive definite (L lower): corrections L⁻ᵀKL⁻¹r, residuals in the A⁻¹-norm.
     Cholesky(LowerFactor<'a>),
     /// A diagonal with exactly massless coordinates, condensed statically: corrections and
-    /// residuals of the condensed pencil (S, A₁) (module `condense`).
+    /// residuals of the condensed pencil (S, A₁) ([`Condensation`]).
     Condensed(&'a Condensation),
 }
 

@@ -15,7 +15,7 @@
 //! factored by a sparse LU with partial pivoting instead, its pattern analysed once for all
 //! modes ([`SparseShifts`]), and the border is eliminated by blocks ([`refine_pair_sparse`]):
 //! each simple mode then costs O(nnz(L + U)) per step instead of the batch's 4n² products
-//! through the reduced eigenvectors (graded 1e12 chain, n = 2000: refine stage 3.1 → 1.6 s).
+//! through the reduced eigenvectors.
 //!
 //! It is chosen by [`crate::Refinement::Auto`] for every selected simple mode whose first-order
 //! bound from the reduction exceeds 1e-8·|ω²| (fewer than 8 guaranteed digits). Modes whose
@@ -23,9 +23,15 @@
 //! close to tell apart) are refined together as one block by [`refine_cluster_projected`]: the
 //! block's invariant subspace is well defined where its single vectors are not.
 //!
-//! A condensed pencil (massless coordinates of a diagonal A, module `condense`) is refined the
-//! same way in the original coordinates; its residuals are mapped exactly to residuals of the
-//! condensed pencil (S, A₁) and its corrections go through the condensed spectrum ([`Metric`]).
+//! A condensed pencil (massless coordinates of a diagonal A, condensed by the dense solve) is
+//! refined the same way in the original coordinates; its residuals are mapped exactly to
+//! residuals of the condensed pencil (S, A₁) ([`Condensation`]) and its corrections go through
+//! the condensed spectrum ([`Metric`]).
+//!
+//! Files: what refinement returns (`pair`), the definite pencil it works in (`metric`,
+//! `condensed`), the corrections through the reduced spectrum (`correction`), the bordered
+//! Newton steps (`bordered`), the projected steps for one mode or a cluster (`projected`) and
+//! for many simple modes at once (`batch`); [`refine_cluster`] here chooses among them.
 
 mod batch;
 mod bordered;

@@ -138,8 +138,8 @@ fn sparse_and_dense_bordered_steps_agree_on_banded_pencils() {
                 fast.residual_a_inv,
                 slow.residual_a_inv
             );
-            // The double-double iterate's residual is far below its rounding's (measured
-            // 1e-22–1e-19 against 3e-6–5e-4 on these chains).
+            // The double-double iterate's residual is far below its rounding's (about 1e-22–1e-19
+            // against 3e-6–5e-4 on these chains).
             let limit = rounded(&a, &b, &l, &fast).residual_a_inv;
             assert!(
                 fast.residual_a_inv <= 1e-8 * limit,

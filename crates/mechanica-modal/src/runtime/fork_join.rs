@@ -27,9 +27,9 @@ pub(crate) fn map_items<T: Sync, R: Send>(items: &[T], par: Par, f: impl Fn(&T) 
 }
 
 /// Runs `solve` on column chunks of `rhs`, one chunk per thread of `par` (each chunk solved
-/// sequentially). For triangular solves with many right-hand sides this keeps both threads on
-/// whole columns; faer's parallel triangular solve was measured 1.1–1.4× slower on a
-/// 256-column triangle with 744 right-hand sides and on n×n back-transformations at n = 1000.
+/// sequentially). For triangular solves with many right-hand sides this keeps every thread on
+/// whole columns, which is faster than faer's parallel triangular solve (measured in
+/// docs/benchmarks.md).
 pub(crate) fn by_column_chunks(rhs: MatMut<'_, f64>, par: Par, solve: &(dyn Fn(MatMut<'_, f64>) + Sync)) {
     by_column_chunks_at(rhs, par, &|_, chunk| solve(chunk));
 }

@@ -1,12 +1,10 @@
 //! Work that a solve needs later, done now on a thread of idle scheduling priority (Linux
 //! `SCHED_IDLE`: it runs only on a core nothing else wants).
 //!
-//! A dense solve leaves a core idle for part of its time: measured on the 2-core host at
-//! n = 1000, the factor stage kept 1.67–1.86 cores busy on average, divide and conquer 1.64, the
-//! Householder application 1.72, the sketches 1.72 (the threads' scheduler statistics), and a
-//! thread of idle priority ran 5–6 sequential Cholesky factorizations of order 1000 per solve
-//! (about 90 ms of a core in a 250 ms solve) without slowing it. Work that does not depend on
-//! the solve's critical path can run there.
+//! A dense solve leaves a core idle for part of its time (every stage keeps fewer cores busy
+//! than it has; measured in docs/benchmarks.md), and a thread of idle priority uses that time
+//! without slowing the solve. Work that does not depend on the solve's critical path can run
+//! there.
 //!
 //! The solve uses a task's result only if the task has finished when it is needed, or, for
 //! work that can hand over what it has done ([`IdleTask::collect`]), after waiting a bounded

@@ -3,12 +3,10 @@
 //! An all-pairs solve of order n works in six n×n matrices (the copies of A and B, three of
 //! divide and conquer, and the bottom certificate's), of which the caller keeps one (the mode
 //! shapes). Fresh memory costs a page fault per 4 KiB on its first write, and the allocator
-//! returns large blocks to the system when they are freed, so every solve faulted its working
-//! set anew. Freed working matrices of at least [`crate::Tuning::kept_from_bytes`] are kept here, at most
-//! [`crate::Tuning::kept_matrices`] of them, and the next solve takes them instead of allocating. Measured at n = 2000
-//! on the 2-core Zen 3 host, six solves in a row: 32 thousand page faults and 0.19 s of system
-//! time per solve before, 14 thousand and 0.08 s after (the wall time, about 1.5 s, moved by
-//! less than the host's spread).
+//! returns large blocks to the system when they are freed, so that each solve would fault its
+//! working set anew. Freed working matrices of at least [`crate::Tuning::kept_from_bytes`] are
+//! kept here, at most [`crate::Tuning::kept_matrices`] of them, and the next solve takes them
+//! instead of allocating, which halves its page faults (measured in docs/benchmarks.md).
 //!
 //! The memory stays with the process after the solve (at n = 4000, up to 5 × 128 MB, less than
 //! the solve's own peak), as optimised BLAS libraries keep their buffers; [`release`] (C:

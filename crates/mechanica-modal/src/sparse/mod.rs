@@ -1,8 +1,16 @@
-//! The k lowest modes of a large sparse pencil (A, B) by shift-invert Lanczos (issue part 5).
+//! The k lowest modes of a large sparse pencil (A, B) by shift-invert Lanczos ([`solve_sparse`]),
+//! certified by the inertia of B − τA ([`count_below_sparse`]).
+//!
+//! Files: the options ([`SparseSolveOptions`]) and the result ([`SparseModalSolution`],
+//! [`SparseAccuracyReport`]); the pencil ([`SparsePencil`], `pencil`) and Matrix Market input
+//! ([`matrix_market`]); the factored operator (`operator`, with the supernodal block solve of
+//! `supernodal`); the Lanczos iteration (`lanczos`); Rayleigh–Ritz (`rayleigh_ritz`); the bounds
+//! (`bounds`); the Sturm check (`sturm`, with the inertia count of `inertia`); small pencils
+//! solved densely (`fallback`); the driver [`solve_sparse`] here.
 //!
 //! - **Operator.** With a shift σ below the lowest mode, K = B − σA is positive definite and
-//!   factored once by faer's sparse Cholesky (AMD ordering; solved by this crate's
-//!   supernodal block solve, `supernodal_solve`, 1.35–1.7× faster than faer's on a 2-D grid).
+//!   factored once by faer's sparse Cholesky (AMD ordering; solved by this crate's supernodal
+//!   block solve, module `supernodal`, which is faster than faer's on 2-D grids).
 //!   T = K⁻¹A is self-adjoint in the A-inner product and has the eigenvalues θ = 1/(ω² − σ) > 0:
 //!   the lowest ω² are the largest θ, well separated. A successful Cholesky factorization of K
 //!   certifies that no mode lies below σ (Sylvester). The automatic σ is −√u·‖B‖_F/‖A‖_F,

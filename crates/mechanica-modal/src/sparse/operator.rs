@@ -68,8 +68,8 @@ pub(crate) fn solve_with(
 /// non-positive pivot returns its index.
 pub(crate) fn factor_llt(symbolic: &SymbolicCholesky<usize>, k: &Csc) -> Result<Result<Vec<f64>, usize>, ModalError> {
     let m = k.to_faer();
-    // Sequential: faster than two threads on this 2-D grid (125 against 140 ms), and no
-    // contention on a shared machine.
+    // Sequential: no slower than two threads on 2-D grids (measured in docs/benchmarks.md), and
+    // no contention on a shared machine.
     let par = Par::Seq;
     let req = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
     let mut mem = MemBuffer::try_new(req).map_err(|_| ModalError::Factorization {

@@ -3,7 +3,7 @@
 
 use crate::error::ModalError;
 
-/// Options of [`solve_sparse`].
+/// Options of [`crate::solve_sparse`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SparseSolveOptions {
     /// Number k of lowest modes wanted (1 ≤ k < n).

@@ -4,7 +4,7 @@
 //!
 //! faer's own supernodal solve dispatches a dense triangular solve and a matrix product per
 //! supernode; on a 2-D grid most supernodes have one to a few columns, so that overhead
-//! dominates (12–21 ms for one right-hand side on the 300×300 grid, nnz(L) = 3.8e6). Here the b
+//! dominates (measured in docs/benchmarks.md). Here the b
 //! right-hand sides are stored row-interleaved (entry (i, c) at i·b + c), so each entry of L is
 //! read once per pass and used b times, and each supernode costs two short loops:
 //!

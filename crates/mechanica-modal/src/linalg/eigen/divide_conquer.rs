@@ -1,5 +1,5 @@
 //! All eigenpairs of a symmetric tridiagonal matrix, T = Z Λ Zᵀ, by divide and conquer: the
-//! eigenvector stage of the dense solve (C = Q T Qᵀ, Y = Q Z; module `symmetric_eigen`).
+//! eigenvector stage of the dense solve (C = Q T Qᵀ, Y = Q Z; [`crate::linalg::eigen`]).
 //!
 //! Method (Cuppen, "A divide and conquer method for the symmetric tridiagonal eigenproblem",
 //! Numer. Math. 36, 1981; Gu & Eisenstat, SIMAX 16, 1995; organised as LAPACK `dstedc`):
@@ -22,9 +22,9 @@
 //! block are gathered in that order, so that two matrix products skip the zero blocks. Values
 //! are not sorted physically between levels: each node hands its parent a permutation.
 //!
-//! Why not faer's `tridiagonal_self_adjoint_evd`: it multiplies deflated columns and zero
-//! blocks, and its root finder is scalar; at n = 2000 it took 0.27 s, of which about two
-//! thirds outside the matrix products (measured with `perf`).
+//! faer's `tridiagonal_self_adjoint_evd` multiplies deflated columns and zero blocks, and its
+//! root finder is scalar, so that most of its time goes outside the matrix products (measured
+//! in docs/benchmarks.md).
 
 use crate::runtime::fork_join::join;
 use crate::tuning::Tuning;
@@ -59,18 +59,13 @@ pub(crate) fn tridiagonal_divide_and_conquer(diag: &[f64], offdiag: &[f64], par:
     }
     let mut d: Vec<f64> = diag.iter().map(|x| x / scale).collect();
     let mut e: Vec<f64> = offdiag.iter().map(|x| x / scale).collect();
-    // Three n×n buffers in kept storage (module `scratch`); fresh ones are zeroed, two on one
-    // thread and one on the other: fresh memory faults every 4 KiB page on its first write
-    // (about 3 µs each on the 2-core Zen 3 host, 6.5 ms per 8 MB), and faults on two cores
-    // proceed in parallel. New
-    // storage is allocated here, on the calling thread: memory allocated on a pool thread comes
-    // from that thread's allocator arena, which returns it to the system when freed (measured
-    // at n = 1000: 4–6 thousand page faults per solve before, 240 after).
-    // Kept storage is used with the values it holds: no entry is read before it is written
-    // (each merge reads only the rows where a column can be nonzero, see `merge`). That spares
-    // zeroing three n×n matrices, and the merges copy only nonzero rows; with the final copy
-    // skipped when the top merge deflates nothing, this stage's min / q1 / median over 29 solves
-    // at n = 1000 went from 32.9 / 36.6 / 42.9 to 29.8 / 34.1 / 36.8 ms.
+    // Three n×n buffers in kept storage (`crate::runtime::scratch`); fresh ones are zeroed, two
+    // on one thread and one on the other: fresh memory faults every 4 KiB page on its first
+    // write, and faults on two cores proceed in parallel. New storage is allocated here, on the
+    // calling thread: memory allocated on a pool thread comes from that thread's allocator
+    // arena, which returns it to the system when freed. Kept storage is used with the values it
+    // holds: no entry is read before it is written (each merge reads only the rows where a
+    // column can be nonzero, see `merge`), which spares zeroing three n×n matrices.
     let (mut u, mut work, mut secular) = (
         crate::runtime::scratch::stale(n, n),
         crate::runtime::scratch::stale(n, n),
@@ -1154,8 +1149,8 @@ mod tests {
 
     #[test]
     fn graded_from_huge_to_tiny_and_multiscale_couplings() {
-        // Found in review: graded over 1e±150 with the large end at the top made the leaves'
-        // QL stall (the bulge underflowed) and lose orthogonality through subnormal rotations.
+        // Graded over 1e±150 with the large end at the top: a leaf's QL iteration must neither
+        // stall (an underflowing bulge) nor lose orthogonality through subnormal rotations.
         for n in [100, 150, 200, 1000] {
             let mut d: Vec<f64> = (0..n)
                 .map(|i| 10f64.powf(-150.0 + 300.0 * i as f64 / (n - 1) as f64))

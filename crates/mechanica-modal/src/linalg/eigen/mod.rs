@@ -1,23 +1,16 @@
-//! Eigen-decomposition C = Y diag(ω²) Yᵀ of the reduced symmetric matrix C = L⁻¹BL⁻ᵀ (8.89
-//! after the reduction): a blocked Householder tridiagonalization C = Q T Qᵀ, the tridiagonal
-//! divide and conquer T = Z Λ Zᵀ of module `tridiagonal_divide` (faer's as fallback), and faer's
-//! blocked Householder application Y = Q Z; values
-//! only: the root-free QL/QR iteration of module `tridiagonal_values` on T.
+//! Eigen-decomposition C = Y diag(ω²) Yᵀ of the reduced symmetric matrix C = L⁻¹BL⁻ᵀ ((8.89)
+//! after the reduction, see docs/theory.md): the blocked Householder tridiagonalization
+//! C = Q T Qᵀ (`tridiagonalize`), the tridiagonal divide and conquer T = Z Λ Zᵀ
+//! (`divide_conquer`, faer's as fallback), and faer's blocked Householder application
+//! Y = Q Z; values only: the root-free QL/QR iteration on T (`ql_values`); a few vectors of a
+//! values-only solve: inverse iteration on T (`inverse_iteration`).
 //!
-//! Why not faer's `self_adjoint_eigen`: faer 0.24 tridiagonalizes column by column, reading and
-//! writing the whole trailing matrix once per column (a rank-2 update fused with a
-//! matrix-vector product). Here the panel algorithm of LAPACK `dsytrd`/`dlatrd` (Dongarra,
-//! Hammarling & Sorensen, "Block reduction of matrices to condensed forms for eigenvalue
-//! computations", J. Comput. Appl. Math. 27, 1989) is used: a panel of [`crate::Tuning::panel`] columns is
-//! reduced with one read-only symmetric matrix-vector product per column, and the trailing
-//! matrix is updated once per panel by a symmetric rank-2·[`crate::Tuning::panel`] update (half the flops,
-//! as matrix products). Only the lower triangle of C is read. From order `PARALLEL_SYMV_FROM` (640)
-//! half of every matrix-vector product runs on a spinning helper thread (module `symv_team`):
-//! with the pool's sleeping threads, woken once per column, the reduction took 41–47 ms at
-//! n = 1000 and 0.29–0.37 s at n = 2000; with the team 34 ms and 0.21–0.24 s (OpenBLAS `dsytrd`
-//! 35 ms and 0.22–0.27 s on the same machine). The helper also takes the panel's correction of
-//! each product (dlatrd's y −= V Wᵀv + W Vᵀv) and half of each trailing update, which faer's
-//! pool did with threads that had gone to sleep during the panel.
+//! faer 0.24's `self_adjoint_eigen` tridiagonalizes column by column, reading and writing the
+//! whole trailing matrix once per column; the panel algorithm of LAPACK `dsytrd` reads it once
+//! per matrix-vector product and updates it once per panel, as matrix products, and a spinning
+//! helper thread (`symv_team`) takes half of each product on large matrices, where the pool's
+//! sleeping threads would be woken once per column (the speed against faer and OpenBLAS is
+//! measured in docs/benchmarks.md).
 
 use crate::ModalError;
 use crate::linalg::eigen::divide_conquer::tridiagonal_divide_and_conquer;
@@ -51,7 +44,7 @@ pub struct SymmetricEigen {
 }
 
 /// Called with T's diagonal and off-diagonal as soon as the tridiagonal form is known (the
-/// solver starts its idle-time certificate there, module `idle_certificate`).
+/// solver starts its idle-time certificate there, `crate::certify::idle_certificate`).
 pub(crate) type OnTridiagonal<'a> = &'a mut dyn FnMut(&[f64], &[f64]);
 
 /// Eigen-decomposition of the symmetric matrix `c` (only its lower triangle is read).
@@ -61,7 +54,7 @@ pub fn symmetric_eigen(c: Mat<f64>, vectors: bool, par: Par) -> Result<Symmetric
 
 /// [`symmetric_eigen`], also handing back the input's storage (overwritten by the Householder
 /// vectors) so that the caller can reuse it instead of allocating: a fresh n×n matrix costs
-/// its page faults (measured 10–20 ms at n = 2000).
+/// its page faults.
 pub(crate) fn symmetric_eigen_returning_input(
     mut c: Mat<f64>,
     vectors: bool,
@@ -158,8 +151,8 @@ pub(crate) struct TridiagonalForm {
 
 /// Eigenvalues of the symmetric matrix `c` (lower triangle read), ascending, and its
 /// tridiagonal form for later eigenvectors. The values come from the root-free QL/QR iteration
-/// (2.7–3.4× faster than faer's values-only tridiagonal solver, which also fails to converge
-/// on some graded matrices).
+/// ([`ql_values`]): faster than faer's values-only tridiagonal solver (measured in
+/// docs/benchmarks.md), which also fails to converge on some graded matrices.
 pub(crate) fn symmetric_values_keeping_form(
     mut c: Mat<f64>,
     par: Par,
@@ -241,10 +234,8 @@ impl TridiagonalForm {
 
 /// Z ← Q Z (or Qᵀ Z) for the blocked reflectors `basis` with triangular factors `factor`
 /// (faer's layout, [`block_factor`]), on column chunks of Z, one per thread of `par`, each
-/// chunk sequential: the threads then never wait for each other between blocks of reflectors.
-/// Measured at n = 1000, Q·Z of all n columns inside the solve (36 solves alternating with
-/// faer's parallel application): median 42.3 against 48.0 ms, paired ratio 0.89 [q1 0.82,
-/// q3 0.95]; alone (60 alternated runs, twice) 44.0 / 40.3 against 47.9 / 46.5 ms.
+/// chunk sequential: the threads then never wait for each other between blocks of reflectors
+/// (faster than faer's parallel application, measured in docs/benchmarks.md).
 fn apply_reflectors(basis: MatRef<'_, f64>, factor: MatRef<'_, f64>, z: MatMut<'_, f64>, transpose: bool, par: Par) {
     type Apply = fn(MatRef<'_, f64>, MatRef<'_, f64>, Conj, MatMut<'_, f64>, Par, &mut faer::dyn_stack::MemStack);
     let (apply, scratch): (Apply, fn(usize, usize, usize) -> faer::dyn_stack::StackReq) = if transpose {

@@ -109,10 +109,10 @@ fn solve_block(d: &mut [f64], e: &mut [f64], sweeps: &mut usize, max_sweeps: usi
     e.iter_mut().for_each(|x| *x *= *x);
     // QR on the block is QL on the reversed block (the same spectrum). The block is turned so
     // that its larger end, measured by |d| + |e| there, is at the top, where QL deflates.
-    // `dsterf` compares |d| alone and deflates at the smaller end; on a zero diagonal with
-    // off-diagonals graded over 1e±150 from the top down that gave six eigenvalues wrong by
-    // 1e-8·‖T‖ (found in review; Sturm counts in the test below), and the rule here passed
-    // every orientation of the graded, zero- and alternating-diagonal probes.
+    // `dsterf` compares |d| alone and deflates at the smaller end, which on a zero diagonal with
+    // off-diagonals graded over 1e±150 from the top down loses eigenvalues to 1e-8·‖T‖; this
+    // rule keeps every orientation of graded, zero- and alternating-diagonal matrices accurate
+    // (the test below checks them against Sturm counts).
     let k = d.len();
     let top = d[0].abs() + e[0].sqrt();
     let bottom = d[k - 1].abs() + e[k - 2].sqrt();
