@@ -1,4 +1,4 @@
-//! Checks, on this machine, the statements issue 5 makes about faer 0.24 (run with
+//! Checks two facts about faer 0.24 behind the dense solver's design (run with
 //! `cargo run --release -p mechanica-modal --example faer_facts`):
 //! 1. `generalized_eigen` (QZ) accuracy and time on a rotated unit chain (exact spectrum known)
 //!    at n = 200 and 600, against `mechanica_modal::solve` on the same pencil;

@@ -127,12 +127,12 @@ impl Dd {
     }
 }
 
-/// Σ_j m[i, j]·x[j] in double-double, for every row i (the product M x as if computed in twice
-/// the working precision, then kept unrounded). Accumulated column by column into separate
-/// high and low parts, which vectorises; on CPUs with FMA and AVX2 the same operations run four
-/// rows per instruction (both products are exact, so results are identical). From
-/// [`crate::Tuning::parallel_rows_from`] rows, when faer's global parallelism allows two threads, the two
-/// halves of the rows are accumulated on two threads (each row's sum is unchanged, so the
+/// Σ_j m[i, j]·x[j] in double-double, for every row i (the product M x as if computed in twice the
+/// working precision, then kept unrounded). Accumulated column by column into separate high and low
+/// parts, which vectorises; on CPUs with FMA and AVX2 the same operations run four rows per
+/// instruction (both products are exact, so results are identical). From
+/// [`crate::Tuning::parallel_rows_from`] rows, when faer's global parallelism allows two threads,
+/// the two halves of the rows are accumulated on two threads (each row's sum is unchanged, so the
 /// result is bitwise the same).
 pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     let n = m.nrows();
@@ -233,8 +233,8 @@ impl<'a> Operand<'a> {
     }
 }
 
-/// The nonzero entries of `m` by columns when it has at most n²/[`crate::Tuning::sparse_fraction`] of them
-/// (one scan, stopping past that many), else None.
+/// The nonzero entries of `m` by columns when it has at most n²/[`crate::Tuning::sparse_fraction`]
+/// of them (one scan, stopping past that many), else None.
 pub(crate) fn sparse_columns(m: MatRef<'_, f64>) -> Option<faer::sparse::SparseColMat<usize, f64>> {
     nonzeros_by_columns(m, m.nrows() * m.ncols() / Tuning::DEFAULT.sparse_fraction)
 }

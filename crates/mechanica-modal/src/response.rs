@@ -1,4 +1,5 @@
-//! The free response of A δ̈ + B δ = 0 from δ(0), δ̇(0) by modal superposition ((8.91), see docs/theory.md).
+//! The free response of A δ̈ + B δ = 0 from δ(0), δ̇(0) by modal superposition ((8.91), see
+//! docs/theory.md).
 //!
 //! With A-orthonormal mode shapes x_k (x_jᵀ A x_k = δ_jk) the modal coordinates of the initial
 //! state are q_k(0) = x_kᵀ A δ(0) and q̇_k(0) = x_kᵀ A δ̇(0), and each coordinate evolves alone:

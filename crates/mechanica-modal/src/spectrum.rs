@@ -39,11 +39,13 @@ pub struct Mode {
     /// Classification.
     pub kind: ModeKind,
     /// Bound on |ω²_computed − ω²_exact| (first-order condition bound or residual bound, see
-    /// [`crate::AccuracyReport::bound_kinds`]); 0 for infinite modes, which are exact by construction.
+    /// [`crate::AccuracyReport::bound_kinds`]); 0 for infinite modes, which are exact by
+    /// construction.
     pub error_bound: f64,
     /// Backward error η of the pair (None when values only were computed or the mode is infinite).
     pub backward_error: Option<f64>,
-    /// Index of this mode's group of (numerically) equal frequencies in [`crate::ModalSolution::groups`].
+    /// Index of this mode's group of (numerically) equal frequencies in
+    /// [`crate::ModalSolution::groups`].
     pub group: usize,
 }
 
@@ -59,8 +61,9 @@ pub struct ModeGroup {
 }
 
 /// Zero when |ω²| is within `bound`; otherwise oscillatory or unstable by its sign. The solvers
-/// pass the larger of the mode's error bound and its [`crate::certify::resolution::data_resolution`]: a mode
-/// is zero when the computation cannot tell it from zero, or the data cannot.
+/// pass the larger of the mode's error bound and its
+/// [`crate::certify::resolution::data_resolution`]: a mode is zero when the computation cannot tell
+/// it from zero, or the data cannot.
 pub fn classify(omega_sq: f64, bound: f64) -> ModeKind {
     if omega_sq.is_infinite() {
         ModeKind::Infinite
@@ -128,8 +131,8 @@ pub(crate) fn clusters(omega: &[f64], bounds: &[f64]) -> Vec<Range<usize>> {
 }
 
 /// Whether the cluster `g` of the selection (entries `first..` of the ascending spectrum
-/// `omega_all`) can be refined: at most [`crate::Tuning::max_refined_cluster`] modes, and not cut by the
-/// selection (an unselected mode within its bounds would be a missing member of the block,
+/// `omega_all`) can be refined: at most [`crate::Tuning::max_refined_cluster`] modes, and not cut
+/// by the selection (an unselected mode within its bounds would be a missing member of the block,
 /// which makes the correction singular).
 pub(crate) fn refinable(g: &Range<usize>, omega: &[f64], bounds: &[f64], omega_all: &[f64], first: usize) -> bool {
     let cut_below = g.start == 0 && first > 0 && overlapping(omega[0], bounds[0], omega_all[first - 1], bounds[0]);

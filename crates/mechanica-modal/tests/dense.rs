@@ -273,8 +273,8 @@ fn values_only_solves_measure_their_weakly_bounded_modes() {
     assert!(mult[1..mult.len() - 1].iter().all(|&m| m == 2), "{mult:?}");
 }
 
-/// Values only with more weakly bounded modes than `Tuning::flagged_vectors_up_to` (masses graded over
-/// six decades make ‖A⁻¹‖ large): all vectors are computed instead, and every mode agrees with
+/// Values only with more weakly bounded modes than `Tuning::flagged_vectors_up_to` (masses graded
+/// over six decades make ‖A⁻¹‖ large): all vectors are computed instead, and every mode agrees with
 /// the all-pairs solve within the two bounds, with measured (not assumed) bounds.
 #[test]
 fn values_only_with_many_weak_modes_computes_all_vectors() {

@@ -198,10 +198,10 @@ fn options(k: usize, block: usize) -> SparseSolveOptions {
 /// of each eigenspace, the other copies only at rounding level. Whether the first run already
 /// finds them from rounding depends on the seed and the basis size; when it does not, the
 /// inertia count reports them missing and a deflated rerun finds them. Either way the result must
-/// be complete and certified (the rerun path itself is forced in the unit tests of `lanczos`,
-/// with a start block exactly orthogonal to an eigenvector). Regression: before τ was kept out of clusters, (8, 100, 8, 2) returned groups [6, 2]
-/// flagged consistent (τ sat on the second eigenvalue) and (16, 100, 16, 2) and (5, 200, 10, 1)
-/// returned wrong groups flagged inconsistent.
+/// be complete and certified (the rerun path itself is forced in the unit tests of the `sparse`
+/// module, with a start block exactly orthogonal to an eigenvector). With τ allowed inside a
+/// cluster, (8, 100, 8, 2) would split its group as [6, 2] while flagged consistent, and
+/// (16, 100, 16, 2) and (5, 200, 10, 1) would return wrong groups.
 #[test]
 fn multiplicity_above_block_size_forces_a_deflated_rerun() {
     for (copies, len, k, block) in [(8, 100, 8, 2), (16, 100, 16, 2), (5, 200, 10, 1)] {

@@ -348,7 +348,7 @@ fn a_selection_that_cuts_a_cluster_keeps_honest_bounds() {
 /// A cluster that chains three exact zero modes (three free chains) to six soft ones (a fixed
 /// chain with springs of 1e-6), beside a 1e12-graded chain, permuted (i → 7i mod 44, exact):
 /// the block refinement's bounds hold at ω² = 0 too, where a bound scaled by each member's own
-/// |ω²| would vanish (found in review: ω² = 5e-37 against a bound of 1.7e-40).
+/// |ω²| would vanish (and fall far below the computed ω² of a zero mode).
 #[test]
 fn a_zero_cluster_chained_to_soft_modes_keeps_valid_bounds() {
     let (af, bf) = testing::free_chain(10);
@@ -413,9 +413,9 @@ fn hadamard_turned(c: &Case) -> PencilProblem {
 
 /// The 96-mass chain turned densely ([`hadamard_turned`]): with Auto refinement, all pairs and
 /// the lowest 3 with and without vectors, the lowest modes are within their bounds of the
-/// 60-digit references and certified to the 8 digits Auto promises (before this test the batch
-/// and the projected steps iterated in double only, and the lowest bound stopped near 1e-6
-/// relative; a cluster of the lowest two whose block step failed kept first-order bounds).
+/// 60-digit references and certified to the 8 digits Auto promises: the steps must iterate in
+/// double-double where a double iterate would stop the lowest bound near 1e-6 relative, and a
+/// cluster of the lowest two whose block step fails must not keep first-order bounds.
 #[test]
 fn a_densely_turned_long_chain_is_certified_to_its_references() {
     let c = cases()

@@ -15,15 +15,15 @@ const NORM_PROBES: usize = 12;
 /// too large for A = I.
 const NORM_POWER: usize = 4;
 
-/// An upper bound of ‖A⁻¹‖₂ from the Cholesky factor L of A that holds with probability
-/// ≥ 1 − 1e-12 over the probes (for an A that does not depend on them; see [`probe_seed`]),
-/// and never below the deterministic lower bounds 1/L_nn² and 1/min_i A_ii: for any matrix M and r independent standard Gaussian vectors ω_i,
-/// ‖M‖ ≤ α√(2/π)·max_i ‖Mω_i‖ except with probability α^(−r) (Halko, Martinsson & Tropp,
-/// "Finding structure with randomness", SIAM Review 53, 2011, Lemma 4.1, after Dixon 1983),
-/// applied to M = (L⁻ᵀL⁻¹)^q = A^(−q), whose norm is ‖A⁻¹‖^q. Cost: 2q triangular solves
-/// on r columns (2qrn² flops). Probes are renormalised after every power, so the bound
-/// is infinite only when ‖A⁻¹‖ itself overflows. A diagonal L (lumped masses) gives the exact
-/// value max_i 1/l_ii² instead, with no probability of failure.
+/// An upper bound of ‖A⁻¹‖₂ from the Cholesky factor L of A that holds with probability ≥ 1 − 1e-12
+/// over the probes (for an A that does not depend on them; see [`probe_seed`]), and never below the
+/// deterministic lower bounds 1/L_nn² and 1/min_i A_ii: for any matrix M and r independent standard
+/// Gaussian vectors ω_i, ‖M‖ ≤ α√(2/π)·max_i ‖Mω_i‖ except with probability α^(−r) (Halko,
+/// Martinsson & Tropp, "Finding structure with randomness", SIAM Review 53, 2011, Lemma 4.1, after
+/// Dixon 1983), applied to M = (L⁻ᵀL⁻¹)^q = A^(−q), whose norm is ‖A⁻¹‖^q. Cost: 2q triangular
+/// solves on r columns (2qrn² flops). Probes are renormalised after every power, so the bound is
+/// infinite only when ‖A⁻¹‖ itself overflows. A diagonal L (lumped masses) gives the exact value
+/// max_i 1/l_ii² instead, with no probability of failure.
 pub(crate) fn a_inverse_norm_bound(l: MatRef<'_, f64>, par: Par) -> f64 {
     let n = l.nrows();
     if n == 0 {

@@ -15,11 +15,11 @@ pub enum Residuals {
     /// orthogonality error are computed exactly (to rounding).
     #[default]
     Exact,
-    /// Gaussian sketches (`crate::certify::sketch`, O(k·n²) flops with k = 32): each backward error and
-    /// the orthogonality error (then a bound on ‖XᵀAX − I‖_F) is an upper bound that fails with
+    /// Gaussian sketches (`crate::certify::sketch`, O(k·n²) flops with k = 32): each backward error
+    /// and the orthogonality error (then a bound on ‖XᵀAX − I‖_F) is an upper bound that fails with
     /// probability at most 1e-12; typically 2–4 times the exact value. Where the exact products
-    /// cost less (all pairs below n ≈ 200, or a few pairs of any pencil) they are formed
-    /// instead, and the report's `residuals` says `Exact`.
+    /// cost less (all pairs below n ≈ 200, or a few pairs of any pencil) they are formed instead,
+    /// and the report's `residuals` says `Exact`.
     Sketched,
 }
 

@@ -21,9 +21,9 @@ pub enum Selection {
 }
 
 /// Whether to refine low modes with extended-precision residuals (`crate::refine`). Clusters of
-/// nearly equal ω² (up to [`crate::Tuning::max_refined_cluster`] modes) are refined as blocks; a semidefinite A
-/// is refined when it is diagonal with exactly zero massless entries (the condensation is then
-/// exact), and otherwise keeps its first-order bounds.
+/// nearly equal ω² (up to [`crate::Tuning::max_refined_cluster`] modes) are refined as blocks; a
+/// semidefinite A is refined when it is diagonal with exactly zero massless entries (the
+/// condensation is then exact), and otherwise keeps its first-order bounds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Refinement {
     /// Refine every selected, simple, finite mode whose first-order error bound from the

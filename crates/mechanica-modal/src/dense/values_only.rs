@@ -7,8 +7,8 @@
 //! relative to a small |ω²| is weak (the lowest modes of a long chain, stiff problems). For each
 //! mode above [`crate::dense::AUTO_REFINE_RELATIVE_BOUND`]·|ω²|:
 //!
-//! 1. its eigenvector z of the tridiagonal form T of C = L⁻¹BL⁻ᵀ is computed by inverse
-//!    iteration ([`crate::linalg::eigen::inverse_iteration`], O(n) per mode), and x = L⁻ᵀQz (O(n²));
+//! 1. its eigenvector z of the tridiagonal form T of C = L⁻¹BL⁻ᵀ is computed by inverse iteration
+//!    ([`crate::linalg::eigen::inverse_iteration`], O(n) per mode), and x = L⁻ᵀQz (O(n²));
 //! 2. its backward error is measured and the bound becomes the first-order η·κ
 //!    ([`crate::BoundKind::FirstOrder`]); the measured η is usually far below n·u;
 //! 3. a mode still above the threshold (stiff and graded problems) is refined as in an
@@ -45,12 +45,13 @@ pub(crate) struct Pencil<'a> {
     pub par: Par,
 }
 
-/// Sharpens the a-priori `report` (from the model `a_priori`) of the selected values `omega` (entries `first..` of the
-/// ascending spectrum `omega_all`, the eigenvalues of `form`'s T): measured first-order bounds
-/// for the flagged modes, refinement and residual bounds for those still flagged. `omega` is
-/// updated where refinement moved a value. When inverse iteration fails, the report keeps its
-/// a-priori bounds. Returns the data resolution ([`crate::certify::resolution::zero_resolution`]) of every mode
-/// whose vector was formed, for the zero classification.
+/// Sharpens the a-priori `report` (from the model `a_priori`) of the selected values `omega`
+/// (entries `first..` of the ascending spectrum `omega_all`, the eigenvalues of `form`'s T):
+/// measured first-order bounds for the flagged modes, refinement and residual bounds for those
+/// still flagged. `omega` is updated where refinement moved a value. When inverse iteration fails,
+/// the report keeps its a-priori bounds. Returns the data resolution
+/// ([`crate::certify::resolution::zero_resolution`]) of every mode whose vector was formed, for the
+/// zero classification.
 pub(crate) fn sharpen(
     pencil: &Pencil<'_>,
     a_priori: APrioriModel,

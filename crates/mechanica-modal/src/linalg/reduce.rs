@@ -243,11 +243,11 @@ fn mirror_lower(mut c: MatMut<'_, f64>) {
     }
 }
 
-/// Blocked sygst, one leading block of [`crate::Tuning::reduce_block`] columns per step (the block itself is
-/// reduced by the same recursion): with L = [L11 0; L21 L22] and B split alike, L C Lᵀ = B gives
-/// C11 = L11⁻¹ B11 L11⁻ᵀ, H = ½ L21 C11, W = B21 L11⁻ᵀ − H, B22' = B22 − (W L21ᵀ + L21 Wᵀ),
-/// C21 = L22⁻¹ (W − H), C22 = L22⁻¹ B22' L22⁻ᵀ. H is formed once per step (LAPACK `dsygst`
-/// forms it twice, by two `dsymm`): a sixth of the flops fewer.
+/// Blocked sygst, one leading block of [`crate::Tuning::reduce_block`] columns per step (the block
+/// itself is reduced by the same recursion): with L = [L11 0; L21 L22] and B split alike, L C Lᵀ =
+/// B gives C11 = L11⁻¹ B11 L11⁻ᵀ, H = ½ L21 C11, W = B21 L11⁻ᵀ − H, B22' = B22 − (W L21ᵀ + L21 Wᵀ),
+/// C21 = L22⁻¹ (W − H), C22 = L22⁻¹ B22' L22⁻ᵀ. H is formed once per step (LAPACK `dsygst` forms it
+/// twice, by two `dsymm`): a sixth of the flops fewer.
 fn reduce_in_place(l: MatRef<'_, f64>, c: MatMut<'_, f64>, par: Par) {
     let n = c.nrows();
     let mut half_product = Mat::<f64>::zeros(n, Tuning::DEFAULT.reduce_block.min(n / 2));
@@ -512,9 +512,9 @@ mod tests {
 
     #[test]
     fn symmetric_reduction_matches_two_triangular_solves() {
-        // 700: several blocks of `Tuning::reduce_block`, each step's H in the shared scratch, on two threads
-        // (every step as two-thread phases); 1300: the first steps with faer's parallel kernels
-        // (trailing order above `Tuning::split_step_up_to`), the later ones in phases.
+        // 700: several blocks of `Tuning::reduce_block`, each step's H in the shared scratch, on
+        // two threads (every step as two-thread phases); 1300: the first steps with faer's parallel
+        // kernels (trailing order above `Tuning::split_step_up_to`), the later ones in phases.
         for n in [1, 5, 48, 49, 130, 257, 700, 1300] {
             let a = spd(n, 1);
             let b = spd(n, 2);

@@ -6,11 +6,11 @@ use crate::linalg::norms::frobenius_norm;
 use crate::refine::correction::ReducedCorrection;
 use faer::{Mat, MatRef};
 
-/// The static condensation of the pencil (B, A) as refinement needs it: the exact identity
-/// (S − ρA₁)z = r₁ − B₁₀B₀₀⁻¹r₀ for any x = Q[w; z] and its residual r = (B − ρA)x, with
-/// S = B₁₁ − B₁₀B₀₀⁻¹B₀₁ the condensed stiffness. A residual measured in double-double on the
-/// stored A and B thus becomes the residual of the condensed definite pencil (S, A₁), whose
-/// residual bounds ([`crate::certify::residual_bounds::residual_bounds`]) then hold for the stored data, however
+/// The static condensation of the pencil (B, A) as refinement needs it: the exact identity (S −
+/// ρA₁)z = r₁ − B₁₀B₀₀⁻¹r₀ for any x = Q[w; z] and its residual r = (B − ρA)x, with S = B₁₁ −
+/// B₁₀B₀₀⁻¹B₀₁ the condensed stiffness. A residual measured in double-double on the stored A and B
+/// thus becomes the residual of the condensed definite pencil (S, A₁), whose residual bounds
+/// ([`crate::certify::residual_bounds::residual_bounds`]) then hold for the stored data, however
 /// much the condensation's own rounding (stiff springs to massless nodes: the subtraction in S
 /// loses u·‖B₁₀‖‖B₀₀⁻¹‖‖B₀₁‖) changed S.
 pub(crate) struct Condensation {

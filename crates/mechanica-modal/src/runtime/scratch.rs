@@ -35,7 +35,8 @@ impl Pool {
         Some(self.kept.swap_remove(fitting))
     }
 
-    /// Keeps `matrix` when it is large enough, dropping the smallest one beyond [`crate::Tuning::kept_matrices`].
+    /// Keeps `matrix` when it is large enough, dropping the smallest one beyond
+    /// [`crate::Tuning::kept_matrices`].
     fn give_back(&mut self, matrix: Mat<f64>) {
         if matrix.nrows() * matrix.ncols() * size_of::<f64>() < Tuning::DEFAULT.kept_from_bytes {
             return;
@@ -138,7 +139,8 @@ mod tests {
         assert_eq!(small_first.take(380, 380).map(|m| m.as_ptr()), Some(small_storage));
     }
 
-    /// Small matrices are not kept, and at most `Tuning::kept_matrices` large ones (the smallest goes).
+    /// Small matrices are not kept, and at most `Tuning::kept_matrices` large ones (the smallest
+    /// goes).
     #[test]
     fn the_pool_is_bounded() {
         let mut pool = Pool::default();

@@ -1,14 +1,14 @@
 //! Sylvester inertia of the sparse matrix B − sA: how many modes of a [`SparsePencil`] lie below
 //! a shift s (the sparse counterpart of [`crate::count_below`]).
 //!
-//! B − sA is factored by faer's supernodal LBLᵀ with Bunch–Kaufman pivoting inside each
-//! supernode ("intranodal"; the fill-reducing AMD ordering is kept), and the signs of the 1×1 and
-//! 2×2 blocks of the block-diagonal factor are counted. For patterns faer keeps simplicial
-//! (e.g. diagonal matrices) the factorization is an unpivoted LDLᵀ. By Sylvester's law of inertia the number
-//! of negative eigenvalues equals the number of modes with ω² < s when A is positive definite
-//! (or semidefinite with B positive definite on the null space of A). Pivoting confined to
-//! supernodes is not backward stable in the worst case: the smallest and largest |pivot| are
-//! reported so that a suspicious factorization (tiny pivots, growth) can be recognised.
+//! B − sA is factored by faer's supernodal LBLᵀ with Bunch–Kaufman pivoting inside each supernode
+//! ("intranodal"; the fill-reducing AMD ordering is kept), and the signs of the 1×1 and 2×2 blocks
+//! of the block-diagonal factor are counted. For patterns faer keeps simplicial (e.g. diagonal
+//! matrices) the factorization is an unpivoted LDLᵀ. By Sylvester's law of inertia the number of
+//! negative eigenvalues equals the number of modes with ω² < s when A is positive definite (or
+//! semidefinite with B positive definite on the null space of A). Pivoting confined to supernodes
+//! is not backward stable in the worst case: the smallest and largest |pivot| are reported so that
+//! a suspicious factorization (tiny pivots, growth) can be recognised.
 
 use crate::sparse::pencil::{Csc, SparsePencil};
 use crate::{InertiaCount, ModalError};

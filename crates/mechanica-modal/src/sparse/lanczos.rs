@@ -260,12 +260,12 @@ fn converged_count(ritz: &RitzPairs, wanted: &[usize], strict: usize, tolerance:
         .iter()
         .enumerate()
         .filter(|&(r, &c)| {
-            let goal = if r < strict {
+            let limit = if r < strict {
                 tolerance
             } else {
                 tolerance.max(Tuning::DEFAULT.buffer_tolerance)
             };
-            ritz.residual(c) <= goal * ritz.theta[c].abs()
+            ritz.residual(c) <= limit * ritz.theta[c].abs()
         })
         .count()
 }

@@ -39,9 +39,9 @@
 //!   are missing (at most 32), so one rerun sees every missing copy of an eigenvalue. After
 //!   [`SparseSolveOptions::max_runs`] runs without agreement the solve fails with
 //!   [`ModalError::LanczosNoConvergence`] (found vs. counted below τ).
-//! - **Repeated eigenvalues at the cut.** Exactly k modes are returned; when the k-th and
-//!   (k+1)-th are equal, [`SparseAccuracyReport::kth_group_multiplicity`] gives the full multiplicity of
-//!   the k-th mode's eigenvalue (all its copies lie below τ and were computed).
+//! - **Repeated eigenvalues at the cut.** Exactly k modes are returned; when the k-th and (k+1)-th
+//!   are equal, [`SparseAccuracyReport::kth_group_multiplicity`] gives the full multiplicity of the
+//!   k-th mode's eigenvalue (all its copies lie below τ and were computed).
 //! - **Bounds.** For a pair with θ = 1/(ω² − σ) the residual s = Ax − θKx gives
 //!   δ = ‖s‖_{K⁻¹}/‖x‖_K (one solve with K): the pencil (A, K) has an eigenvalue within δ of θ
 //!   (Parlett, "The Symmetric Eigenvalue Problem", Thm 15.9.1), and within δ²/gap (Kato–Temple)
@@ -84,15 +84,15 @@ use std::time::{Duration, Instant};
 ///
 /// Exactly k = `options.count` modes are returned, ascending. When the k-th and (k+1)-th ω² are
 /// equal (k cuts through a repeated eigenvalue), the last returned group is an A-orthonormal basis
-/// of only part of that eigenspace; [`SparseAccuracyReport::kth_group_multiplicity`] then exceeds the
-/// last group's multiplicity and says how many modes the whole eigenspace has.
+/// of only part of that eigenspace; [`SparseAccuracyReport::kth_group_multiplicity`] then exceeds
+/// the last group's multiplicity and says how many modes the whole eigenspace has.
 ///
-/// Errors: [`ModalError::TooManyModes`] for k = 0 or k > n (or when the deflated reruns would
-/// need more vectors than the pencil has), [`ModalError::BadShift`], [`ModalError::NoDefiniteShift`],
-/// [`ModalError::MassNotSemidefinite`], and [`ModalError::LanczosNoConvergence`] when a run does not
-/// converge within `max_restarts`, or when after `max_runs` Lanczos runs the inertia count still
-/// shows modes missing below the check shift τ (then `converged` = modes found below τ, `wanted` =
-/// the inertia count below τ, `restarts` = restarts over all runs).
+/// Errors: [`ModalError::TooManyModes`] for k = 0 or k > n (or when the deflated reruns would need
+/// more vectors than the pencil has), [`ModalError::BadShift`], [`ModalError::NoDefiniteShift`],
+/// [`ModalError::MassNotSemidefinite`], and [`ModalError::LanczosNoConvergence`] when a run does
+/// not converge within `max_restarts`, or when after `max_runs` Lanczos runs the inertia count
+/// still shows modes missing below the check shift τ (then `converged` = modes found below τ,
+/// `wanted` = the inertia count below τ, `restarts` = restarts over all runs).
 pub fn solve_sparse(pencil: &SparsePencil, options: &SparseSolveOptions) -> Result<SparseModalSolution, ModalError> {
     solve_sparse_from(pencil, options, None)
 }

@@ -1,4 +1,5 @@
-//! The validated sparse symmetric pencil (A, B) of det(λA + B) = 0 ((8.89), see docs/theory.md), stored in
+//! The validated sparse symmetric pencil (A, B) of det(λA + B) = 0 ((8.89), see
+//! docs/theory.md), stored in
 //! compressed sparse columns (faer `SparseColMat`), both triangles, sorted and without
 //! duplicate entries.
 

@@ -6,8 +6,8 @@
 //! - T, scaled to unit max-norm, is torn at its middle off-diagonal β into
 //!   T = diag(T₁, T₂) + |β| v vᵀ, v = e_{n₁} + sign(β) e_{n₁+1}, with |β| taken off the two
 //!   diagonal entries beside the tear;
-//! - with T_i = Q_i D_i Q_iᵀ solved recursively (leaves of at most [`crate::Tuning::leaf`] rows by the implicit
-//!   QL iteration), T = Q (D + ρ z zᵀ) Qᵀ with z = Qᵀv/√2 and ρ = 2|β|;
+//! - with T_i = Q_i D_i Q_iᵀ solved recursively (leaves of at most [`crate::Tuning::leaf`] rows by
+//!   the implicit QL iteration), T = Q (D + ρ z zᵀ) Qᵀ with z = Qᵀv/√2 and ρ = 2|β|;
 //! - deflation: a pair whose ρ|z_i| is below 8u·max(‖D‖, ‖z‖) keeps (d_i, q_i); two close poles
 //!   are rotated so that one of them deflates (`dlaed2`'s tests);
 //! - the k remaining eigenvalues are the roots of the secular equation

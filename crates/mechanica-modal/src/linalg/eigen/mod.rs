@@ -192,8 +192,8 @@ impl TridiagonalForm {
         &self.t.subdiag
     }
 
-    /// Unit eigenvectors Y = Q Z of the reduced matrix for the ascending eigenvalues `values`
-    /// of T (Z by inverse iteration on T, [`crate::linalg::eigen::inverse_iteration`]), and Z itself.
+    /// Unit eigenvectors Y = Q Z of the reduced matrix for the ascending eigenvalues `values` of T
+    /// (Z by inverse iteration on T, [`crate::linalg::eigen::inverse_iteration`]), and Z itself.
     pub(crate) fn eigenvectors(&mut self, values: &[f64]) -> Result<(Mat<f64>, Mat<f64>), ModalError> {
         let n = self.t.diag.len();
         let z = tridiagonal_eigenvectors(&self.t.diag, &self.t.subdiag, values)

@@ -14,8 +14,9 @@ const SSFMAX: f64 = f64::from_bits((1023 + 511) << 52) / 3.0;
 /// Lower end of the safe range, √tiny/eps² ≈ 1.5e-122: squares keep full precision.
 const SSFMIN: f64 = f64::from_bits((1023 - 405) << 52);
 
-/// Eigenvalues of the symmetric tridiagonal matrix with diagonal `diag` and off-diagonal `offdiag` (len n−1), ascending.
-/// Err(index) if the iteration did not converge (an unreduced block starting at `index` still had a nonzero off-diagonal after 30·n sweeps).
+/// Eigenvalues of the symmetric tridiagonal matrix with diagonal `diag` and off-diagonal `offdiag`
+/// (len n−1), ascending. Err(index) if the iteration did not converge (an unreduced block starting
+/// at `index` still had a nonzero off-diagonal after 30·n sweeps).
 pub(crate) fn tridiagonal_eigenvalues(diag: &[f64], offdiag: &[f64]) -> Result<Vec<f64>, usize> {
     let n = diag.len();
     debug_assert_eq!(offdiag.len(), n.saturating_sub(1));
@@ -369,8 +370,8 @@ mod tests {
     fn graded_over_300_decades_in_every_orientation() {
         // Off-diagonals graded 1e-150 … 1e150 with a zero, graded, alternating or 3× graded
         // diagonal, both ways up: the i-th value must have exactly i Sturm-counted eigenvalues
-        // below it and i + 1 below it plus 1e-12·‖T‖ (the old |d|-only orientation rule of
-        // `dsterf` missed that by up to 1e-8·‖T‖ on the zero diagonal graded downwards).
+        // below it and i + 1 below it plus 1e-12·‖T‖ (`dsterf`'s |d|-only orientation rule
+        // misses that by up to 1e-8·‖T‖ on the zero diagonal graded downwards).
         let n = 1000;
         let grade = |i: usize, m: usize| 10f64.powf(-150.0 + 300.0 * i as f64 / (m - 1) as f64);
         for variant in 0..8 {

@@ -1,11 +1,12 @@
 //! The blocked Householder tridiagonalization C = Q T Qᵀ of a symmetric matrix (LAPACK
 //! `dsytrd`/`dlatrd`, lower; Dongarra, Hammarling & Sorensen, "Block reduction of matrices to
 //! condensed forms for eigenvalue computations", J. Comput. Appl. Math. 27, 1989): a panel of
-//! [`crate::Tuning::panel`] columns is reduced with one read-only symmetric matrix-vector product per column,
-//! and the trailing matrix is updated once per panel by a symmetric rank-2·[`crate::Tuning::panel`] update (half
-//! the flops, as matrix products). Only the lower triangle of C is read. On large trailing
-//! matrices half of every matrix-vector product, of its panel correction and of each trailing
-//! update runs on a spinning helper thread ([`super::symv_team`]).
+//! [`crate::Tuning::panel`] columns is reduced with one read-only symmetric matrix-vector product
+//! per column, and the trailing matrix is updated once per panel by a symmetric
+//! rank-2·[`crate::Tuning::panel`] update (half the flops, as matrix products). Only the lower
+//! triangle of C is read. On large trailing matrices half of every matrix-vector product, of its
+//! panel correction and of each trailing update runs on a spinning helper thread
+//! ([`super::symv_team`]).
 
 use crate::linalg::eigen::symv_team::SymvTeam;
 use crate::linalg::reduce::{columns_holding, subtract_lower_product};
@@ -174,11 +175,11 @@ fn reduce_panel(
     }
 }
 
-/// dlatrd's y for column k = p + i of a panel: y = S v − V (Wᵀ v) − W (Vᵀ v), with
-/// S = A(k+1.., k+1..) (lower triangle read, not yet updated by the panel), v = A(k+1.., k),
-/// V = A(k+1.., p..k) and W = w(k+1.., 0..i). With a team, from order [`crate::Tuning::parallel_symv_from`],
-/// the helper computes the right-hand columns of S v and the correction into `partial`, this
-/// thread the left-hand columns, so that the two take about the same time.
+/// dlatrd's y for column k = p + i of a panel: y = S v − V (Wᵀ v) − W (Vᵀ v), with S = A(k+1..,
+/// k+1..) (lower triangle read, not yet updated by the panel), v = A(k+1.., k), V = A(k+1.., p..k)
+/// and W = w(k+1.., 0..i). With a team, from order [`crate::Tuning::parallel_symv_from`], the
+/// helper computes the right-hand columns of S v and the correction into `partial`, this thread the
+/// left-hand columns, so that the two take about the same time.
 fn panel_product(
     a: &Mat<f64>,
     w: &Mat<f64>,
