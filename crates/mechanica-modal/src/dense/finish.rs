@@ -81,31 +81,12 @@ impl Finish<'_> {
             && lift.is_none()
             && self.options.refinement == Refinement::Auto
         {
-            let pencil = values_only::Pencil {
-                a: self.problem.a(),
-                b: self.problem.b(),
-                l: self.l,
-                residuals: self.options.residuals,
-                par: self.par,
-            };
-            measured_resolution =
-                values_only::sharpen(&pencil, model, form, &mut report, &mut omega, &omega_all, first);
+            measured_resolution = self.sharpen(model, form, &mut report, &mut omega, &omega_all, first);
         }
         if let (Some(xm), Some(products), Some(metric)) = (x.as_mut(), products.as_mut(), self.metric(lift.is_none()))
             && self.options.refinement != Refinement::Off
         {
-            let stage = Stage {
-                a: self.problem.a(),
-                b: self.problem.b(),
-                l: self.l,
-                condensation: self.condensation,
-                policy: self.options.refinement,
-                metric,
-                omega_all: &omega_all,
-                first,
-                reduced: reduced.as_ref(),
-                par: self.par,
-            };
+            let stage = self.refinement_stage(metric, &omega_all, first, reduced.as_ref());
             stage.run(xm, products, &mut report, &mut omega);
         }
         timings.refine = clock.elapsed();
@@ -173,6 +154,49 @@ impl Finish<'_> {
             }
         };
         (products, report, model_used)
+    }
+
+    /// Values only: [`values_only::sharpen`] of the report from the error model `model`;
+    /// returns the data resolution of the modes whose vectors were formed.
+    fn sharpen(
+        &self,
+        model: APrioriModel,
+        form: &mut TridiagonalForm,
+        report: &mut AccuracyReport,
+        omega: &mut [f64],
+        omega_all: &[f64],
+        first: usize,
+    ) -> Vec<(usize, f64)> {
+        let pencil = values_only::Pencil {
+            a: self.problem.a(),
+            b: self.problem.b(),
+            l: self.l,
+            residuals: self.options.residuals,
+            par: self.par,
+        };
+        values_only::sharpen(&pencil, model, form, report, omega, omega_all, first)
+    }
+
+    /// The refinement stage of this solve, refining in `metric`.
+    fn refinement_stage<'s>(
+        &'s self,
+        metric: Metric<'s>,
+        omega_all: &'s [f64],
+        first: usize,
+        reduced: Option<&'s Mat<f64>>,
+    ) -> Stage<'s> {
+        Stage {
+            a: self.problem.a(),
+            b: self.problem.b(),
+            l: self.l,
+            condensation: self.condensation,
+            policy: self.options.refinement,
+            metric,
+            omega_all,
+            first,
+            reduced,
+            par: self.par,
+        }
     }
 
     /// The pencil in which modes are refined: (B, A) through L when no lift is needed, the

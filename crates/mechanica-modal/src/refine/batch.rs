@@ -29,13 +29,6 @@ pub(crate) fn refine_simple_modes(
     x0: MatRef<'_, f64>,
     par: Par,
 ) -> Vec<Option<RefinedPair>> {
-    #[derive(Clone, Copy, PartialEq)]
-    enum State {
-        Iterating,
-        Converged { steps: usize },
-        Failed,
-    }
-    let (y, omega_all) = reduced;
     let (n, k) = (x0.nrows(), x0.ncols());
     let mut x = x0.to_owned();
     let mut state = vec![State::Iterating; k];
@@ -54,50 +47,14 @@ pub(crate) fn refine_simple_modes(
             (rho.to_f64(), r)
         };
         let residuals: Vec<(f64, Vec<f64>)> = map_items(&active, par, residual_of);
-        let mut w = Mat::from_fn(n, active.len(), |i, c| residuals[c].1[i]);
-        l.solve(w.as_mut(), par);
-        let mut coefficients = Mat::<f64>::zeros(y.ncols(), active.len());
-        matmul(
-            coefficients.as_mut(),
-            Accum::Replace,
-            y.transpose(),
-            w.as_ref(),
-            1.0,
-            par,
-        );
+        let delta = corrections(l, reduced, modes, &active, &residuals, par);
         for (c, &mode) in active.iter().enumerate() {
-            let rho = residuals[c].0;
-            let own = modes[mode];
-            for j in 0..coefficients.nrows() {
-                let gap = omega_all[j] - rho;
-                let value = coefficients[(j, c)];
-                coefficients[(j, c)] = if j == own || gap == 0.0 { 0.0 } else { value / gap };
-            }
-        }
-        let mut delta = Mat::<f64>::zeros(n, active.len());
-        matmul(delta.as_mut(), Accum::Replace, y, coefficients.as_ref(), 1.0, par);
-        l.solve_transposed(delta.as_mut(), par);
-        for (c, &mode) in active.iter().enumerate() {
-            let d = delta.col_as_slice(c);
-            if !d.iter().all(|v| v.is_finite()) {
-                state[mode] = State::Failed;
-                continue;
-            }
-            let xmax = x.col_as_slice(mode).iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-            let dmax = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-            let at_rounding = dmax <= Tuning::DEFAULT.stagnation_ulps * f64::EPSILON * xmax;
-            let contracting = dmax <= 0.5 * previous[mode];
-            if !dmax.is_finite() || !(contracting || at_rounding) {
-                state[mode] = State::Failed;
-                continue;
-            }
-            for (xi, di) in x.col_as_slice_mut(mode).iter_mut().zip(d) {
-                *xi -= di;
-            }
-            if dmax <= 2.0 * f64::EPSILON * xmax || (at_rounding && !contracting) {
-                state[mode] = State::Converged { steps: step };
-            }
-            previous[mode] = dmax;
+            state[mode] = take_step(
+                x.col_as_slice_mut(mode),
+                delta.col_as_slice(c),
+                &mut previous[mode],
+                step,
+            );
         }
     }
     let metric = Metric::Cholesky(l);
@@ -115,4 +72,75 @@ pub(crate) fn refine_simple_modes(
         pairs[mode] = pair;
     }
     pairs
+}
+
+/// Where a mode of the batch stands.
+#[derive(Clone, Copy, PartialEq)]
+enum State {
+    Iterating,
+    Converged { steps: usize },
+    Failed,
+}
+
+/// The corrections L⁻ᵀ Σ_{j≠k} y_j y_jᵀ/(ω̃²_j − ρ_k) L⁻¹ r_k of the `active` modes (columns of
+/// the result), from their Rayleigh quotients and residuals (ρ_k, r_k), as two triangular solves
+/// and two products with Y on the block.
+fn corrections(
+    l: LowerFactor<'_>,
+    (y, omega_all): (MatRef<'_, f64>, &[f64]),
+    modes: &[usize],
+    active: &[usize],
+    residuals: &[(f64, Vec<f64>)],
+    par: Par,
+) -> Mat<f64> {
+    let n = y.nrows();
+    let mut w = Mat::from_fn(n, active.len(), |i, c| residuals[c].1[i]);
+    l.solve(w.as_mut(), par);
+    let mut coefficients = Mat::<f64>::zeros(y.ncols(), active.len());
+    matmul(
+        coefficients.as_mut(),
+        Accum::Replace,
+        y.transpose(),
+        w.as_ref(),
+        1.0,
+        par,
+    );
+    for (c, &mode) in active.iter().enumerate() {
+        let rho = residuals[c].0;
+        let own = modes[mode];
+        for j in 0..coefficients.nrows() {
+            let gap = omega_all[j] - rho;
+            let value = coefficients[(j, c)];
+            coefficients[(j, c)] = if j == own || gap == 0.0 { 0.0 } else { value / gap };
+        }
+    }
+    let mut delta = Mat::<f64>::zeros(n, active.len());
+    matmul(delta.as_mut(), Accum::Replace, y, coefficients.as_ref(), 1.0, par);
+    l.solve_transposed(delta.as_mut(), par);
+    delta
+}
+
+/// One mode's step x ← x − d (the `step`-th): failed when d is not finite or neither contracts
+/// (halves the `previous` step's size) nor is at rounding level; converged when it is below
+/// 2u·|x| or stagnates at rounding level.
+fn take_step(x: &mut [f64], d: &[f64], previous: &mut f64, step: usize) -> State {
+    if !d.iter().all(|v| v.is_finite()) {
+        return State::Failed;
+    }
+    let xmax = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let dmax = d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let at_rounding = dmax <= Tuning::DEFAULT.stagnation_ulps * f64::EPSILON * xmax;
+    let contracting = dmax <= 0.5 * *previous;
+    if !dmax.is_finite() || !(contracting || at_rounding) {
+        return State::Failed;
+    }
+    for (xi, di) in x.iter_mut().zip(d) {
+        *xi -= di;
+    }
+    *previous = dmax;
+    if dmax <= 2.0 * f64::EPSILON * xmax || (at_rounding && !contracting) {
+        State::Converged { steps: step }
+    } else {
+        State::Iterating
+    }
 }

@@ -195,37 +195,11 @@ pub(crate) fn finish(
         rounding,
         resolution,
     } = residuals;
-    // Clusters of θ whose δ-intervals overlap; Kato–Temple with the gap to other clusters and to
-    // θ(τ) (no eigenvalue with ω² < τ is unaccounted for when the inertia check passed).
     let theta_tau = 1.0 / (tau - sigma);
     let consistent = inertia.count.below == below && inertia.count.zero == 0;
-    let mut bounds = vec![0.0; cols];
-    for c in 0..cols {
-        let in_cluster = |d: usize| (theta[c] - theta[d]).abs() <= delta[c] + delta[d];
-        let mut g = if consistent && omega_sq[c] < tau {
-            theta[c] - theta_tau
-        } else {
-            0.0
-        };
-        // Quadratic residual bound for a Rayleigh–Ritz cluster (Mathias, SIMAX 19, 1998):
-        // |Δθ| ≤ ‖R‖²/gap with ‖R‖² ≤ Σ δ_d² over the cluster.
-        let mut cluster_sq = 0.0;
-        for d in 0..cols {
-            if in_cluster(d) {
-                cluster_sq += delta[d] * delta[d];
-            } else {
-                g = g.min((theta[c] - theta[d]).abs() - delta[d]);
-            }
-        }
-        let e = if g > 0.0 {
-            delta[c].min(cluster_sq / g)
-        } else {
-            delta[c]
-        };
-        let t = theta[c];
-        let omega_bound = if t > e { e / (t * (t - e)) } else { f64::INFINITY };
-        bounds[c] = omega_bound + rounding[c];
-    }
+    // θ(τ) bounds the gap below the pairs only when no eigenvalue with ω² < τ is unaccounted for.
+    let theta_tau = consistent.then_some(theta_tau);
+    let bounds = omega_bounds(&omega_sq, &theta, &delta, &rounding, (tau, theta_tau));
     let take = k.min(cols);
     let mut modes: Vec<Mode> = (0..cols)
         .map(|c| Mode {
@@ -265,6 +239,47 @@ pub(crate) fn finish(
         vectors,
         groups,
     }
+}
+
+/// The ω² bound of every refined pair from its θ = 1/(ω² − σ) and θ bound δ: clusters of θ whose
+/// δ-intervals overlap, Kato–Temple with the gap to other clusters and, when the inertia check
+/// passed (`theta_tau` given), to θ(τ); mapped to ω² as e/(θ(θ − e)), plus the `rounding` of
+/// each Rayleigh quotient.
+fn omega_bounds(
+    omega_sq: &[f64],
+    theta: &[f64],
+    delta: &[f64],
+    rounding: &[f64],
+    (tau, theta_tau): (f64, Option<f64>),
+) -> Vec<f64> {
+    let cols = theta.len();
+    let mut bounds = vec![0.0; cols];
+    for c in 0..cols {
+        let in_cluster = |d: usize| (theta[c] - theta[d]).abs() <= delta[c] + delta[d];
+        let mut g = match theta_tau {
+            Some(theta_tau) if omega_sq[c] < tau => theta[c] - theta_tau,
+            _ => 0.0,
+        };
+        // Quadratic residual bound for a Rayleigh–Ritz cluster (Mathias, SIMAX 19, 1998):
+        // |Δθ| ≤ ‖R‖²/gap with ‖R‖² ≤ Σ δ_d² over the cluster.
+        let mut cluster_sq = 0.0;
+        for d in 0..cols {
+            if in_cluster(d) {
+                cluster_sq += delta[d] * delta[d];
+            } else {
+                g = g.min((theta[c] - theta[d]).abs() - delta[d]);
+            }
+        }
+        let e = if g > 0.0 {
+            delta[c].min(cluster_sq / g)
+        } else {
+            delta[c]
+        };
+        let t = theta[c];
+        let omega_bound = if t > e { e / (t * (t - e)) } else { f64::INFINITY };
+        bounds[c] = omega_bound + rounding[c];
+    }
+    bounds
 }
 
 /// The multiplicity, among all of `modes` (ascending), of the group of mode `k` − 1 (0 when

@@ -1,6 +1,7 @@
 //! Small sparse pencils solved densely, with the dense report mapped onto the sparse one.
 
-use crate::dense::{Refinement, Selection, SolveOptions, solve};
+use crate::certify::report::AccuracyReport;
+use crate::dense::{ModalSolution, Refinement, Selection, SolveOptions, solve};
 use crate::error::ModalError;
 use crate::problem::PencilProblem;
 use crate::sparse::inertia::SparseInertiaCount;
@@ -20,21 +21,51 @@ pub(crate) fn dense_fallback(
     norm_b: f64,
 ) -> Result<SparseModalSolution, ModalError> {
     let n = pencil.dim();
-    let dense = |m: faer::sparse::SparseColMatRef<'_, usize, f64>| {
-        let mut d = Mat::<f64>::zeros(n, n);
-        let (symbolic, val) = m.parts();
-        for j in 0..n {
-            for p in symbolic.col_range(j) {
-                d[(symbolic.row_idx()[p], j)] = val[p];
-            }
-        }
-        d
-    };
     let clock = Instant::now();
-    let problem = PencilProblem::new(dense(pencil.a()).as_ref(), dense(pencil.b()).as_ref())?;
+    let problem = PencilProblem::new(dense(pencil.a(), n).as_ref(), dense(pencil.b(), n).as_ref())?;
+    let sol = lowest_through_kth_group(&problem, k, n)?;
+    let kth_group_multiplicity = sol
+        .modes
+        .get(k - 1)
+        .and_then(|m| sol.groups.get(m.group))
+        .map_or(0, |g| g.multiplicity);
+    let mut modes = sol.modes;
+    modes.truncate(k);
+    let groups = group_modes(&mut modes);
+    let vectors = match &sol.vectors {
+        Some(v) => v.subcols(0, modes.len()).to_owned(),
+        None => Mat::zeros(n, 0),
+    };
+    let timings = SparseSolveTimings {
+        refine: clock.elapsed(),
+        ..SparseSolveTimings::default()
+    };
+    Ok(SparseModalSolution {
+        report: mapped_report(&sol.accuracy, (norm_a, norm_b), kth_group_multiplicity, timings),
+        modes,
+        vectors,
+        groups,
+    })
+}
+
+/// The sparse matrix `m` of order n stored densely.
+fn dense(m: faer::sparse::SparseColMatRef<'_, usize, f64>, n: usize) -> Mat<f64> {
+    let mut d = Mat::<f64>::zeros(n, n);
+    let (symbolic, val) = m.parts();
+    for j in 0..n {
+        for p in symbolic.col_range(j) {
+            d[(symbolic.row_idx()[p], j)] = val[p];
+        }
+    }
+    d
+}
+
+/// The lowest modes of `problem` (order n) with vectors, more than k until the k-th mode's
+/// group is seen to end, so that a count cutting through a repeated eigenvalue is reported.
+fn lowest_through_kth_group(problem: &PencilProblem, k: usize, n: usize) -> Result<ModalSolution, ModalError> {
     let lowest = |count: usize| {
         solve(
-            &problem,
+            problem,
             &SolveOptions {
                 selection: Selection::Lowest(count),
                 vectors: true,
@@ -43,8 +74,6 @@ pub(crate) fn dense_fallback(
             },
         )
     };
-    // Ask for more than k until the k-th mode's group is seen to end, so that a count cutting
-    // through a repeated eigenvalue is reported (kth_group_multiplicity).
     let mut wanted = (k + 1).min(n);
     let mut sol = match lowest(wanted) {
         Ok(sol) => sol,
@@ -63,47 +92,38 @@ pub(crate) fn dense_fallback(
             Err(e) => return Err(e),
         }
     }
-    let kth_group_multiplicity = sol
-        .modes
-        .get(k - 1)
-        .and_then(|m| sol.groups.get(m.group))
-        .map_or(0, |g| g.multiplicity);
-    let mut modes = sol.modes;
-    modes.truncate(k);
-    let groups = group_modes(&mut modes);
-    let vectors = match &sol.vectors {
-        Some(v) => v.subcols(0, modes.len()).to_owned(),
-        None => Mat::zeros(n, 0),
-    };
-    let check = sol.accuracy.inertia_check;
-    Ok(SparseModalSolution {
-        report: SparseAccuracyReport {
-            shift: f64::NEG_INFINITY,
-            shift_attempts: 0,
-            factor_nnz: 0,
-            norm_a,
-            norm_b,
-            restarts: 0,
-            operator_applications: 0,
-            lanczos_runs: 0,
-            kth_group_multiplicity,
-            max_backward_error: sol.accuracy.max_backward_error.unwrap_or(0.0),
-            orthogonality_error: sol.accuracy.orthogonality_error.unwrap_or(0.0),
-            inertia: check.map(|c| SparseInertiaCount {
-                count: c.count,
-                min_pivot: 0.0,
-                max_pivot: 0.0,
-            }),
-            computed_below: check.map_or(0, |c| c.computed_below),
-            consistent: check.is_some_and(|c| c.consistent),
-            dense_fallback: true,
-            timings: SparseSolveTimings {
-                refine: clock.elapsed(),
-                ..SparseSolveTimings::default()
-            },
-        },
-        modes,
-        vectors,
-        groups,
-    })
+    Ok(sol)
+}
+
+/// The dense solve's report `accuracy` mapped onto the sparse one (no shift, factor or
+/// Lanczos runs; the inertia check's count without pivots).
+fn mapped_report(
+    accuracy: &AccuracyReport,
+    (norm_a, norm_b): (f64, f64),
+    kth_group_multiplicity: usize,
+    timings: SparseSolveTimings,
+) -> SparseAccuracyReport {
+    let check = accuracy.inertia_check;
+    SparseAccuracyReport {
+        shift: f64::NEG_INFINITY,
+        shift_attempts: 0,
+        factor_nnz: 0,
+        norm_a,
+        norm_b,
+        restarts: 0,
+        operator_applications: 0,
+        lanczos_runs: 0,
+        kth_group_multiplicity,
+        max_backward_error: accuracy.max_backward_error.unwrap_or(0.0),
+        orthogonality_error: accuracy.orthogonality_error.unwrap_or(0.0),
+        inertia: check.map(|c| SparseInertiaCount {
+            count: c.count,
+            min_pivot: 0.0,
+            max_pivot: 0.0,
+        }),
+        computed_below: check.map_or(0, |c| c.computed_below),
+        consistent: check.is_some_and(|c| c.consistent),
+        dense_fallback: true,
+        timings,
+    }
 }

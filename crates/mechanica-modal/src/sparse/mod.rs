@@ -72,7 +72,7 @@ use crate::error::ModalError;
 use crate::sparse::bounds::{PairResiduals, finish, pair_residuals};
 use crate::sparse::fallback::dense_fallback;
 use crate::sparse::lanczos::{Lcg, lanczos_run};
-use crate::sparse::operator::{Mass, Operator, factor_below_spectrum};
+use crate::sparse::operator::{Mass, Operator, ShiftedFactor, factor_below_spectrum};
 use crate::sparse::pencil::frobenius;
 use crate::sparse::rayleigh_ritz::{Refined, rayleigh_ritz};
 use crate::sparse::sturm::{Counted, InertiaCounter, TauChoice, joined};
@@ -178,13 +178,7 @@ fn solve_sparse_from(
                 (norm_a, norm_b),
             );
             timings.refine += clock.elapsed();
-            solution.report.shift_attempts = factor.attempts;
-            solution.report.factor_nnz = factor.symbolic.len_val();
-            solution.report.operator_applications = op.applications;
-            solution.report.restarts = restarts;
-            solution.report.lanczos_runs = runs;
-            solution.report.timings = timings;
-            solution.report.timings.solves = op.solve_time;
+            record_costs(&mut solution.report, &factor, &op, (restarts, runs), timings);
             return Ok(solution);
         }
         if runs >= max_runs {
@@ -202,6 +196,24 @@ fn solve_sparse_from(
         found = refined.vectors;
         found.extend_from_slice(&more);
     }
+}
+
+/// Writes what the solve cost into its report: the shift attempts and the factor's size, the
+/// operator applications and solve time, the (restarts, runs) of Lanczos, and the stage times.
+fn record_costs(
+    report: &mut SparseAccuracyReport,
+    factor: &ShiftedFactor,
+    op: &Operator<'_>,
+    (restarts, runs): (usize, usize),
+    timings: SparseSolveTimings,
+) {
+    report.shift_attempts = factor.attempts;
+    report.factor_nnz = factor.symbolic.len_val();
+    report.operator_applications = op.applications;
+    report.restarts = restarts;
+    report.lanczos_runs = runs;
+    report.timings = timings;
+    report.timings.solves = op.solve_time;
 }
 
 /// The first run's result, and the inertia count it started early at the τ given.
