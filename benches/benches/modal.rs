@@ -38,9 +38,10 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use mechanica::modal::faer::Par;
 use mechanica::modal::linalg::reduce::{cholesky_and_reduce, reduce_two_solves};
-use mechanica::modal::{PencilProblem, SolveOptions, SparsePencil, SparseSolveOptions, solve, solve_sparse, testing};
+use mechanica::modal::{PencilProblem, SolveOptions, SparsePencil, SparseSolveOptions, solve, solve_sparse};
 use mechanica_benches::lapack;
 use mechanica_benches::modal::{nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra};
+use mechanica_modal::testing;
 use std::hint::black_box;
 
 const SIZES: [usize; 2] = [200, 1000];

@@ -39,13 +39,14 @@ use mechanica::modal::faer::{Mat, MatRef, Side, get_global_parallelism};
 use mechanica::modal::linalg::reduce::{back_transform, cholesky_lower, reduce};
 use mechanica::modal::{
     ModalSolution, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparsePencil, SparseSolveOptions,
-    count_below, solve, solve_sparse, testing,
+    count_below, solve, solve_sparse,
 };
 use mechanica_benches::modal::{
     from_col_major, from_nalgebra, from_triplets, lumped_fixed_chain, max_backward_error, max_eigenvalue_error,
     nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra, to_triplets,
 };
 use mechanica_benches::{Series, lapack, median_seconds, plot_error_vs_time, write_csv};
+use mechanica_modal::testing;
 use std::time::Duration;
 
 /// Modes whose eigenvalue error is reported.

@@ -4,7 +4,7 @@
 use mechanica::kinematics::nalgebra::{DMatrix, SymmetricEigen};
 use mechanica::modal::faer::sparse::Triplet;
 use mechanica::modal::faer::{Accum, Mat, MatRef, get_global_parallelism};
-use mechanica::modal::testing;
+use mechanica_modal::testing;
 
 /// The dense benchmark pencil of order n with a closed-form spectrum: masses d_i = 1 + i/n,
 /// A = Qᵀ D Q and B = Qᵀ D^½ T D^½ Q with T = tridiag(−1, 2, −1) the fixed–fixed unit chain and Q
