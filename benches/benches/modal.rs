@@ -37,10 +37,11 @@
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use mechanica::modal::faer::Par;
-use mechanica::modal::reduce::{cholesky_and_reduce, reduce_two_solves};
-use mechanica::modal::{PencilProblem, SolveOptions, SparseOptions, SparsePencil, families, solve, solve_sparse};
+use mechanica::modal::linalg::reduce::{cholesky_and_reduce, reduce_two_solves};
+use mechanica::modal::{PencilProblem, SolveOptions, SparsePencil, SparseSolveOptions, solve, solve_sparse};
 use mechanica_benches::lapack;
 use mechanica_benches::modal::{nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra};
+use mechanica_modal::testing;
 use std::hint::black_box;
 
 const SIZES: [usize; 2] = [200, 1000];
@@ -109,14 +110,14 @@ fn sparse(c: &mut Criterion) {
     let mut group = c.benchmark_group("modal_sparse");
     group.sample_size(10);
     let side = 300;
-    let (a, b) = families::grid_laplacian(side, side);
+    let (a, b) = testing::grid_laplacian(side, side);
     let pencil = match SparsePencil::from_triplets(side * side, &a, &b) {
         Ok(p) => p,
         Err(e) => panic!("benchmark grid is valid: {e}"),
     };
-    let options = SparseOptions {
+    let options = SparseSolveOptions {
         count: 10,
-        ..SparseOptions::default()
+        ..SparseSolveOptions::default()
     };
     group.bench_with_input(
         BenchmarkId::new("mechanica_lowest10_grid", side * side),
@@ -130,7 +131,7 @@ fn stiff(c: &mut Criterion) {
     let mut group = c.benchmark_group("modal_stiff");
     group.sample_size(10);
     let n = 500;
-    let (a, b) = families::spring_chain(&families::graded_exponents(n, 12), &vec![0; n]);
+    let (a, b) = testing::spring_chain(&testing::graded_exponents(n, 12), &vec![0; n]);
     let problem = match PencilProblem::new(a.as_ref(), b.as_ref()) {
         Ok(p) => p,
         Err(e) => panic!("benchmark pencil is valid: {e}"),

@@ -18,7 +18,7 @@
 //!   have elapsed, and exactly 3 runs for n ≥ 2000 (a 4000 solve takes seconds)
 //!   ([`mechanica_benches::median_seconds`]). Input copies are inside the timed region for every
 //!   method alike (LAPACK overwrites its inputs).
-//! - **Errors.** Eigenvalue errors only against closed forms ([`families`]) or the committed
+//! - **Errors.** Eigenvalue errors only against closed forms ([`testing`]) or the committed
 //!   60-digit mpmath references (tools/modal_reference.txt): relative for nonzero ω², normwise
 //!   (|ŵ|/ω²_max) for a rigid-body mode. Backward errors η = ‖Bx − ω²Ax‖/((‖B‖_F + |ω²|‖A‖_F)‖x‖)
 //!   are recomputed here for every method from its vectors. `bound` is the largest relative
@@ -36,16 +36,17 @@
 
 use mechanica::modal::faer::sparse::Triplet;
 use mechanica::modal::faer::{Mat, MatRef, Side, get_global_parallelism};
-use mechanica::modal::reduce::{back_transform, cholesky_lower, reduce};
+use mechanica::modal::linalg::reduce::{back_transform, cholesky_lower, reduce};
 use mechanica::modal::{
-    ModalSolution, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparseOptions, SparsePencil,
-    count_below, families, solve, solve_sparse,
+    ModalSolution, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparsePencil, SparseSolveOptions,
+    count_below, solve, solve_sparse,
 };
 use mechanica_benches::modal::{
     from_col_major, from_nalgebra, from_triplets, lumped_fixed_chain, max_backward_error, max_eigenvalue_error,
     nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra, to_triplets,
 };
 use mechanica_benches::{Series, lapack, median_seconds, plot_error_vs_time, write_csv};
+use mechanica_modal::testing;
 use std::time::Duration;
 
 /// Modes whose eigenvalue error is reported.
@@ -191,9 +192,9 @@ fn run(method: Method, case: &Case) -> Option<Row> {
                 Ok(p) => p,
                 Err(e) => return fail(&e),
             };
-            let options = SparseOptions {
+            let options = SparseSolveOptions {
                 count: LOWEST.min(case.n.saturating_sub(1)),
-                ..SparseOptions::default()
+                ..SparseSolveOptions::default()
             };
             let (t, out) = median_seconds(runs, time, || solve_sparse(&pencil, &options));
             let sol = match out {
@@ -319,7 +320,7 @@ fn graded_cases() -> Vec<Case> {
             m = ints(rest);
         } else if let Some(rest) = line.strip_prefix("omega_sq ") {
             let exact: Vec<f64> = rest.split_whitespace().filter_map(|w| w.parse().ok()).collect();
-            let (a, b) = families::spring_chain(&k, &m);
+            let (a, b) = testing::spring_chain(&k, &m);
             let scale = exact.iter().copied().fold(0.0, f64::max);
             // The same chain twice, interleaved (a symmetric structure): every ω² is double.
             let (a2, b2) = (interleaved_copies(&a), interleaved_copies(&b));
@@ -354,8 +355,8 @@ fn interleaved_copies(m: &Mat<f64>) -> Mat<f64> {
 
 fn grid_case(side: usize) -> Case {
     let n = side * side;
-    let (ta, tb) = families::grid_laplacian(side, side);
-    let exact = families::grid_omega_sq(side, side, LOWEST);
+    let (ta, tb) = testing::grid_laplacian(side, side);
+    let exact = testing::grid_omega_sq(side, side, LOWEST);
     let dense = (n <= GRID_DENSE_MAX).then(|| (from_triplets(n, &ta), from_triplets(n, &tb)));
     // The largest ω² of the grid is below 8; only the scale of a zero mode uses it (none here).
     Case {
@@ -380,7 +381,7 @@ fn rotated_case(n: usize) -> Case {
 /// "`kind` fixed chain n=…".
 fn dense_fixed_chain_case(kind: &str, (a, b): (Mat<f64>, Mat<f64>)) -> Case {
     let n = a.nrows();
-    let exact = families::fixed_chain_omega_sq(n);
+    let exact = testing::fixed_chain_omega_sq(n);
     let scale = exact.iter().copied().fold(0.0, f64::max);
     Case {
         label: format!("{kind} fixed chain n={n}"),
@@ -732,22 +733,22 @@ fn main() {
             "fixed",
             "fixed chain",
             "Fixed-fixed spring chain",
-            families::fixed_chain,
-            families::fixed_chain_omega_sq,
+            testing::fixed_chain,
+            testing::fixed_chain_omega_sq,
         ),
         (
             "free",
             "free chain",
             "Free-free spring chain (rigid-body mode)",
-            families::free_chain,
-            families::free_chain_omega_sq,
+            testing::free_chain,
+            testing::free_chain_omega_sq,
         ),
         (
             "ring",
             "ring",
             "Spring ring (double eigenvalues)",
-            families::ring,
-            families::ring_omega_sq,
+            testing::ring,
+            testing::ring_omega_sq,
         ),
     ];
     for (key, label, title, pencil, exact) in chains {

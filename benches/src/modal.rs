@@ -4,25 +4,25 @@
 use mechanica::kinematics::nalgebra::{DMatrix, SymmetricEigen};
 use mechanica::modal::faer::sparse::Triplet;
 use mechanica::modal::faer::{Accum, Mat, MatRef, get_global_parallelism};
-use mechanica::modal::families;
+use mechanica_modal::testing;
 
 /// The dense benchmark pencil of order n with a closed-form spectrum: masses d_i = 1 + i/n,
 /// A = Qᵀ D Q and B = Qᵀ D^½ T D^½ Q with T = tridiag(−1, 2, −1) the fixed–fixed unit chain and Q
 /// a random orthogonal matrix (seed 42). With z = D^½ Q x, B x = ω² A x becomes T z = ω² z, so
-/// ω² = [`families::fixed_chain_omega_sq`] while A is dense and not a multiple of the identity.
+/// ω² = [`testing::fixed_chain_omega_sq`] while A is dense and not a multiple of the identity.
 pub fn rotated_fixed_chain(n: usize) -> (Mat<f64>, Mat<f64>) {
     let d: Vec<f64> = (0..n).map(|i| 1.0 + i as f64 / n as f64).collect();
     let a = Mat::from_fn(n, n, |i, j| if i == j { d[i] } else { 0.0 });
-    let (_, t) = families::fixed_chain(n);
+    let (_, t) = testing::fixed_chain(n);
     let b = Mat::from_fn(n, n, |i, j| (d[i] * d[j]).sqrt() * t[(i, j)]);
-    families::rotate(&a, &b, &families::random_orthogonal(n, 42))
+    testing::rotate(&a, &b, &testing::random_orthogonal(n, 42))
 }
 
-/// [`families::lumped_chain`] with masses 1 + i/n and seed 42: the lumped-mass counterpart of
+/// [`testing::lumped_chain`] with masses 1 + i/n and seed 42: the lumped-mass counterpart of
 /// [`rotated_fixed_chain`] (same ω², A diagonal, B dense).
 pub fn lumped_fixed_chain(n: usize) -> (Mat<f64>, Mat<f64>) {
     let d: Vec<f64> = (0..n).map(|i| 1.0 + i as f64 / n as f64).collect();
-    families::lumped_chain(&d, 42)
+    testing::lumped_chain(&d, 42)
 }
 
 /// Column-major copy with leading dimension nrows (the layout LAPACK takes).

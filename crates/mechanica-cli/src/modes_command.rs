@@ -2,14 +2,14 @@
 //! of a pencil read from Matrix Market files, det(λA + B) = 0 (8.89), with the accuracy report
 //! and the wall time of each stage (read, factor, solve, accuracy, refine, Sturm check).
 //!
-//! Which solver: `--lowest k` on a pencil larger than [`DENSE_LIMIT`] uses the sparse
+//! Which solver: `--lowest k` on a pencil larger than [`Tuning::dense_limit`] uses the sparse
 //! shift-invert Lanczos solver (memory O(nnz + n·k)); everything else is solved densely
 //! (all modes, or the k lowest). `--dense` forces the dense solver.
 
 use crate::report::{Quantity, Report, Step, timed_step};
 use mechanica::modal::faer::Mat;
 use mechanica::modal::{
-    DENSE_LIMIT, ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparseOptions, SparsePencil,
+    ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparsePencil, SparseSolveOptions, Tuning,
     read_matrix_market, solve, solve_sparse,
 };
 use std::path::{Path, PathBuf};
@@ -162,7 +162,8 @@ pub fn run(args: &ModesArgs) -> Result<Report, String> {
     let (read_step, a, b) = read_pencil(args)?;
     let n = a.nrows;
     let mut steps = vec![read_step];
-    let sparse = matches!(args.lowest, Some(k) if n > DENSE_LIMIT && k < n) && !args.dense && !args.values_only;
+    let sparse =
+        matches!(args.lowest, Some(k) if n > Tuning::DEFAULT.dense_limit && k < n) && !args.dense && !args.values_only;
     if sparse {
         steps.extend(sparse_steps(args, &a, &b)?);
     } else {
@@ -227,9 +228,9 @@ fn sparse_steps(
     let pencil = SparsePencil::from_triplets(a.nrows, &a.entries, &b.entries).map_err(|e| e.to_string())?;
     let sol = solve_sparse(
         &pencil,
-        &SparseOptions {
+        &SparseSolveOptions {
             count,
-            ..SparseOptions::default()
+            ..SparseSolveOptions::default()
         },
     )
     .map_err(|e| e.to_string())?;
@@ -329,7 +330,7 @@ fn dense_steps(
 }
 
 /// The accuracy report, refinement and Sturm check steps of a dense solution.
-fn dense_accuracy_steps(acc: &mechanica::modal::AccuracyReport, t: &mechanica::modal::DenseTimings) -> [Step; 3] {
+fn dense_accuracy_steps(acc: &mechanica::modal::AccuracyReport, t: &mechanica::modal::SolveTimings) -> [Step; 3] {
     let accuracy = stage(
         "accuracy report",
         t.accuracy,

@@ -118,7 +118,7 @@ fn spring_mass_chain_built_as_a_mechanism_matches_the_matrix_closed_form() {
         .add_potential(spring(slider(n - 1), ground((n + 1) as f64 * spacing)))
         .expect("wall");
     let modes = mechanism_modes(&mut mechanism, &vec![0.0; n], &SolveOptions::default()).expect("modes");
-    assert_within_bounds(&modes, &mechanica_modal::families::fixed_chain_omega_sq(n));
+    assert_within_bounds(&modes, &mechanica_modal::testing::fixed_chain_omega_sq(n));
     // Effective masses along x sum to the moving mass when every mode is kept.
     let sum: f64 = modes.effective_masses.iter().map(|e| e[0]).sum();
     assert!((sum - n as f64).abs() <= 1e-12 * n as f64, "Σ m_eff = {sum}");

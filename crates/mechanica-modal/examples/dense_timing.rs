@@ -5,7 +5,7 @@
 //! B = D^½ Qᵀ T Q D^½ (same ω²), the lumped-mass case.
 //! `cargo run --release -p mechanica-modal --example dense_timing -- 2000 [auto|off|always] [values] [sketched] [lumped]`
 use mechanica_modal::faer::Mat;
-use mechanica_modal::{PencilProblem, Refinement, Residuals, SolveOptions, families, solve};
+use mechanica_modal::{PencilProblem, Refinement, Residuals, SolveOptions, solve, testing};
 use std::time::Instant;
 
 fn main() {
@@ -27,12 +27,12 @@ fn main() {
     };
     let d: Vec<f64> = (0..n).map(|i| 1.0 + i as f64 / n as f64).collect();
     let a = Mat::from_fn(n, n, |i, j| if i == j { d[i] } else { 0.0 });
-    let (_, t) = families::fixed_chain(n);
+    let (_, t) = testing::fixed_chain(n);
     let b = Mat::from_fn(n, n, |i, j| (d[i] * d[j]).sqrt() * t[(i, j)]);
     let (a, b) = if has("lumped") {
-        families::lumped_chain(&d, 42)
+        testing::lumped_chain(&d, 42)
     } else {
-        families::rotate(&a, &b, &families::random_orthogonal(n, 42))
+        testing::rotate(&a, &b, &testing::random_orthogonal(n, 42))
     };
     let p = match PencilProblem::new(a.as_ref(), b.as_ref()) {
         Ok(p) => p,
@@ -44,7 +44,7 @@ fn main() {
         residuals,
         ..SolveOptions::default()
     };
-    let exact = families::fixed_chain_omega_sq(n);
+    let exact = testing::fixed_chain_omega_sq(n);
     for _ in 0..2 {
         let clock = Instant::now();
         let sol = match solve(&p, &options) {

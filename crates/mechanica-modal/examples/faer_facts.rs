@@ -1,4 +1,4 @@
-//! Checks, on this machine, the statements issue 5 makes about faer 0.24 (run with
+//! Checks two facts about faer 0.24 behind the dense solver's design (run with
 //! `cargo run --release -p mechanica-modal --example faer_facts`):
 //! 1. `generalized_eigen` (QZ) accuracy and time on a rotated unit chain (exact spectrum known)
 //!    at n = 200 and 600, against `mechanica_modal::solve` on the same pencil;
@@ -9,14 +9,14 @@ use mechanica_modal::faer::matrix_free::eigen::{
     PartialEigenParams, partial_self_adjoint_eigen, partial_self_adjoint_eigen_scratch,
 };
 use mechanica_modal::faer::{Col, Mat, Par};
-use mechanica_modal::{PencilProblem, SolveOptions, families, solve};
+use mechanica_modal::{PencilProblem, SolveOptions, solve, testing};
 use std::time::Instant;
 
 fn main() {
     for n in [200, 600] {
-        let q = families::random_orthogonal(n, 3);
-        let (a, b) = families::rotate(&Mat::identity(n, n), &families::fixed_chain(n).1, &q);
-        let exact = families::fixed_chain_omega_sq(n);
+        let q = testing::random_orthogonal(n, 3);
+        let (a, b) = testing::rotate(&Mat::identity(n, n), &testing::fixed_chain(n).1, &q);
+        let exact = testing::fixed_chain_omega_sq(n);
         let t = Instant::now();
         let qz = b.generalized_eigen(&a);
         let t_qz = t.elapsed().as_secs_f64();
@@ -48,7 +48,7 @@ fn main() {
         );
     }
     for (n, nev) in [(40, 5), (64, 5), (100, 5), (100, 40), (300, 5)] {
-        let (_, b) = families::fixed_chain(n);
+        let (_, b) = testing::fixed_chain(n);
         let result = std::panic::catch_unwind(|| {
             let params = PartialEigenParams::default();
             let mut mem = MemBuffer::new(partial_self_adjoint_eigen_scratch(&b, nev, Par::Seq, params));

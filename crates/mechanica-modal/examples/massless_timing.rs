@@ -4,13 +4,13 @@
 //! Prints the wall time, the lowest ω² against that closed form and the stage times.
 //! `cargo run --release -p mechanica-modal --example massless_timing -- 1000`
 use mechanica_modal::faer::Mat;
-use mechanica_modal::{PencilProblem, Residuals, SolveOptions, families, solve};
+use mechanica_modal::{PencilProblem, Residuals, SolveOptions, solve, testing};
 use std::time::Instant;
 
 fn main() {
     let m: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(1000);
     let n = 2 * m + 1;
-    let (_, b) = families::fixed_chain(n);
+    let (_, b) = testing::fixed_chain(n);
     let a = Mat::from_fn(n, n, |i, j| if i == j && i % 2 == 1 { 1.0 } else { 0.0 });
     let problem = match PencilProblem::new(a.as_ref(), b.as_ref()) {
         Ok(p) => p,

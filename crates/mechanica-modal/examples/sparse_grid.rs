@@ -1,6 +1,6 @@
 //! Times the sparse solver on an N×N grid Laplacian (default 300: n = 90 000, 10 lowest modes)
 //! and prints the report. `cargo run --release -p mechanica-modal --example sparse_grid -- 300 10`
-use mechanica_modal::{SparseOptions, SparsePencil, families, solve_sparse};
+use mechanica_modal::{SparsePencil, SparseSolveOptions, solve_sparse, testing};
 use std::time::Instant;
 
 fn main() {
@@ -10,7 +10,7 @@ fn main() {
     if std::env::var("SEQ").is_ok() {
         mechanica_modal::faer::set_global_parallelism(mechanica_modal::faer::Par::Seq);
     }
-    let (a, b) = families::grid_laplacian(side, side);
+    let (a, b) = testing::grid_laplacian(side, side);
     let clock = Instant::now();
     let p = match SparsePencil::from_triplets(side * side, &a, &b) {
         Ok(p) => p,
@@ -20,21 +20,21 @@ fn main() {
     let clock = Instant::now();
     let sol = match solve_sparse(
         &p,
-        &SparseOptions {
+        &SparseSolveOptions {
             count: k,
             block_size: std::env::var("BLOCK")
                 .ok()
                 .and_then(|b| b.parse().ok())
-                .unwrap_or(SparseOptions::default().block_size),
+                .unwrap_or(SparseSolveOptions::default().block_size),
             tolerance: std::env::var("TOL").ok().and_then(|b| b.parse().ok()).unwrap_or(1e-12),
-            ..SparseOptions::default()
+            ..SparseSolveOptions::default()
         },
     ) {
         Ok(s) => s,
         Err(e) => return eprintln!("{e}"),
     };
     let solved = clock.elapsed();
-    let exact = families::grid_omega_sq(side, side, k);
+    let exact = testing::grid_omega_sq(side, side, k);
     let worst = sol
         .modes
         .iter()

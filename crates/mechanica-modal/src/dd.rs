@@ -2,6 +2,9 @@
 //! that must survive cancellation, built on the error-free transformations TwoSum and TwoProd
 //! (Ogita, Rump & Oishi, "Accurate sum and dot product", SIAM J. Sci. Comput. 26, 2005).
 
+#[cfg(target_arch = "x86_64")]
+use crate::runtime::cpu::fused_available;
+use crate::tuning::Tuning;
 use faer::MatRef;
 
 /// An unevaluated sum hi + lo with |lo| ≤ ½ ulp(hi).
@@ -57,13 +60,6 @@ fn two_prod(a: f64, b: f64) -> (f64, f64) {
 #[inline(always)]
 fn two_prod_as<const FUSED: bool>(a: f64, b: f64) -> (f64, f64) {
     if FUSED { two_prod_fused(a, b) } else { two_prod(a, b) }
-}
-
-/// Whether this CPU runs the FMA and AVX2 variants of the kernels below (detected once, cached
-/// by the standard library).
-#[cfg(target_arch = "x86_64")]
-pub(crate) fn fused_available() -> bool {
-    std::arch::is_x86_feature_detected!("fma") && std::arch::is_x86_feature_detected!("avx2")
 }
 
 /// Veltkamp's split a = hi + lo, each half with at most 26 significant bits.
@@ -131,19 +127,19 @@ impl Dd {
     }
 }
 
-/// Σ_j m[i, j]·x[j] in double-double, for every row i (the product M x as if computed in twice
-/// the working precision, then kept unrounded). Accumulated column by column into separate
-/// high and low parts, which vectorises; on CPUs with FMA and AVX2 the same operations run four
-/// rows per instruction (both products are exact, so results are identical). From
-/// [`PARALLEL_ROWS_FROM`] rows, when faer's global parallelism allows two threads, the two
-/// halves of the rows are accumulated on two threads (each row's sum is unchanged, so the
+/// Σ_j m[i, j]·x[j] in double-double, for every row i (the product M x as if computed in twice the
+/// working precision, then kept unrounded). Accumulated column by column into separate high and low
+/// parts, which vectorises; on CPUs with FMA and AVX2 the same operations run four rows per
+/// instruction (both products are exact, so results are identical). From
+/// [`crate::Tuning::parallel_rows_from`] rows, when faer's global parallelism allows two threads,
+/// the two halves of the rows are accumulated on two threads (each row's sum is unchanged, so the
 /// result is bitwise the same).
 pub(crate) fn mat_vec(m: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
     let n = m.nrows();
     let (mut hi, mut lo) = (vec![0.0; n], vec![0.0; n]);
     // Inside a pool thread (refinement runs clusters in parallel) the other threads are busy.
     let nested = rayon::current_thread_index().is_some();
-    if n >= PARALLEL_ROWS_FROM && !nested && faer::get_global_parallelism().degree() >= 2 {
+    if n >= Tuning::DEFAULT.parallel_rows_from && !nested && faer::get_global_parallelism().degree() >= 2 {
         let half = n / 2;
         let (hi_top, hi_bottom) = hi.split_at_mut(half);
         let (lo_top, lo_bottom) = lo.split_at_mut(half);
@@ -184,23 +180,19 @@ enum Structure {
     Sparse(faer::sparse::SparseColMat<usize, f64>),
 }
 
-/// An operand with at most n²/`SPARSE_FRACTION` nonzeros is stored by columns: the sparse
-/// product touches scattered accumulators one term at a time, where the dense kernel runs four
-/// rows per instruction, so it wins only well below full density.
-const SPARSE_FRACTION: usize = 16;
-
 impl<'a> Operand<'a> {
     /// Wraps `matrix`: one scan of its entries, stopping once it holds more nonzeros than a
     /// sparse operand may (a dense matrix costs n²/16 reads).
     pub(crate) fn new(matrix: MatRef<'a, f64>) -> Self {
-        let structure = if crate::reduce::is_diagonal(matrix) && crate::reduce::is_diagonal(matrix.transpose()) {
-            Structure::Diagonal
-        } else {
-            match sparse_columns(matrix) {
-                Some(sparse) => Structure::Sparse(sparse),
-                None => Structure::Dense,
-            }
-        };
+        let structure =
+            if crate::linalg::reduce::is_diagonal(matrix) && crate::linalg::reduce::is_diagonal(matrix.transpose()) {
+                Structure::Diagonal
+            } else {
+                match sparse_columns(matrix) {
+                    Some(sparse) => Structure::Sparse(sparse),
+                    None => Structure::Dense,
+                }
+            };
         Self { matrix, structure }
     }
 
@@ -241,10 +233,10 @@ impl<'a> Operand<'a> {
     }
 }
 
-/// The nonzero entries of `m` by columns when it has at most n²/[`SPARSE_FRACTION`] of them
-/// (one scan, stopping past that many), else None.
+/// The nonzero entries of `m` by columns when it has at most n²/[`crate::Tuning::sparse_fraction`]
+/// of them (one scan, stopping past that many), else None.
 pub(crate) fn sparse_columns(m: MatRef<'_, f64>) -> Option<faer::sparse::SparseColMat<usize, f64>> {
-    nonzeros_by_columns(m, m.nrows() * m.ncols() / SPARSE_FRACTION)
+    nonzeros_by_columns(m, m.nrows() * m.ncols() / Tuning::DEFAULT.sparse_fraction)
 }
 
 /// The nonzero entries of `m` by columns (rows ascending), or None past `limit` nonzeros.
@@ -267,10 +259,6 @@ fn nonzeros_by_columns(m: MatRef<'_, f64>, limit: usize) -> Option<faer::sparse:
     let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(m.nrows(), m.ncols(), column_starts, None, rows);
     Some(faer::sparse::SparseColMat::new(symbolic, values))
 }
-
-/// Orders from which [`mat_vec`] splits its rows between two threads (a thread costs tens of
-/// microseconds; the product of an order-1000 matrix takes milliseconds).
-const PARALLEL_ROWS_FROM: usize = 1000;
 
 /// hi + lo += M x with the fastest exact kernel the CPU has.
 fn accumulate_rows(m: MatRef<'_, f64>, x: &[f64], hi: &mut [f64], lo: &mut [f64]) {
@@ -633,7 +621,7 @@ mod tests {
 
     #[test]
     fn rows_on_two_threads_change_no_bit() {
-        let n = PARALLEL_ROWS_FROM + 37;
+        let n = Tuning::DEFAULT.parallel_rows_from + 37;
         let m = faer::Mat::from_fn(n, n, |i, j| {
             ((i * 31 + j * 17) % 97) as f64 / 7.0 - 6.0 + 1e-9 * j as f64
         });

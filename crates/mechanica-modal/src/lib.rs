@@ -1,88 +1,86 @@
-//! Small oscillations: A δ̈ + B δ = 0 and det(λA + B) = 0 (8.84–8.92), solved with faer,
-//! with every result carrying its own accuracy report.
+//! Small oscillations: A δ̈ + B δ = 0 and det(λA + B) = 0 ((8.84)–(8.92), see docs/theory.md),
+//! solved with faer, every result carrying its own accuracy report.
 //!
-//! This crate works on bare matrices; it needs no mechanism. Entry point: [`solve()`] on a
-//! validated [`PencilProblem`]; [`count_below`] certifies how many modes lie below a shift.
+//! This crate works on bare matrices; it needs no mechanism. Entry points: [`solve()`] on a
+//! validated [`PencilProblem`] (dense), [`solve_sparse`] on a [`SparsePencil`] (the k lowest
+//! modes of a large sparse pencil), [`count_below`] / [`count_below_sparse`] (how many modes lie
+//! below a shift, certified by Sylvester's inertia), [`FreeResponse`] (the motion from initial
+//! conditions).
+//!
+//! # Contract
 //!
 //! - **Sign convention.** det(λA + B) = 0 (8.89): an oscillatory mode has λ = −ω² < 0. Modes
 //!   are ordered by ω² = −λ ascending (unstable, rigid-body, oscillatory, infinite).
-//! - **Dense method** ([`solve()`]): Cholesky A = LLᵀ, the symmetric reduction C = L⁻¹BL⁻ᵀ in
-//!   about n³ flops ([`reduce`], as LAPACK `dsygst`), the eigen-decomposition of C
-//!   ([`symmetric_eigen`]: this crate's blocked tridiagonalization and tridiagonal divide and
-//!   conquer, faer's blocked Householder application; values only by this crate's root-free
-//!   QL/QR), X = L⁻ᵀY. faer's QZ (`generalized_eigen`) is not used: on this machine it loses accuracy
-//!   and speed at a few hundred unknowns (see `examples/faer_facts.rs`).
-//! - **Accuracy** ([`accuracy`]): per-pair backward error, ‖XᵀAX − I‖, a bound per eigenvalue
-//!   and a Sturm check with every solve. The residuals are exact by default (5n²m flops);
-//!   [`Residuals::Sketched`] bounds them from above with Gaussian sketches ([`sketch`]) at
-//!   O(n²) cost, each bound failing with probability ≤ 1e-12. The Sturm check of an all-pairs
-//!   solve certifies the bottom of the spectrum with a Cholesky factorization of B − sA
-//!   (from n = 640 factored on idle core time while the eigenvectors are formed, module
-//!   `idle_certificate`); subsets count with an LBLᵀ factorization at a shift in a gap next to
-//!   the selection.
-//! - **Classification** ([`ModeKind`]): zero when |ω²| is within its own error bound.
-//!   Repeated frequencies are grouped ([`ModeGroup`]) with an A-orthonormal eigenspace basis.
+//! - **Accuracy.** Every mode carries a bound on |ω²_computed − ω²_exact| for the stored A and
+//!   B, from its backward error and condition (first order), a priori (values only), or from an
+//!   extended-precision residual (refined modes, a rigorous residual / Kato–Temple bound); every
+//!   pair its backward error; every solve its A-orthogonality error and a Sturm check that no
+//!   mode below a shift was missed or invented ([`AccuracyReport`], [`SparseAccuracyReport`]).
+//!   Sketched residuals ([`Residuals::Sketched`]) are upper bounds that fail with probability
+//!   at most [`certify::FAILURE_PROBABILITY`] each.
+//! - **Stiff and graded problems.** With [`Refinement::Auto`] every mode whose bound guarantees
+//!   fewer than 8 digits ([`dense::AUTO_REFINE_RELATIVE_BOUND`]) is refined by Newton steps with
+//!   double-double residuals and gets a residual bound (tested on graded chains with ratios up
+//!   to 1e12 against 60-digit references, tools/modal_reference.py).
+//! - **Classification** ([`ModeKind`]): a mode is zero when |ω²| is within its error bound or
+//!   the data resolution of A and B. Repeated frequencies are grouped ([`ModeGroup`]), each
+//!   group's shapes an A-orthonormal basis of its eigenspace.
 //! - **Semidefinite A**: massless directions are condensed out and reported as infinite modes;
 //!   an indefinite A is an error naming the failed Cholesky pivot.
-//! - **Stiff problems**: the reduction is accurate only relative to the largest eigenvalue;
-//!   [`Refinement::Auto`] refines every mode whose bound guarantees fewer than 8 digits by
-//!   Newton steps with double-double residuals (`refine`), and replaces its bound by a
-//!   gap-weighted residual bound. The Newton correction is applied through the reduced
-//!   problem's computed eigen-decomposition (O(n²) per step); only when that stops contracting
-//!   is the bordered matrix factored (LBLᵀ, n³/3). When A and B both have few nonzeros (banded
-//!   or assembled matrices stored densely) each simple mode instead takes bordered steps on a
-//!   sparse LU of B − ω₀²A, with its iterate in double-double, so that its certified bound is
-//!   not limited by rounding the vector (down to u·ω²). Tested on graded chains with ratios up
-//!   to 1e12 against 60-digit mpmath references (tools/modal_reference.py). A values-only solve forms the
-//!   vectors of its weakly bounded modes only, by inverse iteration on the tridiagonal form
-//!   (`values_only`), measures their bounds and refines them the same way.
-//! - **Sparse** ([`solve_sparse`] on a [`SparsePencil`] from faer `SparseColMat`s, triplets or
-//!   Matrix Market files): the k lowest modes by shift-invert block Lanczos on faer's sparse
-//!   Cholesky, certified by the inertia of B − τA ([`count_below_sparse`]), with Rayleigh–Ritz
-//!   refinement, double-double residuals and quadratic (Kato–Temple type) error bounds.
-//! - **Free response** ([`FreeResponse`]): δ(t) = Σ q_k(t) x_k from δ(0), δ̇(0) (8.91), with
-//!   zero (q + q̇t), unstable (cosh/sinh), repeated and massless (static) modes.
+//!
+//! # Pipeline
+//!
+//! Dense ([`dense`]): Cholesky A = LLᵀ (or, for a semidefinite A, static condensation of the
+//! massless directions), the reduction C = L⁻¹BL⁻ᵀ, the eigen-decomposition of C (blocked
+//! tridiagonalization and tridiagonal divide and conquer; values only by a root-free QL
+//! iteration), X = L⁻ᵀY; then the accuracy report ([`certify`]), refinement of weakly bounded
+//! modes, the Sturm check, classification and grouping ([`spectrum`]). Sparse ([`sparse`]):
+//! shift-invert block Lanczos on a sparse Cholesky factor of B − σA, Rayleigh–Ritz on the
+//! pencil, double-double residuals and quadratic bounds, certified by the inertia of B − τA at a
+//! shift τ in a gap above the k-th mode; small pencils go to the dense solver.
+//!
+//! # Layout
+//!
+//! Modules depend one way, checked by tools/module_graph.py: [`error`], [`problem`],
+//! [`tuning`] and the machine helpers (`runtime`) at the bottom; the dense kernels
+//! (`linalg`: Cholesky, reduction, symmetric eigensolver) and double-double arithmetic (`dd`)
+//! above them; [`spectrum`] (modes, classification, clusters); [`certify`] (the accuracy
+//! report, sketches, inertia counts, the bottom certificate); `refine` (Newton steps, bordered
+//! systems, projected corrections); then the solvers [`dense`] and [`sparse`] (which uses the
+//! dense solver for small pencils and Rayleigh–Ritz) and [`response`]. The test problems with
+//! known spectra are in `testing` (cargo feature `testing`); the tuning choices are
+//! [`Tuning::DEFAULT`].
 
-pub mod accuracy;
-mod condense;
+pub mod certify;
 mod dd;
+pub mod dense;
 pub mod error;
-pub mod families;
-mod fork_join;
-mod idle_certificate;
-mod idle_task;
-pub mod inertia;
-pub mod lanczos;
-pub mod matrix_market;
+#[doc(hidden)]
+pub mod linalg;
 pub mod problem;
-pub mod reduce;
 mod refine;
 pub mod response;
-pub mod scratch;
-pub mod sketch;
-pub mod solve;
-pub mod sparse_inertia;
-pub mod sparse_pencil;
-mod supernodal_solve;
-pub mod symmetric_eigen;
-mod symv_team;
-mod tridiagonal_divide;
-mod tridiagonal_values;
-mod tridiagonal_vectors;
-mod values_only;
+mod runtime;
+pub mod sparse;
+pub mod spectrum;
+#[cfg(feature = "testing")]
+pub mod testing;
+pub mod tuning;
 
-pub use accuracy::{AccuracyReport, BoundKind, Residuals};
+pub use certify::{AccuracyReport, BoundKind, InertiaCheck, InertiaCount, Residuals, count_below};
+pub use dense::{Method, ModalSolution, Refinement, Selection, SolveOptions, SolveTimings, solve};
 pub use error::ModalError;
 pub use faer;
-pub use inertia::{InertiaCount, count_below};
-pub use lanczos::{DENSE_LIMIT, SparseModalSolution, SparseOptions, SparseReport, SparseTimings, solve_sparse};
-pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use problem::PencilProblem;
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
-pub use scratch::release as release_scratch;
-pub use solve::{
-    DenseTimings, InertiaCheck, Method, ModalSolution, Mode, ModeGroup, ModeKind, Refinement, Selection, SolveOptions,
-    classify, solve,
+pub use runtime::scratch::release as release_scratch;
+pub use sparse::{
+    MatrixMarket, SparseAccuracyReport, SparseInertiaCount, SparseModalSolution, SparsePencil, SparseSolveOptions,
+    SparseSolveTimings, count_below_sparse, parse_matrix_market, read_matrix_market, solve_sparse,
 };
-pub use sparse_inertia::{SparseInertia, count_below_sparse};
-pub use sparse_pencil::SparsePencil;
+pub use spectrum::{Mode, ModeGroup, ModeKind, classify};
+pub use tuning::Tuning;
+
+// Old name; removed once the C layer uses the new one.
+#[doc(hidden)]
+pub type SparseOptions = SparseSolveOptions;

@@ -1,4 +1,4 @@
-//! The validated symmetric pencil (A, B) of det(λA + B) = 0 (8.89).
+//! The validated symmetric pencil (A, B) of det(λA + B) = 0 ((8.89), see docs/theory.md).
 
 use crate::ModalError;
 use faer::{Mat, MatRef};

@@ -1,4 +1,5 @@
-//! The free response of A δ̈ + B δ = 0 from δ(0), δ̇(0) by modal superposition (8.91).
+//! The free response of A δ̈ + B δ = 0 from δ(0), δ̇(0) by modal superposition ((8.91), see
+//! docs/theory.md).
 //!
 //! With A-orthonormal mode shapes x_k (x_jᵀ A x_k = δ_jk) the modal coordinates of the initial
 //! state are q_k(0) = x_kᵀ A δ(0) and q̇_k(0) = x_kᵀ A δ̇(0), and each coordinate evolves alone:
@@ -15,7 +16,8 @@
 //!
 //! **Massless coordinates** (A only semidefinite; infinite modes). A massless direction has no
 //! dynamics of its own: the equations along the null space of A are static, B₀₁z + B₀₀w = 0
-//! (see `condense`), so those coordinates follow the massive ones instantaneously. The finite
+//! (condensed out by the dense solve), so those coordinates follow the massive ones
+//! instantaneously. The finite
 //! mode shapes already carry that static part, and the projection q_k = x_kᵀAδ(0) sees only
 //! the massive part of δ(0) (A annihilates the null space). The response therefore keeps the
 //! massive part of the initial state and replaces the massless part by its static value; the
@@ -28,7 +30,8 @@
 //! order). A zero mode is integrated as q + q̇t; its true ω² may be anything within its bound e,
 //! which its rate bound √e expresses.
 
-use crate::solve::{ModalSolution, ModeKind, SolveOptions, solve};
+use crate::dense::{ModalSolution, SolveOptions, solve};
+use crate::spectrum::ModeKind;
 use crate::{ModalError, PencilProblem};
 use faer::Mat;
 

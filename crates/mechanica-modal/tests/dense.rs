@@ -3,7 +3,7 @@
 use mechanica_modal::faer::Mat;
 use mechanica_modal::{
     BoundKind, Method, ModalError, ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions,
-    count_below, families, solve,
+    count_below, solve, testing,
 };
 use proptest::prelude::*;
 
@@ -44,31 +44,31 @@ fn check_against(p: &PencilProblem, exact: &[f64]) {
 #[test]
 fn fixed_chain_matches_closed_form() {
     for n in [1, 2, 7, 60, 130] {
-        let (a, b) = families::fixed_chain(n);
-        check_against(&pencil(&a, &b), &families::fixed_chain_omega_sq(n));
+        let (a, b) = testing::fixed_chain(n);
+        check_against(&pencil(&a, &b), &testing::fixed_chain_omega_sq(n));
     }
 }
 
 #[test]
 fn rotated_chain_keeps_its_spectrum() {
     let n = 90;
-    let (a0, b0) = families::fixed_chain(n);
+    let (a0, b0) = testing::fixed_chain(n);
     // Mass matrix diag(1..2) makes A non-trivial; rotate by a random orthogonal Q.
     let (a1, b1) = (
         Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 / n as f64 } else { 0.0 }),
         b0.clone(),
     );
     let reference = solve(&pencil(&a1, &b1), &all_pairs()).expect("diagonal problem");
-    let q = families::random_orthogonal(n, 7);
-    let (a, b) = families::rotate(&a1, &b1, &q);
+    let q = testing::random_orthogonal(n, 7);
+    let (a, b) = testing::rotate(&a1, &b1, &q);
     let sol = solve(&pencil(&a, &b), &all_pairs()).expect("rotated problem");
     for (m, r) in sol.modes.iter().zip(&reference.modes) {
         assert!((m.omega_sq - r.omega_sq).abs() <= m.error_bound + r.error_bound);
     }
     assert!(sol.accuracy.meets_backward_error_target(n));
     let _ = a0;
-    let (ar, br) = families::rotate(&Mat::identity(n, n), &families::fixed_chain(n).1, &q);
-    check_against(&pencil(&ar, &br), &families::fixed_chain_omega_sq(n));
+    let (ar, br) = testing::rotate(&Mat::identity(n, n), &testing::fixed_chain(n).1, &q);
+    check_against(&pencil(&ar, &br), &testing::fixed_chain_omega_sq(n));
 }
 
 /// The certified shift, the error bounds, the backward errors and the orthogonality error.
@@ -85,10 +85,10 @@ type ReportedNumbers = (f64, Vec<f64>, Vec<Option<f64>>, Option<f64>);
 #[test]
 fn large_solves_certify_the_bottom_below_the_closed_form() {
     let n = 700;
-    let q = families::random_orthogonal(n, 3);
-    let (a, b) = families::rotate(&Mat::identity(n, n), &families::fixed_chain(n).1, &q);
+    let q = testing::random_orthogonal(n, 3);
+    let (a, b) = testing::rotate(&Mat::identity(n, n), &testing::fixed_chain(n).1, &q);
     let p = pencil(&a, &b);
-    let lowest = families::fixed_chain_omega_sq(n)[0];
+    let lowest = testing::fixed_chain_omega_sq(n)[0];
     for vectors in [true, false] {
         let mut first_report: Option<ReportedNumbers> = None;
         for _ in 0..3 {
@@ -102,7 +102,7 @@ fn large_solves_certify_the_bottom_below_the_closed_form() {
             if vectors {
                 assert!(sol.accuracy.meets_backward_error_target(n));
             }
-            for (m, w) in sol.modes.iter().zip(families::fixed_chain_omega_sq(n)).take(20) {
+            for (m, w) in sol.modes.iter().zip(testing::fixed_chain_omega_sq(n)).take(20) {
                 assert!(
                     (m.omega_sq - w).abs() <= m.error_bound + 4.0 * U * w,
                     "{} vs {w}",
@@ -150,13 +150,13 @@ fn lumped_masses_over_twelve_decades_keep_the_chain_spectrum() {
             -1.0
         }
     });
-    let (_, t) = families::fixed_chain(n);
+    let (_, t) = testing::fixed_chain(n);
     let similar = hadamard.transpose() * &t * &hadamard;
     let power = |i: usize| -10 + (20 * i / (n - 1)) as i32;
     let a = Mat::from_fn(n, n, |i, j| if i == j { 4f64.powi(power(i)) } else { 0.0 });
     let b = Mat::from_fn(n, n, |i, j| 2f64.powi(power(i) + power(j)) * similar[(i, j)] / n as f64);
     assert!((0..n).all(|j| (0..n).any(|i| i != j && b[(i, j)] != 0.0)), "B is dense");
-    let exact = families::fixed_chain_omega_sq(n);
+    let exact = testing::fixed_chain_omega_sq(n);
     let p = pencil(&a, &b);
     let sol = solve(&p, &all_pairs()).expect("solve");
     assert_eq!(sol.modes.len(), n);
@@ -198,8 +198,8 @@ fn glued_wilkinson_clusters_keep_orthogonal_modes() {
             t[(i + 1, i)] = coupling;
         }
     }
-    let q = families::random_orthogonal(n, 5);
-    let (a, b) = families::rotate(&Mat::identity(n, n), &t, &q);
+    let q = testing::random_orthogonal(n, 5);
+    let (a, b) = testing::rotate(&Mat::identity(n, n), &t, &q);
     let p = pencil(&a, &b);
     let sol = solve(&p, &all_pairs()).expect("solve");
     let eta = sol.accuracy.max_backward_error.expect("vectors");
@@ -233,10 +233,10 @@ fn values_only_solves_measure_their_weakly_bounded_modes() {
         ..all_pairs()
     };
     let n = 700;
-    let q = families::random_orthogonal(n, 11);
-    let (a, b) = families::rotate(&Mat::identity(n, n), &families::fixed_chain(n).1, &q);
+    let q = testing::random_orthogonal(n, 11);
+    let (a, b) = testing::rotate(&Mat::identity(n, n), &testing::fixed_chain(n).1, &q);
     let p = pencil(&a, &b);
-    let exact = families::fixed_chain_omega_sq(n);
+    let exact = testing::fixed_chain_omega_sq(n);
     let sol = solve(&p, &values_only).expect("solve");
     assert!(sol.vectors.is_none());
     for (i, (m, &w)) in sol.modes.iter().zip(&exact).enumerate() {
@@ -260,8 +260,8 @@ fn values_only_solves_measure_their_weakly_bounded_modes() {
     );
 
     let n = 40;
-    let (a, b) = families::ring(n);
-    let exact = families::ring_omega_sq(n);
+    let (a, b) = testing::ring(n);
+    let exact = testing::ring_omega_sq(n);
     let sol = solve(&pencil(&a, &b), &values_only).expect("solve");
     for (i, (m, &w)) in sol.modes.iter().zip(&exact).enumerate() {
         assert!((m.omega_sq - w).abs() <= m.error_bound, "mode {i}");
@@ -273,17 +273,17 @@ fn values_only_solves_measure_their_weakly_bounded_modes() {
     assert!(mult[1..mult.len() - 1].iter().all(|&m| m == 2), "{mult:?}");
 }
 
-/// Values only with more weakly bounded modes than `FLAGGED_VECTORS_UP_TO` (masses graded over
-/// six decades make ‖A⁻¹‖ large): all vectors are computed instead, and every mode agrees with
+/// Values only with more weakly bounded modes than `Tuning::flagged_vectors_up_to` (masses graded
+/// over six decades make ‖A⁻¹‖ large): all vectors are computed instead, and every mode agrees with
 /// the all-pairs solve within the two bounds, with measured (not assumed) bounds.
 #[test]
 fn values_only_with_many_weak_modes_computes_all_vectors() {
     let n = 300;
     let masses: Vec<f64> = (0..n).map(|i| 10f64.powf(-6.0 * i as f64 / (n - 1) as f64)).collect();
     let a = Mat::from_fn(n, n, |i, j| if i == j { masses[i] } else { 0.0 });
-    let b = families::fixed_chain(n).1;
-    let q = families::random_orthogonal(n, 3);
-    let (a, b) = families::rotate(&a, &b, &q);
+    let b = testing::fixed_chain(n).1;
+    let q = testing::random_orthogonal(n, 3);
+    let (a, b) = testing::rotate(&a, &b, &q);
     let p = pencil(&a, &b);
     let values_only = SolveOptions {
         vectors: false,
@@ -300,10 +300,10 @@ fn values_only_with_many_weak_modes_computes_all_vectors() {
     let weak = assumed
         .modes
         .iter()
-        .filter(|m| m.error_bound > mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * m.omega_sq.abs())
+        .filter(|m| m.error_bound > mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * m.omega_sq.abs())
         .count();
     assert!(
-        weak > mechanica_modal::solve::FLAGGED_VECTORS_UP_TO.max(n / 4),
+        weak > mechanica_modal::Tuning::DEFAULT.flagged_vectors_up_to.max(n / 4),
         "{weak} weak modes"
     );
     let measured = solve(&p, &values_only).expect("solve");
@@ -321,9 +321,9 @@ fn values_only_with_many_weak_modes_computes_all_vectors() {
 #[test]
 fn free_chain_has_one_rigid_body_mode() {
     let n = 40;
-    let (a, b) = families::free_chain(n);
+    let (a, b) = testing::free_chain(n);
     let p = pencil(&a, &b);
-    check_against(&p, &families::free_chain_omega_sq(n));
+    check_against(&p, &testing::free_chain_omega_sq(n));
     let sol = solve(&p, &all_pairs()).expect("solve");
     assert_eq!(sol.modes[0].kind, ModeKind::Zero);
     for m in &sol.modes[1..] {
@@ -342,9 +342,9 @@ fn free_chain_has_one_rigid_body_mode() {
 #[test]
 fn ring_eigenvalues_come_in_groups_with_orthonormal_bases() {
     let n = 12;
-    let (a, b) = families::ring(n);
+    let (a, b) = testing::ring(n);
     let p = pencil(&a, &b);
-    check_against(&p, &families::ring_omega_sq(n));
+    check_against(&p, &testing::ring_omega_sq(n));
     let sol = solve(&p, &all_pairs()).expect("solve");
     // k = 0 and k = n/2 are simple; every other frequency is double.
     let mult: Vec<usize> = sol.groups.iter().map(|g| g.multiplicity).collect();
@@ -369,8 +369,8 @@ fn unstable_modes_report_their_growth_rate() {
     // A = I, B = diag(−4, 1, 9): one unstable mode with growth rate 2 (λ = 4 > 0).
     let a = Mat::<f64>::identity(3, 3);
     let b = Mat::from_fn(3, 3, |i, j| if i == j { [-4.0, 1.0, 9.0][i] } else { 0.0 });
-    let q = families::random_orthogonal(3, 1);
-    let (a, b) = families::rotate(&a, &b, &q);
+    let q = testing::random_orthogonal(3, 1);
+    let (a, b) = testing::rotate(&a, &b, &q);
     let sol = solve(&pencil(&a, &b), &all_pairs()).expect("solve");
     match sol.modes[0].kind {
         ModeKind::Unstable { growth_rate } => assert!((growth_rate - 2.0).abs() <= 10.0 * U * 2.0),
@@ -386,7 +386,7 @@ fn massless_coordinate_is_condensed_and_reported_infinite() {
     // ground –1– m=1 –1– (massless) –1– m=1 –1– ground: condensing the middle node leaves the
     // pencil (I, [[1.5, −0.5], [−0.5, 1.5]]) with ω² = 1 and 2, plus one infinite mode.
     let a = Mat::from_fn(3, 3, |i, j| if i == j && i != 1 { 1.0 } else { 0.0 });
-    let (_, b) = families::fixed_chain(3);
+    let (_, b) = testing::fixed_chain(3);
     let sol = solve(&pencil(&a, &b), &all_pairs()).expect("solve");
     assert_eq!(sol.method, Method::CondensedReduction { massless: 1 });
     assert_eq!(sol.modes.len(), 3);
@@ -423,7 +423,7 @@ fn scattered_massless_nodes_of_a_lumped_chain_are_condensed() {
         s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         place.swap(i, (s >> 33) as usize % (i + 1));
     }
-    let (_, t) = families::fixed_chain(n);
+    let (_, t) = testing::fixed_chain(n);
     let a = Mat::from_fn(n, n, |i, j| {
         if i == j && place.iter().position(|&p| p == i).unwrap_or(0) % 2 == 1 {
             1.0
@@ -627,9 +627,9 @@ fn singular_pencil_is_rejected() {
 #[test]
 fn subsets_agree_with_the_full_spectrum() {
     let n = 70;
-    let (a, b) = families::fixed_chain(n);
+    let (a, b) = testing::fixed_chain(n);
     let p = pencil(&a, &b);
-    let exact = families::fixed_chain_omega_sq(n);
+    let exact = testing::fixed_chain_omega_sq(n);
     let lowest = solve(
         &p,
         &SolveOptions {
@@ -691,7 +691,7 @@ fn subsets_agree_with_the_full_spectrum() {
 /// An interval above (or below) the whole spectrum selects nothing, in every mode of solve.
 #[test]
 fn empty_intervals_select_nothing() {
-    let (a, b) = families::fixed_chain(6);
+    let (a, b) = testing::fixed_chain(6);
     let p = pencil(&a, &b);
     for (lower, upper) in [(5.0, 6.0), (-2.0, -1.0)] {
         for vectors in [false, true] {
@@ -797,7 +797,7 @@ fn zero_mass_matrix_gives_only_infinite_modes() {
 #[test]
 fn tiny_orders_do_not_reach_faer_size_limits() {
     for n in 1..=3 {
-        let (a, b) = families::free_chain(n);
+        let (a, b) = testing::free_chain(n);
         let p = pencil(&a, &b);
         for selection in [Selection::All, Selection::Lowest(0), Selection::Lowest(n)] {
             for vectors in [false, true] {
@@ -828,9 +828,9 @@ fn tiny_orders_do_not_reach_faer_size_limits() {
 /// The fixed chain with masses 1 + i/n (ω² of the unit chain), turned by a random rotation.
 fn rotated_graded_mass_chain(n: usize) -> (Mat<f64>, Mat<f64>) {
     let d = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 / n as f64 } else { 0.0 });
-    let (_, t) = families::fixed_chain(n);
+    let (_, t) = testing::fixed_chain(n);
     let b = Mat::from_fn(n, n, |i, j| (d[(i, i)] * d[(j, j)]).sqrt() * t[(i, j)]);
-    families::rotate(&d, &b, &families::random_orthogonal(n, 9))
+    testing::rotate(&d, &b, &testing::random_orthogonal(n, 9))
 }
 
 /// The sketched report bounds the exact one from above, within the factor its lower tail
@@ -841,11 +841,11 @@ fn rotated_graded_mass_chain(n: usize) -> (Mat<f64>, Mat<f64>) {
 fn sketched_residuals_bound_the_exact_ones() {
     let n = 300;
     let (ra, rb) = rotated_graded_mass_chain(n);
-    let (fa, fb) = families::free_chain(n);
-    let graded = families::spring_chain(&families::graded_exponents(n, 12), &vec![0; n]);
+    let (fa, fb) = testing::free_chain(n);
+    let graded = testing::spring_chain(&testing::graded_exponents(n, 12), &vec![0; n]);
     let cases = [
-        (pencil(&ra, &rb), families::fixed_chain_omega_sq(n)),
-        (pencil(&fa, &fb), families::free_chain_omega_sq(n)),
+        (pencil(&ra, &rb), testing::fixed_chain_omega_sq(n)),
+        (pencil(&fa, &fb), testing::free_chain_omega_sq(n)),
         (pencil(&graded.0, &graded.1), Vec::new()),
     ];
     for (p, exact) in &cases {
@@ -892,10 +892,10 @@ fn sketched_residuals_bound_the_exact_ones() {
 fn sketches_are_not_formed_where_exact_products_cost_less() {
     let n = 240;
     let (ra, rb) = rotated_graded_mass_chain(n);
-    let (small_a, small_b) = families::rotate(
+    let (small_a, small_b) = testing::rotate(
         &Mat::<f64>::identity(30, 30),
-        &families::fixed_chain(30).1,
-        &families::random_orthogonal(30, 3),
+        &testing::fixed_chain(30).1,
+        &testing::random_orthogonal(30, 3),
     );
     for (p, selection) in [
         (pencil(&small_a, &small_b), Selection::All),
@@ -929,7 +929,7 @@ fn sketches_are_not_formed_where_exact_products_cost_less() {
 #[test]
 fn rigid_body_modes_of_a_rounded_stiffness_are_zero() {
     let copies = 6;
-    let (a1, b1) = families::free_chain(10);
+    let (a1, b1) = testing::free_chain(10);
     let n1 = a1.nrows();
     let n = copies * n1;
     let copied = |m: &Mat<f64>| {
@@ -941,9 +941,9 @@ fn rigid_body_modes_of_a_rounded_stiffness_are_zero() {
             }
         })
     };
-    let (a, b) = families::rotate(&copied(&a1), &copied(&b1), &families::random_orthogonal(n, 5));
-    let (ar, br) = families::ring(12);
-    let (ar, br) = families::rotate(&ar, &br, &families::random_orthogonal(12, 3));
+    let (a, b) = testing::rotate(&copied(&a1), &copied(&b1), &testing::random_orthogonal(n, 5));
+    let (ar, br) = testing::ring(12);
+    let (ar, br) = testing::rotate(&ar, &br, &testing::random_orthogonal(12, 3));
     for (p, zeros) in [(pencil(&a, &b), copies), (pencil(&ar, &br), 1)] {
         for vectors in [true, false] {
             let options = SolveOptions { vectors, ..all_pairs() };
@@ -1009,8 +1009,8 @@ fn resolved_small_modes_are_not_called_zero() {
 /// two, the nullity of B.
 #[test]
 fn soft_springs_do_not_join_the_rigid_body_group() {
-    let (af, bf) = families::free_chain(10);
-    let (asoft, bsoft) = families::spring_chain(&[-10; 6], &[0; 6]);
+    let (af, bf) = testing::free_chain(10);
+    let (asoft, bsoft) = testing::spring_chain(&[-10; 6], &[0; 6]);
     let blocks = [(&af, &bf), (&af, &bf), (&asoft, &bsoft)];
     let n: usize = blocks.iter().map(|(a, _)| a.nrows()).sum();
     let mut a = Mat::<f64>::zeros(n, n);

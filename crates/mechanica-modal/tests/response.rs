@@ -10,7 +10,7 @@
 use mechanica_modal::faer::prelude::Solve;
 use mechanica_modal::faer::{Mat, Side};
 use mechanica_modal::{
-    CoordinateLaw, FreeResponse, ModalError, PencilProblem, Selection, SolveOptions, families, solve,
+    CoordinateLaw, FreeResponse, ModalError, PencilProblem, Selection, SolveOptions, solve, testing,
 };
 use proptest::prelude::*;
 
@@ -131,10 +131,10 @@ fn shape_condition(problem: &PencilProblem) -> f64 {
 #[test]
 fn rotated_graded_mass_chain_matches_integration() {
     let n = 8;
-    let (_, b0) = families::fixed_chain(n);
+    let (_, b0) = testing::fixed_chain(n);
     let a0 = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + 0.5 * i as f64 } else { 0.0 });
-    let q = families::random_orthogonal(n, 3);
-    let (a, b) = families::rotate(&a0, &b0, &q);
+    let q = testing::random_orthogonal(n, 3);
+    let (a, b) = testing::rotate(&a0, &b0, &q);
     let p = pencil(&a, &b);
     let response = compare(
         &p,
@@ -155,7 +155,7 @@ fn rotated_graded_mass_chain_matches_integration() {
 #[test]
 fn free_chain_drifts_with_its_rigid_body_mode() {
     let n = 7;
-    let (a, b) = families::free_chain(n);
+    let (a, b) = testing::free_chain(n);
     let p = pencil(&a, &b);
     // A net velocity makes the rigid-body coordinate grow linearly.
     let v0: Vec<f64> = pseudo_random(n, 5).iter().map(|v| v + 0.3).collect();
@@ -176,7 +176,7 @@ fn inverted_chain_grows_at_its_rates() {
     // Springs minus a destabilising −1·I (an array of inverted pendulums): the two lowest modes
     // of tridiag(−1, 2, −1) − I have ω² = 4 sin²(kπ/14) − 1 < 0 (k = 1, 2).
     let n = 6;
-    let (a, b0) = families::fixed_chain(n);
+    let (a, b0) = testing::fixed_chain(n);
     let b = Mat::from_fn(n, n, |i, j| b0[(i, j)] - if i == j { 1.0 } else { 0.0 });
     let p = pencil(&a, &b);
     let response = compare(
@@ -195,7 +195,7 @@ fn inverted_chain_grows_at_its_rates() {
             _ => None,
         })
         .collect();
-    let exact: Vec<f64> = families::fixed_chain_omega_sq(n)
+    let exact: Vec<f64> = testing::fixed_chain_omega_sq(n)
         .iter()
         .filter(|w| **w < 1.0)
         .map(|w| (1.0 - w).sqrt())
@@ -209,7 +209,7 @@ fn inverted_chain_grows_at_its_rates() {
 #[test]
 fn ring_with_double_frequencies_matches_integration() {
     let n = 8;
-    let (a, b) = families::ring(n);
+    let (a, b) = testing::ring(n);
     let p = pencil(&a, &b);
     let sol = solve(&p, &SolveOptions::default()).expect("solve");
     assert!(sol.groups.iter().any(|g| g.multiplicity == 2));
@@ -227,7 +227,7 @@ fn ring_with_double_frequencies_matches_integration() {
 fn chain_with_massless_nodes() -> (Mat<f64>, Mat<f64>, Vec<usize>, Vec<usize>) {
     let n = 6;
     let masses = [1.0, 0.0, 2.0, 0.0, 1.0, 1.5];
-    let (_, b) = families::fixed_chain(n);
+    let (_, b) = testing::fixed_chain(n);
     let a = Mat::from_fn(n, n, |i, j| if i == j { masses[i] } else { 0.0 });
     (a, b, vec![0, 2, 4, 5], vec![1, 3])
 }
@@ -298,7 +298,7 @@ fn shape_condition_of(a: &Mat<f64>) -> f64 {
 
 #[test]
 fn incomplete_solutions_are_refused() {
-    let (a, b) = families::fixed_chain(4);
+    let (a, b) = testing::fixed_chain(4);
     let p = pencil(&a, &b);
     let d = [0.1; 4];
     for options in [
@@ -318,7 +318,7 @@ fn incomplete_solutions_are_refused() {
         ));
     }
     // A solution of a different pencil.
-    let (a5, b5) = families::fixed_chain(5);
+    let (a5, b5) = testing::fixed_chain(5);
     let other = solve(&pencil(&a5, &b5), &SolveOptions::default()).expect("solve");
     assert!(matches!(
         FreeResponse::new(&p, &other, &d, &d),
@@ -328,7 +328,7 @@ fn incomplete_solutions_are_refused() {
 
 #[test]
 fn bad_vectors_and_times_are_located() {
-    let (a, b) = families::fixed_chain(4);
+    let (a, b) = testing::fixed_chain(4);
     let p = pencil(&a, &b);
     assert!(matches!(
         FreeResponse::from_problem(&p, &[0.0; 3], &[0.0; 4]),
@@ -362,7 +362,7 @@ fn bad_vectors_and_times_are_located() {
 
 #[test]
 fn unstable_growth_beyond_f64_is_an_error() {
-    let (a, b0) = families::fixed_chain(3);
+    let (a, b0) = testing::fixed_chain(3);
     let b = Mat::from_fn(3, 3, |i, j| b0[(i, j)] - if i == j { 4.0 } else { 0.0 });
     let p = pencil(&a, &b);
     let r = FreeResponse::from_problem(&p, &[0.1, 0.2, 0.3], &[0.0; 3]).expect("response");
@@ -394,9 +394,9 @@ proptest! {
     #[test]
     fn invariants_of_the_free_response(seed in 0u64..1000, t in -20.0f64..20.0) {
         let n = 6;
-        let (_, b0) = families::fixed_chain(n);
+        let (_, b0) = testing::fixed_chain(n);
         let a0 = Mat::from_fn(n, n, |i, j| if i == j { 1.0 + i as f64 } else { 0.0 });
-        let (a, b) = families::rotate(&a0, &b0, &families::random_orthogonal(n, seed));
+        let (a, b) = testing::rotate(&a0, &b0, &testing::random_orthogonal(n, seed));
         let p = pencil(&a, &b);
         let (d0, v0) = (pseudo_random(n, seed + 1), pseudo_random(n, seed + 2));
         let r = FreeResponse::from_problem(&p, &d0, &v0).expect("response");

@@ -2,25 +2,25 @@
 //! eigenvalues), the dense solver, and bad input.
 
 use mechanica_modal::faer::sparse::Triplet;
-use mechanica_modal::{ModalError, SparseOptions, SparsePencil, count_below_sparse, families, solve_sparse};
+use mechanica_modal::{ModalError, SparsePencil, SparseSolveOptions, count_below_sparse, solve_sparse, testing};
 
 const U: f64 = f64::EPSILON;
 
-fn lowest(k: usize) -> SparseOptions {
-    SparseOptions {
+fn lowest(k: usize) -> SparseSolveOptions {
+    SparseSolveOptions {
         count: k,
-        ..SparseOptions::default()
+        ..SparseSolveOptions::default()
     }
 }
 
 /// Every ω² within its bound of the closed form and within 1e-12 relative; groups match the
 /// closed form's multiplicities; XᵀAX = I; the inertia check passed.
 fn check_grid(nx: usize, ny: usize, k: usize, mass: f64) {
-    let (a, b) = families::grid_laplacian(nx, ny);
+    let (a, b) = testing::grid_laplacian(nx, ny);
     let a: Vec<_> = a.iter().map(|t| Triplet::new(t.row, t.col, mass * t.val)).collect();
     let p = SparsePencil::from_triplets(nx * ny, &a, &b).expect("valid");
     let sol = solve_sparse(&p, &lowest(k)).expect("solve");
-    let exact: Vec<f64> = families::grid_omega_sq(nx, ny, k).iter().map(|w| w / mass).collect();
+    let exact: Vec<f64> = testing::grid_omega_sq(nx, ny, k).iter().map(|w| w / mass).collect();
     assert_eq!(sol.modes.len(), k);
     for (m, w) in sol.modes.iter().zip(&exact) {
         let err = (m.omega_sq - w).abs();
@@ -60,10 +60,10 @@ fn inertia_guard_recovers_a_triple_eigenvalue() {
     let p = SparsePencil::from_triplets(n, &a, &b).expect("valid");
     let sol = solve_sparse(
         &p,
-        &SparseOptions {
+        &SparseSolveOptions {
             count: 5,
             block_size: 1,
-            ..SparseOptions::default()
+            ..SparseSolveOptions::default()
         },
     )
     .expect("solve");
@@ -82,9 +82,9 @@ fn inertia_guard_recovers_a_triple_eigenvalue() {
 #[test]
 fn sparse_inertia_counts_grid_modes() {
     let (nx, ny) = (60, 50);
-    let (a, b) = families::grid_laplacian(nx, ny);
+    let (a, b) = testing::grid_laplacian(nx, ny);
     let p = SparsePencil::from_triplets(nx * ny, &a, &b).expect("valid");
-    let exact = families::grid_omega_sq(nx, ny, 40);
+    let exact = testing::grid_omega_sq(nx, ny, 40);
     for j in [0usize, 5, 17, 38] {
         let shift = 0.5 * (exact[j] + exact[j + 1]);
         if exact[j + 1] - exact[j] < 1e-9 {
@@ -99,14 +99,14 @@ fn sparse_inertia_counts_grid_modes() {
 fn unstable_modes_lower_the_shift() {
     // B = Laplacian − I/16 on a 30×30 grid (exact in binary): the lowest modes have ω² < 0.
     let (nx, ny) = (30, 30);
-    let (a, b) = families::grid_laplacian(nx, ny);
+    let (a, b) = testing::grid_laplacian(nx, ny);
     let b: Vec<_> = b
         .iter()
         .map(|t| Triplet::new(t.row, t.col, if t.row == t.col { t.val - 0.0625 } else { t.val }))
         .collect();
     let p = SparsePencil::from_triplets(nx * ny, &a, &b).expect("valid");
     let sol = solve_sparse(&p, &lowest(4)).expect("solve");
-    let exact: Vec<f64> = families::grid_omega_sq(nx, ny, 4).iter().map(|w| w - 0.0625).collect();
+    let exact: Vec<f64> = testing::grid_omega_sq(nx, ny, 4).iter().map(|w| w - 0.0625).collect();
     assert!(exact[0] < 0.0);
     for (m, w) in sol.modes.iter().zip(&exact) {
         // The closed form itself is rounded: a few u of the unshifted ω².
@@ -148,7 +148,7 @@ fn bad_sparse_input_is_located() {
     assert!(matches!(
         solve_sparse(
             &p,
-            &SparseOptions {
+            &SparseSolveOptions {
                 shift: Some(f64::NAN),
                 ..lowest(1)
             }
@@ -157,12 +157,12 @@ fn bad_sparse_input_is_located() {
     ));
     assert!(count_below_sparse(&p, f64::INFINITY).is_err());
     // A shift above a mode cannot be factored: a typed error naming the pivot.
-    let (ga, gb) = families::grid_laplacian(25, 25);
+    let (ga, gb) = testing::grid_laplacian(25, 25);
     let g = SparsePencil::from_triplets(625, &ga, &gb).expect("valid");
     assert!(matches!(
         solve_sparse(
             &g,
-            &SparseOptions {
+            &SparseSolveOptions {
                 shift: Some(0.5),
                 ..lowest(2)
             }
@@ -178,15 +178,15 @@ fn bad_sparse_input_is_located() {
 #[test]
 fn matrix_market_files_feed_the_solver() {
     let (nx, ny) = (22, 21);
-    let (a, b) = families::grid_laplacian(nx, ny);
+    let (a, b) = testing::grid_laplacian(nx, ny);
     let n = nx * ny;
-    let ma = mechanica_modal::parse_matrix_market(&mechanica_modal::matrix_market::symmetric_to_string(n, &a))
+    let ma = mechanica_modal::parse_matrix_market(&mechanica_modal::sparse::matrix_market::symmetric_to_string(n, &a))
         .expect("A parses");
-    let mb = mechanica_modal::parse_matrix_market(&mechanica_modal::matrix_market::symmetric_to_string(n, &b))
+    let mb = mechanica_modal::parse_matrix_market(&mechanica_modal::sparse::matrix_market::symmetric_to_string(n, &b))
         .expect("B parses");
     let p = SparsePencil::from_triplets(n, &ma.entries, &mb.entries).expect("valid");
     let sol = solve_sparse(&p, &lowest(3)).expect("solve");
-    for (m, w) in sol.modes.iter().zip(families::grid_omega_sq(nx, ny, 3)) {
+    for (m, w) in sol.modes.iter().zip(testing::grid_omega_sq(nx, ny, 3)) {
         assert!((m.omega_sq - w).abs() <= m.error_bound);
     }
 }
@@ -195,7 +195,7 @@ fn matrix_market_files_feed_the_solver() {
 fn faer_sparse_matrices_are_accepted() {
     use mechanica_modal::faer::sparse::SparseColMat;
     let (nx, ny) = (21, 20);
-    let (a, b) = families::grid_laplacian(nx, ny);
+    let (a, b) = testing::grid_laplacian(nx, ny);
     let n = nx * ny;
     let to_faer = |t: &[Triplet<usize, usize, f64>]| {
         SparseColMat::<usize, f64>::try_new_from_triplets(n, n, t).expect("valid triplets")
@@ -204,7 +204,7 @@ fn faer_sparse_matrices_are_accepted() {
     let p = SparsePencil::new(fa.as_ref(), fb.as_ref()).expect("valid");
     assert_eq!(p.nnz(), (n, b.len()));
     let sol = solve_sparse(&p, &lowest(2)).expect("solve");
-    for (m, w) in sol.modes.iter().zip(families::grid_omega_sq(nx, ny, 2)) {
+    for (m, w) in sol.modes.iter().zip(testing::grid_omega_sq(nx, ny, 2)) {
         assert!((m.omega_sq - w).abs() <= m.error_bound);
     }
 }
@@ -212,10 +212,10 @@ fn faer_sparse_matrices_are_accepted() {
 /// A tolerance that is not a finite number in (0, 1) is refused before any work.
 #[test]
 fn bad_tolerances_are_refused() {
-    let (a, b) = families::grid_laplacian(25, 25);
+    let (a, b) = testing::grid_laplacian(25, 25);
     let p = SparsePencil::from_triplets(625, &a, &b).expect("valid pencil");
     for tolerance in [f64::NAN, f64::INFINITY, 0.0, -1e-12, 1.0, 2.0] {
-        let options = SparseOptions { tolerance, ..lowest(3) };
+        let options = SparseSolveOptions { tolerance, ..lowest(3) };
         assert!(
             matches!(solve_sparse(&p, &options), Err(ModalError::BadTolerance(t)) if t.to_bits() == tolerance.to_bits()),
             "{tolerance}"
@@ -224,7 +224,7 @@ fn bad_tolerances_are_refused() {
     assert!(
         solve_sparse(
             &p,
-            &SparseOptions {
+            &SparseSolveOptions {
                 tolerance: 1e-8,
                 ..lowest(3)
             }

@@ -11,7 +11,7 @@
 
 use mechanica_modal::faer::Mat;
 use mechanica_modal::faer::sparse::Triplet;
-use mechanica_modal::{ModalError, SparseModalSolution, SparseOptions, SparsePencil, solve_sparse};
+use mechanica_modal::{ModalError, SparseModalSolution, SparsePencil, SparseSolveOptions, solve_sparse};
 use std::f64::consts::PI;
 
 const U: f64 = f64::EPSILON;
@@ -186,11 +186,11 @@ fn torus(m: usize) -> (SparsePencil, Vec<f64>) {
     (SparsePencil::from_triplets(n, &a, &b).expect("valid"), spectrum)
 }
 
-fn options(k: usize, block: usize) -> SparseOptions {
-    SparseOptions {
+fn options(k: usize, block: usize) -> SparseSolveOptions {
+    SparseSolveOptions {
         count: k,
         block_size: block,
-        ..SparseOptions::default()
+        ..SparseSolveOptions::default()
     }
 }
 
@@ -198,10 +198,10 @@ fn options(k: usize, block: usize) -> SparseOptions {
 /// of each eigenspace, the other copies only at rounding level. Whether the first run already
 /// finds them from rounding depends on the seed and the basis size; when it does not, the
 /// inertia count reports them missing and a deflated rerun finds them. Either way the result must
-/// be complete and certified (the rerun path itself is forced in the unit tests of `lanczos`,
-/// with a start block exactly orthogonal to an eigenvector). Regression: before τ was kept out of clusters, (8, 100, 8, 2) returned groups [6, 2]
-/// flagged consistent (τ sat on the second eigenvalue) and (16, 100, 16, 2) and (5, 200, 10, 1)
-/// returned wrong groups flagged inconsistent.
+/// be complete and certified (the rerun path itself is forced in the unit tests of the `sparse`
+/// module, with a start block exactly orthogonal to an eigenvector). With τ allowed inside a
+/// cluster, (8, 100, 8, 2) would split its group as [6, 2] while flagged consistent, and
+/// (16, 100, 16, 2) and (5, 200, 10, 1) would return wrong groups.
 #[test]
 fn multiplicity_above_block_size_forces_a_deflated_rerun() {
     for (copies, len, k, block) in [(8, 100, 8, 2), (16, 100, 16, 2), (5, 200, 10, 1)] {
@@ -246,7 +246,7 @@ fn count_cutting_a_repeated_eigenvalue_is_reported() {
     let sol = solve_sparse(&p, &options(9, 2)).expect("solve");
     check_against_closed_form(&p, &sol, 6, 100, 9);
     assert_eq!(sol.report.kth_group_multiplicity, 6);
-    // The dense path (n ≤ DENSE_LIMIT) reports the cut the same way.
+    // The dense path (n ≤ `Tuning::dense_limit`) reports the cut the same way.
     let p = chains(4, 50);
     let sol = solve_sparse(&p, &options(2, 2)).expect("solve");
     assert!(sol.report.dense_fallback);
@@ -265,7 +265,7 @@ fn count_cutting_a_repeated_eigenvalue_is_reported() {
 #[test]
 fn exhausted_reruns_are_a_typed_error() {
     let p = chains(16, 100);
-    let single = SparseOptions {
+    let single = SparseSolveOptions {
         max_runs: 1,
         ..options(8, 2)
     };
@@ -277,7 +277,7 @@ fn exhausted_reruns_are_a_typed_error() {
         other => panic!("expected LanczosNoConvergence, got {other:?}"),
     }
     // max_runs = 0 is taken as 1, never as "no run".
-    let zero = SparseOptions { max_runs: 0, ..single };
+    let zero = SparseSolveOptions { max_runs: 0, ..single };
     assert!(matches!(
         solve_sparse(&p, &zero),
         Err(ModalError::LanczosNoConvergence { .. })
@@ -319,7 +319,7 @@ proptest::proptest! {
         let len = len.max(401 / copies + 1);
         let k = 1 + (k_frac * (2 * copies + 1) as f64) as usize;
         let p = chains(copies, len);
-        let sol = solve_sparse(&p, &SparseOptions { seed, ..options(k, block) }).expect("solve");
+        let sol = solve_sparse(&p, &SparseSolveOptions { seed, ..options(k, block) }).expect("solve");
         check_against_closed_form(&p, &sol, copies, len, k);
         proptest::prop_assert_eq!(sol.report.kth_group_multiplicity, copies);
     }

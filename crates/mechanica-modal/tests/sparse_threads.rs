@@ -3,17 +3,17 @@
 //! bit for bit. Alone in its test binary, because that setting is process-wide.
 
 use mechanica_modal::faer::{self, Par};
-use mechanica_modal::{SparseOptions, SparsePencil, families, solve_sparse};
+use mechanica_modal::{SparsePencil, SparseSolveOptions, solve_sparse, testing};
 
 #[test]
 fn two_threads_and_one_give_the_same_modes() {
     let side = 45; // n = 2025: above the dense fallback
     let k = 12;
-    let (a, b) = families::grid_laplacian(side, side);
+    let (a, b) = testing::grid_laplacian(side, side);
     let pencil = SparsePencil::from_triplets(side * side, &a, &b).expect("a valid pencil");
-    let options = SparseOptions {
+    let options = SparseSolveOptions {
         count: k,
-        ..SparseOptions::default()
+        ..SparseSolveOptions::default()
     };
     faer::set_global_parallelism(Par::rayon(2));
     let parallel = solve_sparse(&pencil, &options).expect("solves on two threads");
@@ -21,7 +21,7 @@ fn two_threads_and_one_give_the_same_modes() {
     let sequential = solve_sparse(&pencil, &options).expect("solves on one thread");
     assert!(parallel.report.consistent && sequential.report.consistent);
     assert_eq!(parallel.modes.len(), k);
-    let exact = families::grid_omega_sq(side, side, k);
+    let exact = testing::grid_omega_sq(side, side, k);
     for ((p, s), w) in parallel.modes.iter().zip(&sequential.modes).zip(&exact) {
         // Same Lanczos run, same Rayleigh–Ritz, same per-pair residual arithmetic.
         assert_eq!(p.omega_sq.to_bits(), s.omega_sq.to_bits());

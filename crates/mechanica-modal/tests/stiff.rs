@@ -1,7 +1,7 @@
 //! Graded stiff chains (stiffness or stiffness/mass ratios up to 1e12) against 60-digit mpmath
 //! references (tools/modal_reference.py → tools/modal_reference.txt, committed).
 
-use mechanica_modal::{BoundKind, PencilProblem, Refinement, Residuals, SolveOptions, families, solve};
+use mechanica_modal::{BoundKind, PencilProblem, Refinement, Residuals, SolveOptions, solve, testing};
 
 const U: f64 = f64::EPSILON;
 
@@ -45,16 +45,16 @@ fn cases() -> Vec<Case> {
 }
 
 fn problem(c: &Case) -> PencilProblem {
-    let (a, b) = families::spring_chain(&c.stiffness, &c.mass);
+    let (a, b) = testing::spring_chain(&c.stiffness, &c.mass);
     PencilProblem::new(a.as_ref(), b.as_ref()).expect("valid chain")
 }
 
 #[test]
 fn reference_chains_are_the_ones_the_crate_builds() {
     let c = cases();
-    assert_eq!(c[0].stiffness, families::graded_exponents(24, 12));
-    assert_eq!(c[1].stiffness, families::graded_exponents(30, 6));
-    assert_eq!(c[3].stiffness, families::graded_exponents(96, 12));
+    assert_eq!(c[0].stiffness, testing::graded_exponents(24, 12));
+    assert_eq!(c[1].stiffness, testing::graded_exponents(30, 6));
+    assert_eq!(c[3].stiffness, testing::graded_exponents(96, 12));
 }
 
 /// The option sets of an automatically refined solve: all pairs, and values only (where the
@@ -101,7 +101,7 @@ fn refined_modes_are_correct_to_their_bounds() {
                     c.name,
                     m.error_bound
                 );
-                assert!(m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w);
+                assert!(m.error_bound <= mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * w);
                 let refined = sol.accuracy.bound_kinds[i] == BoundKind::Residual;
                 // Values only, the bound is weaker (crate::values_only): the refined value is
                 // as accurate as with all vectors, but the residual's components along modes
@@ -176,7 +176,7 @@ fn values_only_subsets_are_correct_to_their_bounds() {
                 c.name,
                 m.error_bound
             );
-            assert!(m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w);
+            assert!(m.error_bound <= mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * w);
         }
         assert_eq!(sol.accuracy.bound_kinds[0], BoundKind::Residual, "{}", c.name);
     }
@@ -186,7 +186,7 @@ fn values_only_subsets_are_correct_to_their_bounds() {
 /// permutation, so the pencil is stored exactly), the second copy's masses scaled by `scale`:
 /// its ω² are those of the chain divided by `scale`.
 fn doubled(c: &Case, scale: f64) -> PencilProblem {
-    let (a, b) = families::spring_chain(&c.stiffness, &c.mass);
+    let (a, b) = testing::spring_chain(&c.stiffness, &c.mass);
     let n = a.nrows();
     let copy = |m: &mechanica_modal::faer::Mat<f64>, s: f64| {
         mechanica_modal::faer::Mat::from_fn(2 * n, 2 * n, |i, j| {
@@ -226,7 +226,7 @@ fn repeated_stiff_modes_are_refined_as_one_block() {
                     m.error_bound
                 );
                 assert!(
-                    m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w,
+                    m.error_bound <= mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * w,
                     "{} {options:?} mode {i}: bound {:e} relative",
                     c.name,
                     m.error_bound / w
@@ -348,14 +348,14 @@ fn a_selection_that_cuts_a_cluster_keeps_honest_bounds() {
 /// A cluster that chains three exact zero modes (three free chains) to six soft ones (a fixed
 /// chain with springs of 1e-6), beside a 1e12-graded chain, permuted (i → 7i mod 44, exact):
 /// the block refinement's bounds hold at ω² = 0 too, where a bound scaled by each member's own
-/// |ω²| would vanish (found in review: ω² = 5e-37 against a bound of 1.7e-40).
+/// |ω²| would vanish (and fall far below the computed ω² of a zero mode).
 #[test]
 fn a_zero_cluster_chained_to_soft_modes_keeps_valid_bounds() {
-    let (af, bf) = families::free_chain(10);
-    let (asoft, bsoft) = families::fixed_chain(6);
-    let c = families::power_of_ten(-6);
+    let (af, bf) = testing::free_chain(10);
+    let (asoft, bsoft) = testing::fixed_chain(6);
+    let c = testing::power_of_ten(-6);
     let bsoft = mechanica_modal::faer::Mat::from_fn(6, 6, |i, j| c * bsoft[(i, j)]);
-    let (ag, bg) = families::spring_chain(&families::graded_exponents(8, 12), &[0; 8]);
+    let (ag, bg) = testing::spring_chain(&testing::graded_exponents(8, 12), &[0; 8]);
     let blocks = [(&af, &bf), (&af, &bf), (&af, &bf), (&asoft, &bsoft), (&ag, &bg)];
     let n = 44;
     let place = |i: usize| (7 * i) % n;
@@ -374,7 +374,7 @@ fn a_zero_cluster_chained_to_soft_modes_keeps_valid_bounds() {
     }
     assert_eq!(offset, n);
     let p = PencilProblem::new(a.as_ref(), b.as_ref()).expect("valid pencil");
-    let soft: Vec<f64> = families::fixed_chain_omega_sq(6).iter().map(|w| c * w).collect();
+    let soft: Vec<f64> = testing::fixed_chain_omega_sq(6).iter().map(|w| c * w).collect();
     let exact: Vec<f64> = [0.0, 0.0, 0.0].iter().chain(&soft).copied().collect();
     for options in auto_options() {
         let sol = solve(&p, &options).expect("solve");
@@ -396,7 +396,7 @@ fn a_zero_cluster_chained_to_soft_modes_keeps_valid_bounds() {
 /// stiffness is block tridiagonal with 4×4 blocks (about 12n nonzeros), dense to the solver at
 /// n = 96, so the dense refinement paths are taken.
 fn hadamard_turned(c: &Case) -> PencilProblem {
-    let (a, b) = families::spring_chain(&c.stiffness, &c.mass);
+    let (a, b) = testing::spring_chain(&c.stiffness, &c.mass);
     let n = a.nrows();
     assert_eq!(n % 4, 0);
     let sign = |i: usize, j: usize| {
@@ -413,9 +413,9 @@ fn hadamard_turned(c: &Case) -> PencilProblem {
 
 /// The 96-mass chain turned densely ([`hadamard_turned`]): with Auto refinement, all pairs and
 /// the lowest 3 with and without vectors, the lowest modes are within their bounds of the
-/// 60-digit references and certified to the 8 digits Auto promises (before this test the batch
-/// and the projected steps iterated in double only, and the lowest bound stopped near 1e-6
-/// relative; a cluster of the lowest two whose block step failed kept first-order bounds).
+/// 60-digit references and certified to the 8 digits Auto promises: the steps must iterate in
+/// double-double where a double iterate would stop the lowest bound near 1e-6 relative, and a
+/// cluster of the lowest two whose block step fails must not keep first-order bounds.
 #[test]
 fn a_densely_turned_long_chain_is_certified_to_its_references() {
     let c = cases()
@@ -439,7 +439,7 @@ fn a_densely_turned_long_chain_is_certified_to_its_references() {
                     m.error_bound
                 );
                 assert!(
-                    m.error_bound <= mechanica_modal::solve::AUTO_REFINE_RELATIVE_BOUND * w,
+                    m.error_bound <= mechanica_modal::dense::AUTO_REFINE_RELATIVE_BOUND * w,
                     "{options:?} mode {i}: bound {:e} relative",
                     m.error_bound / w
                 );

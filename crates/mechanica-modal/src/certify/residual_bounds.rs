@@ -1,0 +1,298 @@
+//! The bounds of refined modes: gap-weighted residual (Kato–Temple) bounds from their
+//! extended-precision residuals, per mode or per cluster refined as one block.
+
+use crate::certify::a_priori::APrioriModel;
+use crate::certify::report::{AccuracyReport, BoundKind};
+use crate::linalg::norms::vector_norm;
+use crate::spectrum::clusters;
+use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::{Mat, MatRef, Par};
+use std::ops::Range;
+
+/// The computed modes used to split a residual into its modal components.
+pub(crate) struct ModeBasis<'a> {
+    pub a: MatRef<'a, f64>,
+    /// Cholesky factor of A.
+    pub l: MatRef<'a, f64>,
+    /// Computed modes, A-orthonormal to working precision: all selected modes, or (values
+    /// only) those formed for refinement.
+    pub x: MatRef<'a, f64>,
+    /// The index within the selection of each column of `x`.
+    pub modes: &'a [usize],
+    /// Values only: the error model of the unselected modes' values (never measured), for the
+    /// gaps to them; None when they are as accurate as the selected ones.
+    pub unselected: Option<APrioriModel>,
+}
+
+/// The residual of a refined mode, with the cluster of modes refined together as one block
+/// ([`crate::refine::refine_cluster_projected`]; a simple mode is a cluster of one).
+pub(crate) struct RefinedResidual {
+    /// The mode's index within the selection.
+    pub mode: usize,
+    /// The selection indices of the modes refined together with it (contains `mode`).
+    pub cluster: Range<usize>,
+    /// max |x_kᵀAx_l| over distinct refined vectors of the cluster (0 for a single mode).
+    pub orthogonality: f64,
+    /// (B − ω²A)x from double-double, rounded.
+    pub residual: Vec<f64>,
+}
+
+/// Replaces the bounds of refined modes by a gap-weighted Kato–Temple bound.
+///
+/// The residual r = (B − ρA)x of a refined, A-normalised x is split along the computed modes,
+/// r = Σ_j c_j A x_j + r_⊥ with c_j = x_jᵀ r; since the eigenvalue error is
+/// Σ_{j≠i} |γ_j|²(ω²_j − ω²_i) with r's components γ_j(ω²_j − ρ), it is at most
+/// Σ_{j≠i} c_j² / δ_j + ‖r_⊥‖²_{A⁻¹}/δ, with δ_j = |ω²_j − ρ| − bound_j and δ the smallest gap
+/// (first order in the error of the computed basis). It is never taken larger than the linear
+/// residual bound ε = ‖r‖_{A⁻¹}, and u|ρ| is added for rounding ρ to double. Selected modes
+/// missing from the basis only enter through δ (their components stay in r_⊥), and so do
+/// unselected modes (outside `first..first + m` of `omega_all`), with the largest bound of the
+/// selection as their uncertainty, or (values only) their a-priori error if that is larger.
+///
+/// A cluster G of p modes refined as one block gets one bound for all its members, the same
+/// sums taken over the block: ε² = Σ_{k∈G} ‖r_k‖²_{A⁻¹} (the Frobenius norm of the block
+/// residual, which bounds its 2-norm: p eigenvalues lie within it of the Ritz values, Kahan's
+/// theorem; Parlett, "The Symmetric Eigenvalue Problem", Thm 11.5.1), Σ_{j∉G} Σ_{k∈G} c_{jk}²/δ_j
+/// with δ_j the gap from mode j to the nearest member, and ‖R_⊥‖²_F/δ: the quadratic residual
+/// bound of a Ritz block separated by δ from the rest of the spectrum (Mathias, SIMAX 19, 1998).
+/// p·γ·s and u·s are added for the block's A-orthogonality defect γ and the rounding, with s
+/// the largest |ω²| of the block.
+pub(crate) fn residual_bounds(
+    report: &mut AccuracyReport,
+    omega_sq: &[f64],
+    omega_all: &[f64],
+    first: usize,
+    residuals: &[RefinedResidual],
+    basis: &ModeBasis<'_>,
+    par: Par,
+) {
+    let m = omega_sq.len();
+    if residuals.is_empty() {
+        return;
+    }
+    let others_bound = report.error_bounds.iter().copied().fold(0.0, f64::max);
+    let linear: Vec<f64> = (0..m)
+        .map(|i| {
+            report.residual_norms_a_inv[i].map_or(report.error_bounds[i], |e| e + f64::EPSILON * omega_sq[i].abs())
+        })
+        .collect();
+    let split = SplitResiduals::of(basis, residuals, m, par);
+    let spectrum = Spectrum {
+        omega_sq,
+        omega_all,
+        first,
+        linear: &linear,
+        others_bound,
+        unselected: basis.unselected,
+    };
+    for refined in residuals {
+        let i = refined.mode;
+        let group = refined.cluster.clone();
+        // The block's residual columns; a member without one leaves the linear bound.
+        let Some(columns) = group
+            .clone()
+            .map(|g| split.residual_of[g].zip(report.residual_norms_a_inv[g]))
+            .collect::<Option<Vec<(usize, f64)>>>()
+        else {
+            continue;
+        };
+        let bound = split.block_bound(&spectrum, &group, &columns);
+        // Rounding and the block's A-orthogonality defect at the cluster's largest |ω²|: the
+        // Rayleigh–Ritz step in double leaves a mixing of order u between members, which moves a
+        // member's Rayleigh quotient by up to u² times the cluster's spread (a zero mode chained
+        // to soft ones would otherwise get a bound far below its computed ω²).
+        let scale = group.clone().map(|g| omega_sq[g].abs()).fold(0.0, f64::max);
+        let defect = group.len() as f64 * refined.orthogonality * scale;
+        report.error_bounds[i] = bound + defect + f64::EPSILON * scale;
+        report.bound_kinds[i] = BoundKind::Residual;
+    }
+}
+
+/// The spectrum the gaps of [`residual_bounds`] are measured in.
+struct Spectrum<'a> {
+    /// The selected modes' ω².
+    omega_sq: &'a [f64],
+    /// All ω², ascending; the selection is `first..first + omega_sq.len()`.
+    omega_all: &'a [f64],
+    first: usize,
+    /// Each selected mode's linear bound (its residual norm, or its bound before refinement).
+    linear: &'a [f64],
+    /// The largest bound of the selection, the uncertainty of the unselected modes.
+    others_bound: f64,
+    /// Values only: the error model of the unselected modes' values.
+    unselected: Option<APrioriModel>,
+}
+
+/// The refined residuals R split along the computed modes: C = Xᵀ R, and R_⊥ = L⁻¹(R − A X C),
+/// whose column norms are the A⁻¹-norms of the parts outside the basis.
+struct SplitResiduals {
+    c: Mat<f64>,
+    rest: Mat<f64>,
+    /// The basis column of each selected mode (None when not in the basis).
+    column_of: Vec<Option<usize>>,
+    /// The residual column of each selected mode (None when not refined).
+    residual_of: Vec<Option<usize>>,
+}
+
+impl SplitResiduals {
+    /// All refined residuals at once, for a selection of `m` modes.
+    fn of(basis: &ModeBasis<'_>, residuals: &[RefinedResidual], m: usize, par: Par) -> Self {
+        let n = basis.x.nrows();
+        let k = residuals.len();
+        let r = Mat::from_fn(n, k, |row, col| residuals[col].residual[row]);
+        let mut c = Mat::<f64>::zeros(basis.x.ncols(), k);
+        faer::linalg::matmul::matmul(
+            c.as_mut(),
+            faer::Accum::Replace,
+            basis.x.transpose(),
+            r.as_ref(),
+            1.0,
+            par,
+        );
+        let mut xc = Mat::<f64>::zeros(n, k);
+        let mut column_of = vec![None; m];
+        for (col, &mode) in basis.modes.iter().enumerate() {
+            column_of[mode] = Some(col);
+        }
+        let mut residual_of = vec![None; m];
+        for (col, refined) in residuals.iter().enumerate() {
+            residual_of[refined.mode] = Some(col);
+        }
+        faer::linalg::matmul::matmul(xc.as_mut(), faer::Accum::Replace, basis.x, c.as_ref(), 1.0, par);
+        let mut rest = r;
+        faer::linalg::matmul::matmul(rest.as_mut(), faer::Accum::Add, basis.a, xc.as_ref(), -1.0, par);
+        solve_lower_triangular_in_place(basis.l, rest.as_mut(), par);
+        Self {
+            c,
+            rest,
+            column_of,
+            residual_of,
+        }
+    }
+
+    /// The bound of the block `group` (its members' residual columns and residual norms
+    /// `columns`) before its orthogonality defect and rounding: min(ε, ε²/δ, Σ c²/δ_j +
+    /// ‖R_⊥‖²/δ) where the gap δ allows it.
+    fn block_bound(&self, spectrum: &Spectrum<'_>, group: &Range<usize>, columns: &[(usize, f64)]) -> f64 {
+        let Spectrum {
+            omega_sq,
+            omega_all,
+            first,
+            linear,
+            others_bound,
+            unselected,
+        } = *spectrum;
+        let m = omega_sq.len();
+        let eps = columns.iter().map(|(_, e)| e * e).sum::<f64>().sqrt();
+        let distance = |w: f64| {
+            group
+                .clone()
+                .map(|g| (omega_sq[g] - w).abs())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let mut gap = f64::INFINITY;
+        let mut weighted = 0.0;
+        let mut usable = true;
+        for j in (0..m).filter(|j| !group.contains(j)) {
+            let d = distance(omega_sq[j]) - linear[j];
+            gap = gap.min(d);
+            if let Some(basis_col) = self.column_of[j] {
+                if d > 0.0 {
+                    weighted += columns
+                        .iter()
+                        .map(|&(col, _)| self.c[(basis_col, col)].powi(2))
+                        .sum::<f64>()
+                        / d;
+                } else {
+                    usable = false;
+                }
+            }
+        }
+        for (k, &w) in omega_all.iter().enumerate() {
+            if k < first || k >= first + m {
+                let uncertainty = unselected.map_or(others_bound, |model| model.bound(w).max(others_bound));
+                gap = gap.min(distance(w) - uncertainty);
+            }
+        }
+        let eps_rest = columns
+            .iter()
+            .map(|&(col, _)| vector_norm(self.rest.col(col)).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let mut bound = eps;
+        if gap > eps {
+            bound = bound.min(eps * eps / gap);
+            if usable && gap > eps_rest {
+                bound = bound.min(weighted + eps_rest * eps_rest / gap);
+            }
+        }
+        bound
+    }
+}
+
+/// Narrows the clusters of refined modes to what their refined residuals can tell apart.
+/// Clusters are formed from the reduction's bounds, which on stiff problems are wide enough to
+/// chain modes that are far apart (the lowest ten of a 1e12 chain); the block's bound then
+/// carries its Rayleigh–Ritz defect at the block's largest ω². After refinement each member's
+/// residual places an eigenvalue within e_i = ‖r_i‖_{A⁻¹} of ω²_i, so the clusters of the
+/// intervals ω²_i ± e_i ([`clusters`]) are separated from one another: each keeps the block's
+/// A-orthogonality defect (a maximum over more pairs) and its members' residuals, and a member
+/// alone keeps none (its ω² is its own Rayleigh quotient, not a mixture).
+pub(crate) fn split_refined_clusters(residuals: &mut [RefinedResidual], omega: &[f64], residual_norms: &[Option<f64>]) {
+    let mut start = 0;
+    while start < residuals.len() {
+        let block = residuals[start].cluster.clone();
+        let members = residuals[start..].iter().take_while(|r| r.cluster == block).count();
+        let complete = members == block.len();
+        let sharp: Option<Vec<f64>> = block
+            .clone()
+            .map(|i| residual_norms[i].map(|e| e + f64::EPSILON * omega[i].abs()))
+            .collect();
+        if let (true, Some(sharp)) = (complete && block.len() > 1, sharp) {
+            for sub in clusters(&omega[block.clone()], &sharp) {
+                let sub = block.start + sub.start..block.start + sub.end;
+                for record in residuals[start..start + members]
+                    .iter_mut()
+                    .filter(|r| sub.contains(&r.mode))
+                {
+                    record.cluster = sub.clone();
+                    if sub.len() == 1 {
+                        record.orthogonality = 0.0;
+                    }
+                }
+            }
+        }
+        start += members;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(mode: usize, cluster: Range<usize>) -> RefinedResidual {
+        RefinedResidual {
+            mode,
+            cluster,
+            orthogonality: 1e-15,
+            residual: Vec::new(),
+        }
+    }
+    /// A block of four refined together: modes 0 and 1 are a pair within their refined
+    /// residuals, 2 and 3 stand apart; a block with a member lacking its residual norm, and a
+    /// block cut short (a member not refined), keep their clusters.
+    #[test]
+    fn refined_blocks_split_where_their_residuals_separate_the_modes() {
+        let omega = [1.0, 1.0 + 2e-15, 2.0, 3.0, 5.0, 5.5, 7.0, 7.5];
+        let mut norms = vec![Some(1e-15); omega.len()];
+        norms[5] = None;
+        let mut residuals: Vec<RefinedResidual> = (0..4).map(|i| record(i, 0..4)).collect();
+        residuals.extend((4..6).map(|i| record(i, 4..6)));
+        residuals.push(record(6, 6..8));
+        split_refined_clusters(&mut residuals, &omega, &norms);
+        let clusters: Vec<Range<usize>> = residuals.iter().map(|r| r.cluster.clone()).collect();
+        assert_eq!(clusters, vec![0..2, 0..2, 2..3, 3..4, 4..6, 4..6, 6..8]);
+        let orthogonality: Vec<f64> = residuals.iter().map(|r| r.orthogonality).collect();
+        assert_eq!(orthogonality, vec![1e-15, 1e-15, 0.0, 0.0, 1e-15, 1e-15, 1e-15]);
+    }
+}

@@ -1,0 +1,273 @@
+//! The common tail of every dense solve: the accuracy report, refinement of weakly bounded
+//! modes ([`crate::dense::refinement`]), the Sturm check, classification and grouping.
+
+use crate::certify::a_priori::APrioriModel;
+use crate::certify::products::PairProducts;
+use crate::certify::report::AccuracyReport;
+use crate::certify::resolution::zero_resolution;
+use crate::certify::sketch::SketchRows;
+use crate::certify::sturm::inertia_check;
+use crate::dense::definite::Definite;
+use crate::dense::idle_inputs::IdleResults;
+use crate::dense::options::{Refinement, Selection, SolveOptions};
+use crate::dense::refinement::Stage;
+use crate::dense::solution::{Method, ModalSolution};
+use crate::dense::values_only;
+use crate::error::ModalError;
+use crate::linalg::eigen::TridiagonalForm;
+use crate::linalg::reduce::LowerFactor;
+use crate::problem::PencilProblem;
+use crate::refine::{Condensation, Metric};
+use crate::runtime::scratch;
+use crate::spectrum::{Mode, ModeKind, classify, group_modes};
+use faer::{Mat, MatRef, Par};
+use std::time::Instant;
+
+/// Maps mode shapes of a condensed pencil back to the original coordinates.
+pub(crate) type Lift<'a> = &'a dyn Fn(MatRef<'_, f64>) -> Mat<f64>;
+
+/// The common tail of every solve: refinement, accuracy report, classification, groups.
+pub(crate) struct Finish<'a> {
+    pub problem: &'a PencilProblem,
+    /// Cholesky factor of the (condensed) mass matrix used for A⁻¹-norms.
+    pub l: MatRef<'a, f64>,
+    pub norm_a: f64,
+    pub norm_b: f64,
+    pub options: &'a SolveOptions,
+    pub par: Par,
+    /// For a condensed pencil: the number of negative eigenvalues of the stiffness block B₀₀ of
+    /// the massless directions, by which the inertia of B − sA exceeds the count of modes
+    /// below s (Haynsworth: In(B − sA) = In(B₀₀) + In(S − sA₁), S the condensed stiffness).
+    pub condensed_stiffness_negatives: Option<usize>,
+    /// For a condensed pencil whose condensation is exact (diagonal A): what refinement needs
+    /// to correct its modes and bound them in the condensed pencil.
+    pub condensation: Option<&'a Condensation>,
+}
+
+impl Finish<'_> {
+    /// `def` holds the finite spectrum of the (possibly condensed) pencil; `lift` maps its
+    /// vectors to the original coordinates (None: identity); `infinite` are unit null vectors
+    /// of A appended as infinite modes.
+    pub(crate) fn run(
+        &self,
+        def: Definite,
+        infinite: Vec<Vec<f64>>,
+        lift: Option<Lift<'_>>,
+        method: Method,
+        idle: IdleResults,
+    ) -> Result<ModalSolution, ModalError> {
+        let Definite {
+            omega_sq: omega_all,
+            first,
+            end,
+            vectors,
+            reduced,
+            mut form,
+            a_priori,
+            mut timings,
+        } = def;
+        let mut omega: Vec<f64> = omega_all[first..end].to_vec();
+        let mut x = match (vectors, lift) {
+            (Some(v), Some(f)) => Some(f(v.as_ref())),
+            (v, _) => v,
+        };
+        let clock = Instant::now();
+        let (mut products, mut report, a_priori) = self.first_report(x.as_ref(), &omega, a_priori, idle.sketch_rows);
+        timings.accuracy += clock.elapsed();
+        let clock = Instant::now();
+        // Values only: the data resolution of the modes whose vectors were formed.
+        let mut measured_resolution: Vec<(usize, f64)> = Vec::new();
+        if let (Some(form), Some(model)) = (form.as_mut(), a_priori)
+            && lift.is_none()
+            && self.options.refinement == Refinement::Auto
+        {
+            measured_resolution = self.sharpen(model, form, &mut report, &mut omega, &omega_all, first);
+        }
+        if let (Some(xm), Some(products), Some(metric)) = (x.as_mut(), products.as_mut(), self.metric(lift.is_none()))
+            && self.options.refinement != Refinement::Off
+        {
+            let stage = self.refinement_stage(metric, &omega_all, first, reduced.as_ref());
+            stage.run(xm, products, &mut report, &mut omega);
+        }
+        timings.refine = clock.elapsed();
+        let clock = Instant::now();
+        if let (Some(x), Some(p)) = (&x, products.as_mut()) {
+            report.finish(p, self.problem.a(), x.as_ref(), &omega, self.par);
+        }
+        timings.accuracy += clock.elapsed();
+        let clock = Instant::now();
+        // The reduced eigenvectors are no longer needed: their storage takes the certificate's
+        // matrix (a fresh n×n allocation costs its page faults).
+        if let Some(storage) = reduced.or_else(|| form.map(TridiagonalForm::into_storage)) {
+            scratch::give_back(storage);
+        }
+        report.inertia_check = inertia_check(
+            self.problem,
+            &omega_all,
+            (first, end),
+            &report.error_bounds,
+            self.condensed_stiffness_negatives,
+            idle.certificate,
+            self.par,
+        )?;
+        timings.inertia = clock.elapsed();
+        let resolution = self.resolution(x.as_ref(), a_priori, &omega, measured_resolution);
+        if !self.options.vectors {
+            x = None;
+            report.backward_errors.iter_mut().for_each(|e| *e = None);
+            report.orthogonality_error = None;
+        }
+        let mut modes = finite_modes(&omega, &report, &resolution);
+        if matches!(self.options.selection, Selection::All) && !infinite.is_empty() {
+            x = append_infinite(&mut modes, x, &infinite);
+        }
+        let groups = group_modes(&mut modes);
+        Ok(ModalSolution {
+            modes,
+            vectors: x,
+            groups,
+            accuracy: report,
+            method,
+            timings,
+        })
+    }
+
+    /// The report before refinement: with vectors, the pair products and the first-order bounds
+    /// they give; values only, the a-priori bounds of the error model (`a_priori`, when the
+    /// solve computed it already, else computed here), which is returned for later use.
+    fn first_report(
+        &self,
+        x: Option<&Mat<f64>>,
+        omega: &[f64],
+        a_priori: Option<APrioriModel>,
+        sketch_rows: Option<SketchRows>,
+    ) -> (Option<PairProducts>, AccuracyReport, Option<APrioriModel>) {
+        let (a, b) = (self.problem.a(), self.problem.b());
+        let products = x.map(|x| PairProducts::new(a, b, x.as_ref(), self.options.residuals, sketch_rows, self.par));
+        let mut model_used = None;
+        let report = match (x, &products) {
+            (Some(x), Some(p)) => AccuracyReport::from_products(p, x.as_ref(), omega, self.norm_a, self.norm_b),
+            _ => {
+                let model = a_priori.unwrap_or_else(|| APrioriModel::new(self.l, self.norm_a, self.norm_b, self.par));
+                model_used = Some(model);
+                AccuracyReport::a_priori(self.norm_a, self.norm_b, model.bounds(omega))
+            }
+        };
+        (products, report, model_used)
+    }
+
+    /// Values only: [`values_only::sharpen`] of the report from the error model `model`;
+    /// returns the data resolution of the modes whose vectors were formed.
+    fn sharpen(
+        &self,
+        model: APrioriModel,
+        form: &mut TridiagonalForm,
+        report: &mut AccuracyReport,
+        omega: &mut [f64],
+        omega_all: &[f64],
+        first: usize,
+    ) -> Vec<(usize, f64)> {
+        let pencil = values_only::Pencil {
+            a: self.problem.a(),
+            b: self.problem.b(),
+            l: self.l,
+            residuals: self.options.residuals,
+            par: self.par,
+        };
+        values_only::sharpen(&pencil, model, form, report, omega, omega_all, first)
+    }
+
+    /// The refinement stage of this solve, refining in `metric`.
+    fn refinement_stage<'s>(
+        &'s self,
+        metric: Metric<'s>,
+        omega_all: &'s [f64],
+        first: usize,
+        reduced: Option<&'s Mat<f64>>,
+    ) -> Stage<'s> {
+        Stage {
+            a: self.problem.a(),
+            b: self.problem.b(),
+            l: self.l,
+            condensation: self.condensation,
+            policy: self.options.refinement,
+            metric,
+            omega_all,
+            first,
+            reduced,
+            par: self.par,
+        }
+    }
+
+    /// The pencil in which modes are refined: (B, A) through L when no lift is needed, the
+    /// condensed pencil when its condensation is exact (diagonal A), else none.
+    fn metric(&self, unlifted: bool) -> Option<Metric<'_>> {
+        match (unlifted, self.condensation) {
+            (true, _) => Some(Metric::Cholesky(LowerFactor::new(self.l))),
+            (false, Some(c)) => Some(Metric::Condensed(c)),
+            (false, None) => None,
+        }
+    }
+
+    /// What the data resolve of each mode, for the zero classification: its
+    /// [`zero_resolution`] from its shape, or (values only) the a-priori model's, replaced by
+    /// the `measured` values of the modes whose vectors were formed.
+    fn resolution(
+        &self,
+        x: Option<&Mat<f64>>,
+        a_priori: Option<APrioriModel>,
+        omega: &[f64],
+        measured: Vec<(usize, f64)>,
+    ) -> Vec<f64> {
+        let (a, b) = (self.problem.a(), self.problem.b());
+        let mut resolution: Vec<f64> = (0..omega.len())
+            .map(|i| match (x, &a_priori) {
+                (Some(x), _) => zero_resolution(a, b, x.col_as_slice(i), omega[i], (self.norm_a, self.norm_b)),
+                (None, Some(model)) => model.data_resolution(omega[i]),
+                (None, None) => 0.0,
+            })
+            .collect();
+        for (i, value) in measured {
+            resolution[i] = value;
+        }
+        resolution
+    }
+}
+
+/// The finite modes from their values, bounds and backward errors, classified against the
+/// larger of their bound and their data resolution.
+fn finite_modes(omega: &[f64], report: &AccuracyReport, resolution: &[f64]) -> Vec<Mode> {
+    (0..omega.len())
+        .map(|i| {
+            let bound = report.error_bounds[i];
+            Mode {
+                lambda: -omega[i],
+                omega_sq: omega[i],
+                kind: classify(omega[i], bound.max(resolution[i])),
+                error_bound: bound,
+                backward_error: report.backward_errors.get(i).copied().flatten(),
+                group: 0,
+            }
+        })
+        .collect()
+}
+
+/// Appends the infinite modes (unit null vectors of A, exact) after the finite ones, and their
+/// shapes after the finite shapes `x` (when shapes are returned).
+fn append_infinite(modes: &mut Vec<Mode>, x: Option<Mat<f64>>, infinite: &[Vec<f64>]) -> Option<Mat<f64>> {
+    let m = modes.len();
+    for _ in infinite {
+        modes.push(Mode {
+            lambda: f64::NEG_INFINITY,
+            omega_sq: f64::INFINITY,
+            kind: ModeKind::Infinite,
+            error_bound: 0.0,
+            backward_error: None,
+            group: 0,
+        });
+    }
+    x.map(|xf| {
+        let (n, extra) = (xf.nrows(), infinite.len());
+        Mat::from_fn(n, m + extra, |r, c| if c < m { xf[(r, c)] } else { infinite[c - m][r] })
+    })
+}

@@ -1,0 +1,184 @@
+//! The dense solver of det(λA + B) = 0 ((8.89), see docs/theory.md), [`solve`]: the Cholesky
+//! reduction to a standard symmetric problem C = L⁻¹BL⁻ᵀ ([`crate::linalg`]), its
+//! eigen-decomposition, the back-transformation X = L⁻ᵀY, an accuracy report, classification,
+//! grouping of repeated frequencies, static condensation of massless coordinates, and
+//! refinement of the low modes of stiff problems. Modes are ordered by ω² = −λ ascending
+//! ([`crate::spectrum`]).
+//!
+//! Files: what is asked ([`SolveOptions`], `options`) and returned ([`ModalSolution`],
+//! `solution`); the definite pencil's spectrum from L (`definite`); the condensation of a
+//! semidefinite A (`condense`, a transform [`solve`] calls before the definite solve); the
+//! report inputs formed on idle core time (`idle_inputs`); the common tail of every solve
+//! (`finish`: report, Sturm check, classification) with its refinement stage (`refinement`) and
+//! the values-only sharpening (`values_only`).
+
+mod condense;
+mod definite;
+mod finish;
+mod idle_inputs;
+mod options;
+mod refinement;
+mod solution;
+mod values_only;
+
+pub use options::{AUTO_REFINE_RELATIVE_BOUND, Refinement, Selection, SolveOptions};
+pub use solution::{Method, ModalSolution, SolveTimings};
+
+use crate::certify::a_priori::APrioriModel;
+use crate::certify::idle_certificate;
+use crate::certify::products::Residuals;
+use crate::dense::condense::condense;
+use crate::dense::definite::{select, solve_definite, solve_definite_owned};
+use crate::dense::finish::Finish;
+use crate::dense::idle_inputs::{EarlyInputs, IdleResults};
+use crate::dense::options::{check_interval, weakly_bounded};
+use crate::dense::solution::empty_solution;
+use crate::error::ModalError;
+use crate::linalg::eigen::OnTridiagonal;
+use crate::linalg::norms::frobenius_norm;
+use crate::linalg::reduce::{Cholesky, cholesky_owned, lower_entry};
+use crate::problem::PencilProblem;
+use crate::runtime::fork_join::join;
+use crate::runtime::idle_task::IdleTask;
+use crate::runtime::scratch;
+use crate::tuning::Tuning;
+use faer::{MatRef, Par};
+use std::time::Instant;
+
+/// Solves det(λA + B) = 0 (8.89) for the selected modes, with a full accuracy report.
+///
+/// A positive definite: Cholesky reduction. A positive semidefinite: the massless directions
+/// (null space of A, from its eigen-decomposition) are condensed out statically and reported as
+/// infinite modes. A indefinite: [`ModalError::IndefiniteMass`], naming the failed pivot.
+pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSolution, ModalError> {
+    check_interval(options.selection)?;
+    let (a, b) = (problem.a(), problem.b());
+    let n = problem.dim();
+    // Below a few hundred unknowns thread start-up costs more than it saves (mechanisms).
+    let par = if n < Tuning::DEFAULT.sequential_below {
+        Par::Seq
+    } else {
+        faer::get_global_parallelism()
+    };
+    if n == 0 {
+        return select(&[], options.selection).map(|_| empty_solution());
+    }
+    // The refinement and the residual bounds need the vectors even when the caller does not.
+    let want_vectors = options.vectors || options.refinement == Refinement::Always;
+    // All modes of a large pencil: work off the critical path goes to idle core time.
+    let idle_time =
+        matches!(options.selection, Selection::All) && n >= Tuning::DEFAULT.idle_time_from && par.degree() > 1;
+    let early_inputs = idle_time
+        .then(|| EarlyInputs::start(problem, want_vectors && options.residuals == Residuals::Sketched))
+        .flatten();
+    let clock = Instant::now();
+    // The copies of A (factored in place) and B (reduced in place) take kept working storage
+    // (`crate::runtime::scratch`) and are written on two threads: the first write of fresh
+    // memory faults every page, and faults on two cores proceed in parallel. Only the lower
+    // triangles are read (the factorization and the reduction use no other entry); the upper
+    // ones are zeroed, as L's must be.
+    let (mut a_copy, mut b_copy) = (scratch::empty(n, n), scratch::empty(n, n));
+    join(
+        || a_copy.resize_with(n, n, |i, j| lower_entry(a, i, j)),
+        || b_copy.resize_with(n, n, |i, j| lower_entry(b, i, j)),
+        par,
+    );
+    match cholesky_owned(a_copy, par) {
+        Cholesky::Factor(l) => {
+            let cholesky_time = clock.elapsed();
+            // The bottom certificate is factored on idle time once T is known.
+            let mut certificate = None;
+            let mut start_certificate =
+                |diag: &[f64], subdiag: &[f64]| certificate = idle_certificate::start(problem, diag, subdiag);
+            let hook: Option<OnTridiagonal<'_>> = if idle_time { Some(&mut start_certificate) } else { None };
+            let mut def = solve_definite_owned(l.as_ref(), b_copy, options.selection, want_vectors, par, hook)?;
+            let early = early_inputs.and_then(IdleTask::finished);
+            let (norm_a, norm_b) = match &early {
+                Some(inputs) => inputs.norms,
+                None => (frobenius_norm(a), frobenius_norm(b)),
+            };
+            if !want_vectors && options.refinement == Refinement::Auto {
+                // Values only: the modes whose a-priori bound is too weak get their vectors
+                // (crate::values_only), unless they are so many that all vectors cost less.
+                let clock = Instant::now();
+                let selected = &def.omega_sq[def.first..def.end];
+                let model = APrioriModel::new(l.as_ref(), norm_a, norm_b, par);
+                def.timings.accuracy = clock.elapsed();
+                let flagged = selected.iter().filter(|&&w| weakly_bounded(model.bound(w), w)).count();
+                if flagged > Tuning::DEFAULT.flagged_vectors_up_to.max(n / 4) {
+                    let first_try = def.timings;
+                    def = solve_definite(l.as_ref(), b, options.selection, true, par)?;
+                    def.timings.factor += first_try.factor;
+                    def.timings.eigen += first_try.eigen;
+                    def.timings.accuracy += first_try.accuracy;
+                } else {
+                    def.a_priori = Some(model);
+                }
+            }
+            def.timings.factor += cholesky_time;
+            let finish = Finish {
+                problem,
+                l: l.as_ref(),
+                norm_a,
+                norm_b,
+                options,
+                par,
+                condensed_stiffness_negatives: None,
+                condensation: None,
+            };
+            let idle = IdleResults {
+                certificate,
+                sketch_rows: early.and_then(|inputs| inputs.sketch_rows),
+            };
+            let solution = finish.run(def, Vec::new(), None, Method::CholeskyReduction, idle);
+            scratch::give_back(l);
+            solution
+        }
+        Cholesky::Failed { pivot } => {
+            let (norm_a, norm_b) = (frobenius_norm(a), frobenius_norm(b));
+            solve_semidefinite(problem, pivot, options, (norm_a, norm_b), par)
+        }
+    }
+}
+
+/// Solves a pencil whose Cholesky factorization of A failed at `pivot`: the massless directions
+/// are condensed out ([`condense`]), the definite pencil (S, A₁) is solved, and its modes are
+/// lifted back, with the infinite modes appended.
+fn solve_semidefinite(
+    problem: &PencilProblem,
+    pivot: usize,
+    options: &SolveOptions,
+    (norm_a, norm_b): (f64, f64),
+    par: Par,
+) -> Result<ModalSolution, ModalError> {
+    let clock = Instant::now();
+    let mut condensed = condense(problem, pivot, norm_b, par)?;
+    let want_vectors = options.vectors || options.refinement == Refinement::Always;
+    let condensation_time = clock.elapsed();
+    let l1 = condensed.condensation.l1.as_ref();
+    let mut def = solve_definite(l1, condensed.stiffness.as_ref(), options.selection, want_vectors, par)?;
+    def.timings.factor += condensation_time;
+    let infinite = std::mem::take(&mut condensed.infinite);
+    let condensed = &condensed;
+    let lift = |z: MatRef<'_, f64>| condensed.lift(z);
+    let condensation = &condensed.condensation;
+    let finish = Finish {
+        problem,
+        l: condensation.l1.as_ref(),
+        norm_a,
+        norm_b,
+        options,
+        par,
+        condensed_stiffness_negatives: Some(condensed.stiffness_negatives),
+        condensation: condensation.refinable.then_some(condensation),
+    };
+    finish.run(
+        def,
+        infinite,
+        Some(&lift),
+        Method::CondensedReduction {
+            massless: condensed.massless,
+        },
+        IdleResults::default(),
+    )
+}

@@ -1,0 +1,275 @@
+//! The refinement stage of a dense solve: the clusters of weakly bounded modes are refined
+//! ([`crate::refine`]), their columns of X and values replaced, and their bounds replaced by
+//! residual bounds in the definite pencil the residuals belong to.
+
+use crate::certify::products::PairProducts;
+use crate::certify::report::{AccuracyReport, BoundKind};
+use crate::certify::residual_bounds::{ModeBasis, RefinedResidual, residual_bounds, split_refined_clusters};
+use crate::dd::Operand;
+use crate::dense::options::{Refinement, weakly_bounded};
+use crate::refine::{
+    Condensation, Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts,
+    polish_simple_mode, refine_cluster, refine_simple_modes,
+};
+use crate::runtime::fork_join::map_items;
+use crate::spectrum::{clusters, refinable};
+use faer::{Mat, MatRef, Par};
+use std::ops::Range;
+
+/// What the refinement of a dense solve's selected modes works on.
+pub(crate) struct Stage<'a> {
+    /// The stored pencil's A and B.
+    pub a: MatRef<'a, f64>,
+    pub b: MatRef<'a, f64>,
+    /// The Cholesky factor of the (condensed) mass matrix.
+    pub l: MatRef<'a, f64>,
+    /// For a condensed pencil: its exact condensation (diagonal A).
+    pub condensation: Option<&'a Condensation>,
+    pub policy: Refinement,
+    pub metric: Metric<'a>,
+    /// All ω² of the (condensed) pencil, ascending; the selection starts at index `first`.
+    pub omega_all: &'a [f64],
+    pub first: usize,
+    /// All n eigenvectors Y of the reduced matrix, when they were computed.
+    pub reduced: Option<&'a Mat<f64>>,
+    pub par: Par,
+}
+
+/// The operands and the sparse shifts that every refined cluster of a stage shares.
+struct Operands<'a> {
+    mass: Operand<'a>,
+    stiffness: Operand<'a>,
+    shifts: Option<SparseShifts>,
+}
+
+impl Stage<'_> {
+    /// Refines the clusters of weakly bounded modes (every cluster under
+    /// [`Refinement::Always`]) of the selected modes `omega` with shapes `x`, and updates `x`,
+    /// `omega`, the pair `products` and the `report` (residual norms, steps, backward errors and
+    /// residual bounds) for every refined mode.
+    pub(crate) fn run(
+        &self,
+        x: &mut Mat<f64>,
+        products: &mut PairProducts,
+        report: &mut AccuracyReport,
+        omega: &mut [f64],
+    ) {
+        let jobs = self.jobs(report, omega);
+        let (mass, stiffness) = (Operand::new(self.a), Operand::new(self.b));
+        let shifts = if jobs.is_empty() {
+            None
+        } else {
+            SparseShifts::new(&mass, &stiffness)
+        };
+        let operands = Operands {
+            mass,
+            stiffness,
+            shifts,
+        };
+        let refined = self.refine_jobs(&operands, &jobs, x.as_ref(), omega);
+        let (mut residuals, changed) = apply_refined(&jobs, refined, x, report, omega);
+        products.update_columns(self.a, self.b, x.as_ref(), &changed, self.par);
+        for &i in &changed {
+            report.set_pair_error(products, x.as_ref(), i, omega[i]);
+        }
+        split_refined_clusters(&mut residuals, omega, &report.residual_norms_a_inv);
+        let first_order = (report.error_bounds.clone(), report.bound_kinds.clone());
+        self.residual_bounds(report, omega, &residuals, x.as_ref());
+        self.polish(&operands, &mut residuals, first_order, x, products, report, omega);
+    }
+
+    /// The clusters to refine: those the policy asks for (a weakly bounded member, or all under
+    /// [`Refinement::Always`]) that refinement can take ([`refinable`]).
+    fn jobs(&self, report: &AccuracyReport, omega: &[f64]) -> Vec<Range<usize>> {
+        clusters(omega, &report.error_bounds)
+            .into_iter()
+            .filter(|g| {
+                let wanted = self.policy == Refinement::Always
+                    || g.clone().any(|i| weakly_bounded(report.error_bounds[i], omega[i]));
+                wanted && refinable(g, omega, &report.error_bounds, self.omega_all, self.first)
+            })
+            .collect()
+    }
+
+    /// Each job's refined cluster (None where refinement declined). Simple modes of a definite
+    /// pencil are refined as one batch whose corrections are block products
+    /// ([`refine_simple_modes`]); a mode whose batch step fails, and every cluster, takes its own
+    /// path. A sparse pencil's simple modes take theirs at once: a sparse bordered factorization
+    /// per mode costs less than the batch's products through Y. Clusters are independent: each
+    /// is refined from its own columns of X, sequentially inside, and the clusters are shared
+    /// among the threads.
+    fn refine_jobs(
+        &self,
+        operands: &Operands<'_>,
+        jobs: &[Range<usize>],
+        start: MatRef<'_, f64>,
+        omega: &[f64],
+    ) -> Vec<Option<RefinedCluster>> {
+        let refine_one = |g: &Range<usize>| {
+            let x0 = start.subcols(g.start, g.len()).to_owned();
+            let mut spectrum = self.reduced.map(|y| ReducedSpectrum {
+                y: y.as_ref(),
+                omega_sq: self.omega_all,
+                modes: self.first + g.start..self.first + g.end,
+            });
+            let correction = spectrum.as_mut().map(|s| s as &mut dyn ReducedCorrection);
+            refine_cluster(
+                &operands.mass,
+                &operands.stiffness,
+                operands.shifts.as_ref(),
+                self.metric,
+                correction,
+                x0.as_ref(),
+                omega[g.start],
+            )
+        };
+        let mut refined: Vec<Option<RefinedCluster>> = vec![None; jobs.len()];
+        let mut pending: Vec<usize> = (0..jobs.len()).collect();
+        if let (Metric::Cholesky(l), Some(y), None) = (self.metric, self.reduced, &operands.shifts) {
+            let singles: Vec<usize> = pending.iter().copied().filter(|&j| jobs[j].len() == 1).collect();
+            if !singles.is_empty() {
+                let x0 = Mat::from_fn(start.nrows(), singles.len(), |i, c| start[(i, jobs[singles[c]].start)]);
+                let modes: Vec<usize> = singles.iter().map(|&j| self.first + jobs[j].start).collect();
+                let pairs = refine_simple_modes(
+                    &operands.mass,
+                    &operands.stiffness,
+                    l,
+                    (y.as_ref(), self.omega_all),
+                    &modes,
+                    x0.as_ref(),
+                    self.par,
+                );
+                for (&j, pair) in singles.iter().zip(pairs) {
+                    refined[j] = pair.map(RefinedCluster::single);
+                }
+                pending.retain(|&j| refined[j].is_none());
+            }
+        }
+        let rest: Vec<Option<RefinedCluster>> = map_items(&pending, self.par, |&j| refine_one(&jobs[j]));
+        for (&j, cluster) in pending.iter().zip(rest) {
+            refined[j] = cluster;
+        }
+        refined
+    }
+
+    /// Simple modes refined in double (the batch, the projected step) whose bound is still
+    /// weak: their residual is limited by rounding the vector. More projected steps with a
+    /// double-double iterate, kept where they lower the residual; then the bounds again, from
+    /// the first-order bounds `first_order` of the changed pairs.
+    #[allow(clippy::too_many_arguments)]
+    fn polish(
+        &self,
+        operands: &Operands<'_>,
+        residuals: &mut [RefinedResidual],
+        first_order: (Vec<f64>, Vec<BoundKind>),
+        x: &mut Mat<f64>,
+        products: &mut PairProducts,
+        report: &mut AccuracyReport,
+        omega: &mut [f64],
+    ) {
+        let (Metric::Cholesky(_), Some(y), None) = (self.metric, self.reduced, &operands.shifts) else {
+            return;
+        };
+        let weak: Vec<usize> = (0..residuals.len())
+            .filter(|&k| {
+                let i = residuals[k].mode;
+                residuals[k].cluster.len() == 1 && weakly_bounded(report.error_bounds[i], omega[i])
+            })
+            .collect();
+        let polish = |&k: &usize| {
+            let i = residuals[k].mode;
+            let mut spectrum = ReducedSpectrum {
+                y: y.as_ref(),
+                omega_sq: self.omega_all,
+                modes: self.first + i..self.first + i + 1,
+            };
+            let steps = report.refinement_steps[i];
+            polish_simple_mode(
+                &operands.mass,
+                &operands.stiffness,
+                self.metric,
+                &mut spectrum,
+                x.col_as_slice(i),
+                steps,
+            )
+        };
+        let polished: Vec<Option<RefinedPair>> = map_items(&weak, self.par, polish);
+        let mut improved: Vec<usize> = Vec::new();
+        for (&k, pair) in weak.iter().zip(polished) {
+            let i = residuals[k].mode;
+            let Some(p) = pair.filter(|p| Some(p.residual_a_inv) < report.residual_norms_a_inv[i]) else {
+                continue;
+            };
+            x.col_as_slice_mut(i).copy_from_slice(&p.x);
+            omega[i] = p.omega_sq;
+            report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
+            report.refinement_steps[i] = p.steps;
+            residuals[k].residual = p.residual;
+            improved.push(i);
+        }
+        if !improved.is_empty() {
+            products.update_columns(self.a, self.b, x.as_ref(), &improved, self.par);
+            (report.error_bounds, report.bound_kinds) = first_order;
+            for &i in &improved {
+                report.set_pair_error(products, x.as_ref(), i, omega[i]);
+            }
+            self.residual_bounds(report, omega, residuals, x.as_ref());
+        }
+    }
+
+    /// The refined modes' residual bounds ([`residual_bounds`]), in the definite pencil the
+    /// residuals belong to: (B, A) itself, or the condensed (S, A₁) with the modes' rows at the
+    /// coordinates with mass.
+    fn residual_bounds(
+        &self,
+        report: &mut AccuracyReport,
+        omega: &[f64],
+        residuals: &[RefinedResidual],
+        x: MatRef<'_, f64>,
+    ) {
+        let all: Vec<usize> = (0..omega.len()).collect();
+        let condensed = self.condensation.map(|c| (c.condensed_mass(), c.massed_rows(x)));
+        let (basis_a, basis_x) = match &condensed {
+            Some((a1, z)) => (a1.as_ref(), z.as_ref()),
+            None => (self.a, x),
+        };
+        let basis = ModeBasis {
+            a: basis_a,
+            l: self.l,
+            x: basis_x,
+            modes: &all,
+            unselected: None,
+        };
+        residual_bounds(report, omega, self.omega_all, self.first, residuals, &basis, self.par);
+    }
+}
+
+/// Writes the refined clusters into `x`, `omega` and the report's residual norms and steps;
+/// returns each refined mode's residual record and the changed columns.
+fn apply_refined(
+    jobs: &[Range<usize>],
+    refined: Vec<Option<RefinedCluster>>,
+    x: &mut Mat<f64>,
+    report: &mut AccuracyReport,
+    omega: &mut [f64],
+) -> (Vec<RefinedResidual>, Vec<usize>) {
+    let mut residuals: Vec<RefinedResidual> = Vec::new();
+    let mut changed: Vec<usize> = Vec::new();
+    for (g, cluster) in jobs.iter().zip(refined) {
+        let Some(cluster) = cluster else { continue };
+        for (i, p) in g.clone().zip(cluster.pairs) {
+            x.col_as_slice_mut(i).copy_from_slice(&p.x);
+            omega[i] = p.omega_sq;
+            report.residual_norms_a_inv[i] = Some(p.residual_a_inv);
+            report.refinement_steps[i] = p.steps;
+            changed.push(i);
+            residuals.push(RefinedResidual {
+                mode: i,
+                cluster: g.clone(),
+                orthogonality: cluster.orthogonality,
+                residual: p.residual,
+            });
+        }
+    }
+    (residuals, changed)
+}

@@ -1,0 +1,210 @@
+//! Newton steps on the bordered system [[B − ω₀²A, −Ax₀], [−(Ax₀)ᵀ, 0]] with the Jacobian frozen
+//! at the starting pair: factored densely (Bunch–Kaufman LBLᵀ), or, when A and B both have few
+//! nonzeros, by a sparse LU of B − ω₀²A with the border eliminated by blocks.
+
+use crate::dd::{Dd, Operand, SplitVector, dot};
+use crate::refine::metric::Metric;
+use crate::refine::pair::{RefinedPair, finish_pair};
+use crate::tuning::Tuning;
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
+
+/// Refines (ω₀², x₀) by Newton steps on the bordered matrix [B − ω₀²A, −Ax₀; −(Ax₀)ᵀ, 0]
+/// (nonsingular for a simple finite eigenvalue, also when A is singular), factored densely,
+/// with the final residual measured in `metric`; None if the bordered matrix is singular to
+/// working precision (the eigenvalue is not simple) or xᵀAx is not positive.
+pub(crate) fn refine_pair(
+    a: &Operand<'_>,
+    b: &Operand<'_>,
+    metric: Metric<'_>,
+    x0: &[f64],
+    omega0: f64,
+) -> Option<RefinedPair> {
+    let ax0: Vec<f64> = a.product(x0).iter().map(|v| v.to_f64()).collect();
+    let jacobian = BorderedJacobian::dense(a, b, &ax0, omega0);
+    let (x, steps, _) = newton_steps(a, b, &jacobian, x0, omega0)?;
+    finish_pair(a, b, metric, x, steps)
+}
+
+/// [`refine_pair`] for A and B with few nonzeros, the Jacobian factored sparsely
+/// ([`BorderedJacobian::sparse`]): O(n·w²) per mode for a bandwidth w, where the spectral
+/// correction of [`refine_cluster_projected`] costs 4n² per step. None if the factorization
+/// fails or the steps do not converge (then the other methods are tried).
+pub(crate) fn refine_pair_sparse(
+    a: &Operand<'_>,
+    b: &Operand<'_>,
+    shifts: &SparseShifts,
+    metric: Metric<'_>,
+    x0: &[f64],
+    omega0: f64,
+) -> Option<RefinedPair> {
+    let ax0: Vec<f64> = a.product(x0).iter().map(|v| v.to_f64()).collect();
+    let jacobian = BorderedJacobian::sparse(shifts, &ax0, omega0)?;
+    match newton_steps(a, b, &jacobian, x0, omega0)? {
+        (x, steps, true) => finish_pair(a, b, metric, x, steps),
+        _ => None,
+    }
+}
+
+/// K = B − sA for a pencil whose A and B both have few nonzeros: the union of their patterns
+/// with both values on it, and its LU symbolic analysis (column ordering, structure), found once
+/// for every shift of a refinement stage.
+pub(crate) struct SparseShifts {
+    pattern: faer::sparse::SymbolicSparseColMat<usize>,
+    b_values: Vec<f64>,
+    a_values: Vec<f64>,
+    symbolic: faer::sparse::linalg::solvers::SymbolicLu<usize>,
+}
+
+impl SparseShifts {
+    /// None when A or B is dense, or the symbolic analysis fails.
+    pub(crate) fn new(a: &Operand<'_>, b: &Operand<'_>) -> Option<Self> {
+        let n = a.matrix().nrows();
+        let mut column_starts = Vec::with_capacity(n + 1);
+        let (mut rows, mut b_values, mut a_values) = (Vec::new(), Vec::new(), Vec::new());
+        column_starts.push(0);
+        for j in 0..n {
+            let (bj, aj) = (b.column_nonzeros(j)?, a.column_nonzeros(j)?);
+            // The rows of B's and A's column j merged (both ascending).
+            let (mut p, mut q) = (0, 0);
+            while p < bj.len() || q < aj.len() {
+                let row_b = bj.get(p).map_or(usize::MAX, |e| e.0);
+                let row_a = aj.get(q).map_or(usize::MAX, |e| e.0);
+                let row = row_b.min(row_a);
+                rows.push(row);
+                b_values.push(if row_b == row { bj[p].1 } else { 0.0 });
+                a_values.push(if row_a == row { aj[q].1 } else { 0.0 });
+                p += usize::from(row_b == row);
+                q += usize::from(row_a == row);
+            }
+            column_starts.push(rows.len());
+        }
+        let pattern = faer::sparse::SymbolicSparseColMat::new_checked(n, n, column_starts, None, rows);
+        let symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.as_ref()).ok()?;
+        Some(Self {
+            pattern,
+            b_values,
+            a_values,
+            symbolic,
+        })
+    }
+
+    /// The LU factorization with partial pivoting of B − shift·A; None if it fails.
+    fn factor(&self, shift: f64) -> Option<faer::sparse::linalg::solvers::Lu<usize, f64>> {
+        let values: Vec<f64> = self
+            .b_values
+            .iter()
+            .zip(&self.a_values)
+            .map(|(b, a)| b - shift * a)
+            .collect();
+        let k = faer::sparse::SparseColMatRef::new(self.pattern.as_ref(), &values);
+        faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(self.symbolic.clone(), k).ok()
+    }
+}
+
+/// Newton steps of [`refine_pair`] with the frozen Jacobian `jacobian`: the iterate, the steps
+/// taken and whether a step fell below the rounding of a double iterate; None if a step was not
+/// finite. The iterate is kept in double-double, and the steps go on past that point while
+/// they still halve (to about u² of the iterate): the final residual, and so the certified
+/// bound, is then not limited by rounding the vector to double.
+fn newton_steps(
+    a: &Operand<'_>,
+    b: &Operand<'_>,
+    jacobian: &BorderedJacobian,
+    x0: &[f64],
+    omega0: f64,
+) -> Option<(SplitVector, usize, bool)> {
+    let n = x0.len();
+    let mut x = SplitVector::of(x0.to_vec());
+    let mut omega = Dd::of(omega0);
+    let mut converged = false;
+    let mut previous = f64::INFINITY;
+    for step in 1..=Tuning::DEFAULT.max_newton_steps {
+        let bx = b.product_split(&x);
+        let axd = a.product_split(&x);
+        let residual: Vec<f64> = (0..n).map(|i| -(bx[i].minus(omega.times(axd[i]))).to_f64()).collect();
+        // Normalisation residual: (Ax₀)ᵀx − 1, computed as x₀ᵀ(Ax) in double-double.
+        let normalisation = dot(x0, &axd).minus(Dd::of(1.0)).to_f64();
+        let (dx, d_omega) = jacobian.solve(residual, normalisation)?;
+        let xmax = x.hi.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let dmax = dx.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        x.add(&dx);
+        omega = omega.plus(Dd::of(d_omega));
+        converged |= dmax <= 2.0 * f64::EPSILON * xmax && d_omega.abs() <= 2.0 * f64::EPSILON * omega.hi.abs();
+        if converged && (dmax <= 4.0 * f64::EPSILON * f64::EPSILON * xmax || dmax > 0.5 * previous) {
+            return Some((x, step, true));
+        }
+        previous = dmax;
+    }
+    Some((x, Tuning::DEFAULT.max_newton_steps, converged))
+}
+
+/// The Jacobian [K, −a; −aᵀ, 0] of [`refine_pair`] with K = B − ω₀²A and a = A x₀, factored
+/// once in double precision.
+enum BorderedJacobian {
+    /// Bunch–Kaufman LBLᵀ of the dense matrix of order n + 1 ((n + 1)³/3 flops).
+    Dense(faer::linalg::solvers::Lblt<f64>),
+    /// A sparse LU of K alone with partial pivoting (the dense border row would fill the
+    /// factors), the border by block elimination: K⁻¹a and aᵀK⁻¹a are formed once.
+    Sparse {
+        lu: faer::sparse::linalg::solvers::Lu<usize, f64>,
+        a: Vec<f64>,
+        k_inv_a: Vec<f64>,
+        schur: f64,
+    },
+}
+
+impl BorderedJacobian {
+    fn dense(a: &Operand<'_>, b: &Operand<'_>, ax0: &[f64], omega0: f64) -> Self {
+        let n = ax0.len();
+        let border = Mat::from_fn(n + 1, n + 1, |i, j| match (i < n, j < n) {
+            (true, true) => b.matrix()[(i, j)] - omega0 * a.matrix()[(i, j)],
+            (true, false) => -ax0[i],
+            (false, true) => -ax0[j],
+            (false, false) => 0.0,
+        });
+        Self::Dense(border.lblt(Side::Lower))
+    }
+
+    /// The sparse factorization of K = B − ω₀²A (O(n·w²) for a bandwidth w instead of
+    /// (n + 1)³/3); None if it fails or gives a non-finite K⁻¹a (K singular to working
+    /// precision). Block elimination loses accuracy along K's near-null vector, which is x₀
+    /// itself; the Newton steps measure their residuals in double-double, and steps that do not
+    /// converge are discarded ([`refine_pair_sparse`]).
+    fn sparse(shifts: &SparseShifts, ax0: &[f64], omega0: f64) -> Option<Self> {
+        let n = ax0.len();
+        let lu = shifts.factor(omega0)?;
+        let k_inv_a = lu.solve(Mat::from_fn(n, 1, |i, _| ax0[i]));
+        let k_inv_a: Vec<f64> = k_inv_a.col(0).iter().copied().collect();
+        let schur: f64 = ax0.iter().zip(&k_inv_a).map(|(u, v)| u * v).sum();
+        if !(schur.is_finite() && schur != 0.0 && k_inv_a.iter().all(|v| v.is_finite())) {
+            return None;
+        }
+        Some(Self::Sparse {
+            lu,
+            a: ax0.to_vec(),
+            k_inv_a,
+            schur,
+        })
+    }
+
+    /// (δx, δω²) with K δx − a δω² = r and −aᵀδx = s; None if not finite.
+    fn solve(&self, r: Vec<f64>, s: f64) -> Option<(Vec<f64>, f64)> {
+        let n = r.len();
+        let (dx, d_omega) = match self {
+            Self::Dense(lblt) => {
+                let rhs = Mat::from_fn(n + 1, 1, |i, _| if i < n { r[i] } else { s });
+                let delta = lblt.solve(&rhs);
+                ((0..n).map(|i| delta[(i, 0)]).collect::<Vec<f64>>(), delta[(n, 0)])
+            }
+            Self::Sparse { lu, a, k_inv_a, schur } => {
+                // δx = K⁻¹r + δω² K⁻¹a, and −aᵀδx = s gives δω².
+                let y = lu.solve(Mat::from_fn(n, 1, |i, _| r[i]));
+                let a_y: f64 = a.iter().zip(y.col(0).iter()).map(|(u, v)| u * v).sum();
+                let d_omega = -(s + a_y) / schur;
+                ((0..n).map(|i| y[(i, 0)] + d_omega * k_inv_a[i]).collect(), d_omega)
+            }
+        };
+        (dx.iter().all(|v| v.is_finite()) && d_omega.is_finite()).then_some((dx, d_omega))
+    }
+}

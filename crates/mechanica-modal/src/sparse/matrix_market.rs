@@ -1,0 +1,254 @@
+//! Matrix Market coordinate files (the exchange format of SciPy, PETSc and the SuiteSparse
+//! collection): `%%MatrixMarket matrix coordinate real|integer general|symmetric`, 1-based
+//! indices. Symmetric files store one triangle; the reader mirrors it so the result holds both
+//! triangles, as [`crate::SparsePencil::from_triplets`] expects. Every malformed line gives
+//! [`ModalError::MatrixMarket`] with its 1-based line number.
+
+use crate::ModalError;
+use faer::sparse::Triplet;
+use std::path::Path;
+
+/// A matrix read from a Matrix Market file: its shape and entries (both triangles).
+#[derive(Debug, Clone)]
+pub struct MatrixMarket {
+    /// Number of rows.
+    pub nrows: usize,
+    /// Number of columns.
+    pub ncols: usize,
+    /// Entries (0-based indices); symmetric files are mirrored, duplicates kept (summed later).
+    pub entries: Vec<Triplet<usize, usize, f64>>,
+    /// Whether the file declared itself symmetric.
+    pub symmetric: bool,
+}
+
+fn bad(line: usize, detail: impl Into<String>) -> ModalError {
+    ModalError::MatrixMarket {
+        line,
+        detail: detail.into(),
+    }
+}
+
+/// Reads a Matrix Market file.
+pub fn read_matrix_market(path: &Path) -> Result<MatrixMarket, ModalError> {
+    let text = std::fs::read_to_string(path).map_err(|e| ModalError::Io {
+        path: path.display().to_string(),
+        detail: e.to_string(),
+    })?;
+    parse_matrix_market(&text)
+}
+
+/// Parses the text of a Matrix Market coordinate file.
+pub fn parse_matrix_market(text: &str) -> Result<MatrixMarket, ModalError> {
+    let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l));
+    let (_, header) = lines.next().ok_or_else(|| bad(1, "empty file"))?;
+    let symmetric = parse_header(header)?;
+    // Size line: the first line that is neither a comment nor blank.
+    let (size_line, size) = lines
+        .by_ref()
+        .find(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('%'))
+        .ok_or_else(|| bad(2, "missing the size line 'rows cols entries'"))?;
+    let (nrows, ncols, nnz) = parse_size(size_line, size, symmetric)?;
+    let mut entries = Vec::with_capacity(if symmetric { 2 * nnz } else { nnz });
+    let mut read = 0usize;
+    let mut last_line = size_line;
+    for (number, line) in lines {
+        last_line = number;
+        let trimmed = line.trim();
+        if trimmed.is_empty() || trimmed.starts_with('%') {
+            continue;
+        }
+        if read == nnz {
+            return Err(bad(number, format!("more entries than the {nnz} declared")));
+        }
+        let (r, c, value) = parse_entry(number, trimmed, (nrows, ncols), symmetric)?;
+        entries.push(Triplet::new(r, c, value));
+        if symmetric && r != c {
+            entries.push(Triplet::new(c, r, value));
+        }
+        read += 1;
+    }
+    if read != nnz {
+        return Err(bad(last_line, format!("{read} entries found, {nnz} declared")));
+    }
+    Ok(MatrixMarket {
+        nrows,
+        ncols,
+        entries,
+        symmetric,
+    })
+}
+
+/// The header `%%MatrixMarket matrix coordinate <real|integer|double> <general|symmetric>`
+/// (case-insensitive): whether the matrix is stored symmetric.
+fn parse_header(header: &str) -> Result<bool, ModalError> {
+    let words: Vec<String> = header.split_whitespace().map(str::to_ascii_lowercase).collect();
+    if words.first().map(String::as_str) != Some("%%matrixmarket") {
+        return Err(bad(1, "missing the %%MatrixMarket header"));
+    }
+    if words.len() != 5 {
+        return Err(bad(
+            1,
+            "header needs: %%MatrixMarket matrix coordinate <field> <symmetry>",
+        ));
+    }
+    if words[1] != "matrix" || words[2] != "coordinate" {
+        return Err(bad(
+            1,
+            format!(
+                "unsupported object/format '{} {}' (need 'matrix coordinate')",
+                words[1], words[2]
+            ),
+        ));
+    }
+    if words[3] != "real" && words[3] != "integer" && words[3] != "double" {
+        return Err(bad(
+            1,
+            format!("unsupported field '{}' (need real or integer)", words[3]),
+        ));
+    }
+    match words[4].as_str() {
+        "general" => Ok(false),
+        "symmetric" => Ok(true),
+        other => Err(bad(
+            1,
+            format!("unsupported symmetry '{other}' (need general or symmetric)"),
+        )),
+    }
+}
+
+/// A non-negative integer `token` of line `line` (`what` names it in the error).
+fn parse_usize(line: usize, token: &str, what: &str) -> Result<usize, ModalError> {
+    token
+        .parse::<usize>()
+        .map_err(|_| bad(line, format!("{what} '{token}' is not a non-negative integer")))
+}
+
+/// The size line `rows cols entries` (line `size_line`); a symmetric matrix must be square.
+fn parse_size(size_line: usize, size: &str, symmetric: bool) -> Result<(usize, usize, usize), ModalError> {
+    let tokens: Vec<&str> = size.split_whitespace().collect();
+    if tokens.len() != 3 {
+        return Err(bad(size_line, "size line needs exactly 3 integers: rows cols entries"));
+    }
+    let nrows = parse_usize(size_line, tokens[0], "rows")?;
+    let ncols = parse_usize(size_line, tokens[1], "cols")?;
+    let nnz = parse_usize(size_line, tokens[2], "entries")?;
+    if symmetric && nrows != ncols {
+        return Err(bad(
+            size_line,
+            format!("a symmetric matrix must be square, got {nrows}×{ncols}"),
+        ));
+    }
+    Ok((nrows, ncols, nnz))
+}
+
+/// The entry `row col value` of line `number` as zero-based (row, col, value): indices within
+/// the matrix's size, a finite value, and the lower triangle only when the file is symmetric.
+fn parse_entry(
+    number: usize,
+    trimmed: &str,
+    (nrows, ncols): (usize, usize),
+    symmetric: bool,
+) -> Result<(usize, usize, f64), ModalError> {
+    let t: Vec<&str> = trimmed.split_whitespace().collect();
+    if t.len() != 3 {
+        return Err(bad(
+            number,
+            format!("entry needs 'row col value', got {} tokens", t.len()),
+        ));
+    }
+    let row = parse_usize(number, t[0], "row")?;
+    let col = parse_usize(number, t[1], "col")?;
+    if row == 0 || row > nrows || col == 0 || col > ncols {
+        return Err(bad(
+            number,
+            format!("index ({row}, {col}) outside 1..={nrows} × 1..={ncols}"),
+        ));
+    }
+    let value: f64 = t[2]
+        .parse()
+        .map_err(|_| bad(number, format!("value '{}' is not a number", t[2])))?;
+    if !value.is_finite() {
+        return Err(bad(number, format!("value {value} is not finite")));
+    }
+    let (r, c) = (row - 1, col - 1);
+    if symmetric && r < c {
+        return Err(bad(
+            number,
+            "a symmetric file stores the lower triangle (row ≥ col) only",
+        ));
+    }
+    Ok((r, c, value))
+}
+
+/// The text of a symmetric matrix (lower triangle of `entries`, which must hold both) in
+/// Matrix Market coordinate format, for tests and tools.
+pub fn symmetric_to_string(n: usize, entries: &[Triplet<usize, usize, f64>]) -> String {
+    let lower: Vec<_> = entries.iter().filter(|e| e.row >= e.col).collect();
+    let mut s = format!(
+        "%%MatrixMarket matrix coordinate real symmetric\n{n} {n} {}\n",
+        lower.len()
+    );
+    for e in lower {
+        s.push_str(&format!("{} {} {:e}\n", e.row + 1, e.col + 1, e.val));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line_of(text: &str) -> usize {
+        match parse_matrix_market(text) {
+            Err(ModalError::MatrixMarket { line, .. }) => line,
+            other => panic!("expected a located parse error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn symmetric_file_is_mirrored() {
+        let text = "%%MatrixMarket matrix coordinate real symmetric\n% comment\n2 2 3\n1 1 2.0\n2 1 -1\n2 2 2e0\n";
+        let m = parse_matrix_market(text).expect("valid");
+        assert_eq!((m.nrows, m.ncols, m.entries.len()), (2, 2, 4));
+        let has = |r: usize, c: usize, v: f64| m.entries.iter().any(|e| (e.row, e.col, e.val) == (r, c, v));
+        assert!(has(0, 1, -1.0) && has(1, 0, -1.0));
+    }
+
+    #[test]
+    fn round_trip_through_text() {
+        let entries = vec![
+            Triplet::new(0, 0, 2.5),
+            Triplet::new(1, 0, -1.0),
+            Triplet::new(0, 1, -1.0),
+        ];
+        let text = symmetric_to_string(2, &entries);
+        let m = parse_matrix_market(&text).expect("valid");
+        assert_eq!(m.entries.len(), 3);
+    }
+
+    #[test]
+    fn malformed_files_name_their_line() {
+        assert_eq!(line_of(""), 1);
+        assert_eq!(line_of("hello\n"), 1);
+        assert_eq!(line_of("%%MatrixMarket matrix array real general\n2 2\n"), 1);
+        assert_eq!(line_of("%%MatrixMarket matrix coordinate complex general\n"), 1);
+        assert_eq!(line_of("%%MatrixMarket matrix coordinate real skew-symmetric\n"), 1);
+        let h = "%%MatrixMarket matrix coordinate real general\n";
+        assert_eq!(line_of(&format!("{h}%c\n2 x 1\n")), 3);
+        assert_eq!(line_of(&format!("{h}2 2\n")), 2);
+        assert_eq!(line_of(&format!("{h}2 2 2\n1 1 1.0\n3 1 1.0\n")), 4);
+        assert_eq!(line_of(&format!("{h}2 2 1\n1 1 abc\n")), 3);
+        assert_eq!(line_of(&format!("{h}2 2 1\n1 1 nan\n")), 3);
+        assert_eq!(line_of(&format!("{h}2 2 1\n1 1\n")), 3);
+        assert_eq!(line_of(&format!("{h}2 2 1\n1 1 1\n2 2 1\n")), 4);
+        assert_eq!(line_of(&format!("{h}2 2 2\n1 1 1\n")), 3);
+        assert_eq!(line_of(&format!("{h}2 2 1\n0 1 1\n")), 3);
+        let s = "%%MatrixMarket matrix coordinate real symmetric\n";
+        assert_eq!(line_of(&format!("{s}2 3 0\n")), 2);
+        assert_eq!(line_of(&format!("{s}2 2 1\n1 2 1\n")), 3);
+        assert!(matches!(
+            read_matrix_market(Path::new("/nonexistent/file.mtx")),
+            Err(ModalError::Io { .. })
+        ));
+    }
+}
