@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// What was wrong with which matrix input, or which step of a solve failed.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum ModalError {
     /// A matrix is not square, or A and B differ in size.
     #[error("{what} has shape {rows}×{cols}, expected {expected}×{expected}")]

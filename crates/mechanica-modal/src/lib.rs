@@ -80,7 +80,3 @@ pub use sparse::{
 };
 pub use spectrum::{Mode, ModeGroup, ModeKind, classify};
 pub use tuning::Tuning;
-
-// Old name; removed once the C layer uses the new one.
-#[doc(hidden)]
-pub type SparseOptions = SparseSolveOptions;

@@ -10,6 +10,7 @@ use faer::{Mat, MatMut, MatRef, Par};
 
 /// How the accuracy report measures the residuals and the A-orthogonality of dense pairs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum Residuals {
     /// A X, B X and XᵀAX formed in full (5n²m flops for m pairs): every backward error and the
     /// orthogonality error are computed exactly (to rounding).

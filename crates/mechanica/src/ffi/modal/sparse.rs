@@ -7,7 +7,7 @@ use crate::ffi::boundary::{FfiError, boundary};
 use crate::ffi::status::*;
 use crate::ffi::validate::*;
 use mechanica_modal::faer::sparse::Triplet;
-use mechanica_modal::{SparseModalSolution, SparseOptions, SparsePencil, solve_sparse};
+use mechanica_modal::{SparseModalSolution, SparsePencil, SparseSolveOptions, solve_sparse};
 
 /// Accuracy and cost summary of mech_modal_sparse_lowest and mech_modal_sparse_solve.
 #[repr(C)]
@@ -89,7 +89,7 @@ unsafe fn solve_csc(
     n: usize,
     a: CscInput,
     b: CscInput,
-    options: &SparseOptions,
+    options: &SparseSolveOptions,
 ) -> Result<SparseModalSolution, FfiError> {
     // SAFETY: caller's contract.
     let (a, b) = unsafe { (read_csc(n, a, "a")?, read_csc(n, b, "b")?) };
@@ -179,9 +179,9 @@ pub unsafe extern "C" fn mech_modal_sparse_lowest(
         let r_out = Out::optional(report_out, "report_out")?;
         let a = CscInput::new(a_col_ptr, a_row_idx, a_values);
         let b = CscInput::new(b_col_ptr, b_row_idx, b_values);
-        let options = SparseOptions {
+        let options = SparseSolveOptions {
             count,
-            ..SparseOptions::default()
+            ..SparseSolveOptions::default()
         };
         // SAFETY: caller's contract.
         let sol = unsafe { solve_csc(n, a, b, &options) }?;
@@ -231,8 +231,8 @@ pub struct mech_modal_sparse_options_t {
     pub shift: f64,
 }
 
-impl From<&SparseOptions> for mech_modal_sparse_options_t {
-    fn from(o: &SparseOptions) -> Self {
+impl From<&SparseSolveOptions> for mech_modal_sparse_options_t {
+    fn from(o: &SparseSolveOptions) -> Self {
         Self {
             count: o.count,
             tolerance: o.tolerance,
@@ -259,7 +259,7 @@ pub unsafe extern "C" fn mech_modal_sparse_options_default(
     boundary(|| {
         let out = Out::new(options_out, "options_out")?;
         // SAFETY: caller's contract.
-        unsafe { out.write((&SparseOptions::default()).into()) };
+        unsafe { out.write((&SparseSolveOptions::default()).into()) };
         Ok(())
     })
 }
@@ -303,10 +303,10 @@ fn sparse_details(sol: &SparseModalSolution) -> mech_modal_sparse_details_t {
     }
 }
 
-/// [`SparseOptions`] from the C options: zero fields take the defaults; a non-finite or
+/// [`SparseSolveOptions`] from the C options: zero fields take the defaults; a non-finite or
 /// out-of-range tolerance or shift, or a `shift_given` other than 0 and 1, is refused.
-fn sparse_options(o: &mech_modal_sparse_options_t) -> Result<SparseOptions, FfiError> {
-    let defaults = SparseOptions::default();
+fn sparse_options(o: &mech_modal_sparse_options_t) -> Result<SparseSolveOptions, FfiError> {
+    let defaults = SparseSolveOptions::default();
     if !o.tolerance.is_finite() || (o.shift_given == 1 && !o.shift.is_finite()) {
         return Err(FfiError::new(
             MECH_STATUS_NON_FINITE,
@@ -324,7 +324,7 @@ fn sparse_options(o: &mech_modal_sparse_options_t) -> Result<SparseOptions, FfiE
         }
     };
     let nonzero = |value: usize, default: usize| if value == 0 { default } else { value };
-    Ok(SparseOptions {
+    Ok(SparseSolveOptions {
         count: o.count,
         shift,
         tolerance: if o.tolerance == 0.0 {
@@ -413,7 +413,7 @@ mod tests {
             unsafe { mech_modal_sparse_options_default(&mut written) },
             MECH_STATUS_OK
         );
-        assert_eq!(sparse_options(&written), Ok(SparseOptions::default()));
+        assert_eq!(sparse_options(&written), Ok(SparseSolveOptions::default()));
         assert_eq!(written.count, 10);
         assert_eq!(written.shift_given, 0);
     }
