@@ -48,7 +48,10 @@ pub fn parse_matrix_market(text: &str) -> Result<MatrixMarket, ModalError> {
         .find(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('%'))
         .ok_or_else(|| bad(2, "missing the size line 'rows cols entries'"))?;
     let (nrows, ncols, nnz) = parse_size(size_line, size, symmetric)?;
-    let mut entries = Vec::with_capacity(if symmetric { 2 * nnz } else { nnz });
+    // Reserve only what the text can hold: an entry line "r c v" takes at least 6 bytes, so a
+    // header declaring more entries than that reserves nothing it cannot fill.
+    let entry_bound = nnz.min(text.len() / 6 + 1);
+    let mut entries = Vec::with_capacity(if symmetric { 2 * entry_bound } else { entry_bound });
     let mut read = 0usize;
     let mut last_line = size_line;
     for (number, line) in lines {
@@ -202,6 +205,22 @@ mod tests {
         match parse_matrix_market(text) {
             Err(ModalError::MatrixMarket { line, .. }) => line,
             other => panic!("expected a located parse error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_huge_declared_entry_count_is_a_located_error_not_an_allocation() {
+        for declared in ["1000000000", "18446744073709551615"] {
+            for kind in ["general", "symmetric"] {
+                let text = format!("%%MatrixMarket matrix coordinate real {kind}\n2 2 {declared}\n1 1 1.0\n");
+                match parse_matrix_market(&text) {
+                    Err(ModalError::MatrixMarket { line, detail }) => {
+                        assert_eq!(line, 3, "{kind} {declared}");
+                        assert!(detail.contains("1 entries found"), "{detail}");
+                    }
+                    other => panic!("expected a located parse error, got {other:?}"),
+                }
+            }
         }
     }
 
