@@ -18,6 +18,7 @@ mod finish;
 mod idle_inputs;
 mod options;
 mod refinement;
+mod reversed;
 mod solution;
 mod values_only;
 
@@ -32,6 +33,7 @@ use crate::dense::definite::{select, solve_definite, solve_definite_owned};
 use crate::dense::finish::Finish;
 use crate::dense::idle_inputs::{EarlyInputs, IdleResults};
 use crate::dense::options::{check_interval, weakly_bounded};
+use crate::dense::reversed::{adopt_reversed_bottom, bottom_is_weak};
 use crate::dense::solution::empty_solution;
 use crate::error::ModalError;
 use crate::linalg::eigen::OnTridiagonal;
@@ -92,12 +94,24 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 |diag: &[f64], subdiag: &[f64]| certificate = idle_certificate::start(problem, diag, subdiag);
             let hook: Option<OnTridiagonal<'_>> = if idle_time { Some(&mut start_certificate) } else { None };
             let mut def = solve_definite_owned(l.as_ref(), b_copy, options.selection, want_vectors, par, hook)?;
+            if options.refinement != Refinement::Off && bottom_is_weak(&def.omega_sq) {
+                if !want_vectors {
+                    // The reversed modes are refined from their shapes, so the solve needs all of them.
+                    let first_try = def.timings;
+                    def = solve_definite(l.as_ref(), b, options.selection, true, par)?;
+                    def.timings.factor += first_try.factor;
+                    def.timings.eigen += first_try.eigen;
+                }
+                let clock = Instant::now();
+                adopt_reversed_bottom(&mut def, a, b, l.as_ref(), par);
+                def.timings.factor += clock.elapsed();
+            }
             let early = early_inputs.and_then(IdleTask::finished);
             let (norm_a, norm_b) = match &early {
                 Some(inputs) => inputs.norms,
                 None => (frobenius_norm(a), frobenius_norm(b)),
             };
-            if !want_vectors && options.refinement == Refinement::Auto {
+            if def.vectors.is_none() && options.refinement == Refinement::Auto {
                 // Values only: the modes whose a-priori bound is too weak get their vectors
                 // (crate::values_only), unless they are so many that all vectors cost less.
                 let clock = Instant::now();

@@ -2,6 +2,8 @@
 //! unit spring chains (fixed, free, ring), their congruence by a random orthogonal matrix
 //! (dense pencils with the same eigenvalues), and graded stiff chains.
 
+pub mod graded;
+
 use faer::Mat;
 use faer::sparse::Triplet;
 use std::f64::consts::PI;

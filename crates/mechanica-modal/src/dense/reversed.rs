@@ -1,0 +1,159 @@
+//! The low modes of a graded pencil by role reversal ((8.89) read backwards, see
+//! docs/theory.md, "Relative accuracy of the low modes").
+//!
+//! The reduction C = L⁻¹BL⁻ᵀ (A = LLᵀ) gives every ω² to an absolute error of order u‖C‖, the
+//! size of the largest ω²: the low modes of a pencil whose ω² span many decades come out with
+//! no correct digit, their shapes mixed. The reversed pencil A x = μ (B + sA) x, μ = 1/(ω² + s),
+//! reduced by the Cholesky factor R of B + sA to M = R⁻¹AR⁻ᵀ, has the low modes as its
+//! *dominant* eigenvalues, each to an absolute error of order u·μ_max: mode j's ω² to about
+//! u·(ω²_j + s)²·μ_max, fine where ω²_j is near the bottom. Each mode takes the side with the
+//! smaller error estimate; the modes taken from the reversed side are then refined and bounded
+//! like every other mode ([`crate::dense::refinement`]), so the estimate decides only where the
+//! starting pairs come from, never what is reported as the error.
+//!
+//! The shift s is 0 when B has a Cholesky factor (B positive definite). Otherwise (rigid-body
+//! modes, or an unstable pencil) s grows from the rounding level of B by factors of
+//! [`SHIFT_GROWTH`] until B + sA has one, at most [`SHIFT_ATTEMPTS`] times; a pencil that never
+//! admits one keeps the reduction's modes.
+
+use crate::dense::definite::Definite;
+use crate::dense::options::weakly_bounded;
+use crate::linalg::eigen::symmetric_eigen_returning_input;
+use crate::linalg::reduce::{Cholesky, back_transform, cholesky_owned, lower_entry, reduce};
+use faer::{Mat, MatRef, Par};
+
+/// Factor by which the shift grows between Cholesky attempts of B + sA.
+const SHIFT_GROWTH: f64 = 1e3;
+/// Cholesky attempts of B + sA after the unshifted one.
+const SHIFT_ATTEMPTS: usize = 6;
+
+/// The lowest modes of a pencil from its reversed form.
+pub(crate) struct ReversedBottom {
+    /// The ω² of the lowest modes, ascending.
+    pub omega_sq: Vec<f64>,
+    /// Their shapes, A-normalised columns (n × omega_sq.len()).
+    pub vectors: Mat<f64>,
+}
+
+/// The modes of (B, A) whose ω² the reversed pencil gives with a smaller error estimate than the
+/// reduction's u·`forward_scale` (the largest |ω²| of the reduction): the lowest modes, up to
+/// where u·(ω²_j + s)²·μ_max reaches u·forward_scale. None when B + sA has no Cholesky factor
+/// for any shift tried, or when no mode gains.
+pub(crate) fn reversed_bottom(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    forward_scale: f64,
+    par: Par,
+) -> Option<ReversedBottom> {
+    let (shift, r) = shifted_factor(a, b, par)?;
+    let m = reduce(r.as_ref(), a, par);
+    let (eigen, _) = symmetric_eigen_returning_input(m, true, par, None).ok()?;
+    let z = eigen.vectors?;
+    let mu_max = eigen.values.last().copied().filter(|&v| v > 0.0)?;
+    let mut taken: Vec<usize> = Vec::new();
+    for (j, &mu) in eigen.values.iter().enumerate().rev() {
+        let reversed_error = mu_max / (mu * mu);
+        if !(mu > 0.0 && reversed_error < forward_scale) {
+            break;
+        }
+        taken.push(j);
+    }
+    if taken.is_empty() {
+        return None;
+    }
+    let omega_sq: Vec<f64> = taken.iter().map(|&j| 1.0 / eigen.values[j] - shift).collect();
+    let mut vectors = Mat::from_fn(a.nrows(), taken.len(), |i, c| z[(i, taken[c])]);
+    back_transform(r.as_ref(), vectors.as_mut(), par);
+    normalise_in_a(a, &mut vectors);
+    omega_sq
+        .iter()
+        .all(|w| w.is_finite())
+        .then_some(ReversedBottom { omega_sq, vectors })
+}
+
+/// The smallest shift tried for which B + sA has a Cholesky factor, with that factor.
+fn shifted_factor(a: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Option<(f64, Mat<f64>)> {
+    let n = a.nrows();
+    let diagonal_ratio = (0..n)
+        .map(|i| b[(i, i)].abs() / a[(i, i)])
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    let first_shift = 16.0 * n as f64 * f64::EPSILON * diagonal_ratio;
+    let mut shift = 0.0;
+    for attempt in 0..=SHIFT_ATTEMPTS {
+        if attempt == 1 {
+            shift = first_shift;
+        } else if attempt > 1 {
+            shift *= SHIFT_GROWTH;
+        }
+        if attempt > 0 && !(shift > 0.0 && shift.is_finite()) {
+            return None;
+        }
+        let k = Mat::from_fn(n, n, |i, j| lower_entry(b, i, j) + shift * lower_entry(a, i, j));
+        if let Cholesky::Factor(r) = cholesky_owned(k, par) {
+            return Some((shift, r));
+        }
+    }
+    None
+}
+
+/// Scales every column x to xᵀAx = 1.
+fn normalise_in_a(a: MatRef<'_, f64>, x: &mut Mat<f64>) {
+    for c in 0..x.ncols() {
+        let col = x.col(c);
+        let ax = a * col;
+        let norm_sq: f64 = col.iter().zip(ax.iter()).map(|(u, v)| u * v).sum();
+        if norm_sq > 0.0 && norm_sq.is_finite() {
+            let s = norm_sq.sqrt().recip();
+            x.col_mut(c).iter_mut().for_each(|v| *v *= s);
+        }
+    }
+}
+
+/// Whether the reduction's lowest |ω²| in `omega_sq` is so far below u·n·max|ω²| that its
+/// error estimate guarantees fewer than the 8 digits of [`crate::dense::AUTO_REFINE_RELATIVE_BOUND`]: the pencil is
+/// graded, and its bottom is worth the reversed solve.
+pub(crate) fn bottom_is_weak(omega_sq: &[f64]) -> bool {
+    let scale = omega_sq.iter().fold(0.0_f64, |m, w| m.max(w.abs()));
+    let lowest = omega_sq.iter().fold(f64::INFINITY, |m, w| m.min(w.abs()));
+    let estimate = f64::EPSILON * omega_sq.len() as f64 * scale;
+    !omega_sq.is_empty() && weakly_bounded(estimate, lowest)
+}
+
+/// Replaces the lowest modes of the reduction's spectrum `def` (values, selected shapes, and
+/// the reduced eigenvectors Y = LᵀX that refinement corrects through) by those of
+/// [`reversed_bottom`], where that gains. Returns whether anything was replaced.
+pub(crate) fn adopt_reversed_bottom(
+    def: &mut Definite,
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    l: MatRef<'_, f64>,
+    par: Par,
+) -> bool {
+    let scale = def.omega_sq.iter().fold(0.0_f64, |m, w| m.max(w.abs()));
+    let Some(bottom) = reversed_bottom(a, b, scale, par) else {
+        return false;
+    };
+    let n = def.omega_sq.len();
+    // Keep the spectrum ascending across the seam between the two sides.
+    let mut m = bottom.omega_sq.len().min(n);
+    while m > 0 && m < n && bottom.omega_sq[m - 1] > def.omega_sq[m] {
+        m -= 1;
+    }
+    if m == 0 {
+        return false;
+    }
+    def.omega_sq[..m].copy_from_slice(&bottom.omega_sq[..m]);
+    if let Some(x) = def.vectors.as_mut() {
+        for j in def.first..def.end.min(m) {
+            x.col_mut(j - def.first).copy_from(bottom.vectors.col(j));
+        }
+    }
+    if let Some(y) = def.reduced.as_mut() {
+        for j in 0..m {
+            let reduced = l.transpose() * bottom.vectors.col(j);
+            y.col_mut(j).copy_from(&reduced);
+        }
+    }
+    true
+}
