@@ -175,8 +175,9 @@ impl PairProducts {
         }
     }
 
-    /// Backward error η_i and first-order bound η_i·κ_i of the pair (ω²_i, x_i). Sketched, the
-    /// residual is its probabilistic upper bound and x_iᵀAx_i ≥ 1 − ‖XᵀAX − I‖_F.
+    /// Backward error η_i and first-order bound max(η_i, u)·κ_i of the pair (ω²_i, x_i) (the
+    /// rounding allowance of the reported bound is added by [`crate::certify::report::AccuracyReport::finish`]). Sketched,
+    /// the residual is its probabilistic upper bound and x_iᵀAx_i ≥ 1 − ‖XᵀAX − I‖_F.
     pub(crate) fn pair_error(
         &self,
         x: MatRef<'_, f64>,

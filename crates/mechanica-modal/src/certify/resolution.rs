@@ -48,3 +48,11 @@ pub(crate) fn zero_resolution(
         normwise
     }
 }
+
+/// The rounding of the double-double residual and Rayleigh quotient of an A-normalised shape
+/// x: each of their n-term sums errs by at most about n·u²(|x|ᵀ|B||x| + |ω²|·|x|ᵀ|A||x|), a
+/// term that matters only where ω² is cancelled far below the entries (a near-zero mode of a
+/// stiff structure). It is 4n·u times the data resolution, which has the same sums.
+pub(crate) fn extended_rounding(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: &[f64], omega_sq: f64) -> f64 {
+    4.0 * x.len() as f64 * f64::EPSILON * data_resolution(a, b, x, omega_sq)
+}

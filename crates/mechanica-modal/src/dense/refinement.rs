@@ -5,7 +5,7 @@
 use crate::certify::products::PairProducts;
 use crate::certify::report::{AccuracyReport, BoundKind};
 use crate::certify::residual_bounds::{ModeBasis, RefinedResidual, residual_bounds, split_refined_clusters};
-use crate::certify::resolution::data_resolution;
+use crate::certify::resolution::extended_rounding;
 use crate::dd::Operand;
 use crate::dense::options::{Refinement, weakly_bounded};
 use crate::refine::{
@@ -86,7 +86,8 @@ impl Stage<'_> {
             .into_iter()
             .filter(|g| {
                 let wanted = self.policy == Refinement::Always
-                    || g.clone().any(|i| weakly_bounded(report.error_bounds[i], omega[i]));
+                    || g.clone()
+                        .any(|i| weakly_bounded(report.bound_with_rounding(i, self.a.nrows()), omega[i]));
                 wanted && refinable(g, omega, &report.error_bounds, self.omega_all, self.first)
             })
             .collect()
@@ -248,14 +249,6 @@ impl Stage<'_> {
             report.error_bounds[i] += extended_rounding(self.a, self.b, &shape, omega[i]);
         }
     }
-}
-
-/// The rounding of the double-double residual and Rayleigh quotient of an A-normalised shape
-/// x: each of their n-term sums errs by at most about n·u²(|x|ᵀ|B||x| + |ω²|·|x|ᵀ|A||x|), a
-/// term that matters only where ω² is cancelled far below the entries (a near-zero mode of a
-/// stiff structure). It is 4n·u times the data resolution, which has the same sums.
-fn extended_rounding(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: &[f64], omega_sq: f64) -> f64 {
-    4.0 * x.len() as f64 * f64::EPSILON * data_resolution(a, b, x, omega_sq)
 }
 
 /// Writes the refined clusters into `x`, `omega` and the report's residual norms and steps;

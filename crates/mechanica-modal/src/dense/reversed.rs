@@ -17,7 +17,6 @@
 //! admits one keeps the reduction's modes.
 
 use crate::dense::definite::Definite;
-use crate::dense::options::weakly_bounded;
 use crate::linalg::eigen::symmetric_eigen_returning_input;
 use crate::linalg::reduce::{Cholesky, back_transform, cholesky_owned, lower_entry, reduce};
 use faer::{Mat, MatRef, Par};
@@ -110,15 +109,29 @@ fn normalise_in_a(a: MatRef<'_, f64>, x: &mut Mat<f64>) {
     }
 }
 
-/// Whether the reduction's lowest |ω²| in `omega_sq` is so far below u·n·max|ω²| that its
-/// error estimate guarantees fewer than the 8 digits of [`crate::dense::AUTO_REFINE_RELATIVE_BOUND`]: the pencil is
-/// graded, and its bottom is worth the reversed solve.
+/// The relative error estimate u·n·max|ω²| / min|ω²| of the reduction's lowest mode from which
+/// the reversed solve is used: below it, the reduction's pairs are close enough for Newton
+/// refinement to start from (graded chains to ratios of 1e12 and beyond); above it, they can be
+/// mixed beyond repair (random gradings).
+pub(crate) const REVERSAL_FROM: f64 = 1e-4;
+
+/// Whether the reduction's spectrum `omega_sq` has a mode whose relative error estimate
+/// u·n·max|ω²| / |ω²| exceeds [`REVERSAL_FROM`] while |ω²| is above the estimate itself (a mode
+/// visibly not zero but poorly resolved), or more modes within the estimate of zero than a free
+/// body has rigid-body modes ([`RIGID_BODY_MODES`]): the pencil is graded, and its bottom is worth
+/// the reversed solve. A free structure whose only small modes are its rigid-body ones is not.
 pub(crate) fn bottom_is_weak(omega_sq: &[f64]) -> bool {
     let scale = omega_sq.iter().fold(0.0_f64, |m, w| m.max(w.abs()));
-    let lowest = omega_sq.iter().fold(f64::INFINITY, |m, w| m.min(w.abs()));
     let estimate = f64::EPSILON * omega_sq.len() as f64 * scale;
-    !omega_sq.is_empty() && weakly_bounded(estimate, lowest)
+    let within_estimate = omega_sq.iter().filter(|w| w.abs() <= estimate).count();
+    let poorly_resolved = omega_sq
+        .iter()
+        .any(|w| w.abs() > estimate && estimate > REVERSAL_FROM * w.abs());
+    poorly_resolved || within_estimate > RIGID_BODY_MODES
 }
+
+/// The rigid-body modes of one free body in space.
+const RIGID_BODY_MODES: usize = 6;
 
 /// Replaces the lowest modes of the reduction's spectrum `def` (values, selected shapes, and
 /// the reduced eigenvectors Y = LᵀX that refinement corrects through) by those of

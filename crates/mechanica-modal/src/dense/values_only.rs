@@ -25,7 +25,7 @@ use crate::certify::a_priori::APrioriModel;
 use crate::certify::products::{PairProducts, Residuals};
 use crate::certify::report::{AccuracyReport, BoundKind};
 use crate::certify::residual_bounds::{ModeBasis, RefinedResidual, residual_bounds};
-use crate::certify::resolution::zero_resolution;
+use crate::certify::resolution::{extended_rounding, zero_resolution};
 use crate::dd::Operand;
 use crate::dense::options::weakly_bounded;
 use crate::linalg::eigen::TridiagonalForm;
@@ -105,6 +105,13 @@ pub(crate) fn sharpen(
         unselected: Some(a_priori),
     };
     residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
+    for refined in &residuals {
+        let col = flagged.iter().position(|&i| i == refined.mode);
+        if let Some(col) = col {
+            let i = refined.mode;
+            report.error_bounds[i] += extended_rounding(a, b, x.col_as_slice(col), omega[i]);
+        }
+    }
     let norms = (report.norm_a, report.norm_b);
     flagged
         .iter()
