@@ -25,6 +25,9 @@ fn main() {
     let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(30);
     let seeds: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(10);
     let mode = args.get(3).cloned().unwrap_or_else(|| "auto".into());
+    if mode == "cost" {
+        return cost(n, seeds);
+    }
     for (shape, fixed) in [
         (Shape::Chain, true),
         (Shape::Tree, true),
@@ -86,6 +89,39 @@ fn main() {
         }
         println!(
             "{shape:?} fixed={fixed} n={n} {mode}: outside {outside}, misclassified {miscl}, errors {errs}, worst rel low5 {worst:e}"
+        );
+    }
+}
+
+/// Median wall time of a certified (`Refinement::Auto`) and a plain (`Refinement::Off`) solve of
+/// fixed graded trees, and their ratio.
+fn cost(n: usize, seeds: u64) {
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    for seed in 0..seeds {
+        let sys = spring_tree(&GradedFamily::new(n, Shape::Tree, true), seed);
+        let p = PencilProblem::new(sys.a.as_ref(), sys.b.as_ref()).expect("valid pencil");
+        let time = |refinement| {
+            median(
+                (0..3)
+                    .map(|_| {
+                        let clock = std::time::Instant::now();
+                        let options = SolveOptions {
+                            refinement,
+                            ..SolveOptions::default()
+                        };
+                        solve(&p, &options).expect("solve");
+                        clock.elapsed().as_secs_f64()
+                    })
+                    .collect(),
+            )
+        };
+        let (plain, certified) = (time(Refinement::Off), time(Refinement::Auto));
+        println!(
+            "n {n} seed {seed}: plain {plain:.4} s, certified {certified:.4} s, ratio {:.2}",
+            certified / plain
         );
     }
 }
