@@ -119,6 +119,9 @@ fn cost(n: usize, seeds: u64) {
             )
         };
         let (plain, certified) = (time(Refinement::Off), time(Refinement::Auto));
+        let detail = solve(&p, &SolveOptions::default()).expect("solve");
+        let refined = detail.accuracy.refinement_steps.iter().filter(|&&s| s > 0).count();
+        println!("  stages {:?}, refined modes {refined}", detail.timings);
         println!(
             "n {n} seed {seed}: plain {plain:.4} s, certified {certified:.4} s, ratio {:.2}",
             certified / plain

@@ -198,6 +198,15 @@ pub enum ModalError {
         /// What is wrong.
         detail: String,
     },
+    /// The pencil's entries span more binary orders than double precision holds once scaled
+    /// to a common range, or a result (an ω², a bound) lies outside the range of doubles.
+    #[error("{what} is outside the range of double precision: {detail}")]
+    OutOfRange {
+        /// The entry or result concerned.
+        what: String,
+        /// Its value and the range it would need.
+        detail: String,
+    },
     /// faer's eigensolver did not converge.
     #[error("the symmetric eigensolver did not converge on the reduced {n}×{n} matrix")]
     NoConvergence {

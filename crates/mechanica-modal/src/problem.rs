@@ -83,7 +83,13 @@ fn checked_symmetric(what: &'static str, m: MatRef<'_, f64>, n: usize) -> Result
             }
         }
     }
-    Ok(Mat::from_fn(n, n, |i, j| 0.5 * (m[(i, j)] + m[(j, i)])))
+    // The mean of two entries near the largest double must not overflow: halve first (exact for
+    // normal numbers; an entry and its mirror are equal or within SYMMETRY_ULPS, so this is the
+    // midpoint to the last bit except among subnormals).
+    Ok(Mat::from_fn(n, n, |i, j| {
+        let (x, y) = (m[(i, j)], m[(j, i)]);
+        if x == y { x } else { 0.5 * x + 0.5 * y }
+    }))
 }
 
 #[cfg(test)]

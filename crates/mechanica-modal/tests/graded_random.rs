@@ -186,3 +186,85 @@ fn the_reference_reproduces_the_closed_form_of_a_unit_chain() {
         assert!((r - e).abs() <= 4.0 * f64::EPSILON * e, "{r} vs {e}");
     }
 }
+
+/// x·2^e in exact steps.
+fn times_power_of_two(x: f64, e: i32) -> f64 {
+    let mut value = x;
+    let mut remaining = e;
+    while remaining != 0 {
+        let step = remaining.clamp(-1000, 1000);
+        value *= 2f64.powi(step);
+        remaining -= step;
+    }
+    value
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+    /// A graded system with A scaled by 2^p and B by 2^q, anywhere in the double range (entries
+    /// up to 1e308 and down to subnormal): the modes are the unscaled reference times 2^(q − p)
+    /// within their bounds, and a spectrum that leaves the range of doubles is a typed error.
+    #[test]
+    fn graded_systems_anywhere_in_the_double_range(
+        n in 4usize..40,
+        tree in any::<bool>(),
+        fixed in any::<bool>(),
+        p in -1000i32..1000,
+        q in -1000i32..1000,
+        seed in any::<u64>(),
+    ) {
+        let system = spring_tree(&family(n, tree, fixed, 4.0, 6.0), seed);
+        let reference = tree_pencil_spectrum(&system);
+        let (lo_a, hi_a) = (1e-4 * 0.9, 1.0);
+        let (lo_b, hi_b) = (1e-300, 4.0 * 1e6);
+        // Keep every stored nonzero entry a normal or subnormal double, never zero or infinite.
+        prop_assume!(times_power_of_two(lo_a, p) > 0.0 && times_power_of_two(hi_a, p).is_finite());
+        prop_assume!(times_power_of_two(hi_b, q).is_finite() && times_power_of_two(lo_b, q) >= 0.0);
+        let scaled = |m: &Mat<f64>, e: i32| Mat::from_fn(m.nrows(), m.ncols(), |i, j| times_power_of_two(m[(i, j)], e));
+        let (a, b) = (scaled(&system.a, p), scaled(&system.b, q));
+        prop_assume!(b.col_iter().flat_map(|c| c.iter().copied().collect::<Vec<_>>()).zip(system.b.col_iter().flat_map(|c| c.iter().copied().collect::<Vec<_>>())).all(|(s, o)| (s == 0.0) == (o == 0.0) && times_power_of_two(s, -q) == o));
+        let problem = PencilProblem::new(a.as_ref(), b.as_ref()).expect("finite pencil");
+        let exact: Vec<f64> = reference.iter().map(|&w| times_power_of_two(w, q - p)).collect();
+        let representable = exact.iter().all(|w| w.is_finite());
+        match solve(&problem, &SolveOptions::default()) {
+            Ok(solution) => {
+                prop_assert!(representable);
+                for (k, (mode, w)) in solution.modes.iter().zip(&exact).enumerate() {
+                    let error = (mode.omega_sq - w).abs();
+                    let allowed = mode.error_bound + 1e-24 * w.abs() + times_power_of_two(1e-300, q - p).max(f64::from_bits(1));
+                    prop_assert!(error <= allowed, "mode {}: {} vs {} (bound {:e})", k, mode.omega_sq, w, mode.error_bound);
+                }
+            }
+            Err(mechanica_modal::ModalError::OutOfRange { .. }) => prop_assert!(!representable || exact.iter().any(|w| w.abs() > 1e300)),
+            Err(other) => prop_assert!(false, "unexpected error {}", other),
+        }
+    }
+}
+
+/// Lumped masses 1, 2, 3 and 1.8e19 on a chain: a small mass is a mass, never a massless
+/// coordinate, however large its neighbour.
+#[test]
+fn a_small_mass_beside_a_huge_one_is_not_massless() {
+    let masses = [1.0, 2.0, 3.0, 1.8e19];
+    let n = masses.len();
+    let a = Mat::from_fn(n, n, |i, j| if i == j { masses[i] } else { 0.0 });
+    let b = mechanica_modal::testing::fixed_chain(n).1;
+    let parent = (0..n).map(|i| i.checked_sub(1)).collect();
+    let system = SpringTree {
+        a,
+        b,
+        parent,
+        rigid_modes: 0,
+    };
+    let reference = tree_pencil_spectrum(&system);
+    let problem = PencilProblem::new(system.a.as_ref(), system.b.as_ref()).expect("pencil");
+    let solution = solve(&problem, &SolveOptions::default()).expect("solve");
+    for (mode, exact) in solution.modes.iter().zip(&reference) {
+        assert!(matches!(mode.kind, ModeKind::Oscillatory { .. }), "{mode:?}");
+        assert!(
+            (mode.omega_sq - exact).abs() <= mode.error_bound,
+            "{} vs {exact}",
+            mode.omega_sq
+        );
+    }
+}

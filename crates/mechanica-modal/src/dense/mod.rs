@@ -19,6 +19,7 @@ mod idle_inputs;
 mod options;
 mod refinement;
 mod reversed;
+mod scaling;
 mod solution;
 mod values_only;
 
@@ -34,6 +35,7 @@ use crate::dense::finish::Finish;
 use crate::dense::idle_inputs::{EarlyInputs, IdleResults};
 use crate::dense::options::{check_interval, weakly_bounded};
 use crate::dense::reversed::{adopt_reversed_bottom, bottom_is_weak};
+use crate::dense::scaling::PencilScale;
 use crate::dense::solution::empty_solution;
 use crate::error::ModalError;
 use crate::linalg::eigen::OnTridiagonal;
@@ -52,8 +54,29 @@ use std::time::Instant;
 /// A positive definite: Cholesky reduction. A positive semidefinite: the massless directions
 /// (null space of A, from its eigen-decomposition) are condensed out statically and reported as
 /// infinite modes. A indefinite: [`ModalError::IndefiniteMass`], naming the failed pivot.
+/// Entries near the ends of the double range (1e±308, subnormal) are first scaled by powers of
+/// two (`scaling`), exactly; a result outside the range of doubles is
+/// [`ModalError::OutOfRange`].
 pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSolution, ModalError> {
     check_interval(options.selection)?;
+    match PencilScale::of(problem)? {
+        None => solve_in_range(problem, options),
+        Some(scale) => {
+            let selection = match options.selection {
+                Selection::Interval { lower, upper } => Selection::Interval {
+                    lower: scale.to_scaled(lower),
+                    upper: scale.to_scaled(upper),
+                },
+                other => other,
+            };
+            let scaled_options = SolveOptions { selection, ..*options };
+            scale.restore(solve_in_range(&scale.apply(problem)?, &scaled_options)?)
+        }
+    }
+}
+
+/// [`solve`] of a pencil whose entries need no scaling.
+fn solve_in_range(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSolution, ModalError> {
     let (a, b) = (problem.a(), problem.b());
     let n = problem.dim();
     // Below a few hundred unknowns thread start-up costs more than it saves (mechanisms).

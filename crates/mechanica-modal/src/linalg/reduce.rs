@@ -73,14 +73,14 @@ pub(crate) fn is_diagonal(m: MatRef<'_, f64>) -> bool {
     (0..m.ncols()).all(|j| (j + 1..m.nrows()).all(|i| m[(i, j)] == 0.0))
 }
 
-/// [`factor_in_place`] of a diagonal A: l_ii = √a_ii, with the same pivot test (a pivot that is
-/// not positive, NaN, or ≤ n·u·max_j a_jj fails).
+/// [`factor_in_place`] of a diagonal A (lumped masses): l_ii = √a_ii. A pivot fails only when
+/// it is not positive (or NaN): a lumped mass is massless only when it is exactly zero, never
+/// for being small beside another mass, since each diagonal entry is its own exact pivot.
 fn factor_diagonal_in_place(mut l: MatMut<'_, f64>) -> Result<(), usize> {
     let n = l.nrows();
-    let tolerance = n as f64 * f64::EPSILON * max_diagonal(l.rb());
     if let Some(pivot) = (0..n).find(|&i| {
         let pivot = l[(i, i)];
-        pivot.is_nan() || pivot <= tolerance
+        pivot.is_nan() || pivot <= 0.0
     }) {
         return Err(pivot);
     }
@@ -658,9 +658,10 @@ mod tests {
 
     #[test]
     fn diagonal_mass_names_its_failing_pivot() {
-        // Zero, negative and negligible (≤ n·u·max a_jj) diagonal entries fail at their index.
+        // Zero and negative diagonal entries fail at their index; a lumped mass is massless
+        // only when it is exactly zero.
         let n = 50;
-        for (bad, value) in [(0, 0.0), (17, -1.0), (49, 1e-20)] {
+        for (bad, value) in [(0, 0.0), (17, -1.0), (31, -0.0)] {
             let a = Mat::from_fn(n, n, |i, j| match (i == j, i == bad) {
                 (true, true) => value,
                 (true, false) => 1.0 + i as f64,
@@ -670,6 +671,21 @@ mod tests {
                 Cholesky::Failed { pivot } => assert_eq!(pivot, bad),
                 Cholesky::Factor(_) => panic!("a_{bad}{bad} = {value} factored"),
             }
+        }
+    }
+
+    #[test]
+    fn a_tiny_lumped_mass_is_a_mass() {
+        // 1e-20 beside masses of order 50 (far below n·u·max a_jj) is still a positive pivot.
+        let n = 50;
+        let a = Mat::from_fn(n, n, |i, j| match (i == j, i == 49) {
+            (true, true) => 1e-20,
+            (true, false) => 1.0 + i as f64,
+            _ => 0.0,
+        });
+        match cholesky(a.as_ref(), Par::Seq) {
+            Cholesky::Factor(l) => assert_eq!(l[(49, 49)], 1e-10),
+            Cholesky::Failed { pivot } => panic!("pivot {pivot} failed"),
         }
     }
 
