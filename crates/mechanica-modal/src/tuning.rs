@@ -132,6 +132,11 @@ pub struct Tuning {
     /// At or below this order the sparse solver converts to dense and calls [`crate::solve()`]
     /// (default 400): the dense solve is faster there.
     pub dense_limit: usize,
+    /// Up to this order a sparse solve whose Lanczos iteration does not converge (a graded pencil
+    /// whose shifted factor cannot be applied to the accuracy asked) is finished by the dense
+    /// solver instead of returning [`crate::ModalError::LanczosNoConvergence`] (default 4000:
+    /// n² doubles, about 128 MB per working matrix).
+    pub dense_rescue_limit: usize,
     /// Relative Ritz residual to which the buffer modes above the k-th converge (default 1e-8):
     /// they only place the inertia shift τ in a real gap of relative width ≥ √u, and after
     /// Rayleigh–Ritz their ω² err by about its square.
@@ -183,6 +188,7 @@ impl Tuning {
         max_projected_steps: 8,
         stagnation_ulps: 16.0,
         dense_limit: 400,
+        dense_rescue_limit: 4000,
         buffer_tolerance: 1e-8,
         rough_tolerance: 1e-6,
         max_rerun_block: 32,

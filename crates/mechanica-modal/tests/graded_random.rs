@@ -268,3 +268,36 @@ fn a_small_mass_beside_a_huge_one_is_not_massless() {
         );
     }
 }
+
+/// The sparse solver's own path (Lanczos above the dense limit) on graded chains and trees of a
+/// few thousand masses: the six lowest modes within their bounds, right to 1e-8, classified.
+#[test]
+fn sparse_lanczos_on_large_graded_systems() {
+    for (k, (tree, fixed)) in [(false, true), (true, true), (false, false), (true, false)]
+        .into_iter()
+        .enumerate()
+    {
+        let n = 800;
+        let system = spring_tree(&family(n, tree, fixed, 8.0, 12.0), 77 + k as u64);
+        let reference = mechanica_modal::testing::graded::tree_pencil_lowest(&system, 6);
+        let modes = modes_of(&system, Use::Sparse(6));
+        for (i, (mode, exact)) in modes.iter().zip(&reference).enumerate() {
+            let error = (mode.omega_sq - exact).abs();
+            let context = format!(
+                "tree {tree} fixed {fixed} mode {i}: {} vs {exact}, bound {:e}",
+                mode.omega_sq, mode.error_bound
+            );
+            assert!(error <= mode.error_bound + 1e-24 * exact.abs() + 1e-300, "{context}");
+            if i >= system.rigid_modes {
+                assert!(error <= 1e-8 * exact.abs(), "{context}");
+                assert!(
+                    matches!(mode.kind, ModeKind::Oscillatory { .. }),
+                    "{context}: {:?}",
+                    mode.kind
+                );
+            } else {
+                assert_eq!(mode.kind, ModeKind::Zero, "{context}");
+            }
+        }
+    }
+}

@@ -52,6 +52,23 @@ pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> 
     positive
 }
 
+/// Whether B itself is positive definite beyond rounding: its Cholesky factorization succeeds
+/// and every pivot l_jj² exceeds 4n·u·max_k b_kk, the rounding that elimination can leave in a
+/// pivot of a matrix singular up to rounding (the stiffness of a free structure, assembled
+/// from springs up to max b_kk). Then, by Sylvester's law, no mode has ω² ≤ 0: the pencil has
+/// neither rigid-body nor unstable modes.
+pub(crate) fn stiffness_is_definite(problem: &PencilProblem, par: faer::Par) -> bool {
+    let b = problem.b();
+    let n = problem.dim();
+    let largest = (0..n).map(|j| b[(j, j)]).fold(0.0_f64, f64::max);
+    let mut k = shifted_lower(problem, 0.0);
+    let factored = crate::linalg::reduce::factor_unchecked(k.as_mut(), par).is_ok();
+    let tolerance = 4.0 * n as f64 * f64::EPSILON * largest;
+    let definite = factored && (0..n).all(|j| k[(j, j)] * k[(j, j)] > tolerance);
+    crate::runtime::scratch::give_back(k);
+    definite
+}
+
 /// The lower triangle of B − shift·A (the strict upper triangle zero), in kept storage when
 /// some fits ([`crate::runtime::scratch`]).
 pub(crate) fn shifted_lower(problem: &PencilProblem, shift: f64) -> Mat<f64> {

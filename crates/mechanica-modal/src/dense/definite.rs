@@ -30,6 +30,10 @@ pub(crate) struct Definite {
     pub a_priori: Option<APrioriModel>,
     /// The reduction's time (as `factor`) and the eigensolver's (as `eigen`).
     pub timings: SolveTimings,
+    /// Error estimates of all n ω² (not bounds) when some came from the reversed pencil
+    /// (`crate::dense::reversed`): refinement forms its clusters from them, since the
+    /// first-order bounds of such modes are normwise and would join modes known apart.
+    pub estimates: Option<Vec<f64>>,
 }
 
 pub(crate) fn select(omega_sq: &[f64], selection: Selection) -> Result<(usize, usize), ModalError> {
@@ -82,6 +86,7 @@ pub(crate) fn solve_definite_owned(
             form: None,
             a_priori: None,
             timings: SolveTimings::default(),
+            estimates: None,
         });
     }
     let clock = Instant::now();
@@ -104,6 +109,7 @@ pub(crate) fn solve_definite_owned(
             form: Some(form),
             a_priori: None,
             timings,
+            estimates: None,
         });
     }
     let (eigen, mut spent) = symmetric_eigen_returning_input(c, true, par, on_tridiagonal)?;
@@ -129,5 +135,6 @@ pub(crate) fn solve_definite_owned(
         form: None,
         a_priori: None,
         timings,
+        estimates: None,
     })
 }

@@ -2,6 +2,7 @@
 //! modes ([`crate::dense::refinement`]), the Sturm check, classification and grouping.
 
 use crate::certify::a_priori::APrioriModel;
+use crate::certify::inertia::stiffness_is_definite;
 use crate::certify::products::PairProducts;
 use crate::certify::report::AccuracyReport;
 use crate::certify::resolution::zero_resolution;
@@ -65,6 +66,7 @@ impl Finish<'_> {
             mut form,
             a_priori,
             mut timings,
+            estimates,
         } = def;
         let mut omega: Vec<f64> = omega_all[first..end].to_vec();
         let mut x = match (vectors, lift) {
@@ -86,7 +88,8 @@ impl Finish<'_> {
         if let (Some(xm), Some(products), Some(metric)) = (x.as_mut(), products.as_mut(), self.metric(lift.is_none()))
             && self.options.refinement != Refinement::Off
         {
-            let stage = self.refinement_stage(metric, &omega_all, first, reduced.as_ref());
+            let mut stage = self.refinement_stage(metric, &omega_all, first, reduced.as_ref());
+            stage.estimates = estimates.as_deref().map(|e| &e[first..end]);
             stage.run(xm, products, &mut report, &mut omega);
         }
         timings.refine = clock.elapsed();
@@ -118,6 +121,7 @@ impl Finish<'_> {
             report.orthogonality_error = None;
         }
         let mut modes = finite_modes(&omega, &report, &resolution);
+        certify_positive_stiffness(self.problem, &mut modes, self.par);
         if matches!(self.options.selection, Selection::All) && !infinite.is_empty() {
             x = append_infinite(&mut modes, x, &infinite);
         }
@@ -195,6 +199,7 @@ impl Finish<'_> {
             omega_all,
             first,
             reduced,
+            estimates: None,
             par: self.par,
         }
     }
@@ -250,6 +255,22 @@ fn finite_modes(omega: &[f64], report: &AccuracyReport, resolution: &[f64]) -> V
             }
         })
         .collect()
+}
+
+/// A mode the data resolution or its bound would call zero, or unstable, when B itself is
+/// positive definite ([`stiffness_is_definite`]): Sylvester's law then puts every finite ω²
+/// above zero, so the mode is oscillatory. The Cholesky factorization of B is paid only when
+/// such a mode is present.
+fn certify_positive_stiffness(problem: &PencilProblem, modes: &mut [Mode], par: Par) {
+    let doubtful = |m: &Mode| matches!(m.kind, ModeKind::Zero | ModeKind::Unstable { .. });
+    if !modes.iter().any(doubtful) || !stiffness_is_definite(problem, par) {
+        return;
+    }
+    for mode in modes.iter_mut().filter(|m| doubtful(m)) {
+        mode.kind = ModeKind::Oscillatory {
+            omega: mode.omega_sq.max(0.0).sqrt(),
+        };
+    }
 }
 
 /// Appends the infinite modes (unit null vectors of A, exact) after the finite ones, and their

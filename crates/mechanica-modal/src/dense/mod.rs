@@ -59,8 +59,8 @@ use std::time::Instant;
 /// [`ModalError::OutOfRange`].
 pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSolution, ModalError> {
     check_interval(options.selection)?;
-    match PencilScale::of(problem)? {
-        None => solve_in_range(problem, options),
+    let solution = match PencilScale::of(problem)? {
+        None => solve_in_range(problem, options)?,
         Some(scale) => {
             let selection = match options.selection {
                 Selection::Interval { lower, upper } => Selection::Interval {
@@ -70,8 +70,25 @@ pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSol
                 other => other,
             };
             let scaled_options = SolveOptions { selection, ..*options };
-            scale.restore(solve_in_range(&scale.apply(problem)?, &scaled_options)?)
+            scale.restore(solve_in_range(&scale.apply(problem)?, &scaled_options)?)?
         }
+    };
+    check_finite(&solution)?;
+    Ok(solution)
+}
+
+/// Every finite mode's ω² and bound are numbers: a NaN or an overflow anywhere in the solve is
+/// a typed error, never a reported value.
+fn check_finite(solution: &ModalSolution) -> Result<(), ModalError> {
+    let bad = solution.modes.iter().enumerate().find(|(_, m)| {
+        m.kind != crate::spectrum::ModeKind::Infinite && !(m.omega_sq.is_finite() && m.error_bound.is_finite())
+    });
+    match bad {
+        Some((k, mode)) => Err(ModalError::OutOfRange {
+            what: format!("mode {k}"),
+            detail: format!("ω² {} with error bound {}", mode.omega_sq, mode.error_bound),
+        }),
+        None => Ok(()),
     }
 }
 

@@ -33,6 +33,9 @@ pub(crate) struct Stage<'a> {
     pub first: usize,
     /// All n eigenvectors Y of the reduced matrix, when they were computed.
     pub reduced: Option<&'a Mat<f64>>,
+    /// The selected modes' error estimates when some came from the reversed pencil: the
+    /// clusters are formed from the smaller of each mode's bound and its estimate.
+    pub estimates: Option<&'a [f64]>,
     pub par: Par,
 }
 
@@ -82,13 +85,22 @@ impl Stage<'_> {
     /// The clusters to refine: those the policy asks for (a weakly bounded member, or all under
     /// [`Refinement::Always`]) that refinement can take ([`refinable`]).
     fn jobs(&self, report: &AccuracyReport, omega: &[f64]) -> Vec<Range<usize>> {
-        clusters(omega, &report.error_bounds)
+        let separation: Vec<f64> = match self.estimates {
+            Some(estimates) => report
+                .error_bounds
+                .iter()
+                .zip(estimates)
+                .map(|(b, e)| b.min(*e))
+                .collect(),
+            None => report.error_bounds.clone(),
+        };
+        clusters(omega, &separation)
             .into_iter()
             .filter(|g| {
                 let wanted = self.policy == Refinement::Always
                     || g.clone()
                         .any(|i| weakly_bounded(report.bound_with_rounding(i, self.a.nrows()), omega[i]));
-                wanted && refinable(g, omega, &report.error_bounds, self.omega_all, self.first)
+                wanted && refinable(g, omega, &separation, self.omega_all, self.first)
             })
             .collect()
     }

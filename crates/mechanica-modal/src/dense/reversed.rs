@@ -30,6 +30,8 @@ const SHIFT_ATTEMPTS: usize = 6;
 pub(crate) struct ReversedBottom {
     /// The ω² of the lowest modes, ascending.
     pub omega_sq: Vec<f64>,
+    /// Their error estimates n·u·(ω² + s)²·μ_max (not bounds).
+    pub estimates: Vec<f64>,
     /// Their shapes, A-normalised columns (n × omega_sq.len()).
     pub vectors: Mat<f64>,
 }
@@ -61,13 +63,19 @@ pub(crate) fn reversed_bottom(
         return None;
     }
     let omega_sq: Vec<f64> = taken.iter().map(|&j| 1.0 / eigen.values[j] - shift).collect();
+    let order = a.nrows() as f64 * f64::EPSILON;
+    let estimates: Vec<f64> = taken
+        .iter()
+        .map(|&j| order * mu_max / (eigen.values[j] * eigen.values[j]))
+        .collect();
     let mut vectors = Mat::from_fn(a.nrows(), taken.len(), |i, c| z[(i, taken[c])]);
     back_transform(r.as_ref(), vectors.as_mut(), par);
     normalise_in_a(a, &mut vectors);
-    omega_sq
-        .iter()
-        .all(|w| w.is_finite())
-        .then_some(ReversedBottom { omega_sq, vectors })
+    omega_sq.iter().all(|w| w.is_finite()).then_some(ReversedBottom {
+        omega_sq,
+        estimates,
+        vectors,
+    })
 }
 
 /// The smallest shift tried for which B + sA has a Cholesky factor, with that factor.
@@ -156,6 +164,10 @@ pub(crate) fn adopt_reversed_bottom(
     if m == 0 {
         return false;
     }
+    let forward_estimate = f64::EPSILON * n as f64 * scale;
+    let mut estimates = vec![forward_estimate; n];
+    estimates[..m].copy_from_slice(&bottom.estimates[..m]);
+    def.estimates = Some(estimates);
     def.omega_sq[..m].copy_from_slice(&bottom.omega_sq[..m]);
     if let Some(x) = def.vectors.as_mut() {
         for j in def.first..def.end.min(m) {

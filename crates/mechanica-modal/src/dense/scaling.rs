@@ -16,6 +16,10 @@ use faer::{Mat, MatRef};
 /// The largest binary exponent the scaled entries keep (so that sums of n² squares, Frobenius
 /// norms, do not overflow).
 const TOP_EXPONENT: i32 = 0;
+/// A pencil whose largest entries of A and of B have binary exponents within ±SAFE_EXPONENT
+/// (and no nonzero entry below 2^−900) is solved as stored: its ω², their squares in the
+/// quadratic bounds and the double-double products all stay far inside the range.
+const SAFE_EXPONENT: i32 = 100;
 /// The smallest binary exponent a scaled nonzero entry may have: normal numbers only.
 const BOTTOM_EXPONENT: i32 = f64::MIN_EXP;
 
@@ -30,7 +34,7 @@ pub(crate) struct PencilScale {
 impl PencilScale {
     /// The scale of `problem`: its largest entries brought to [1/2, 1), or, when that would
     /// take its smallest nonzero entry below the normal range, as high as the largest allows.
-    /// None when no scaling is needed (every nonzero entry within [2^−500, 2^500]).
+    /// None when no scaling is needed (see [`SAFE_EXPONENT`]).
     pub(crate) fn of(problem: &PencilProblem) -> Result<Option<Self>, ModalError> {
         let (mass, mass_needed) = exponent_for("A", problem.a())?;
         let (stiffness, stiffness_needed) = exponent_for("B", problem.b())?;
@@ -160,7 +164,7 @@ fn exponent_for(what: &str, m: MatRef<'_, f64>) -> Result<(i32, bool), ModalErro
         return Ok((0, false));
     }
     let (top, bottom) = (exponent(largest), exponent(smallest));
-    let needed = !(-500..=500).contains(&top) || bottom < -500;
+    let needed = !(-SAFE_EXPONENT..=SAFE_EXPONENT).contains(&top) || bottom < -900;
     let mut shift = top - TOP_EXPONENT;
     if bottom - shift < BOTTOM_EXPONENT {
         shift = bottom - BOTTOM_EXPONENT;

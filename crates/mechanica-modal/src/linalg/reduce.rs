@@ -99,6 +99,13 @@ pub(crate) fn factor_in_place(mut l: MatMut<'_, f64>, par: Par) -> Result<(), us
     check_pivots(l.rb(), max_diag)
 }
 
+/// Factors the lower triangle of `l` in place with no negligible-pivot test: Err(pivot) only at
+/// a pivot that is not positive; the caller judges the pivots.
+pub(crate) fn factor_unchecked(mut l: MatMut<'_, f64>, par: Par) -> Result<(), usize> {
+    let par = factor_parallelism(l.nrows(), par);
+    factor_recursive(l.rb_mut(), par)
+}
+
 /// The largest diagonal entry of `l`: before factoring, the scale of the pivot test.
 pub(crate) fn max_diagonal(l: MatRef<'_, f64>) -> f64 {
     (0..l.nrows()).map(|i| l[(i, i)]).fold(0.0_f64, f64::max)

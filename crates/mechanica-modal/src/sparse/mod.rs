@@ -92,9 +92,21 @@ use std::time::{Duration, Instant};
 /// [`ModalError::MassNotSemidefinite`], and [`ModalError::LanczosNoConvergence`] when a run does
 /// not converge within `max_restarts`, or when after `max_runs` Lanczos runs the inertia count
 /// still shows modes missing below the check shift τ (then `converged` = modes found below τ,
-/// `wanted` = the inertia count below τ, `restarts` = restarts over all runs).
+/// `wanted` = the inertia count below τ, `restarts` = restarts over all runs). Up to order
+/// [`Tuning::dense_rescue_limit`] a pencil on which a run exhausts `max_restarts` (typically a
+/// graded one, whose shifted factor cannot be applied to the accuracy asked) is solved densely
+/// instead, with the dense solver's
+/// certified low modes; [`SparseAccuracyReport`] then says `dense_fallback`.
 pub fn solve_sparse(pencil: &SparsePencil, options: &SparseSolveOptions) -> Result<SparseModalSolution, ModalError> {
-    solve_sparse_from(pencil, options, None)
+    match solve_sparse_from(pencil, options, None) {
+        Err(ModalError::LanczosNoConvergence { restarts, .. })
+            if restarts >= options.max_restarts && pencil.dim() <= Tuning::DEFAULT.dense_rescue_limit =>
+        {
+            options.check(pencil.dim())?;
+            dense_fallback(pencil, options.count, frobenius(pencil.a()), frobenius(pencil.b()))
+        }
+        other => other,
+    }
 }
 
 /// [`solve_sparse`] with an optional first start block (n × block size, column-major): lets tests

@@ -57,8 +57,9 @@ pub struct SparseAccuracyReport {
     pub computed_below: usize,
     /// Whether the inertia count equals computed_below (no mode below τ missed or invented).
     pub consistent: bool,
-    /// True when the problem was small enough to be solved densely (n ≤
-    /// [`crate::Tuning::dense_limit`]).
+    /// True when the problem was solved densely: small enough (n ≤
+    /// [`crate::Tuning::dense_limit`]), or Lanczos did not converge on it and n ≤
+    /// [`crate::Tuning::dense_rescue_limit`].
     pub dense_fallback: bool,
     /// Stage timings.
     pub timings: SparseSolveTimings,

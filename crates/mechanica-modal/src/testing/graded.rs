@@ -208,6 +208,11 @@ fn midpoint(lo: Dd, hi: Dd) -> Dd {
 /// Every ω² of the spring tree's stored pencil, ascending, each to about 1e-24 relative (or
 /// 1e-300 absolute near zero), by bisection on the inertia counts of B − σA.
 pub fn tree_pencil_spectrum(system: &SpringTree) -> Vec<f64> {
+    tree_pencil_lowest(system, system.parent.len())
+}
+
+/// The `k` lowest ω² of [`tree_pencil_spectrum`].
+pub fn tree_pencil_lowest(system: &SpringTree, k: usize) -> Vec<f64> {
     let (a, b, parent) = (&system.a, &system.b, &system.parent[..]);
     let n = parent.len();
     let order = leaves_first(parent);
@@ -218,7 +223,7 @@ pub fn tree_pencil_spectrum(system: &SpringTree) -> Vec<f64> {
         * 2.0
         + 1.0;
     let count = |s: Dd| tree_count_below(a, b, parent, &order, s);
-    (0..n)
+    (0..k.min(n))
         .map(|k| {
             // The k-th value (from 0) is where the count first exceeds k.
             let (mut lo, mut hi) = (Dd::of(-reach), Dd::of(reach));
