@@ -1146,7 +1146,7 @@ typedef struct mech_modal_mode_t {
     double omega_sq;
     /**
      * ω (rad/s) for an oscillatory mode, the growth rate √λ (1/s) for an unstable one, 0 for a
-     * zero mode, +HUGE_VAL for an infinite one.
+     * zero or undecided mode, +HUGE_VAL for an infinite one.
      */
     double rate;
     /**
@@ -2003,7 +2003,7 @@ typedef struct mech_modal_sparse_details_t {
 
 #if defined(MECH_FEATURE_MODAL)
 /**
- * |λ| within its error bound: rigid-body (zero-frequency) mode.
+ * |λ| within the data's resolution: rigid-body (zero-frequency) mode.
  */
 #define MECH_MODAL_KIND_ZERO 1
 #endif
@@ -2020,6 +2020,14 @@ typedef struct mech_modal_sparse_details_t {
  * Massless direction (A x = 0): infinite frequency.
  */
 #define MECH_MODAL_KIND_INFINITE 3
+#endif
+
+#if defined(MECH_FEATURE_MODAL)
+/**
+ * The interval omega_sq ± error_bound contains zero and is far wider than the data's
+ * resolution: neither the sign nor the size of ω² is known (rate 0).
+ */
+#define MECH_MODAL_KIND_UNDECIDED 4
 #endif
 
 #ifdef __cplusplus

@@ -314,6 +314,7 @@ fn mode_label(modes: &MechanismModes, k: usize) -> String {
         ModeKind::Zero => format!("mode {} — zero", k + 1),
         ModeKind::Unstable { growth_rate } => format!("mode {} — unstable, γ = {growth_rate:.4} 1/s", k + 1),
         ModeKind::Infinite => format!("mode {} — infinite", k + 1),
+        ModeKind::Undecided => format!("mode {} — undecided (ω² ± bound contains 0)", k + 1),
     }
 }
 

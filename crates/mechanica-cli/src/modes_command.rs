@@ -63,17 +63,20 @@ fn stage(analysis: &str, time: Duration, quantities: Vec<Quantity>) -> Step {
     }
 }
 
-/// The classification code written to the report (0 oscillatory, 1 zero, 2 unstable, 3 infinite).
+/// The classification code written to the report (0 oscillatory, 1 zero, 2 unstable, 3 infinite,
+/// 4 undecided: the interval ω² ± bound contains zero).
 fn kind_code(kind: ModeKind) -> f64 {
     match kind {
         ModeKind::Oscillatory { .. } => 0.0,
         ModeKind::Zero => 1.0,
         ModeKind::Unstable { .. } => 2.0,
         ModeKind::Infinite => 3.0,
+        ModeKind::Undecided => 4.0,
     }
 }
 
-const KIND_UNIT: &str = "kind (0 oscillatory, 1 zero/rigid-body, 2 unstable, 3 infinite)";
+const KIND_UNIT: &str =
+    "kind (0 oscillatory, 1 zero/rigid-body, 2 unstable, 3 infinite, 4 undecided: ω² ± bound contains 0)";
 
 /// The per-mode quantities shared by the dense and the sparse report.
 fn mode_quantities(modes: &[mechanica::modal::Mode], groups: &[mechanica::modal::ModeGroup]) -> Vec<Quantity> {

@@ -216,7 +216,8 @@ fn propagate_assembly_error(solution: &mut ModalSolution, b: &Mat<f64>) {
         }
         let norm_sq: f64 = (0..x.nrows()).map(|r| x[(r, k)] * x[(r, k)]).sum();
         mode.error_bound += delta * norm_sq;
-        mode.kind = mechanica_modal::classify(mode.omega_sq, mode.error_bound);
+        // The assembly error is the model's own resolution: within the bound, a mode is zero.
+        mode.kind = mechanica_modal::classify(mode.omega_sq, mode.error_bound, mode.error_bound);
         if let Some(bound) = solution.accuracy.error_bounds.get_mut(k) {
             *bound = mode.error_bound;
         }

@@ -176,6 +176,15 @@ impl FreeResponse {
                     ModeKind::Oscillatory { omega } => CoordinateLaw::Oscillatory { omega },
                     ModeKind::Unstable { growth_rate } => CoordinateLaw::Exponential { growth_rate },
                     ModeKind::Zero | ModeKind::Infinite => CoordinateLaw::Linear,
+                    // Sign unknown: the motion of the computed value, whose rate error the
+                    // coordinate's bound states.
+                    ModeKind::Undecided if mode.omega_sq > 0.0 => CoordinateLaw::Oscillatory {
+                        omega: mode.omega_sq.sqrt(),
+                    },
+                    ModeKind::Undecided if mode.omega_sq < 0.0 => CoordinateLaw::Exponential {
+                        growth_rate: (-mode.omega_sq).sqrt(),
+                    },
+                    ModeKind::Undecided => CoordinateLaw::Linear,
                 };
                 ModalCoordinate {
                     mode: k,

@@ -18,7 +18,7 @@ pub enum ModeKind {
         /// Angular frequency ω (rad/s).
         omega: f64,
     },
-    /// |λ| within its error bound: a rigid-body (zero-frequency) mode, δ(t) = x (a + b t).
+    /// |λ| within the data's resolution: a rigid-body (zero-frequency) mode, δ(t) = x (a + b t).
     Zero,
     /// λ > 0 beyond its error bound: the equilibrium is unstable, δ(t) ∝ x e^{±γt}.
     Unstable {
@@ -27,6 +27,10 @@ pub enum ModeKind {
     },
     /// A massless direction (A x = 0, A semidefinite): λ = −∞, infinite frequency.
     Infinite,
+    /// The interval ω² ± error bound contains zero and is far wider than the data's resolution:
+    /// the computation cannot decide whether the mode is oscillatory, rigid-body or unstable
+    /// (an unrefined stiff mode). Its interval is [`Mode::omega_sq`] ± [`Mode::error_bound`].
+    Undecided,
 }
 
 /// One eigenpair's scalar data.
@@ -60,21 +64,36 @@ pub struct ModeGroup {
     pub omega_sq: f64,
 }
 
-/// Zero when |ω²| is within `bound`; otherwise oscillatory or unstable by its sign. The solvers
-/// pass the larger of the mode's error bound and its
-/// [`crate::certify::resolution::data_resolution`]: a mode is zero when the computation cannot tell
-/// it from zero, or the data cannot.
-pub fn classify(omega_sq: f64, bound: f64) -> ModeKind {
+/// How far a mode's error bound may exceed its data resolution and the mode still be called zero
+/// when its interval contains zero: within three orders the computation's uncertainty is that of
+/// the data themselves, which no double-precision solve improves on.
+pub const UNDECIDED_RATIO: f64 = 1e3;
+
+/// The classification of a mode with value `omega_sq`, error bound `bound` (the interval
+/// ω² ± bound contains the exact ω² of the stored pencil) and data `resolution` (how far
+/// rounding A and B entrywise can move it, [`crate::certify::resolution::data_resolution`]):
+/// - infinite ω²: [`ModeKind::Infinite`];
+/// - |ω²| within the resolution: [`ModeKind::Zero`], the data cannot tell it from zero;
+/// - an interval that excludes zero: oscillatory or unstable by its sign;
+/// - an interval that contains zero: zero when the bound is within [`UNDECIDED_RATIO`] of the
+///   resolution, else [`ModeKind::Undecided`]: neither the sign nor the size is known.
+pub fn classify(omega_sq: f64, bound: f64, resolution: f64) -> ModeKind {
     if omega_sq.is_infinite() {
         ModeKind::Infinite
-    } else if omega_sq.abs() <= bound {
+    } else if omega_sq.abs() <= resolution {
         ModeKind::Zero
-    } else if omega_sq > 0.0 {
-        ModeKind::Oscillatory { omega: omega_sq.sqrt() }
-    } else {
-        ModeKind::Unstable {
-            growth_rate: (-omega_sq).sqrt(),
+    } else if omega_sq.abs() > bound {
+        if omega_sq > 0.0 {
+            ModeKind::Oscillatory { omega: omega_sq.sqrt() }
+        } else {
+            ModeKind::Unstable {
+                growth_rate: (-omega_sq).sqrt(),
+            }
         }
+    } else if bound <= UNDECIDED_RATIO * resolution {
+        ModeKind::Zero
+    } else {
+        ModeKind::Undecided
     }
 }
 
@@ -141,4 +160,24 @@ pub(crate) fn refinable(g: &Range<usize>, omega: &[f64], bounds: &[f64], omega_a
         && first + omega.len() < omega_all.len()
         && overlapping(omega[last], bounds[last], omega_all[first + omega.len()], bounds[last]);
     g.len() <= Tuning::DEFAULT.max_refined_cluster && !cut_below && !cut_above
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn classification_follows_the_interval_and_the_resolution() {
+        // Resolved values: by sign.
+        assert_eq!(classify(4.0, 1e-3, 1e-12), ModeKind::Oscillatory { omega: 2.0 });
+        assert_eq!(classify(-4.0, 1e-3, 1e-12), ModeKind::Unstable { growth_rate: 2.0 });
+        // Within the data's resolution: zero, whatever the bound.
+        assert_eq!(classify(1e-13, 1e-20, 1e-12), ModeKind::Zero);
+        // An interval containing zero, within three orders of the resolution: zero.
+        assert_eq!(classify(1e-11, 1e-10, 1e-12), ModeKind::Zero);
+        // An interval containing zero, far wider than the resolution: undecided.
+        assert_eq!(classify(1e-3, 1e2, 1e-12), ModeKind::Undecided);
+        assert_eq!(classify(-1e-3, 1e2, 1e-12), ModeKind::Undecided);
+        assert_eq!(classify(f64::INFINITY, 0.0, 0.0), ModeKind::Infinite);
+    }
 }

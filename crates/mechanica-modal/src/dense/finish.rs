@@ -4,13 +4,13 @@
 use crate::certify::a_priori::APrioriModel;
 use crate::certify::inertia::stiffness_is_definite;
 use crate::certify::products::PairProducts;
-use crate::certify::report::AccuracyReport;
+use crate::certify::report::{AccuracyReport, BoundKind};
 use crate::certify::resolution::zero_resolution;
 use crate::certify::sketch::SketchRows;
 use crate::certify::sturm::inertia_check;
 use crate::dense::definite::Definite;
 use crate::dense::idle_inputs::IdleResults;
-use crate::dense::options::{Refinement, Selection, SolveOptions};
+use crate::dense::options::{Refinement, Selection, SolveOptions, weakly_bounded};
 use crate::dense::refinement::Stage;
 use crate::dense::solution::{Method, ModalSolution};
 use crate::dense::values_only;
@@ -94,6 +94,9 @@ impl Finish<'_> {
         }
         timings.refine = clock.elapsed();
         let clock = Instant::now();
+        if self.options.refinement == Refinement::Off && x.is_some() {
+            self.widen_unrefined_bounds(&mut report, &omega, a_priori);
+        }
         if let (Some(x), Some(p)) = (&x, products.as_mut()) {
             report.finish(p, self.problem.a(), x.as_ref(), &omega, self.par);
         }
@@ -158,6 +161,28 @@ impl Finish<'_> {
             }
         };
         (products, report, model_used)
+    }
+
+    /// Without refinement, a first-order bound that guarantees fewer than 8 digits belongs to a
+    /// mode near the reduction's error level, where the first-order theory (a simple eigenvalue
+    /// whose perturbation stays below its gaps) need not hold: such a bound is raised to the
+    /// a-priori bound of the reduction ([`APrioriModel`]), a Weyl bound that needs no gap.
+    fn widen_unrefined_bounds(&self, report: &mut AccuracyReport, omega: &[f64], a_priori: Option<APrioriModel>) {
+        let n = self.problem.dim();
+        let weak: Vec<usize> = (0..omega.len())
+            .filter(|&i| weakly_bounded(report.bound_with_rounding(i, n), omega[i]))
+            .collect();
+        if weak.is_empty() {
+            return;
+        }
+        let model = a_priori.unwrap_or_else(|| APrioriModel::new(self.l, self.norm_a, self.norm_b, self.par));
+        for i in weak {
+            let weyl = model.bound(omega[i]);
+            if weyl > report.bound_with_rounding(i, n) {
+                report.error_bounds[i] = weyl;
+                report.bound_kinds[i] = BoundKind::APriori;
+            }
+        }
     }
 
     /// Values only: [`values_only::sharpen`] of the report from the error model `model`;
@@ -248,7 +273,7 @@ fn finite_modes(omega: &[f64], report: &AccuracyReport, resolution: &[f64]) -> V
             Mode {
                 lambda: -omega[i],
                 omega_sq: omega[i],
-                kind: classify(omega[i], bound.max(resolution[i])),
+                kind: classify(omega[i], bound, resolution[i]),
                 error_bound: bound,
                 backward_error: report.backward_errors.get(i).copied().flatten(),
                 group: 0,
@@ -262,7 +287,7 @@ fn finite_modes(omega: &[f64], report: &AccuracyReport, resolution: &[f64]) -> V
 /// above zero, so the mode is oscillatory. The Cholesky factorization of B is paid only when
 /// such a mode is present.
 fn certify_positive_stiffness(problem: &PencilProblem, modes: &mut [Mode], par: Par) {
-    let doubtful = |m: &Mode| matches!(m.kind, ModeKind::Zero | ModeKind::Unstable { .. });
+    let doubtful = |m: &Mode| matches!(m.kind, ModeKind::Zero | ModeKind::Unstable { .. } | ModeKind::Undecided);
     if !modes.iter().any(doubtful) || !stiffness_is_definite(problem, par) {
         return;
     }

@@ -205,7 +205,7 @@ pub(crate) fn finish(
         .map(|c| Mode {
             lambda: -omega_sq[c],
             omega_sq: omega_sq[c],
-            kind: classify(omega_sq[c], bounds[c].max(resolution[c])),
+            kind: classify(omega_sq[c], bounds[c], resolution[c]),
             error_bound: bounds[c],
             backward_error: Some(eta[c]),
             group: 0,

@@ -7,12 +7,15 @@ use mechanica_modal::{Mode, ModeGroup, ModeKind};
 pub type mech_modal_kind_t = i32;
 /// λ < 0: oscillates at ω = √(−λ) rad/s.
 pub const MECH_MODAL_KIND_OSCILLATORY: mech_modal_kind_t = 0;
-/// |λ| within its error bound: rigid-body (zero-frequency) mode.
+/// |λ| within the data's resolution: rigid-body (zero-frequency) mode.
 pub const MECH_MODAL_KIND_ZERO: mech_modal_kind_t = 1;
 /// λ > 0: unstable equilibrium, growth rate √λ (1/s).
 pub const MECH_MODAL_KIND_UNSTABLE: mech_modal_kind_t = 2;
 /// Massless direction (A x = 0): infinite frequency.
 pub const MECH_MODAL_KIND_INFINITE: mech_modal_kind_t = 3;
+/// The interval omega_sq ± error_bound contains zero and is far wider than the data's
+/// resolution: neither the sign nor the size of ω² is known (rate 0).
+pub const MECH_MODAL_KIND_UNDECIDED: mech_modal_kind_t = 4;
 
 /// Scalar data of one mode.
 #[repr(C)]
@@ -23,7 +26,7 @@ pub struct mech_modal_mode_t {
     /// ω² = −λ (rad²/s²); +HUGE_VAL for an infinite mode.
     pub omega_sq: f64,
     /// ω (rad/s) for an oscillatory mode, the growth rate √λ (1/s) for an unstable one, 0 for a
-    /// zero mode, +HUGE_VAL for an infinite one.
+    /// zero or undecided mode, +HUGE_VAL for an infinite one.
     pub rate: f64,
     /// Bound on |ω²_computed − ω²_exact|.
     pub error_bound: f64,
@@ -44,6 +47,7 @@ pub(crate) fn kind_to_c(kind: ModeKind) -> (mech_modal_kind_t, f64) {
         ModeKind::Zero => (MECH_MODAL_KIND_ZERO, 0.0),
         ModeKind::Unstable { growth_rate } => (MECH_MODAL_KIND_UNSTABLE, growth_rate),
         ModeKind::Infinite => (MECH_MODAL_KIND_INFINITE, f64::INFINITY),
+        ModeKind::Undecided => (MECH_MODAL_KIND_UNDECIDED, 0.0),
     }
 }
 
