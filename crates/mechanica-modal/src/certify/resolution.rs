@@ -1,7 +1,7 @@
 //! The resolution of the data: how far rounding the stored A and B can move ω², below which a
 //! mode cannot be told from a rigid-body mode (the zero classification of [`crate::classify`]).
 
-use faer::MatRef;
+use faer::{Mat, MatRef, Par};
 
 /// The change of ω² that rounding A and B entrywise can cause for an A-normalised mode shape x:
 /// |xᵀδBx| + |ω²|·|xᵀδAx| ≤ u(|x|ᵀ|B||x| + |ω²|·|x|ᵀ|A||x|) for |δA| ≤ u|A|, |δB| ≤ u|B| (u
@@ -49,10 +49,58 @@ pub(crate) fn zero_resolution(
     }
 }
 
-/// The rounding of the double-double residual and Rayleigh quotient of an A-normalised shape
-/// x: each of their n-term sums errs by at most about n·u²(|x|ᵀ|B||x| + |ω²|·|x|ᵀ|A||x|), a
+/// [`data_resolution`] of the columns `columns` of `x` (A-normalised shapes) with their ω², at
+/// once: |B||X| and |A||X| as two matrix products (gemm speed) instead of n² scalar steps per
+/// mode.
+pub(crate) fn data_resolutions(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    x: MatRef<'_, f64>,
+    columns: &[usize],
+    omega_sq: &[f64],
+    par: Par,
+) -> Vec<f64> {
+    if columns.is_empty() {
+        return Vec::new();
+    }
+    let n = x.nrows();
+    let abs_x = Mat::from_fn(n, columns.len(), |i, c| x[(i, columns[c])].abs());
+    let quadratic = |m: MatRef<'_, f64>| -> Vec<f64> {
+        let abs_m = Mat::from_fn(n, n, |i, j| m[(i, j)].abs());
+        let mut product = Mat::<f64>::zeros(n, columns.len());
+        faer::linalg::matmul::matmul(
+            product.as_mut(),
+            faer::Accum::Replace,
+            abs_m.as_ref(),
+            abs_x.as_ref(),
+            1.0,
+            par,
+        );
+        (0..columns.len())
+            .map(|c| abs_x.col(c).iter().zip(product.col(c).iter()).map(|(u, v)| u * v).sum())
+            .collect()
+    };
+    let (stiffness, mass) = (quadratic(b), quadratic(a));
+    (0..columns.len())
+        .map(|c| f64::EPSILON * (stiffness[c] + omega_sq[c].abs() * mass[c]))
+        .collect()
+}
+
+/// The rounding of the double-double residual and Rayleigh quotient of the A-normalised shapes
+/// `columns` of `x`: each of their n-term sums errs by at most about n·u²(|x|ᵀ|B||x| + |ω²|·|x|ᵀ|A||x|), a
 /// term that matters only where ω² is cancelled far below the entries (a near-zero mode of a
-/// stiff structure). It is 4n·u times the data resolution, which has the same sums.
-pub(crate) fn extended_rounding(a: MatRef<'_, f64>, b: MatRef<'_, f64>, x: &[f64], omega_sq: f64) -> f64 {
-    4.0 * x.len() as f64 * f64::EPSILON * data_resolution(a, b, x, omega_sq)
+/// stiff structure). It is 4n·u times the data resolution ([`data_resolutions`]), which has the same sums.
+pub(crate) fn extended_roundings(
+    a: MatRef<'_, f64>,
+    b: MatRef<'_, f64>,
+    x: MatRef<'_, f64>,
+    columns: &[usize],
+    omega_sq: &[f64],
+    par: Par,
+) -> Vec<f64> {
+    let scale = 4.0 * x.nrows() as f64 * f64::EPSILON;
+    data_resolutions(a, b, x, columns, omega_sq, par)
+        .into_iter()
+        .map(|r| scale * r)
+        .collect()
 }

@@ -5,7 +5,7 @@ use crate::certify::a_priori::APrioriModel;
 use crate::certify::inertia::stiffness_is_definite;
 use crate::certify::products::PairProducts;
 use crate::certify::report::{AccuracyReport, BoundKind};
-use crate::certify::resolution::zero_resolution;
+use crate::certify::resolution::{data_resolutions, normwise_resolution};
 use crate::certify::sketch::SketchRows;
 use crate::certify::sturm::inertia_check;
 use crate::dense::definite::Definite;
@@ -252,11 +252,26 @@ impl Finish<'_> {
         let (a, b) = (self.problem.a(), self.problem.b());
         let mut resolution: Vec<f64> = (0..omega.len())
             .map(|i| match (x, &a_priori) {
-                (Some(x), _) => zero_resolution(a, b, x.col_as_slice(i), omega[i], (self.norm_a, self.norm_b)),
+                (Some(x), _) => {
+                    let shape_norm_sq = x.col(i).iter().map(|v| v * v).sum::<f64>();
+                    normwise_resolution(omega[i], self.norm_a, self.norm_b, shape_norm_sq)
+                }
                 (None, Some(model)) => model.data_resolution(omega[i]),
                 (None, None) => 0.0,
             })
             .collect();
+        // Where |ω²| is within the cheap normwise value, only the componentwise one can decide
+        // (crate::certify::resolution::zero_resolution), computed for those modes at once.
+        if let Some(x) = x {
+            let columns: Vec<usize> = (0..omega.len()).filter(|&i| omega[i].abs() <= resolution[i]).collect();
+            let values: Vec<f64> = columns.iter().map(|&i| omega[i]).collect();
+            for (&i, r) in columns
+                .iter()
+                .zip(data_resolutions(a, b, x.as_ref(), &columns, &values, self.par))
+            {
+                resolution[i] = r;
+            }
+        }
         for (i, value) in measured {
             resolution[i] = value;
         }

@@ -5,7 +5,7 @@
 use crate::certify::products::PairProducts;
 use crate::certify::report::{AccuracyReport, BoundKind};
 use crate::certify::residual_bounds::{ModeBasis, RefinedResidual, residual_bounds, split_refined_clusters};
-use crate::certify::resolution::extended_rounding;
+use crate::certify::resolution::extended_roundings;
 use crate::dd::Operand;
 use crate::dense::options::{Refinement, weakly_bounded};
 use crate::refine::{
@@ -255,10 +255,11 @@ impl Stage<'_> {
             unselected: None,
         };
         residual_bounds(report, omega, self.omega_all, self.first, residuals, &basis, self.par);
-        for refined in residuals {
-            let i = refined.mode;
-            let shape: Vec<f64> = x.col(i).iter().copied().collect();
-            report.error_bounds[i] += extended_rounding(self.a, self.b, &shape, omega[i]);
+        let columns: Vec<usize> = residuals.iter().map(|r| r.mode).collect();
+        let values: Vec<f64> = columns.iter().map(|&i| omega[i]).collect();
+        let rounding = extended_roundings(self.a, self.b, x, &columns, &values, self.par);
+        for (&i, r) in columns.iter().zip(rounding) {
+            report.error_bounds[i] += r;
         }
     }
 }

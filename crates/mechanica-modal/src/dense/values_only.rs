@@ -25,7 +25,7 @@ use crate::certify::a_priori::APrioriModel;
 use crate::certify::products::{PairProducts, Residuals};
 use crate::certify::report::{AccuracyReport, BoundKind};
 use crate::certify::residual_bounds::{ModeBasis, RefinedResidual, residual_bounds};
-use crate::certify::resolution::{extended_rounding, zero_resolution};
+use crate::certify::resolution::{extended_roundings, zero_resolution};
 use crate::dd::Operand;
 use crate::dense::options::weakly_bounded;
 use crate::linalg::eigen::TridiagonalForm;
@@ -105,12 +105,14 @@ pub(crate) fn sharpen(
         unselected: Some(a_priori),
     };
     residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
-    for refined in &residuals {
-        let col = flagged.iter().position(|&i| i == refined.mode);
-        if let Some(col) = col {
-            let i = refined.mode;
-            report.error_bounds[i] += extended_rounding(a, b, x.col_as_slice(col), omega[i]);
-        }
+    let columns: Vec<usize> = residuals
+        .iter()
+        .filter_map(|r| flagged.iter().position(|&i| i == r.mode))
+        .collect();
+    let values: Vec<f64> = columns.iter().map(|&col| omega[flagged[col]]).collect();
+    let rounding = extended_roundings(a, b, x.as_ref(), &columns, &values, pencil.par);
+    for (&col, r) in columns.iter().zip(rounding) {
+        report.error_bounds[flagged[col]] += r;
     }
     let norms = (report.norm_a, report.norm_b);
     flagged
