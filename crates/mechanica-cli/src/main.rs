@@ -27,6 +27,10 @@ struct Cli {
     /// instead of refusing the file.
     #[arg(long, global = true)]
     repair_inertia: bool,
+    /// URDF input: make a link without <inertial> whose mesh cannot be used (missing file,
+    /// unsupported format) massless, with a warning in the report, instead of refusing the file.
+    #[arg(long, global = true)]
+    allow_missing_mesh: bool,
     /// Write SVG plots (spectrum, mode shapes, free response, impact energy) into this directory.
     #[arg(long, global = true, value_name = "DIR")]
     plot: Option<std::path::PathBuf>,
@@ -58,7 +62,11 @@ fn main() -> ExitCode {
     let report = match cli.command.unwrap_or(Command::Run { scene: None }) {
         Command::Run { scene: None } => default_scene::run(cli.plot.as_deref()),
         Command::Run { scene: Some(path) } if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) => {
-            urdf::load(&path, cli.repair_inertia).and_then(|(scene, notes)| {
+            let options = urdf::UrdfOptions {
+                repair_inertia: cli.repair_inertia,
+                allow_missing_mesh: cli.allow_missing_mesh,
+            };
+            urdf::load(&path, options).and_then(|(scene, notes)| {
                 let mut report = scene_run::run(&scene, &path, cli.plot.as_deref())?;
                 if let Some(first) = report.steps.first_mut() {
                     first.notes.extend(notes);
