@@ -6,10 +6,10 @@
 //!   Every link's tensor is checked (mass crate validity: symmetry, semidefiniteness, triangle
 //!   inequality); all invalid links are reported at once, and `--repair-inertia` replaces each
 //!   by the nearest physical tensor (documented in `mechanica_mass::validity::repair`).
-//! - A link without `<inertial>` whose collision (or else visual) geometry is a mesh gets the
-//!   mesh's mass properties at 1000 kg/m³ (water; URDF gives no density); the file name is
-//!   resolved relative to the URDF (then to the working directory), `package://` and
-//!   `file://` prefixes stripped. A mesh that cannot be used (missing file, a format other
+//! - A link without `<inertial>` (or with a zero mass there) whose collision (or else visual)
+//!   geometry is a mesh gets the mesh's mass properties at 1000 kg/m³ (water; URDF gives no
+//!   density); the file name is resolved relative to the URDF (then to the working directory),
+//!   `package://` and `file://` prefixes stripped. A mesh that cannot be used (missing file, a format other
 //!   than STL or OBJ such as `.dae`, a mesh without a volume) is an error naming the link and
 //!   the mesh; with [`UrdfOptions::allow_missing_mesh`] the link is massless instead and the
 //!   report carries a warning. A link with neither `<inertial>` nor a mesh is a massless frame.
