@@ -27,6 +27,14 @@ struct Cli {
     /// instead of refusing the file.
     #[arg(long, global = true)]
     repair_inertia: bool,
+    /// URDF input: make a link without <inertial> whose mesh cannot be used (missing file,
+    /// unsupported format) massless, with a warning in the report, instead of refusing the file.
+    #[arg(long, global = true)]
+    allow_missing_mesh: bool,
+    /// Scene input: the most values a free response may store, samples × (dof + 1); a scene
+    /// asking for more is refused.
+    #[arg(long, global = true, value_name = "N", default_value_t = scene::SceneLimits::DEFAULT.max_response_values)]
+    max_response_values: usize,
     /// Write SVG plots (spectrum, mode shapes, free response, impact energy) into this directory.
     #[arg(long, global = true, value_name = "DIR")]
     plot: Option<std::path::PathBuf>,
@@ -58,7 +66,11 @@ fn main() -> ExitCode {
     let report = match cli.command.unwrap_or(Command::Run { scene: None }) {
         Command::Run { scene: None } => default_scene::run(cli.plot.as_deref()),
         Command::Run { scene: Some(path) } if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) => {
-            urdf::load(&path, cli.repair_inertia).and_then(|(scene, notes)| {
+            let options = urdf::UrdfOptions {
+                repair_inertia: cli.repair_inertia,
+                allow_missing_mesh: cli.allow_missing_mesh,
+            };
+            urdf::load(&path, options).and_then(|(scene, notes)| {
                 let mut report = scene_run::run(&scene, &path, cli.plot.as_deref())?;
                 if let Some(first) = report.steps.first_mut() {
                     first.notes.extend(notes);
@@ -66,9 +78,14 @@ fn main() -> ExitCode {
                 Ok(report)
             })
         }
-        Command::Run { scene: Some(path) } => scene::Scene::load(&path)
-            .map_err(|e| e.to_string())
-            .and_then(|scene| scene_run::run(&scene, &path, cli.plot.as_deref())),
+        Command::Run { scene: Some(path) } => {
+            let limits = scene::SceneLimits {
+                max_response_values: cli.max_response_values,
+            };
+            scene::Scene::load_with(&path, &limits)
+                .map_err(|e| e.to_string())
+                .and_then(|scene| scene_run::run(&scene, &path, cli.plot.as_deref()))
+        }
         Command::Mass(args) => mass_command::run(&args),
         Command::Modes(args) => modes_command::run(&args),
         Command::Version => report::version_report(),

@@ -47,16 +47,16 @@ pub fn build_mechanism(scene: &Scene, model: &Model) -> Result<Mechanism, String
             .map(|(_, b)| *b)
             .ok_or_else(|| format!("joint_spring[{i}]: no joint \"{}\"", spring.joint.get_ref()))?;
         let range = model.tree.dof_range(body);
-        if spring.coordinate >= range.len() {
+        let coordinate = *spring.coordinate.get_ref();
+        if coordinate >= range.len() {
             return Err(format!(
-                "joint_spring[{i}].coordinate: the joint has {} coordinates, got index {}",
+                "joint_spring[{i}].coordinate: the joint has {} coordinates, got index {coordinate}",
                 range.len(),
-                spring.coordinate
             ));
         }
         mechanism
             .add_potential(JointSpring {
-                coordinate: range.start + spring.coordinate,
+                coordinate: range.start + coordinate,
                 stiffness: spring.stiffness,
                 rest: spring.rest,
             })
@@ -127,7 +127,8 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
         };
         let mut step = equilibrium_step(&mut mechanism, &mut q, &mut locked, &options)?;
         if !spec.starts.is_empty() {
-            add_equilibria_from_starts(&mut step, &mut mechanism, &q, &spec.starts, &options)?;
+            let starts: Vec<Vec<f64>> = spec.starts.iter().map(|s| s.get_ref().clone()).collect();
+            add_equilibria_from_starts(&mut step, &mut mechanism, &q, &starts, &options)?;
         }
         steps.push(step);
     }
@@ -136,7 +137,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     steps.push(step);
     record_mode_plots(&modes, plots);
     if let Some(response) = &analyses.response {
-        steps.push(response_step(&modes, response, plots)?);
+        steps.push(response_step(&modes, response.get_ref(), plots)?);
     }
     Ok(())
 }
@@ -252,7 +253,10 @@ fn modes_step(
     spec: &crate::scene::ModesSpec,
 ) -> Result<(Step, MechanismModes), String> {
     let options = SolveOptions {
-        selection: spec.lowest.map_or(Selection::All, Selection::Lowest),
+        selection: spec
+            .lowest
+            .as_ref()
+            .map_or(Selection::All, |k| Selection::Lowest(*k.get_ref())),
         ..SolveOptions::default()
     };
     let mut modes: Option<MechanismModes> = None;
@@ -263,6 +267,21 @@ fn modes_step(
         Ok::<_, String>(quantities)
     })?;
     let modes = modes.ok_or("internal: modes missing")?;
+    let finite = |m: &&mechanica::modal::Mode| m.omega_sq.is_finite() && m.error_bound.is_finite();
+    let massive = |m: &&mechanica::modal::Mode| !matches!(m.kind, ModeKind::Infinite);
+    if let Some(mode) = modes.solution.modes.iter().filter(massive).find(|m| !finite(m)) {
+        let value = if mode.omega_sq.is_finite() {
+            mode.error_bound
+        } else {
+            mode.omega_sq
+        };
+        return Err(crate::report::NonFiniteResult {
+            analysis: step.analysis.clone(),
+            quantity: "ω² of a finite mode or its error bound".into(),
+            value,
+        }
+        .to_string());
+    }
     step.notes.push(stability_note(&modes.stability));
     if let Some(gyro) = &modes.gyroscopic {
         step.notes.push(format!(
@@ -318,6 +337,12 @@ fn mode_label(modes: &MechanismModes, k: usize) -> String {
     }
 }
 
+/// The mode quantities that are +∞ for the infinite modes of massless directions.
+pub(crate) const INFINITE_FOR_MASSLESS_MODES: [&str; 3] = [OMEGA_SQ, OMEGA, FREQUENCY];
+const OMEGA_SQ: &str = "ω² (8.89: λ = −ω²)";
+const OMEGA: &str = "ω";
+const FREQUENCY: &str = "f = ω/2π";
+
 fn mode_quantities(m: &MechanismModes) -> Vec<crate::report::Quantity> {
     let modes = &m.solution.modes;
     let omega: Vec<f64> = modes
@@ -332,7 +357,7 @@ fn mode_quantities(m: &MechanismModes) -> Vec<crate::report::Quantity> {
     let accuracy = &m.solution.accuracy;
     let mut out = vec![
         quantity(
-            "ω² (8.89: λ = −ω²)",
+            OMEGA_SQ,
             modes.iter().map(|mode| mode.omega_sq).collect(),
             "rad²/s²",
             Some(format!(
@@ -346,9 +371,9 @@ fn mode_quantities(m: &MechanismModes) -> Vec<crate::report::Quantity> {
                 }
             )),
         ),
-        quantity("ω", omega.clone(), "rad/s", None),
+        quantity(OMEGA, omega.clone(), "rad/s", None),
         quantity(
-            "f = ω/2π",
+            FREQUENCY,
             omega.iter().map(|w| w / std::f64::consts::TAU).collect(),
             "Hz",
             None,
@@ -385,6 +410,9 @@ fn mode_quantities(m: &MechanismModes) -> Vec<crate::report::Quantity> {
     out
 }
 
+/// The free response δ(t) from the scene's initial disturbance, sampled `spec.samples` times
+/// over the span (the sample count was checked against the scene limits when the scene was
+/// read; the series are still allocated fallibly).
 fn response_step(
     modes: &MechanismModes,
     spec: &crate::scene::ResponseSpec,
@@ -392,38 +420,27 @@ fn response_step(
 ) -> Result<Step, String> {
     let n = modes.q.len();
     timed_step("free response δ(t) by modal superposition (8.91)", || {
-        if !(spec.duration.is_finite() && spec.duration > 0.0) || spec.samples < 2 {
-            return Err("analyses.response: duration must be > 0 and samples ≥ 2".to_string());
+        if modes.mass_matrix.nrows() != n || modes.solution.modes.len() != n {
+            return Err(
+                "analyses.response: the free response needs every mode of every coordinate (no `lowest`, no coordinate resting on a joint limit)"
+                    .to_string(),
+            );
         }
-        let delta0 = spec.dq0.clone().unwrap_or_else(|| vec![0.0; n]);
-        let v0 = spec.v0.clone().unwrap_or_else(|| vec![0.0; n]);
+        let zeros = vec![0.0; n];
+        let delta0 = spec.dq0.as_ref().map_or(&zeros, |v| v.get_ref());
+        let v0 = spec.v0.as_ref().map_or(&zeros, |v| v.get_ref());
         let problem = PencilProblem::new(modes.mass_matrix.as_ref(), modes.stiffness_matrix.as_ref())
             .map_err(|e| e.to_string())?;
-        let full = if modes.solution.modes.len() == n {
-            modes.solution.clone()
-        } else {
-            return Err("analyses.response needs every mode: remove `lowest` from analyses.modes".into());
-        };
-        let response = FreeResponse::new(&problem, &full, &delta0, &v0).map_err(|e| e.to_string())?;
-        let mut series = ResponseSeries {
-            times: Vec::with_capacity(spec.samples),
-            values: vec![Vec::with_capacity(spec.samples); n],
-        };
-        let mut out = vec![0.0; n];
-        for i in 0..spec.samples {
-            let t = spec.duration * i as f64 / (spec.samples - 1) as f64;
-            response.at(t, &mut out).map_err(|e| e.to_string())?;
-            series.times.push(t);
-            for (k, v) in out.iter().enumerate() {
-                series.values[k].push(*v);
-            }
-        }
+        let response =
+            FreeResponse::new(&problem, &modes.solution, delta0, v0).map_err(|e| format!("analyses.response: {e}"))?;
+        let duration = *spec.duration.get_ref();
+        let (series, end) = sample_response(&response, duration, *spec.samples.get_ref(), n)?;
         let fit = response.fit();
-        let end_bound = response.error_bound(spec.duration).map_err(|e| e.to_string())?;
+        let end_bound = response.error_bound(duration).map_err(|e| e.to_string())?;
         let quantities = vec![
             quantity(
                 "δ(T) at the end of the span",
-                out.clone(),
+                end,
                 "rad | m",
                 Some(format!("error bound {end_bound:.1e}")),
             ),
@@ -437,6 +454,38 @@ fn response_step(
         plots.response = Some(series);
         Ok(quantities)
     })
+}
+
+/// `samples` ≥ 2 equally spaced values of δ(t) over [0, `duration`] (n coordinates each), and
+/// δ at the end; an error instead of an abort when the series cannot be allocated.
+fn sample_response(
+    response: &FreeResponse,
+    duration: f64,
+    samples: usize,
+    n: usize,
+) -> Result<(ResponseSeries, Vec<f64>), String> {
+    let reserve = |v: &mut Vec<f64>| {
+        v.try_reserve_exact(samples)
+            .map_err(|_| format!("analyses.response.samples: cannot allocate {samples} samples"))
+    };
+    let mut series = ResponseSeries {
+        times: Vec::new(),
+        values: vec![Vec::new(); n],
+    };
+    reserve(&mut series.times)?;
+    for values in &mut series.values {
+        reserve(values)?;
+    }
+    let mut out = vec![0.0; n];
+    for i in 0..samples {
+        let t = duration * i as f64 / (samples - 1) as f64;
+        response.at(t, &mut out).map_err(|e| e.to_string())?;
+        series.times.push(t);
+        for (k, v) in out.iter().enumerate() {
+            series.values[k].push(*v);
+        }
+    }
+    Ok((series, out))
 }
 
 fn law_named(name: &str) -> RestitutionLaw {

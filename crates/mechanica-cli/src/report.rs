@@ -65,6 +65,47 @@ impl Report {
     }
 }
 
+/// A computed value that is not a finite number: the inputs' scale overflowed double
+/// precision somewhere. A run stops with this error (and a non-zero exit) instead of
+/// reporting the value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NonFiniteResult {
+    /// The step that computed it.
+    pub analysis: String,
+    /// The quantity.
+    pub quantity: String,
+    /// The value (±∞ or NaN).
+    pub value: f64,
+}
+
+impl std::fmt::Display for NonFiniteResult {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: {} is {}, not a finite number (the inputs overflow double precision: check the scale of masses, lengths and loads)",
+            self.analysis, self.quantity, self.value
+        )
+    }
+}
+
+impl std::error::Error for NonFiniteResult {}
+
+/// Ok when every value of `step` is finite, except +∞ in the quantities for which
+/// `may_be_infinite(name)` holds (e.g. ω of a massless direction).
+pub fn check_finite(step: &Step, may_be_infinite: impl Fn(&str) -> bool) -> Result<(), NonFiniteResult> {
+    for q in &step.quantities {
+        let allowed = |v: f64| v.is_finite() || (v == f64::INFINITY && may_be_infinite(&q.name));
+        if let Some(&value) = q.values.iter().find(|&&v| !allowed(v)) {
+            return Err(NonFiniteResult {
+                analysis: step.analysis.clone(),
+                quantity: q.name.clone(),
+                value,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Times `body` and wraps its quantities into a step.
 pub fn timed_step<E>(analysis: &str, body: impl FnOnce() -> Result<Vec<Quantity>, E>) -> Result<Step, E> {
     let start = std::time::Instant::now();

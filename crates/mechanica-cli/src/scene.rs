@@ -51,15 +51,18 @@
 //! mass_properties = true
 //! equilibrium = { seek = "minimum" }   # or "stationary"; optional starts = [[...], ...]
 //! modes = { lowest = 4 }               # optional lowest = k; at the equilibrium if one is asked
-//! response = { duration = 5.0, samples = 200, dq0 = [0.1, 0.0] }   # free response (8.91)
+//! response = { duration = 5.0, samples = 200, dq0 = [0.1, 0.0] }   # free response (8.91);
+//!                                      # needs every mode; samples × (dof + 1) ≤ 10⁷ unless
+//!                                      # raised by --max-response-values
 //! impact = { body = "lower", point = [0.0, 0.0, -1.0], normal = [0.0, 0.0, 1.0],
 //!            friction = 0.3, restitution = 0.5, law = "stronge",
 //!            compare_laws = true }           # at q0 with qd0; compare_laws adds the other two laws
 //! ```
 //!
 //! `inertia` lists the six independent entries (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) about the centre
-//! of mass, in the body frame. Unknown fields are errors. Every error names the file, the line
-//! and column, and the field.
+//! of mass, in the body frame. Unknown fields are errors, and so are coordinate counts that do
+//! not match the joints (q0, qd0, limits, joint springs, starts, dq0, v0). Every error names
+//! the file, the line and column, and the field.
 
 use serde::Deserialize;
 use std::collections::HashMap;
@@ -119,8 +122,8 @@ pub struct JointSpringSpec {
     #[serde(default)]
     pub rest: f64,
     /// Index of the coordinate within the joint.
-    #[serde(default)]
-    pub coordinate: usize,
+    #[serde(default = "unlocated_zero")]
+    pub coordinate: Spanned<usize>,
 }
 
 /// A spring between two points.
@@ -264,6 +267,18 @@ pub enum JointKind {
     Fixed,
 }
 
+impl JointKind {
+    /// The number of coordinates of a joint of this kind.
+    pub fn dof(self) -> usize {
+        match self {
+            JointKind::Revolute | JointKind::Prismatic => 1,
+            JointKind::Spherical | JointKind::Planar => 3,
+            JointKind::Free => 6,
+            JointKind::Fixed => 0,
+        }
+    }
+}
+
 /// The analyses a scene asks for.
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -276,7 +291,7 @@ pub struct Analyses {
     /// Small-oscillation modes, at the equilibrium when one is searched, else at q0.
     pub modes: Option<ModesSpec>,
     /// The free response from a disturbed equilibrium (8.91); needs `modes`.
-    pub response: Option<ResponseSpec>,
+    pub response: Option<Spanned<ResponseSpec>>,
     /// One impact of a body point against the ground, at (q0, qd0).
     pub impact: Option<ImpactSpec>,
 }
@@ -289,7 +304,7 @@ pub struct EquilibriumSpec {
     pub seek: Option<Spanned<String>>,
     /// Further starting points (each of length dof).
     #[serde(default)]
-    pub starts: Vec<Vec<f64>>,
+    pub starts: Vec<Spanned<Vec<f64>>>,
     /// Iteration limit.
     pub max_iterations: Option<usize>,
 }
@@ -299,7 +314,7 @@ pub struct EquilibriumSpec {
 #[serde(deny_unknown_fields)]
 pub struct ModesSpec {
     /// Only the k lowest modes.
-    pub lowest: Option<usize>,
+    pub lowest: Option<Spanned<usize>>,
 }
 
 /// Free-response options.
@@ -307,18 +322,44 @@ pub struct ModesSpec {
 #[serde(deny_unknown_fields)]
 pub struct ResponseSpec {
     /// Time span, s.
-    pub duration: f64,
-    /// Number of samples.
+    pub duration: Spanned<f64>,
+    /// Number of samples (at least 2; see [`SceneLimits::max_response_values`]).
     #[serde(default = "default_samples")]
-    pub samples: usize,
+    pub samples: Spanned<usize>,
     /// Initial displacement from the equilibrium, per coordinate.
-    pub dq0: Option<Vec<f64>>,
+    pub dq0: Option<Spanned<Vec<f64>>>,
     /// Initial velocity, per coordinate.
-    pub v0: Option<Vec<f64>>,
+    pub v0: Option<Spanned<Vec<f64>>>,
 }
 
-fn default_samples() -> usize {
-    200
+fn default_samples() -> Spanned<usize> {
+    Spanned::new(0..0, 200)
+}
+
+fn unlocated_zero() -> Spanned<usize> {
+    Spanned::new(0..0, 0)
+}
+
+/// Limits on what a scene may ask for, so that a typing slip cannot exhaust memory or time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SceneLimits {
+    /// The largest number of values a free response may store: samples × (dof + 1) (the times
+    /// and every coordinate), 8 bytes each.
+    pub max_response_values: usize,
+}
+
+impl SceneLimits {
+    /// 10⁷ values (80 MB): e.g. 10⁶ samples of a 9-coordinate mechanism. The `mechanica run`
+    /// option `--max-response-values` raises it.
+    pub const DEFAULT: SceneLimits = SceneLimits {
+        max_response_values: 10_000_000,
+    };
+}
+
+impl Default for SceneLimits {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
 }
 
 /// An impact of a body point against the ground.
@@ -381,41 +422,50 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
 }
 
 impl Scene {
-    /// Reads and validates the scene file at `path`.
-    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    /// Reads and validates the scene file at `path` under `limits`.
+    pub fn load_with(path: &Path, limits: &SceneLimits) -> Result<Scene, SceneError> {
         let text = std::fs::read_to_string(path).map_err(|e| SceneError {
             file: path.to_path_buf(),
             position: None,
             field: String::new(),
             message: format!("cannot read the scene file: {e}"),
         })?;
-        Scene::parse(&text, path)
+        Scene::parse_with(&text, path, limits)
     }
 
-    /// Parses and validates scene text; `file` is used in error messages.
+    /// Parses and validates scene text under the default [`SceneLimits`]; `file` is used in
+    /// error messages.
     pub fn parse(text: &str, file: &Path) -> Result<Scene, SceneError> {
+        Scene::parse_with(text, file, &SceneLimits::DEFAULT)
+    }
+
+    /// Parses and validates scene text under `limits`; `file` is used in error messages.
+    pub fn parse_with(text: &str, file: &Path, limits: &SceneLimits) -> Result<Scene, SceneError> {
         let scene: Scene = toml::from_str(text).map_err(|e| SceneError {
             file: file.to_path_buf(),
             position: e.span().map(|s| line_column(text, s.start)),
             field: String::new(),
             message: e.message().trim().to_string(),
         })?;
-        scene.validate(text, file)?;
+        scene.validate(text, file, limits)?;
         Ok(scene)
     }
 
     /// Validates a scene built in memory (e.g. from a URDF); errors name the file and field.
     pub fn check(&self, file: &Path) -> Result<(), String> {
-        self.validate("", file).map_err(|e| e.to_string())
+        self.validate("", file, &SceneLimits::DEFAULT)
+            .map_err(|e| e.to_string())
     }
 
     /// Checks what the schema cannot: unique names, resolvable references, one parent per body,
-    /// no cycles, one mass source per body, finite numbers and unit axes.
-    fn validate(&self, text: &str, file: &Path) -> Result<(), SceneError> {
+    /// no cycles, one mass source per body, unit axes, coordinate counts (q0, qd0, limits,
+    /// joint springs, starts, dq0, v0) and the analyses' options within `limits`.
+    fn validate(&self, text: &str, file: &Path, limits: &SceneLimits) -> Result<(), SceneError> {
         let validator = Validator {
             scene: self,
             text,
             file,
+            limits,
         };
         let index_of = validator.body_indices()?;
         let parent_of = validator.parent_indices(&index_of)?;
@@ -425,7 +475,9 @@ impl Scene {
             validator.check_unit_axis(&frame.axis, "rotating_frame.axis".into())?;
         }
         validator.check_option_names()?;
-        validator.check_response_needs_modes()
+        validator.check_joint_values()?;
+        validator.check_joint_springs()?;
+        validator.check_analyses()
     }
 }
 
@@ -437,6 +489,8 @@ struct Validator<'a> {
     text: &'a str,
     /// The scene file, named in every error.
     file: &'a Path,
+    /// What the analyses may ask for.
+    limits: &'a SceneLimits,
 }
 
 /// Index of each body, by name.
@@ -449,7 +503,7 @@ impl<'a> Validator<'a> {
             file: self.file.to_path_buf(),
             // A scene built in memory (no source text) has no positions to report.
             position: span
-                .filter(|_| !self.text.is_empty())
+                .filter(|s| !self.text.is_empty() && s.end > s.start)
                 .map(|s| line_column(self.text, s.start)),
             field,
             message,
@@ -692,14 +746,148 @@ impl<'a> Validator<'a> {
         Ok(())
     }
 
-    /// Ok unless a free response is asked for without `modes`.
-    fn check_response_needs_modes(&self) -> Result<(), SceneError> {
-        if self.scene.analyses.response.is_some() && self.scene.analyses.modes.is_none() {
+    /// The number of coordinates of the whole scene (each body has one joint once
+    /// [`Validator::parent_indices`] has passed).
+    fn dof(&self) -> usize {
+        self.scene.joints.iter().map(|j| j.kind.get_ref().dof()).sum()
+    }
+
+    /// An error on `field` at `values` unless it holds `expected` numbers.
+    fn check_length(
+        &self,
+        values: &Spanned<Vec<f64>>,
+        expected: usize,
+        field: String,
+        whose: &str,
+    ) -> Result<(), SceneError> {
+        let got = values.get_ref().len();
+        if got == expected {
+            return Ok(());
+        }
+        Err(self.error(
+            Some(values.span()),
+            field,
+            format!("{got} values given, {whose} {expected} coordinate(s)"),
+        ))
+    }
+
+    /// Ok when every joint's q0 and qd0 have one value per coordinate of the joint and limits
+    /// are given on one-coordinate joints only.
+    fn check_joint_values(&self) -> Result<(), SceneError> {
+        for (j, joint) in self.scene.joints.iter().enumerate() {
+            let dof = joint.kind.get_ref().dof();
+            let kind = format!("{:?}", joint.kind.get_ref()).to_lowercase();
+            let whose = format!("the {kind} joint \"{}\" has", joint.name);
+            for (values, what) in [(&joint.q0, "q0"), (&joint.qd0, "qd0")] {
+                if let Some(values) = values {
+                    self.check_length(values, dof, format!("joint[{j}].{what}"), &whose)?;
+                }
+            }
+            if let Some(limits) = &joint.limits
+                && dof != 1
+            {
+                return Err(self.error(
+                    Some(limits.span()),
+                    format!("joint[{j}].limits"),
+                    format!("limits apply to one-coordinate joints only; {whose} {dof}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Ok when every joint spring's coordinate index lies within its joint.
+    fn check_joint_springs(&self) -> Result<(), SceneError> {
+        for (i, spring) in self.scene.joint_springs.iter().enumerate() {
+            let Some(joint) = self.scene.joints.iter().find(|j| &j.name == spring.joint.get_ref()) else {
+                continue;
+            };
+            let dof = joint.kind.get_ref().dof();
+            let index = *spring.coordinate.get_ref();
+            if index >= dof {
+                let span = Some(spring.coordinate.span()).filter(|s| s.end > s.start);
+                return Err(self.error(
+                    span.or(Some(spring.joint.span())),
+                    format!("joint_spring[{i}].coordinate"),
+                    format!("coordinate {index} of joint \"{}\", which has {dof}", joint.name),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Ok when the equilibrium starts, the modes and the free response ask for something
+    /// well defined (lengths equal to the dof, a free response with every mode, at least two
+    /// samples over a positive finite span, within the limits).
+    fn check_analyses(&self) -> Result<(), SceneError> {
+        let analyses = &self.scene.analyses;
+        let dof = self.dof();
+        let whose = "the scene has";
+        if let Some(equilibrium) = &analyses.equilibrium {
+            for (i, start) in equilibrium.starts.iter().enumerate() {
+                self.check_length(start, dof, format!("analyses.equilibrium.starts[{i}]"), whose)?;
+            }
+        }
+        if let Some(lowest) = analyses.modes.as_ref().and_then(|m| m.lowest.as_ref())
+            && !(1..=dof.max(1)).contains(lowest.get_ref())
+        {
             return Err(self.error(
-                None,
+                Some(lowest.span()),
+                "analyses.modes.lowest".into(),
+                format!("{} modes asked for; the scene has {dof} coordinates", lowest.get_ref()),
+            ));
+        }
+        match &analyses.response {
+            Some(response) => self.check_response(response, dof),
+            None => Ok(()),
+        }
+    }
+
+    /// Ok when the free response is well defined (see [`Validator::check_analyses`]).
+    fn check_response(&self, response: &Spanned<ResponseSpec>, dof: usize) -> Result<(), SceneError> {
+        let analyses = &self.scene.analyses;
+        let spec = response.get_ref();
+        let at = |field: &str| format!("analyses.response.{field}");
+        let Some(modes) = &analyses.modes else {
+            return Err(self.error(
+                Some(response.span()),
                 "analyses.response".into(),
                 "the free response needs `modes`".into(),
             ));
+        };
+        if let Some(lowest) = &modes.lowest {
+            return Err(self.error(
+                Some(lowest.span()),
+                "analyses.modes.lowest".into(),
+                "the free response needs every mode: remove `lowest`".into(),
+            ));
+        }
+        let duration = *spec.duration.get_ref();
+        if !(duration.is_finite() && duration > 0.0) {
+            let message = format!("the duration must be finite and > 0 s, got {duration}");
+            return Err(self.error(Some(spec.duration.span()), at("duration"), message));
+        }
+        let samples = *spec.samples.get_ref();
+        let stored = samples as u128 * (dof as u128 + 1);
+        if samples < 2 || stored > self.limits.max_response_values as u128 {
+            let message = if samples < 2 {
+                format!("at least 2 samples are needed, got {samples}")
+            } else {
+                format!(
+                    "{samples} samples of {dof} coordinates store {stored} values, above the limit of {} \
+                     (raise it with --max-response-values)",
+                    self.limits.max_response_values
+                )
+            };
+            let span = Some(spec.samples.span())
+                .filter(|s| s.end > s.start)
+                .unwrap_or(response.span());
+            return Err(self.error(Some(span), at("samples"), message));
+        }
+        for (values, what) in [(&spec.dq0, "dq0"), (&spec.v0, "v0")] {
+            if let Some(values) = values {
+                self.check_length(values, dof, at(what), "the scene has")?;
+            }
         }
         Ok(())
     }
@@ -786,9 +974,124 @@ mass_properties = true
         assert_eq!(parse(&text).expect_err("two parents").field, "joint[1].child");
     }
 
+    /// The 1-based line of the first line of `text` containing `needle`.
+    fn line_of(text: &str, needle: &str) -> Option<usize> {
+        text.lines().position(|l| l.contains(needle)).map(|i| i + 1)
+    }
+
+    /// Each semantic error names its field and the line of the offending value.
+    #[test]
+    fn semantic_errors_name_the_field_and_the_line() {
+        let analyses = "[analyses]\nequilibrium = {}\nmodes = {}\n";
+        let with_analyses = PENDULUM.replace("[analyses]\nmass_properties = true\n", analyses);
+        let response = |block: &str| format!("{with_analyses}response = {block}\n");
+        let cases: Vec<(String, &str, &str)> = vec![
+            (
+                PENDULUM.replace(
+                    "origin = [0.0, 0.0, -1.0]",
+                    "origin = [0.0, 0.0, -1.0]\nq0 = [0.1, 0.2]",
+                ),
+                "joint[1].q0",
+                "q0 = [0.1, 0.2]",
+            ),
+            (
+                PENDULUM.replace("axis = [0.0, 1.0, 0.0]\n\n", "axis = [0.0, 1.0, 0.0]\nqd0 = []\n\n"),
+                "joint[0].qd0",
+                "qd0 = []",
+            ),
+            (
+                PENDULUM
+                    .replacen("type = \"revolute\"", "type = \"spherical\"", 1)
+                    .replace("axis = [0.0, 1.0, 0.0]\n\n", "limits = [-1.0, 1.0]\n\n"),
+                "joint[0].limits",
+                "limits = [-1.0, 1.0]",
+            ),
+            (
+                format!("{PENDULUM}\n[[joint_spring]]\njoint = \"elbow\"\nstiffness = 1.0\ncoordinate = 1\n"),
+                "joint_spring[0].coordinate",
+                "coordinate = 1",
+            ),
+            (
+                with_analyses.replace("equilibrium = {}", "equilibrium = { starts = [[0.1, 0.2], [0.3]] }"),
+                "analyses.equilibrium.starts[1]",
+                "starts =",
+            ),
+            (
+                with_analyses.replace("modes = {}", "modes = { lowest = 0 }"),
+                "analyses.modes.lowest",
+                "lowest = 0",
+            ),
+            (
+                response("{ duration = 0.0 }"),
+                "analyses.response.duration",
+                "response =",
+            ),
+            (
+                response("{ duration = 1.0, samples = 1 }"),
+                "analyses.response.samples",
+                "response =",
+            ),
+            (
+                response("{ duration = 1.0, samples = 10000000000 }"),
+                "analyses.response.samples",
+                "response =",
+            ),
+            (
+                response("{ duration = 1.0, dq0 = [0.1, 0.0, 0.0] }"),
+                "analyses.response.dq0",
+                "response =",
+            ),
+            (
+                response("{ duration = 1.0, v0 = [0.1] }"),
+                "analyses.response.v0",
+                "response =",
+            ),
+            (
+                PENDULUM.replace(
+                    "mass_properties = true",
+                    "mass_properties = true\nresponse = { duration = 1.0 }",
+                ),
+                "analyses.response",
+                "response =",
+            ),
+            (
+                response("{ duration = 1.0 }").replace("modes = {}", "modes = { lowest = 1 }"),
+                "analyses.modes.lowest",
+                "lowest = 1",
+            ),
+        ];
+        for (text, field, needle) in cases {
+            let e = parse(&text).expect_err(field);
+            assert_eq!(e.field, field, "{e}");
+            assert_eq!(e.position.map(|p| p.0), line_of(&text, needle), "{field}: {e}");
+        }
+    }
+
+    /// The response limit counts samples × (dof + 1) values and can be raised.
+    #[test]
+    fn the_response_limit_is_on_stored_values_and_can_be_raised() {
+        let text = PENDULUM.replace(
+            "mass_properties = true",
+            "modes = {}\nresponse = { duration = 1.0, samples = 1000 }",
+        );
+        // Two coordinates: 1000 samples store 3000 values.
+        let tight = SceneLimits {
+            max_response_values: 2999,
+        };
+        let e = Scene::parse_with(&text, Path::new("scene.toml"), &tight).expect_err("over the limit");
+        assert!(
+            e.message.contains("3000 values") && e.message.contains("--max-response-values"),
+            "{e}"
+        );
+        let enough = SceneLimits {
+            max_response_values: 3000,
+        };
+        Scene::parse_with(&text, Path::new("scene.toml"), &enough).expect("at the limit");
+    }
+
     #[test]
     fn a_missing_file_is_reported_with_its_path() {
-        let e = Scene::load(Path::new("/nonexistent/scene.toml")).expect_err("missing");
+        let e = Scene::load_with(Path::new("/nonexistent/scene.toml"), &SceneLimits::DEFAULT).expect_err("missing");
         assert!(e.to_string().contains("/nonexistent/scene.toml"), "{e}");
     }
 }

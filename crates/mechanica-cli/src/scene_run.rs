@@ -43,6 +43,12 @@ pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report
     }
     let mut plots = crate::plots::PlotData::default();
     crate::mechanism_run::run(scene, &model, &mut steps, &mut plots)?;
+    for step in &steps {
+        crate::report::check_finite(step, |name| {
+            crate::mechanism_run::INFINITE_FOR_MASSLESS_MODES.contains(&name)
+        })
+        .map_err(|e| e.to_string())?;
+    }
     if let Some(dir) = plot_dir {
         let written = plots.write_all(dir)?;
         steps.push(crate::report::Step {
@@ -147,7 +153,14 @@ pub(crate) fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
             body_mass(b, i, file).map(|m| m.transformed(&offset))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let index_of = |name: &str| scene.bodies.iter().position(|b| b.name.get_ref() == name);
+    let body_index: std::collections::HashMap<&str, usize> = scene
+        .bodies
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (b.name.get_ref().as_str(), i))
+        .collect();
+    let joint_of_child: std::collections::HashMap<&str, &JointSpec> =
+        scene.joints.iter().map(|j| (j.child.get_ref().as_str(), j)).collect();
     // The scene guarantees one joint per body; add bodies in scene order so indices agree.
     let mut builder = TreeBuilder::new();
     let mut q0 = Vec::new();
@@ -155,12 +168,10 @@ pub(crate) fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
     let mut joint_body = Vec::new();
     let mut limits = Vec::new();
     for (i, body) in scene.bodies.iter().enumerate() {
-        let joint = scene
-            .joints
-            .iter()
-            .find(|j| j.child.get_ref() == body.name.get_ref())
+        let joint = *joint_of_child
+            .get(body.name.get_ref().as_str())
             .ok_or_else(|| format!("{}: body[{i}] has no joint", file.display()))?;
-        let parent = index_of(joint.parent.get_ref());
+        let parent = body_index.get(joint.parent.get_ref().as_str()).copied();
         let lib_joint = joint_of(joint);
         let index = builder.add_body(
             parent,
@@ -232,6 +243,14 @@ fn mass_report(model: &Model, gravity: Option<Vector3<f64>>) -> Result<Vec<Quant
     }
     let total = MassProperties::sum(world.iter()).map_err(|e| e.to_string())?;
     let axes = total.principal_axes().map_err(|e| e.to_string())?;
+    if !axes.relative_residual.is_finite() {
+        return Err(crate::report::NonFiniteResult {
+            analysis: "mass properties at q0".into(),
+            quantity: "principal axes' relative residual".into(),
+            value: axes.relative_residual,
+        }
+        .to_string());
+    }
     let mut quantities = vec![
         quantity("total mass", vec![total.mass], "kg", None),
         quantity(

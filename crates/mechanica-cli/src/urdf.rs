@@ -6,10 +6,13 @@
 //!   Every link's tensor is checked (mass crate validity: symmetry, semidefiniteness, triangle
 //!   inequality); all invalid links are reported at once, and `--repair-inertia` replaces each
 //!   by the nearest physical tensor (documented in `mechanica_mass::validity::repair`).
-//! - A link without `<inertial>` whose collision (or else visual) geometry is a mesh file
-//!   that exists gets the mesh's mass properties at 1000 kg/m³ (water; URDF gives no
-//!   density) — the file name is resolved relative to the URDF, `package://` prefixes
-//!   stripped. Otherwise it is massless.
+//! - A link without `<inertial>` (or with a zero mass there) whose collision (or else visual)
+//!   geometry is a mesh gets the mesh's mass properties at 1000 kg/m³ (water; URDF gives no
+//!   density); the file name is resolved relative to the URDF (then to the working directory),
+//!   `package://` and `file://` prefixes stripped. A mesh that cannot be used (missing file, a format other
+//!   than STL or OBJ such as `.dae`, a mesh without a volume) is an error naming the link and
+//!   the mesh; with [`UrdfOptions::allow_missing_mesh`] the link is massless instead and the
+//!   report carries a warning. A link with neither `<inertial>` nor a mesh is a massless frame.
 //! - **Joints**: revolute and continuous → revolute, prismatic, fixed, floating → free,
 //!   spherical, planar (normal along the joint's z only). Placements use the joint origin
 //!   (xyz, rpy = R_z(yaw) R_y(pitch) R_x(roll)); the child link frame is the joint frame at
@@ -20,7 +23,7 @@
 //!   the limits, and its modes.
 
 use crate::scene::{Analyses, BodySpec, EquilibriumSpec, ExplicitMass, JointKind, JointSpec, ModesSpec, Scene};
-use mechanica::kinematics::nalgebra::{Matrix3, Rotation3, Vector3};
+use mechanica::kinematics::nalgebra::{Isometry3, Matrix3, Rotation3, Vector3};
 use mechanica::mass::MassProperties;
 use mechanica::mass::mesh::MeshOptions;
 use mechanica::mass::primitives::Amount;
@@ -35,16 +38,36 @@ fn spanned<T>(value: T) -> Spanned<T> {
     Spanned::new(0..0, value)
 }
 
+/// No mass anywhere: a frame.
+fn massless() -> MassProperties {
+    MassProperties {
+        mass: 0.0,
+        p_oc: Vector3::zeros(),
+        inertia_c: Matrix3::zeros(),
+    }
+}
+
 fn rotation(rpy: [f64; 3]) -> Rotation3<f64> {
     Rotation3::from_euler_angles(rpy[0], rpy[1], rpy[2])
 }
 
-/// Loads `path` as a scene. With `repair_inertia`, invalid link tensors are repaired (and the
-/// repairs listed in the returned notes); otherwise they are an error naming every such link.
-pub fn load(path: &Path, repair_inertia: bool) -> Result<(Scene, Vec<String>), String> {
+/// How a URDF file is turned into a scene when its links are not physical as written.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct UrdfOptions {
+    /// Replace invalid link tensors by the nearest physical ones (noted in the report) instead
+    /// of refusing the file.
+    pub repair_inertia: bool,
+    /// Make a link without `<inertial>` whose mesh cannot be used massless (with a warning in
+    /// the report) instead of refusing the file.
+    pub allow_missing_mesh: bool,
+}
+
+/// Loads `path` as a scene, with the notes and warnings for the report (see the module docs
+/// and [`UrdfOptions`]); every link that cannot be used is named in one error.
+pub fn load(path: &Path, options: UrdfOptions) -> Result<(Scene, Vec<String>), String> {
     let robot = urdf_rs::read_file(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut notes = Vec::new();
-    let bodies = link_bodies(path, &robot.links, repair_inertia, &mut notes)?;
+    let bodies = link_bodies(path, &robot.links, options, &mut notes)?;
     let root = root_link(path, &robot)?;
     let mut joints = vec![JointSpec {
         name: "base (fixed to ground)".into(),
@@ -91,15 +114,17 @@ fn located(path: &Path, what: String) -> String {
     format!("{}: {what}", path.display())
 }
 
-/// One body per link, with explicit mass properties (see the module docs); mesh fallbacks and
-/// repairs are added to `notes`, and every invalid link is named in one error.
+/// One body per link, with explicit mass properties (see the module docs); mesh fallbacks,
+/// repairs and warnings are added to `notes`, and every link that cannot be used is named in
+/// one error.
 fn link_bodies(
     path: &Path,
     links: &[urdf_rs::Link],
-    repair_inertia: bool,
+    options: UrdfOptions,
     notes: &mut Vec<String>,
 ) -> Result<Vec<BodySpec>, String> {
-    let mut problems = Vec::new();
+    let mut inertia_problems = Vec::new();
+    let mut mesh_problems = Vec::new();
     let mut bodies = Vec::new();
     for link in links {
         if link.name == "ground" {
@@ -108,64 +133,103 @@ fn link_bodies(
                 "a link named \"ground\" clashes with the scene's name for the world".into(),
             ));
         }
-        let mut props = link_mass_properties(path, link, notes);
-        if props.mass < 0.0 || !props.mass.is_finite() {
-            problems.push(format!(
-                "link \"{}\": mass {} is not a physical mass",
-                link.name, props.mass
-            ));
-        } else if props.mass > 0.0 {
-            match check(&props, &ValidityTolerance::default()) {
-                Ok(_) => {}
-                Err(error) if repair_inertia => match repair(&props, &ValidityTolerance::default()) {
-                    Ok((fixed, report)) => {
-                        notes.push(format!(
-                            "link \"{}\": inertia repaired (relative change {:.2e}): {error}",
-                            link.name, report.relative_change
-                        ));
-                        props = fixed;
-                    }
-                    Err(e) => problems.push(format!("link \"{}\": {e}", link.name)),
-                },
-                Err(error) => problems.push(format!("link \"{}\": {error}", link.name)),
+        let mut props = match link_mass_properties(path, link, notes) {
+            Ok(props) => props,
+            Err(problem) if options.allow_missing_mesh => {
+                notes.push(format!("warning: {problem}; the link is massless"));
+                massless()
             }
+            Err(problem) => {
+                mesh_problems.push(problem);
+                massless()
+            }
+        };
+        match checked_inertia(link, &props, options.repair_inertia, notes) {
+            Ok(checked) => props = checked,
+            Err(problem) => inertia_problems.push(problem),
         }
         bodies.push(explicit_body(&link.name, &props));
     }
-    if !problems.is_empty() {
+    if !mesh_problems.is_empty() {
+        return Err(located(
+            path,
+            format!(
+                "links without <inertial> whose mesh cannot be used (run with --allow-missing-mesh to make them massless):\n  {}",
+                mesh_problems.join("\n  ")
+            ),
+        ));
+    }
+    if !inertia_problems.is_empty() {
         return Err(located(
             path,
             format!(
                 "invalid inertias (run with --repair-inertia to replace them by the nearest physical tensors):\n  {}",
-                problems.join("\n  ")
+                inertia_problems.join("\n  ")
             ),
         ));
     }
     Ok(bodies)
 }
 
+/// `props` when it is physical (a finite mass ≥ 0 and, when massive, a valid tensor), or its
+/// repair when `repair` is set (noted in `notes`); else the problem, naming the link.
+fn checked_inertia(
+    link: &urdf_rs::Link,
+    props: &MassProperties,
+    repair_inertia: bool,
+    notes: &mut Vec<String>,
+) -> Result<MassProperties, String> {
+    if props.mass < 0.0 || !props.mass.is_finite() {
+        return Err(format!(
+            "link \"{}\": mass {} is not a physical mass",
+            link.name, props.mass
+        ));
+    }
+    if props.mass == 0.0 {
+        return Ok(*props);
+    }
+    match check(props, &ValidityTolerance::default()) {
+        Ok(_) => Ok(*props),
+        Err(error) if repair_inertia => match repair(props, &ValidityTolerance::default()) {
+            Ok((fixed, report)) => {
+                notes.push(format!(
+                    "link \"{}\": inertia repaired (relative change {:.2e}): {error}",
+                    link.name, report.relative_change
+                ));
+                Ok(fixed)
+            }
+            Err(e) => Err(format!("link \"{}\": {e}", link.name)),
+        },
+        Err(error) => Err(format!("link \"{}\": {error}", link.name)),
+    }
+}
+
 /// A link's mass properties in the link frame: from `<inertial>` (tensor rotated by its rpy),
-/// or, for a massless one, from its mesh at [`MESH_DENSITY`] when there is one (noted in `notes`).
-fn link_mass_properties(path: &Path, link: &urdf_rs::Link, notes: &mut Vec<String>) -> MassProperties {
+/// or, for a massless one, from its mesh at [`MESH_DENSITY`] when it has one (noted in
+/// `notes`). A mesh that cannot be used is an error naming the link and the mesh.
+fn link_mass_properties(path: &Path, link: &urdf_rs::Link, notes: &mut Vec<String>) -> Result<MassProperties, String> {
     let inertial = &link.inertial;
     let r = rotation(inertial.origin.rpy.0);
     let i = &inertial.inertia;
     let tensor = Matrix3::new(i.ixx, i.ixy, i.ixz, i.ixy, i.iyy, i.iyz, i.ixz, i.iyz, i.izz);
-    let mut props = MassProperties {
+    let props = MassProperties {
         mass: inertial.mass.value,
         p_oc: Vector3::from(inertial.origin.xyz.0),
         inertia_c: r.matrix() * tensor * r.matrix().transpose(),
     };
-    if props.mass == 0.0
-        && let Some((mesh_props, file)) = mesh_mass(path, link)
-    {
-        notes.push(format!(
-            "link \"{}\": no <inertial>; mass properties from mesh {file} at {MESH_DENSITY} kg/m³",
-            link.name
-        ));
-        props = mesh_props;
+    if props.mass != 0.0 {
+        return Ok(props);
     }
-    props
+    let Some(mesh) = first_mesh(link) else {
+        return Ok(props);
+    };
+    let (mesh_props, file) = mesh_mass(path, &mesh)
+        .map_err(|problem| format!("link \"{}\": mesh \"{}\": {problem}", link.name, mesh.filename))?;
+    notes.push(format!(
+        "link \"{}\": no <inertial>; mass properties from mesh {file} at {MESH_DENSITY} kg/m³",
+        link.name
+    ));
+    Ok(mesh_props)
 }
 
 /// A scene body named `name` with the explicit mass properties `props` (central inertia).
@@ -252,37 +316,54 @@ fn joint_spec(path: &Path, joint: &urdf_rs::Joint) -> Result<JointSpec, String> 
     })
 }
 
-/// The mass properties of a link's first mesh geometry (collision, else visual), when its
-/// file exists.
-fn mesh_mass(urdf: &Path, link: &urdf_rs::Link) -> Option<(MassProperties, String)> {
+/// A mesh geometry of a link: its file name as written, scale and pose in the link frame.
+struct LinkMesh {
+    filename: String,
+    scale: [f64; 3],
+    pose: Isometry3<f64>,
+}
+
+/// The link's first mesh geometry, collision before visual.
+fn first_mesh(link: &urdf_rs::Link) -> Option<LinkMesh> {
     let geometries = link
         .collision
         .iter()
         .map(|c| (&c.geometry, &c.origin))
         .chain(link.visual.iter().map(|v| (&v.geometry, &v.origin)));
-    for (geometry, origin) in geometries {
-        if let urdf_rs::Geometry::Mesh { filename, scale } = geometry {
-            let relative = filename.trim_start_matches("package://").trim_start_matches("file://");
-            let base = urdf.parent().unwrap_or(Path::new("."));
-            let path = [base.join(relative), Path::new(relative).to_path_buf()]
-                .into_iter()
-                .find(|p| p.exists())?;
-            let mut mesh = mechanica::mass::io::load_mesh(&path).ok()?;
-            let s = scale.map_or([1.0; 3], |s| s.0);
-            for v in &mut mesh.vertices {
-                for k in 0..3 {
-                    v[k] *= s[k];
-                }
-            }
-            let props = mesh
-                .mass_properties(Amount::Density(MESH_DENSITY), &MeshOptions::default())
-                .ok()?;
-            let pose = mechanica::kinematics::nalgebra::Isometry3::from_parts(
-                Vector3::from(origin.xyz.0).into(),
-                rotation(origin.rpy.0).into(),
-            );
-            return Some((props.properties.transformed(&pose), path.display().to_string()));
+    geometries.into_iter().find_map(|(geometry, origin)| match geometry {
+        urdf_rs::Geometry::Mesh { filename, scale } => Some(LinkMesh {
+            filename: filename.clone(),
+            scale: scale.map_or([1.0; 3], |s| s.0),
+            pose: Isometry3::from_parts(Vector3::from(origin.xyz.0).into(), rotation(origin.rpy.0).into()),
+        }),
+        _ => None,
+    })
+}
+
+/// The mass properties of `mesh` at [`MESH_DENSITY`] in the link frame and the file they came
+/// from, or what prevents them: the file is found nowhere, cannot be read, or has no volume.
+fn mesh_mass(urdf: &Path, mesh: &LinkMesh) -> Result<(MassProperties, String), String> {
+    let relative = mesh
+        .filename
+        .trim_start_matches("package://")
+        .trim_start_matches("file://");
+    let base = urdf.parent().unwrap_or(Path::new("."));
+    let mut candidates = vec![base.join(relative)];
+    if candidates[0] != Path::new(relative) {
+        candidates.push(Path::new(relative).to_path_buf());
+    }
+    let Some(path) = candidates.iter().find(|p| p.is_file()) else {
+        let looked: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();
+        return Err(format!("file not found (looked for {})", looked.join(" and ")));
+    };
+    let mut triangles = mechanica::mass::io::load_mesh(path).map_err(|e| e.to_string())?;
+    for v in &mut triangles.vertices {
+        for k in 0..3 {
+            v[k] *= mesh.scale[k];
         }
     }
-    None
+    let props = triangles
+        .mass_properties(Amount::Density(MESH_DENSITY), &MeshOptions::default())
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok((props.properties.transformed(&mesh.pose), path.display().to_string()))
 }

@@ -229,3 +229,63 @@ fn a_urdf_robot_runs_and_invalid_inertias_are_reported_per_link() {
         "{err}"
     );
 }
+
+#[test]
+fn a_response_over_the_value_limit_is_refused_at_once_and_the_limit_can_be_raised() {
+    let dir = scratch("limit");
+    let chain = std::fs::read_to_string(examples().join("spring_pendulum_chain.toml")).expect("example");
+    let huge = dir.join("huge.toml");
+    std::fs::write(&huge, chain.replace("samples = 400", "samples = 10000000000")).expect("write");
+    let (ok, out, err) = mechanica(&["run", huge.to_str().expect("path")]);
+    assert!(!ok && out.is_empty(), "{out}");
+    let line = chain.lines().position(|l| l.starts_with("response =")).map(|i| i + 1);
+    assert!(
+        err.contains(&format!("huge.toml:{}:", line.expect("response line")))
+            && err.contains("field analyses.response.samples")
+            && err.contains("--max-response-values"),
+        "{err}"
+    );
+    // The example stores 400 × (3 + 1) values: refused under a limit of 1599, run under 1600.
+    let example = examples().join("spring_pendulum_chain.toml");
+    let example = example.to_str().expect("path");
+    let (ok, _, err) = mechanica(&["run", example, "--max-response-values", "1599"]);
+    assert!(!ok && err.contains("1600 values"), "{err}");
+    let (ok, out, err) = mechanica(&["run", example, "--max-response-values", "1600"]);
+    assert!(ok && out.contains("free response"), "{err}");
+}
+
+#[test]
+fn results_that_overflow_are_refused_with_a_non_zero_exit() {
+    let dir = scratch("overflow");
+    let base = std::fs::read_to_string(examples().join("double_pendulum.toml")).expect("example");
+    let heavy = "primitive = { shape = \"rod\", length = 1.0, mass = 1e308 }";
+    for (name, text) in [
+        (
+            "heavy_upper",
+            base.replacen("primitive = { shape = \"rod\", length = 1.0, mass = 1.0 }", heavy, 1),
+        ),
+        (
+            "heavy_both",
+            base.replace("primitive = { shape = \"rod\", length = 1.0, mass = 1.0 }", heavy),
+        ),
+        (
+            "heavy_with_modes",
+            base.replacen("primitive = { shape = \"rod\", length = 1.0, mass = 1.0 }", heavy, 1)
+                .replace("mass_properties = true", "equilibrium = {}\nmodes = {}"),
+        ),
+    ] {
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, text).expect("write");
+        for json in [false, true] {
+            let mut args = vec!["run", path.to_str().expect("path")];
+            if json {
+                args.push("--json");
+            }
+            let (ok, out, err) = mechanica(&args);
+            assert!(!ok, "{name}: must fail:\n{out}");
+            assert!(out.is_empty(), "{name}: nothing half-written: {out}");
+            // Every refusal names the offending value.
+            assert!(err.contains("inf") || err.contains("NaN"), "{name}: {err}");
+        }
+    }
+}

@@ -189,15 +189,32 @@ impl<'a> Configuration<'a> {
     /// For two coordinates k, l on one root path: (earlier, later) in the carrying order, and
     /// whether both are rotation-vector coordinates of the same joint.
     pub(crate) fn ordered(&self, k: usize, l: usize) -> (usize, usize, bool) {
-        let same_rotation_block = self.rank[k].1
+        let block = self.same_rotation_block(k, l);
+        if self.rank[k].0 <= self.rank[l].0 {
+            (k, l, block)
+        } else {
+            (l, k, block)
+        }
+    }
+
+    /// True when k and l are both rotation-vector coordinates of the same joint.
+    pub(crate) fn same_rotation_block(&self, k: usize, l: usize) -> bool {
+        self.rank[k].1
             && self.rank[l].1
             && self.tree.dof_body(k).is_some()
-            && self.tree.dof_body(k) == self.tree.dof_body(l);
-        if self.rank[k].0 <= self.rank[l].0 {
-            (k, l, same_rotation_block)
-        } else {
-            (l, k, same_rotation_block)
-        }
+            && self.tree.dof_body(k) == self.tree.dof_body(l)
+    }
+
+    /// The coordinates that carry `late` or are `late` itself: those of its own joint up to
+    /// `late` (the earlier ones in [`Configuration::ordered`]'s order), then every coordinate of
+    /// each ancestor joint. Each pair of coordinates on one root path is (carrier, `late`) for
+    /// exactly one `late`, so a loop over all `late` and their carriers visits every such pair
+    /// once, in O(n·depth).
+    pub(crate) fn carriers(&self, late: usize) -> impl Iterator<Item = usize> + '_ {
+        let body = self.tree.dof_body(late);
+        let own = body.map_or(0..0, |b| self.tree.dof_range(b).start..late + 1);
+        let ancestors = std::iter::successors(body.and_then(|b| self.tree.parent(b)), |&b| self.tree.parent(b));
+        own.chain(ancestors.flat_map(|b| self.tree.dof_range(b)))
     }
 
     /// Errors unless the rotation vector of the joint owning k is zero (see the module docs).

@@ -222,7 +222,9 @@ impl Mechanism {
     /// The gyroscopic matrix G(q) of the motion relative to a rotating frame (zero without
     /// one): G_kl = 2 ∫ρ ∂x/∂q_k · (Ω × ∂x/∂q_l) dV, skew-symmetric, so that small motions obey
     /// A δ̈ + G δ̇ + B δ = 0. With the subtree moments (m, h, S) of the later of k, l:
-    /// G_kl = 2 Ω·[−S (w_k × w_l) + (w_l × h) × a_k + a_l × (w_k × h) + m a_l × a_k].
+    /// G_kl = 2 Ω·[−S (w_k × w_l) + (w_l × h) × a_k + a_l × (w_k × h) + m a_l × a_k]
+    ///      = 2 [w_k·(h × (Ω × a_l) − w_l × SΩ) + a_k·(Ω × (w_l × h) + m Ω × a_l)],
+    /// linear in k's column, so each later coordinate l costs O(depth): O(n·depth) in all.
     pub fn gyroscopic_matrix(&self, q: &[f64]) -> Result<Mat<f64>, MechanismError> {
         let ws = self.positions(q)?;
         let n = self.dof();
@@ -230,24 +232,17 @@ impl Mechanism {
         let Some(frame) = self.rotation else { return Ok(g) };
         let omega = frame.axis.into_inner() * frame.rate;
         let config = Configuration::new(&self.tree, &ws, q, &self.bodies)?;
-        let body_of = |c: usize| self.tree.dof_body(c).unwrap_or(0);
-        for k in 0..n {
-            for l in (k + 1)..n {
-                let (bk, bl) = (body_of(k), body_of(l));
-                if !(self.tree.is_ancestor_or_self(bk, bl) || self.tree.is_ancestor_or_self(bl, bk)) {
-                    continue;
-                }
-                let (_, late, _) = config.ordered(k, l);
-                let m = config.subtree_moments(body_of(late));
-                let (ck, cl) = (config.column(k), config.column(l));
-                let h = m.first;
-                let integral = -(m.second * ck.w.cross(&cl.w))
-                    + cl.w.cross(&h).cross(&ck.a)
-                    + cl.a.cross(&ck.w.cross(&h))
-                    + cl.a.cross(&ck.a) * m.mass;
-                let value = 2.0 * omega.dot(&integral);
-                g[(k, l)] = value;
-                g[(l, k)] = -value;
+        for late in 0..n {
+            let body = self.tree.dof_body(late).unwrap_or(0);
+            let m = config.subtree_moments(body);
+            let cl = config.column(late);
+            let on_w = m.first.cross(&omega.cross(&cl.a)) - cl.w.cross(&(m.second * omega));
+            let on_a = omega.cross(&cl.w.cross(&m.first)) + omega.cross(&cl.a) * m.mass;
+            for early in config.carriers(late).filter(|&e| e != late) {
+                let ce = config.column(early);
+                let value = 2.0 * (ce.w.dot(&on_w) + ce.a.dot(&on_a));
+                g[(early, late)] = value;
+                g[(late, early)] = -value;
             }
         }
         Ok(g)

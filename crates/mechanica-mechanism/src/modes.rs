@@ -172,8 +172,12 @@ pub fn mechanism_modes_with_locks(
     let stability = stability_of(&solution);
     let gradient_norm = free.iter().map(|&k| evaluation.gradient[k].powi(2)).sum::<f64>().sqrt();
     if let Some(x) = solution.vectors.take() {
+        let mut row_of = vec![None; n_all];
+        for (i, &k) in free.iter().enumerate() {
+            row_of[k] = Some(i);
+        }
         solution.vectors = Some(Mat::from_fn(n_all, x.ncols(), |r, c| {
-            free.iter().position(|&k| k == r).map_or(0.0, |i| x[(i, c)])
+            row_of[r].map_or(0.0, |i| x[(i, c)])
         }));
     }
     let (body_displacements, effective_masses, total_mass) = shapes_in_space(mechanism, &q, &solution)?;
@@ -226,63 +230,64 @@ fn propagate_assembly_error(solution: &mut ModalSolution, b: &Mat<f64>) {
 
 type Shapes = (Vec<Vec<BodyDisplacement>>, Vec<[f64; 3]>, f64);
 
+/// Per mode, the displacement of every body and the effective masses (see the module docs).
+/// A mode x moves the points of body i by δx = Ω_i × (x − r) + V_i, with the sums Ω_i = Σ w_k x_k
+/// and V_i = Σ ā_k x_k over the coordinates k on i's root path of the columns referred to the
+/// root's origin r (ā_k = v_k + w_k × (r − o_k)); both sums grow from parent to child, so every
+/// mode costs O(n) operations.
 fn shapes_in_space(mechanism: &Mechanism, q: &[f64], solution: &ModalSolution) -> Result<Shapes, MechanismError> {
-    let tree = mechanism.tree();
-    let n = tree.dof();
-    let mut ws = tree.workspace();
-    tree.update_positions(&mut ws, q)?;
     let bodies = mechanism.bodies();
     let total_mass: f64 = bodies.iter().map(|b| b.mass).sum();
-    // Per body: Jacobians of the centre of mass and of the rotation.
-    let mut point = Vec::with_capacity(bodies.len());
-    let mut angular = Vec::with_capacity(bodies.len());
-    let mut com_jacobian = vec![0.0; 3 * n];
-    for (i, body) in bodies.iter().enumerate() {
-        let mut jp = vec![0.0; 3 * n];
-        let mut jw = vec![0.0; 3 * n];
-        tree.point_jacobian(&ws, i, &body.p_oc, &mut jp)?;
-        tree.angular_jacobian(&ws, i, &mut jw)?;
-        for (c, p) in com_jacobian.iter_mut().zip(&jp) {
-            *c += body.mass * p;
-        }
-        point.push(jp);
-        angular.push(jw);
-    }
     let Some(x) = &solution.vectors else {
         return Ok((Vec::new(), Vec::new(), total_mass));
     };
+    let tree = mechanism.tree();
+    let mut ws = tree.workspace();
+    tree.update_positions(&mut ws, q)?;
+    let order = tree.topological_order();
+    let root = ws.position(order.first().copied().unwrap_or(0))?;
+    let mut columns = Vec::with_capacity(tree.dof());
+    for k in 0..tree.dof() {
+        let (w, v) = ws.motion_column(k)?;
+        let origin = ws.position(tree.dof_body(k).unwrap_or(0))?;
+        columns.push((w, v + w.cross(&(root - origin))));
+    }
+    let mut centres = Vec::with_capacity(bodies.len());
+    for (i, body) in bodies.iter().enumerate() {
+        centres.push(ws.point_position(i, &body.p_oc)? - root);
+    }
     let mut displacements = Vec::with_capacity(x.ncols());
     let mut effective = Vec::with_capacity(x.ncols());
+    let mut sums = vec![(Vector3::zeros(), Vector3::zeros()); bodies.len()];
     for m in 0..x.ncols() {
-        let finite = !matches!(solution.modes[m].kind, ModeKind::Infinite);
-        let combine = |jac: &[f64]| {
-            let mut v = Vector3::zeros();
-            for k in 0..n {
-                for r in 0..3 {
-                    v[r] += jac[3 * k + r] * x[(k, m)];
-                }
+        for &i in order {
+            let (mut spin, mut shift) = tree.parent(i).map_or((Vector3::zeros(), Vector3::zeros()), |p| sums[p]);
+            for k in tree.dof_range(i) {
+                spin += columns[k].0 * x[(k, m)];
+                shift += columns[k].1 * x[(k, m)];
             }
-            v
-        };
-        displacements.push(
-            (0..bodies.len())
-                .map(|i| BodyDisplacement {
-                    translation: combine(&point[i]),
-                    rotation: combine(&angular[i]),
-                })
-                .collect(),
-        );
+            sums[i] = (spin, shift);
+        }
+        let moved: Vec<BodyDisplacement> = sums
+            .iter()
+            .zip(&centres)
+            .map(|((spin, shift), c)| BodyDisplacement {
+                translation: spin.cross(c) + shift,
+                rotation: *spin,
+            })
+            .collect();
         // Γ_d = x_kᵀ L_d with L_d = Σ m_i J_iᵀ d = (M J_c)ᵀ d; x_k is A-normalised.
-        let participation = combine(&com_jacobian);
-        effective.push(if finite {
+        let participation: Vector3<f64> = moved.iter().zip(bodies).map(|(d, b)| d.translation * b.mass).sum();
+        effective.push(if matches!(solution.modes[m].kind, ModeKind::Infinite) {
+            [0.0; 3]
+        } else {
             [
                 participation.x.powi(2),
                 participation.y.powi(2),
                 participation.z.powi(2),
             ]
-        } else {
-            [0.0; 3]
         });
+        displacements.push(moved);
     }
     Ok((displacements, effective, total_mass))
 }

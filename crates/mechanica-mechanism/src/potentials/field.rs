@@ -2,6 +2,7 @@
 //! the subtree mass moments (no per-point work).
 
 use super::{Potential, PotentialSum};
+use crate::configuration::{Column, Moments};
 use crate::{Configuration, MechanismError};
 use mechanica_kinematics::tree::KinematicTree;
 use nalgebra::{Matrix3, Vector3};
@@ -17,7 +18,9 @@ use nalgebra::{Matrix3, Vector3};
 /// - ∂U/∂q_k = w_k·(ax(K S) − h × g) + (K h − m g)·a_k over the subtree of k's body, with
 ///   ax(M) = (M₃₂ − M₂₃, M₁₃ − M₃₁, M₂₁ − M₁₂);
 /// - ∂²U/∂q_k∂q_l = ∫ρ (∂x/∂q_k)ᵀ K ∂x/∂q_l + ∫ρ (Kx − g)·∂²x/∂q_k∂q_l over the subtree of the
-///   later of k and l, both integrals in closed form in (m, h, S).
+///   later of k and l, both integrals in closed form in (m, h, S). Both are linear in the
+///   earlier column, so each later coordinate l gives two vectors once and every pair costs
+///   two dot products: the Hessian takes O(n·depth) operations.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UniformField {
     /// Gravitational acceleration g (world, m/s²).
@@ -43,6 +46,44 @@ impl UniformField {
             gravity,
             k: projector * (-rate * rate),
         }
+    }
+}
+
+impl UniformField {
+    /// The vectors (p, r) with ∂²U/∂q_e∂q_l = w_e·p + a_e·r for every coordinate e that carries
+    /// l (outside one rotation vector), from l's column (w_l, a_l) and the moments (m, h, S) of
+    /// l's subtree. The Gram part ∫ρ J_eᵀ K J_l and the curvature part ∫ρ (Kx − g)·(w_e × J_l)
+    /// (module docs) are both linear in (w_e, a_e); with tr([w]× M) = −w·ax(M):
+    /// p = ax(K W_l S) − ax(W_l S K) + h × K a_l + a_l × K h − (w_l × h) × g − m a_l × g and
+    /// r = K (w_l × h) + m K a_l.
+    fn pair_weights(&self, m: &Moments, late: &Column) -> (Vector3<f64>, Vector3<f64>) {
+        let (g, k) = (&self.gravity, &self.k);
+        let wl = late.w.cross_matrix();
+        let spin_h = late.w.cross(&m.first);
+        let on_w = axial(&(k * wl * m.second)) - axial(&(wl * m.second * k))
+            + m.first.cross(&(k * late.a))
+            + late.a.cross(&(k * m.first))
+            - spin_h.cross(g)
+            - late.a.cross(g) * m.mass;
+        let on_a = k * spin_h + k * late.a * m.mass;
+        (on_w, on_a)
+    }
+
+    /// ∂²U/∂q_e∂q_l for two coordinates of one rotation vector at φ = 0: the Gram part plus
+    /// the symmetric part of the curvature (see [`Configuration`]), over l's subtree moments.
+    fn rotation_block_entry(&self, m: &Moments, early: &Column, late: &Column) -> f64 {
+        let (g, k) = (&self.gravity, &self.k);
+        let (we, wl) = (early.w.cross_matrix(), late.w.cross_matrix());
+        let gram = trace_of_product(&(we.transpose() * k * wl), &m.second)
+            + early.a.dot(&(k * wl * m.first))
+            + (we * m.first).dot(&(k * late.a))
+            + m.mass * early.a.dot(&(k * late.a));
+        let curvature = |e: &Matrix3<f64>, l: &Matrix3<f64>, la: &Vector3<f64>| {
+            trace_of_product(&(k * e * l), &m.second) + (k * m.first).dot(&(e * la))
+                - g.dot(&(e * l * m.first))
+                - m.mass * g.dot(&(e * la))
+        };
+        gram + 0.5 * (curvature(&we, &wl, &late.a) + curvature(&wl, &we, &early.a))
     }
 }
 
@@ -85,40 +126,21 @@ impl Potential for UniformField {
         let Some(hessian) = sum.hessian.as_mut() else {
             return Ok(());
         };
-        for c in 0..n {
-            for d in c..n {
-                let (bc, bd) = (body_of(c), body_of(d));
-                let (early, late, block) = if tree.is_ancestor_or_self(bc, bd) || tree.is_ancestor_or_self(bd, bc) {
-                    config.ordered(c, d)
+        for late in 0..n {
+            let m = config.subtree_moments(body_of(late));
+            let cl = config.column(late);
+            let (on_w, on_a) = self.pair_weights(&m, &cl);
+            for early in config.carriers(late) {
+                let ce = config.column(early);
+                let value = if config.same_rotation_block(early, late) {
+                    config.require_rebased(early)?;
+                    self.rotation_block_entry(&m, &ce, &cl)
                 } else {
-                    continue;
+                    ce.w.dot(&on_w) + ce.a.dot(&on_a)
                 };
-                if block {
-                    config.require_rebased(c)?;
-                }
-                let m = config.subtree_moments(body_of(late));
-                let (ce, cl) = (config.column(early), config.column(late));
-                let (we, wl) = (ce.w.cross_matrix(), cl.w.cross_matrix());
-                // ∫ρ J_eᵀ K J_l for J = W x + a.
-                let gram = trace_of_product(&(we.transpose() * k * wl), &m.second)
-                    + ce.a.dot(&(k * wl * m.first))
-                    + (we * m.first).dot(&(k * cl.a))
-                    + m.mass * ce.a.dot(&(k * cl.a));
-                // ∫ρ (Kx − g)·(w_e × ∂x/∂q_l), symmetrised inside one rotation vector.
-                let curvature = |e: &Matrix3<f64>, l: &Matrix3<f64>, la: &Vector3<f64>| {
-                    trace_of_product(&(k * e * l), &m.second) + (k * m.first).dot(&(e * la))
-                        - g.dot(&(e * l * m.first))
-                        - m.mass * g.dot(&(e * la))
-                };
-                let second = if block {
-                    0.5 * (curvature(&we, &wl, &cl.a) + curvature(&wl, &we, &ce.a))
-                } else {
-                    curvature(&we, &wl, &cl.a)
-                };
-                let value = gram + second;
-                hessian[(c, d)] += value;
-                if c != d {
-                    hessian[(d, c)] += value;
+                hessian[(early, late)] += value;
+                if early != late {
+                    hessian[(late, early)] += value;
                 }
             }
         }

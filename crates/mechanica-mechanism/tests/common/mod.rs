@@ -81,3 +81,74 @@ pub fn random_vector(n: usize, seed: u64, s: f64) -> Vec<f64> {
         })
         .collect()
 }
+
+/// A random tree for comparing assemblies, drawn from `seed`: `n` bodies, each hanging from
+/// the previous one with a probability drawn per tree (from chains to bushy trees) and else
+/// from a random earlier body; joints of every kind (revolute, prismatic, planar, spherical,
+/// free, fixed; no rotation-vector joints unless `rotation_vectors`); lengths and masses
+/// scaled by per-tree factors L and M between 1e-3 and 1e3; with `massless`, about one body in
+/// eight without mass. Returns the tree, the bodies and L.
+pub fn random_scaled_tree(
+    n: usize,
+    seed: u64,
+    rotation_vectors: bool,
+    massless: bool,
+) -> (KinematicTree, Vec<MassProperties>, f64) {
+    let mut draw = {
+        let mut state = random_vector(1, seed, 1.0)[0].to_bits() ^ seed;
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64) / ((1u64 << 53) as f64)
+        }
+    };
+    let length = 10f64.powf(6.0 * draw() - 3.0);
+    let mass = 10f64.powf(6.0 * draw() - 3.0);
+    let chain_bias = draw();
+    let kinds = if rotation_vectors { 6.0 } else { 4.0 };
+    let mut builder = TreeBuilder::new();
+    let mut bodies = Vec::new();
+    for i in 0..n {
+        let parent = match i {
+            0 => None,
+            _ if draw() < chain_bias => Some(i - 1),
+            _ => Some((draw() * i as f64) as usize),
+        };
+        let axis = spread(1.0, &mut draw).normalize();
+        let joint = match (draw() * kinds) as usize {
+            0 => Joint::Revolute { axis },
+            1 => Joint::Prismatic { axis },
+            2 => Joint::Planar,
+            3 => Joint::Fixed,
+            4 => Joint::Spherical,
+            _ => Joint::Free,
+        };
+        let rotation = UnitQuaternion::from_scaled_axis(spread(4.0, &mut draw));
+        let placement = Isometry3::from_parts(Translation3::from(spread(2.0 * length, &mut draw)), rotation);
+        builder.add_body(parent, joint, placement);
+        let sides = Vector3::new(0.1 + draw(), 0.1 + draw(), 0.1 + draw()) * length;
+        let m = if massless && draw() < 0.125 {
+            0.0
+        } else {
+            mass * (0.2 + draw())
+        };
+        let [a, b, c] = [sides.x, sides.y, sides.z];
+        let box_inertia =
+            nalgebra::Matrix3::from_diagonal(&Vector3::new(b * b + c * c, a * a + c * c, a * a + b * b)) * (m / 12.0);
+        let r = UnitQuaternion::from_scaled_axis(spread(4.0, &mut draw)).to_rotation_matrix();
+        let inertia = r.matrix() * box_inertia * r.matrix().transpose();
+        let com = spread(2.0 * length, &mut draw);
+        bodies.push(MassProperties {
+            mass: m,
+            p_oc: com,
+            inertia_c: inertia,
+        });
+    }
+    (builder.build().expect("valid random tree"), bodies, length)
+}
+
+/// A vector of independent uniform entries in [−s/2, s/2].
+fn spread(s: f64, draw: &mut impl FnMut() -> f64) -> Vector3<f64> {
+    Vector3::new(draw() - 0.5, draw() - 0.5, draw() - 0.5) * s
+}

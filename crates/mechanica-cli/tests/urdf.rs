@@ -1,0 +1,178 @@
+//! `mechanica run` on URDF robots whose links take their mass from meshes: a usable mesh gives
+//! the closed-form pendulum frequency, an unusable one (missing file, `package://` path, a
+//! `.dae`, a misspelt name) is an error naming the link and the mesh unless
+//! `--allow-missing-mesh` makes the link massless with a warning.
+
+use std::path::PathBuf;
+mod common;
+use common::{mechanica, values};
+
+const G: f64 = 9.81;
+
+/// A fresh directory under the system temp dir, unique to this test and process.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mechanica-urdf-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+/// An OBJ cube of side `s` centred on the origin, faces counter-clockwise seen from outside.
+fn cube_obj(s: f64) -> String {
+    let h = 0.5 * s;
+    let mut text = String::new();
+    for k in 0..8 {
+        let c = |bit: usize| if k & bit != 0 { h } else { -h };
+        text.push_str(&format!("v {} {} {}\n", c(1), c(2), c(4)));
+    }
+    // Corner k (1-based k + 1 in OBJ) has x bit 1, y bit 2, z bit 4.
+    for [a, b, c] in [
+        [0, 2, 3],
+        [0, 3, 1],
+        [4, 5, 7],
+        [4, 7, 6],
+        [0, 1, 5],
+        [0, 5, 4],
+        [2, 6, 7],
+        [2, 7, 3],
+        [0, 4, 6],
+        [0, 6, 2],
+        [1, 3, 7],
+        [1, 7, 5],
+    ] {
+        text.push_str(&format!("f {} {} {}\n", a + 1, b + 1, c + 1));
+    }
+    text
+}
+
+/// A rod pendulum (1 kg, 1 m, hinge about y) carrying, by a fixed joint at its tip, one tool
+/// link per mesh file name in `meshes`, each without `<inertial>`.
+fn pendulum_with_tools(meshes: &[&str]) -> String {
+    let mut text = String::from(
+        r#"<?xml version="1.0"?>
+<robot name="tooled_pendulum">
+  <link name="base"/>
+  <link name="upper">
+    <inertial>
+      <origin xyz="0 0 -0.5" rpy="0 0 0"/>
+      <mass value="1.0"/>
+      <inertia ixx="0.08333333333333333" ixy="0" ixz="0" iyy="0.08333333333333333" iyz="0" izz="1e-6"/>
+    </inertial>
+  </link>
+  <joint name="hinge" type="continuous">
+    <parent link="base"/><child link="upper"/>
+    <origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="0 1 0"/>
+  </joint>
+"#,
+    );
+    for (i, mesh) in meshes.iter().enumerate() {
+        text.push_str(&format!(
+            r#"  <link name="tool{i}">
+    <visual><geometry><box size="1 1 1"/></geometry></visual>
+    <collision><origin xyz="0 0 0" rpy="0 0 0"/><geometry><mesh filename="{mesh}"/></geometry></collision>
+  </link>
+  <joint name="mount{i}" type="fixed">
+    <parent link="upper"/><child link="tool{i}"/>
+    <origin xyz="0 0 -1" rpy="0 0 0"/>
+  </joint>
+"#
+        ));
+    }
+    text.push_str("</robot>\n");
+    text
+}
+
+/// ω² of the rod pendulum alone: m g d / I_pivot with d = 1/2, I_pivot = 1/12 + 1/4.
+fn rod_alone() -> f64 {
+    G * 0.5 / (1.0 / 12.0 + 0.25)
+}
+
+fn lowest_omega_sq(out: &str) -> f64 {
+    let json: serde_json::Value = serde_json::from_str(out).expect("JSON report");
+    values(&json, "ω²")[0]
+}
+
+#[test]
+fn a_usable_mesh_gives_the_link_its_mass_at_water_density() {
+    let dir = scratch("usable");
+    std::fs::write(dir.join("cube.obj"), cube_obj(0.1)).expect("mesh");
+    let urdf = dir.join("robot.urdf");
+    std::fs::write(&urdf, pendulum_with_tools(&["cube.obj"])).expect("urdf");
+    let (ok, out, err) = mechanica(&["run", urdf.to_str().expect("path"), "--json"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("mass properties from mesh"), "{out}");
+    // Cube of 0.1 m at 1000 kg/m³: 1 kg at 1 m below the hinge, central moment m s²/6.
+    let (m_cube, i_cube) = (1.0, 0.01 / 6.0);
+    let exact = G * (0.5 + m_cube) / (1.0 / 12.0 + 0.25 + i_cube + m_cube);
+    let got = lowest_omega_sq(&out);
+    assert!((got - exact).abs() <= 1e-10 * exact, "{got} vs {exact}");
+}
+
+#[test]
+fn unusable_meshes_are_errors_naming_each_link_and_mesh() {
+    let dir = scratch("unusable");
+    std::fs::write(dir.join("cube.obj"), cube_obj(0.1)).expect("mesh");
+    std::fs::write(dir.join("tool.dae"), "<COLLADA/>\n").expect("dae");
+    let meshes = ["package://robot/meshes/tool.stl", "tool.dae", "cub.obj"];
+    let urdf = dir.join("robot.urdf");
+    std::fs::write(&urdf, pendulum_with_tools(&meshes)).expect("urdf");
+    let (ok, out, err) = mechanica(&["run", urdf.to_str().expect("path")]);
+    assert!(!ok, "must refuse:\n{out}");
+    assert!(out.is_empty(), "nothing half-written: {out}");
+    assert!(
+        err.contains("--allow-missing-mesh") && err.contains("robot.urdf"),
+        "{err}"
+    );
+    for (i, mesh) in meshes.iter().enumerate() {
+        assert!(
+            err.contains(&format!("link \"tool{i}\": mesh \"{mesh}\"")),
+            "tool{i} / {mesh}: {err}"
+        );
+    }
+    assert!(
+        err.contains("not found") && err.contains("unknown mesh format"),
+        "{err}"
+    );
+}
+
+#[test]
+fn allow_missing_mesh_makes_the_links_massless_with_a_warning_in_text_and_json() {
+    let dir = scratch("allowed");
+    let meshes = ["package://robot/meshes/tool.stl", "tool.dae"];
+    let urdf = dir.join("robot.urdf");
+    std::fs::write(&urdf, pendulum_with_tools(&meshes)).expect("urdf");
+    let path = urdf.to_str().expect("path");
+    let (ok, out, err) = mechanica(&["run", path, "--json", "--allow-missing-mesh"]);
+    assert!(ok, "{err}");
+    // Massless tools leave the rod's own frequency.
+    let got = lowest_omega_sq(&out);
+    assert!(
+        (got - rod_alone()).abs() <= 1e-10 * rod_alone(),
+        "{got} vs {}",
+        rod_alone()
+    );
+    let json: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let notes: Vec<&str> = json["steps"]
+        .as_array()
+        .expect("steps")
+        .iter()
+        .flat_map(|s| s["notes"].as_array().into_iter().flatten())
+        .filter_map(|n| n.as_str())
+        .filter(|n| n.starts_with("warning:"))
+        .collect();
+    assert_eq!(notes.len(), meshes.len(), "{notes:?}");
+    for (i, mesh) in meshes.iter().enumerate() {
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.contains(&format!("link \"tool{i}\"")) && n.contains(mesh)),
+            "{notes:?}"
+        );
+    }
+    let (ok, text, err) = mechanica(&["run", path, "--allow-missing-mesh"]);
+    assert!(ok, "{err}");
+    assert!(
+        text.contains("warning: link \"tool0\"") && text.contains("massless"),
+        "{text}"
+    );
+}
