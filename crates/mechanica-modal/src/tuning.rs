@@ -34,6 +34,13 @@ pub struct Tuning {
     /// keep the bounds of the reduction (default 16): a block step costs 4p double-double
     /// matrix-vector products.
     pub max_refined_cluster: usize,
+    /// `Refinement::Auto` refines the weakly bounded modes of a selection from the lowest up, at
+    /// most max(`auto_refined_at_least`, n / `auto_refined_fraction`) of them (default 256 and
+    /// 4): each costs O(n²) double-double work, so refining all n of a graded pencil would cost
+    /// many dense solves. The others keep their (true, weaker) bounds.
+    pub auto_refined_at_least: usize,
+    /// See [`Tuning::auto_refined_at_least`].
+    pub auto_refined_fraction: usize,
 
     // Cholesky factorization and reduction (module `linalg::reduce`).
     /// Orders at or below which the recursive Cholesky factorization calls faer's blocked
@@ -165,6 +172,8 @@ impl Tuning {
         idle_time_from: 192,
         flagged_vectors_up_to: 32,
         max_refined_cluster: 16,
+        auto_refined_at_least: 256,
+        auto_refined_fraction: 4,
         cholesky_base_case: 128,
         reduce_base_case: 48,
         reduce_block: 256,

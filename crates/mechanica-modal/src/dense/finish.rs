@@ -94,7 +94,7 @@ impl Finish<'_> {
         }
         timings.refine = clock.elapsed();
         let clock = Instant::now();
-        if self.options.refinement == Refinement::Off && x.is_some() {
+        if self.options.refinement != Refinement::Always && x.is_some() {
             self.widen_unrefined_bounds(&mut report, &omega, a_priori);
         }
         if let (Some(x), Some(p)) = (&x, products.as_mut()) {
@@ -124,6 +124,7 @@ impl Finish<'_> {
             report.orthogonality_error = None;
         }
         let mut modes = finite_modes(&omega, &report, &resolution);
+        order_above_positive_modes(&mut modes);
         certify_positive_stiffness(self.problem, &mut modes, self.par);
         if matches!(self.options.selection, Selection::All) && !infinite.is_empty() {
             x = append_infinite(&mut modes, x, &infinite);
@@ -163,14 +164,18 @@ impl Finish<'_> {
         (products, report, model_used)
     }
 
-    /// Without refinement, a first-order bound that guarantees fewer than 8 digits belongs to a
+    /// A mode left unrefined (`Refinement::Off`, or beyond the budget of `Refinement::Auto`)
+    /// whose first-order bound guarantees fewer than 8 digits belongs to a
     /// mode near the reduction's error level, where the first-order theory (a simple eigenvalue
     /// whose perturbation stays below its gaps) need not hold: such a bound is raised to the
     /// a-priori bound of the reduction ([`APrioriModel`]), a Weyl bound that needs no gap.
     fn widen_unrefined_bounds(&self, report: &mut AccuracyReport, omega: &[f64], a_priori: Option<APrioriModel>) {
         let n = self.problem.dim();
         let weak: Vec<usize> = (0..omega.len())
-            .filter(|&i| weakly_bounded(report.bound_with_rounding(i, n), omega[i]))
+            .filter(|&i| {
+                report.bound_kinds[i] == BoundKind::FirstOrder
+                    && weakly_bounded(report.bound_with_rounding(i, n), omega[i])
+            })
             .collect();
         if weak.is_empty() {
             return;
@@ -295,6 +300,25 @@ fn finite_modes(omega: &[f64], report: &AccuracyReport, resolution: &[f64]) -> V
             }
         })
         .collect()
+}
+
+/// A mode called zero or undecided above an oscillatory mode whose interval lies entirely above
+/// zero: the
+/// modes are in ascending order (the order the Sturm check certifies), so its exact ω² is at
+/// least that positive one's, and the mode is oscillatory (an unrefined mode with a wide bound
+/// above refined low modes).
+fn order_above_positive_modes(modes: &mut [Mode]) {
+    let mut positive_below = false;
+    for mode in modes.iter_mut() {
+        if positive_below && matches!(mode.kind, ModeKind::Zero | ModeKind::Undecided) {
+            mode.kind = ModeKind::Oscillatory {
+                omega: mode.omega_sq.max(0.0).sqrt(),
+            };
+        }
+        // Only a resolved mode counts: one within the data's resolution is zero whatever its
+        // bound says of the stored numbers.
+        positive_below |= matches!(mode.kind, ModeKind::Oscillatory { .. }) && mode.omega_sq - mode.error_bound > 0.0;
+    }
 }
 
 /// A mode the data resolution or its bound would call zero, or unstable, when B itself is

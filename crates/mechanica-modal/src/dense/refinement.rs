@@ -14,6 +14,7 @@ use crate::refine::{
 };
 use crate::runtime::fork_join::map_items;
 use crate::spectrum::{clusters, refinable};
+use crate::tuning::Tuning;
 use faer::{Mat, MatRef, Par};
 use std::ops::Range;
 
@@ -94,13 +95,28 @@ impl Stage<'_> {
                 .collect(),
             None => report.error_bounds.clone(),
         };
-        clusters(omega, &separation)
+        let jobs: Vec<Range<usize>> = clusters(omega, &separation)
             .into_iter()
             .filter(|g| {
                 let wanted = self.policy == Refinement::Always
                     || g.clone()
                         .any(|i| weakly_bounded(report.bound_with_rounding(i, self.a.nrows()), omega[i]));
                 wanted && refinable(g, omega, &separation, self.omega_all, self.first)
+            })
+            .collect();
+        if self.policy == Refinement::Always {
+            return jobs;
+        }
+        // Auto: the lowest weak modes first, within the budget of Tuning::auto_refined_at_least.
+        let tuning = Tuning::DEFAULT;
+        let budget = tuning
+            .auto_refined_at_least
+            .max(self.a.nrows() / tuning.auto_refined_fraction.max(1));
+        let mut taken = 0;
+        jobs.into_iter()
+            .take_while(|g| {
+                taken += g.len();
+                taken <= budget
             })
             .collect()
     }
