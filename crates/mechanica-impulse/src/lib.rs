@@ -17,6 +17,7 @@
 //! - [`showcase`]: Kane's double pendulum striking a rough floor under each restitution law.
 
 pub mod body;
+mod compensated;
 pub mod contact;
 pub mod contact_space;
 pub mod error;
@@ -25,7 +26,9 @@ pub mod mechanism;
 pub mod mechanism_contact;
 pub mod multi_contact;
 pub mod point;
+mod process;
 pub mod showcase;
+mod tangent_block;
 
 pub use body::{BodyResponse, RigidBody};
 pub use contact::{TwoBodyImpact, resolve_contact};
