@@ -194,8 +194,12 @@ impl RigidBody {
         self.constrained(c, "hinge axis")
     }
 
-    /// Restricts the mobility to the null space of the constraint rows `c` (C x = 0):
-    /// G' = G − G Cᵀ (C G Cᵀ)⁺ C G, the mobility with the constraint impulse eliminated.
+    /// Restricts the mobility to the null space of the constraint rows `c` (C x = 0), with the
+    /// constraint impulse eliminated: G' = G − G Cᵀ (C G Cᵀ)⁺ C G. It is formed as
+    /// G' = (L Q)(L Q)ᵀ with G = L Lᵀ and Q an orthonormal basis of null(C L), so that G' is
+    /// positive semidefinite with the exact rank of the allowed motions (a revolute hinge
+    /// leaves rank one) up to the rounding of its entries; the difference form leaves the
+    /// constrained directions at the rounding of G times the condition of C G Cᵀ.
     fn constrained(&self, c: DMatrix<f64>, what: &'static str) -> Result<Self, ImpulseError> {
         let x = self.state();
         let residual = (&c * DMatrix::from_column_slice(6, 1, x.as_slice())).norm();
@@ -208,26 +212,22 @@ impl RigidBody {
                 tolerance,
             });
         }
-        let g = DMatrix::from_column_slice(6, 6, self.mobility.as_slice());
-        let gct = &g * c.transpose();
-        let cgct = &c * &gct;
-        let scale = cgct.amax();
-        let pinv = if scale > 0.0 {
-            cgct.clone()
-                .svd(true, true)
-                .pseudo_inverse(scale * 1e-12)
-                .map_err(|_| ImpulseError::Singular {
-                    what: "hinge constraint (SVD did not converge)",
-                    value: scale,
-                })?
-        } else {
-            DMatrix::zeros(cgct.nrows(), cgct.ncols())
-        };
-        let reduced = &g - &gct * pinv * gct.transpose();
+        let l = mobility_square_root(&self.mobility);
+        let mut cl = DMatrix::zeros(6, 6);
+        cl.rows_mut(0, c.nrows())
+            .copy_from(&(&c * DMatrix::from_column_slice(6, 6, l.as_slice())));
+        let svd = cl.svd(false, true);
+        let v_t = svd.v_t.ok_or(ImpulseError::Singular {
+            what: "hinge constraint (SVD did not converge)",
+            value: 0.0,
+        })?;
+        let largest = svd.singular_values.max();
         let mut mobility = Matrix6::zeros();
-        for i in 0..6 {
-            for j in 0..6 {
-                mobility[(i, j)] = 0.5 * (reduced[(i, j)] + reduced[(j, i)]);
+        for k in 0..6 {
+            if svd.singular_values[k] <= 1e-12 * largest {
+                let q = Vector6::from_iterator(v_t.row(k).iter().copied());
+                let b = l * q;
+                mobility += b * b.transpose();
             }
         }
         Ok(Self {
@@ -396,6 +396,18 @@ pub(crate) fn check_symmetric_psd(what: &'static str, m: &Matrix3<f64>) -> Resul
         });
     }
     Ok(())
+}
+
+/// A square root L of a symmetric positive semidefinite 6×6 mobility, G = L Lᵀ, from its
+/// eigen-decomposition (eigenvalues below zero by rounding are taken as zero).
+fn mobility_square_root(g: &Matrix6<f64>) -> Matrix6<f64> {
+    let eig = ((g + g.transpose()) * 0.5).symmetric_eigen();
+    let mut l = eig.eigenvectors;
+    for k in 0..6 {
+        let root = eig.eigenvalues[k].max(0.0).sqrt();
+        l.column_mut(k).scale_mut(root);
+    }
+    l
 }
 
 /// A pseudo-inverse, the unit vectors spanning the null space, and how many there are.

@@ -15,14 +15,14 @@ use nalgebra::{Matrix3, Vector3};
 pub(crate) const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
 
 /// a + b = s + e exactly (Knuth's TwoSum).
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     let v = s - a;
     (s, (a - (s - v)) + (b - v))
 }
 
 /// a·b = p + e exactly (TwoProduct with a fused multiply-add).
-fn two_product(a: f64, b: f64) -> (f64, f64) {
+pub(crate) fn two_product(a: f64, b: f64) -> (f64, f64) {
     let p = a * b;
     (p, a.mul_add(b, -p))
 }
@@ -48,36 +48,6 @@ pub(crate) fn dot2_split(x: &[f64], y: &[f64]) -> (f64, f64) {
     two_sum(sum, error)
 }
 
-/// The congruence Rᵀ W R as an unevaluated sum hi + lo of two symmetric matrices: each entry
-/// Σ_kl R_ki W_kl R_lj is summed in compensated arithmetic from the exact splits of the
-/// products R_ki W_kl, so that hi + lo is exact up to about u²·Σ|terms| however much the terms
-/// cancel (a large W seen along a direction in which it is small). Rounding it to one double
-/// per entry would perturb a block of condition κ by κ·u; the impact process keeps both parts.
-pub(crate) fn congruence(r: &Matrix3<f64>, w: &Matrix3<f64>) -> (Matrix3<f64>, Matrix3<f64>) {
-    let entry = |i: usize, j: usize| {
-        let (mut x, mut y) = ([0.0; 18], [0.0; 18]);
-        for k in 0..3 {
-            for l in 0..3 {
-                let (p, e) = two_product(r[(k, i)], w[(k, l)]);
-                let slot = 2 * (3 * k + l);
-                x[slot] = p;
-                x[slot + 1] = e;
-                y[slot] = r[(l, j)];
-                y[slot + 1] = r[(l, j)];
-            }
-        }
-        dot2_split(&x, &y)
-    };
-    let (mut hi, mut lo) = (Matrix3::zeros(), Matrix3::zeros());
-    for i in 0..3 {
-        for j in i..3 {
-            let (h, l) = entry(i, j);
-            (hi[(i, j)], hi[(j, i)], lo[(i, j)], lo[(j, i)]) = (h, h, l, l);
-        }
-    }
-    (hi, lo)
-}
-
 /// The matrix–vector product M x as hi + lo, each component in compensated arithmetic.
 pub(crate) fn mul_vec(m: &Matrix3<f64>, x: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     let (mut hi, mut lo) = (Vector3::zeros(), Vector3::zeros());
@@ -85,6 +55,63 @@ pub(crate) fn mul_vec(m: &Matrix3<f64>, x: &Vector3<f64>) -> (Vector3<f64>, Vect
         (hi[i], lo[i]) = dot2_split(&[m[(i, 0)], m[(i, 1)], m[(i, 2)]], x.as_slice());
     }
     (hi, lo)
+}
+
+/// A double-double number hi + lo (|lo| ≤ ½ ulp(hi)), about 32 significant digits: just the
+/// operations the exact contact frame needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Dd {
+    pub hi: f64,
+    pub lo: f64,
+}
+
+impl Dd {
+    /// The double `x`.
+    pub fn new(x: f64) -> Self {
+        Self { hi: x, lo: 0.0 }
+    }
+
+    fn normalized(hi: f64, lo: f64) -> Self {
+        let (hi, lo) = two_sum(hi, lo);
+        Self { hi, lo }
+    }
+
+    /// self + other.
+    pub fn add(self, other: Self) -> Self {
+        let (s, e) = two_sum(self.hi, other.hi);
+        Self::normalized(s, e + self.lo + other.lo)
+    }
+
+    /// self·other.
+    pub fn mul(self, other: Self) -> Self {
+        let (p, e) = two_product(self.hi, other.hi);
+        Self::normalized(p, e + self.hi * other.lo + self.lo * other.hi)
+    }
+
+    /// −self.
+    pub fn neg(self) -> Self {
+        Self {
+            hi: -self.hi,
+            lo: -self.lo,
+        }
+    }
+
+    /// self/other (other ≠ 0), by one correction of the quotient of the high parts.
+    pub fn div(self, other: Self) -> Self {
+        let q = self.hi / other.hi;
+        let r = self.add(other.mul(Self::new(q)).neg());
+        Self::normalized(q, (r.hi + r.lo) / other.hi)
+    }
+
+    /// √self (self ≥ 0), by one Newton correction of the square root of the high part.
+    pub fn sqrt(self) -> Self {
+        if self.hi <= 0.0 {
+            return Self::new(0.0);
+        }
+        let r = self.hi.sqrt();
+        let (p, e) = two_product(r, r);
+        Self::normalized(r, ((self.hi - p) - e + self.lo) / (2.0 * r))
+    }
 }
 
 /// Σ |xᵢ yᵢ|: the magnitude against which the rounding of a plain dot product is measured.
@@ -111,15 +138,22 @@ mod tests {
     }
 
     #[test]
-    fn the_congruence_keeps_the_small_entries_of_a_large_rank_one_term() {
-        // W = 1e12 a aᵀ + I with a ⟂ e₃ of R = I: the (2, 2) entry is exactly 1, which a plain
-        // product R ᵀ W R also gets; rotate by a quarter turn about e₃ (exact) so that the
-        // entries mix, and compare with the exact rotated matrix.
-        let a = Vector3::new(0.6, 0.8, 0.0);
-        let w = a * a.transpose() * 1e12 + Matrix3::identity();
-        let r = Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
-        let exact = Matrix3::new(w[(1, 1)], -w[(1, 0)], 0.0, -w[(0, 1)], w[(0, 0)], 0.0, 0.0, 0.0, 1.0);
-        assert_eq!(congruence(&r, &w), (exact, Matrix3::zeros()));
-        assert_eq!(mul_vec(&w, &Vector3::z()), (Vector3::z(), Vector3::zeros()));
+    fn double_double_keeps_what_one_double_rounds_away() {
+        // (1 + 2⁻⁶⁰)·3 / 3 = 1 + 2⁻⁶⁰, and √((1 + 2⁻³⁰)²) = 1 + 2⁻³⁰, both beyond one double.
+        let x = Dd::new(1.0).add(Dd::new(2f64.powi(-60)));
+        let y = x.mul(Dd::new(3.0)).div(Dd::new(3.0));
+        assert_eq!((y.hi, y.lo), (1.0, 2f64.powi(-60)));
+        let a = Dd::new(1.0 + 2f64.powi(-30));
+        let root = a.mul(a).sqrt();
+        assert_eq!((root.hi, root.lo), (1.0 + 2f64.powi(-30), 0.0));
+    }
+
+    #[test]
+    fn the_compensated_product_keeps_what_the_rows_cancel() {
+        // Row 0: 1e16 + 1 − 1e16 = 1; row 1: 0.1 + 0.2 − 0.3 = 2⁻⁵⁵ exactly for these doubles
+        // (plain summation gives 2⁻⁵⁴).
+        let m = Matrix3::new(1e16, 1.0, -1e16, 0.1, 0.2, -0.3, 0.0, 0.0, 1.0);
+        let (hi, lo) = mul_vec(&m, &Vector3::new(1.0, 1.0, 1.0));
+        assert_eq!(hi + lo, Vector3::new(1.0, 2f64.powi(-55), 1.0));
     }
 }

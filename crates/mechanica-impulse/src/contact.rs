@@ -42,13 +42,13 @@ pub fn resolve_contact(
     options: &ImpactOptions,
 ) -> Result<TwoBodyImpact, ImpulseError> {
     check_all_finite("contact point", p_wr.iter())?;
-    let n = unit_vector("contact normal", n_w)?;
+    unit_vector("contact normal", n_w)?;
     law.validate()?;
     body1.check_impulse_point("body 1 contact", p_wr)?;
     body2.check_impulse_point("body 2 contact", p_wr)?;
     let w = body1.point_mobility(p_wr) + body2.point_mobility(p_wr);
     let u = body2.velocity_at(p_wr) - body1.velocity_at(p_wr);
-    let contact = resolve_validated(&w, &u, &n, law, options)?;
+    let contact = resolve_validated(&w, &u, n_w, law, options)?;
     let p = contact.impulse_w;
     let body2_response = body2.respond(&p, &(p_wr - body2.p_wc()).cross(&p));
     let body1_response = body1.respond(&-p, &(p_wr - body1.p_wc()).cross(&-p));

@@ -30,8 +30,9 @@
 //! The energy change is reported by the exact identity ΔT = P·(u⁻ + ½ W P).
 
 use crate::ImpulseError;
-use crate::body::{check_symmetric_psd, orthonormal_complement, unit_vector};
-use crate::compensated::{congruence, dot2, mul_vec};
+use crate::body::{check_symmetric_psd, unit_vector};
+use crate::compensated::{dot2, mul_vec};
+use crate::contact_frame::ContactFrame;
 use crate::error::{check_all_finite, check_finite, check_result};
 use crate::process::Process;
 use nalgebra::{Matrix3, Vector3};
@@ -175,21 +176,24 @@ pub fn resolve_in_contact_space(
     check_all_finite("contact mobility", w_w.iter())?;
     check_symmetric_psd("contact mobility", w_w)?;
     check_all_finite("relative velocity", u_w.iter())?;
-    let n = unit_vector("contact normal", n_w)?;
+    unit_vector("contact normal", n_w)?;
     law.validate()?;
-    resolve_validated(w_w, u_w, &n, law, options)
+    resolve_validated(w_w, u_w, n_w, law, options)
 }
 
 /// [`resolve_in_contact_space`] for inputs already validated (W symmetric PSD and finite,
 /// u finite, n unit, law valid).
+///
+/// `n_raw` is the normal as given (of unit length within the tolerance of
+/// [`crate::body::UNIT_TOLERANCE`]); the contact frame uses it normalised.
 pub(crate) fn resolve_validated(
     w_w: &Matrix3<f64>,
     u_w: &Vector3<f64>,
-    n: &Vector3<f64>,
+    n_raw: &Vector3<f64>,
     law: &ContactLaw,
     options: &ImpactOptions,
 ) -> Result<ContactImpulse, ImpulseError> {
-    let n = *n;
+    let n = n_raw / n_raw.norm();
     check_finite("tolerance", options.tolerance)?;
     if options.tolerance <= 0.0 {
         return Err(ImpulseError::Singular {
@@ -211,15 +215,12 @@ pub(crate) fn resolve_validated(
             steps: 0,
         });
     }
-    let (t1, t2) = orthonormal_complement(&n);
-    let r = Matrix3::from_columns(&[t1, t2, n]);
+    let frame = ContactFrame::new(n_raw);
     let w_sym = (w_w + w_w.transpose()) * 0.5;
-    let w = congruence(&r, &w_sym);
-    let u0 = mul_vec(&r.transpose(), u_w);
-    let mut process = Process::new(w, u0, law, options)?;
+    let mut process = Process::new(frame.congruence(&w_sym), frame.components(u_w), law, options)?;
     process.run()?;
     let p_c = Vector3::new(process.q.x, process.q.y, process.p);
-    let impulse_w = r * p_c;
+    let impulse_w = frame.hi * p_c;
     let normal_impulse = process.p;
     let (w_p, w_p_lo) = mul_vec(&w_sym, &impulse_w);
     let u_after_w = Vector3::from_fn(|i, _| dot2(&[u_w[i], w_p[i], w_p_lo[i]], &[1.0, 1.0, 1.0]));

@@ -19,6 +19,7 @@
 pub mod body;
 mod compensated;
 pub mod contact;
+mod contact_frame;
 pub mod contact_space;
 pub mod error;
 pub mod fixation;

@@ -30,12 +30,15 @@ use nalgebra::{Matrix2, Vector2};
 /// treated as singular (condition number above about 1e12).
 pub const BLOCK_RANK_RELATIVE: f64 = 1e-12;
 
-/// A solution of a 2×2 system with a bound on its error (Euclidean norm).
+/// A solution of a 2×2 system as an unevaluated sum x + lo, with a bound on its error.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Solution2 {
     /// The solution.
     pub x: Vector2<f64>,
-    /// A bound on |x − x*|, x* the exact solution for the stored matrix and right side.
+    /// The last computed correction, not added to `x`: x + lo is closer to x* than x is.
+    pub lo: Vector2<f64>,
+    /// A bound on |x − x*| (and so on |x + lo − x*|), x* the exact solution for the stored
+    /// matrix and right side.
     pub error: f64,
 }
 
@@ -134,6 +137,7 @@ impl Factor2 {
         if self.rank < 2 {
             return Solution2 {
                 x,
+                lo: Vector2::zeros(),
                 error: 4.0 * UNIT_ROUNDOFF * x.norm(),
             };
         }
@@ -141,6 +145,7 @@ impl Factor2 {
         let correction = self.apply_inverse(&self.residual(&x, b, b_lo));
         Solution2 {
             x,
+            lo: -correction,
             error: 2.0 * correction.norm() + 4.0 * UNIT_ROUNDOFF * x.norm(),
         }
     }
@@ -188,36 +193,65 @@ pub(crate) fn slip_ray(
     if !norm.is_finite() || norm <= 0.0 {
         return Solution2 {
             x: Vector2::new(1.0, 0.0),
+            lo: Vector2::zeros(),
             error: 2.0,
         };
     }
     let (s, alpha) = ray_correction(w_tt, w_tn, f, &(s / norm), alpha);
-    let (next, _) = ray_correction(w_tt, w_tn, f, &s, alpha);
+    let (s, alpha) = ray_correction(w_tt, w_tn, f, &s, alpha);
+    // ŝ + lo carries the last Newton step unrounded; the step from there bounds the error.
+    let (d_alpha, lo) = ray_step(w_tt, w_tn, f, (&s, &Vector2::zeros()), alpha);
+    let (_, next) = ray_step(w_tt, w_tn, f, (&s, &lo), alpha + d_alpha);
     Solution2 {
         x: s,
-        error: 2.0 * (next - s).norm() + 4.0 * UNIT_ROUNDOFF,
+        lo,
+        error: 2.0 * next.norm() + 2.0 * lo.norm_squared() + 4.0 * UNIT_ROUNDOFF * UNIT_ROUNDOFF,
     }
 }
 
 /// One Newton step on the bordered system (f W_TT + α I) ŝ = W_Tn, |ŝ| = 1, from the unit
-/// `s` and `alpha`: with M = f W_TT + α I and the compensated residual ρ = W_Tn − M ŝ, the
-/// step δŝ = M⁻¹ρ − δα M⁻¹ŝ, δα = ŝᵀM⁻¹ρ / ŝᵀM⁻¹ŝ keeps ŝ ⟂ δŝ. Returns the renormalised
-/// direction and the new α.
+/// `s` and `alpha` ([`ray_step`]): the renormalised direction and the new α.
 fn ray_correction(
-    (w_tt, w_tt_lo): (&Matrix2<f64>, &Matrix2<f64>),
-    (w_tn, w_tn_lo): (&Vector2<f64>, &Vector2<f64>),
+    w_tt: (&Matrix2<f64>, &Matrix2<f64>),
+    w_tn: (&Vector2<f64>, &Vector2<f64>),
     f: f64,
     s: &Vector2<f64>,
     alpha: f64,
 ) -> (Vector2<f64>, f64) {
+    let (d_alpha, step) = ray_step(w_tt, w_tn, f, (s, &Vector2::zeros()), alpha);
+    let next = s + step;
+    let norm = next.norm();
+    if norm > 0.0 {
+        (next / norm, alpha + d_alpha)
+    } else {
+        (*s, alpha)
+    }
+}
+
+/// The Newton step (δα, δŝ) of the bordered system (f W_TT + α I) ŝ = W_Tn, |ŝ|² = 1, at
+/// ŝ: with M = f W_TT + α I, the compensated residual ρ = W_Tn − M ŝ and the length defect
+/// ε = |ŝ|² − 1, δŝ = M⁻¹ρ − δα M⁻¹ŝ and δα = (ŝᵀM⁻¹ρ + ε/2) / ŝᵀM⁻¹ŝ, so that
+/// 2 ŝ·δŝ = −ε. (A defect removed along ŝ alone would leave the curve ŝ(α).)
+/// The direction is ŝ = `s` + `s_lo` (an unevaluated sum; `s` a unit vector, `s_lo` ⟂ it and
+/// tiny), and the residual includes both parts.
+fn ray_step(
+    (w_tt, w_tt_lo): (&Matrix2<f64>, &Matrix2<f64>),
+    (w_tn, w_tn_lo): (&Vector2<f64>, &Vector2<f64>),
+    f: f64,
+    (s, s_lo): (&Vector2<f64>, &Vector2<f64>),
+    alpha: f64,
+) -> (f64, Vector2<f64>) {
     let factor = Factor2::new(&(w_tt * f + Matrix2::identity() * alpha), &Matrix2::zeros(), 0.0);
     let (f0, f0_err) = split_product(f, s[0]);
     let (f1, f1_err) = split_product(f, s[1]);
+    let (g0, g1) = (f * s_lo[0], f * s_lo[1]);
     let rho = |i: usize| {
         let (m, lo) = (w_tt.row(i), w_tt_lo.row(i));
         dot2(
-            &[w_tn[i], w_tn_lo[i], m[0], m[0], m[1], m[1], lo[0], lo[1], s[i]],
-            &[1.0, 1.0, -f0, -f0_err, -f1, -f1_err, -f0, -f1, -alpha],
+            &[
+                w_tn[i], w_tn_lo[i], m[0], m[0], m[1], m[1], lo[0], lo[1], m[0], m[1], s[i], s_lo[i],
+            ],
+            &[1.0, 1.0, -f0, -f0_err, -f1, -f1_err, -f0, -f1, -g0, -g1, -alpha, -alpha],
         )
     };
     let rho = Vector2::new(rho(0), rho(1));
@@ -225,16 +259,14 @@ fn ray_correction(
     let m_s = factor.apply_inverse(s);
     let curvature = s.dot(&m_s);
     if !curvature.is_finite() || curvature <= 0.0 {
-        return (*s, alpha);
+        return (0.0, Vector2::zeros());
     }
-    let d_alpha = s.dot(&m_rho) / curvature;
-    let next = s + m_rho - m_s * d_alpha;
-    let norm = next.norm();
-    if norm > 0.0 {
-        (next / norm, alpha + d_alpha)
-    } else {
-        (*s, alpha)
-    }
+    let defect = dot2(
+        &[s.x, s.y, -1.0, 2.0 * s.x, 2.0 * s.y],
+        &[s.x, s.y, 1.0, s_lo.x, s_lo.y],
+    );
+    let d_alpha = (s.dot(&m_rho) + 0.5 * defect) / curvature;
+    (d_alpha, m_rho - m_s * d_alpha)
 }
 
 /// a·b = p + e exactly (TwoProduct).

@@ -382,3 +382,40 @@ fn a_static_body_struck_by_a_point_mass_in_contact_space() {
     assert!((out.normal_impulse - (1.0 + e) * m * v).abs() < 1e-14 * m * v);
     assert!((out.energy_change - 0.5 * m * ((out.u_after_w.norm_squared()) - (0.25 + v * v))).abs() < 1e-13);
 }
+
+/// A swerving slip whose direction settles long before it halts: the step cap near a halt
+/// (half the slip speed over the largest possible rate) once took more than the step budget;
+/// the slip is now finished in closed form once its remaining turn is below the tolerance.
+#[test]
+fn a_slip_that_stops_swerving_long_before_it_halts_finishes() {
+    let b = Body::new(
+        2.2566309931730295,
+        Vector3::new(0.7750475024818083, -0.9909589799763204, -0.8494229061319916),
+        Matrix3::new(
+            0.9650233942636324,
+            0.05892415121112926,
+            0.11129912940775538,
+            0.05892415121112926,
+            0.550655255187719,
+            -0.4603491831559823,
+            0.11129912940775533,
+            -0.4603491831559823,
+            0.4294569538373744,
+        ),
+        Vector3::new(1.272644709179955, 0.36727615673265107, 1.3728722726026752),
+        Vector3::new(0.9335659001667853, -1.3690511512708896, -0.546728541536205),
+    );
+    let r = Vector3::new(-0.6974885365872442, 1.5967483806237999, -1.7335967922471072);
+    let n = Vector3::new(-0.34275392572614216, -0.22621733417523632, -0.9117593999506155).normalize();
+    let law = ContactLaw::new(0.0, 2.442091041837602, RestitutionLaw::Stronge).expect("law");
+    let ground = RigidBody::fixed(Vector3::zeros()).expect("ground");
+    let out = resolve_contact(&ground, &b.rigid(), &r, &n, &law, &ImpactOptions::default()).expect("impact");
+    assert!(out.contact.steps < 1000, "{} steps", out.contact.steps);
+    // (7.71) about the contact point, and no energy gained.
+    let before = b.angular_momentum_about(&r, &b.v, &b.w);
+    let after = b.angular_momentum_about(&r, &out.body2.v_wc_after, &out.body2.w_w_after);
+    assert!((after - before).norm() <= 1e-11 * (before.norm() + b.props.mass * b.v.norm() * (b.props.p_oc - r).norm()));
+    assert!(b.energy_after(&out.body2) <= b.energy_before());
+    // The contact stops slipping (e = 0: the normal velocity ends at zero too).
+    assert!(out.contact.u_after_w.norm() <= 1e-8 * out.u_before_w.norm());
+}

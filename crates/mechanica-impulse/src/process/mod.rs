@@ -23,6 +23,19 @@ use crate::tangent_block::{BLOCK_RANK_RELATIVE, Factor2, Solution2, slip_ray};
 use linear::Direction;
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 
+/// The state at the end of compression.
+#[derive(Debug, Clone, Copy)]
+struct Compression {
+    /// p_c.
+    p: f64,
+    /// The compression work ∫₀^{p_c} u_n dp (negative).
+    work: f64,
+    /// A bound on the error of `work`.
+    work_error: f64,
+    /// A bound on the error of p_c.
+    p_error: f64,
+}
+
 /// What a segment of the process ended with.
 enum SegmentEnd {
     /// The impact is over.
@@ -55,14 +68,18 @@ pub(crate) struct Process {
     pub p: f64,
     /// Accumulated tangential impulse P_T.
     pub q: Vector2<f64>,
-    /// Normal work ∫₀^p u_n dp.
+    /// Normal work of the current phase: ∫₀^p u_n dp during compression, ∫_{p_c}^p u_n dp
+    /// afterwards (kept apart so that Stronge's event e²·|compression work| is not the small
+    /// difference of two large works).
     work: f64,
     /// A bound on the error of `work`.
     work_error: f64,
-    /// (p_c, work, work error) at the end of compression.
-    compression: Option<(f64, f64, f64)>,
+    /// The state at the end of compression.
+    compression: Option<Compression>,
     /// A bound on |P − P*| (see the module documentation).
     pub error: f64,
+    /// A bound on |p − p*|, the normal impulse alone (≤ `error`).
+    p_error: f64,
     /// Integration steps and closed-form segments.
     pub steps: usize,
     halted: bool,
@@ -106,6 +123,7 @@ impl Process {
             work_error: 0.0,
             compression: None,
             error: 0.0,
+            p_error: 0.0,
             steps: 0,
             halted: false,
             final_mode: None,
@@ -114,7 +132,7 @@ impl Process {
 
     /// The normal impulse at the end of compression (the final one if it never ended).
     pub fn compression_impulse(&self) -> f64 {
-        self.compression.map_or(self.p, |(p, _, _)| p)
+        self.compression.map_or(self.p, |c| c.p)
     }
 
     /// Row i of W as the six terms (hi, lo) that multiply (P, P).
@@ -173,7 +191,12 @@ impl Process {
     pub fn run(&mut self) -> Result<(), ImpulseError> {
         if self.f == 0.0 {
             self.final_mode = Some(ContactMode::Frictionless);
-            self.linear(Direction::slip(&Vector2::zeros(), 0.0, 0.0), (f64::INFINITY, 0.0))?;
+            let none = Solution2 {
+                x: Vector2::zeros(),
+                lo: Vector2::zeros(),
+                error: 0.0,
+            };
+            self.linear(Direction::slip(&none, 0.0), (f64::INFINITY, 0.0))?;
             return Ok(());
         }
         if self.f == f64::INFINITY {
@@ -206,7 +229,7 @@ impl Process {
         if ut.norm() > 0.0 {
             let stop = self.block.solve(&-ut, &Vector2::zeros());
             self.q = stop.x;
-            self.error += stop.error;
+            self.add_error(stop.error);
         }
         self.final_mode = Some(ContactMode::Stick);
         self.linear_stick(Direction::stick(&self.stick_ratio()))?;
@@ -222,8 +245,14 @@ impl Process {
         if swerve.abs() > 8.0 * f64::EPSILON * rate.norm() {
             return self.integrate_swerving();
         }
-        // Straight slip: u_T stays along ŝ, |u_T| changes at the constant rate ŝ·rate.
-        let along = s_hat.dot(&rate);
+        self.straight_slip(&s_hat, speed, 4.0 * UNIT_ROUNDOFF)
+    }
+
+    /// Slip that keeps its direction ŝ (error bound `s_error`): u_T stays along ŝ and |u_T|
+    /// changes at the constant rate ŝ·(W_Tn − f W_TT ŝ), so it halts, if at all, after
+    /// Δp = `speed`/|ŝ·rate|, located in closed form.
+    fn straight_slip(&mut self, s_hat: &Vector2<f64>, speed: f64, s_error: f64) -> Result<SegmentEnd, ImpulseError> {
+        let along = s_hat.dot(&(self.w_tn() - self.f * self.w_tt() * s_hat));
         let u = UNIT_ROUNDOFF;
         let halt = if along < 0.0 {
             let speed_error = 4.0 * u * speed;
@@ -233,30 +262,75 @@ impl Process {
             (f64::INFINITY, 0.0)
         };
         self.steps += 1;
-        self.linear(Direction::slip(&s_hat, self.f, 4.0 * u), halt)
+        let direction = Solution2 {
+            x: *s_hat,
+            lo: Vector2::zeros(),
+            error: s_error,
+        };
+        self.linear(Direction::slip(&direction, self.f), halt)
     }
 
     /// The contact has no slip: stick if the cone allows it, otherwise slip along the ray.
+    /// The tangential velocity left below the rest threshold η is neglected, and the error
+    /// this makes is added to the bound ([`Process::rest_cutoff_error`]).
     fn continue_from_rest(&mut self) -> Result<(), ImpulseError> {
+        let u = self.velocity(self.p, &self.q);
+        let ut = Vector2::new(u.x, u.y);
         let t_stick = self.stick_ratio();
         self.steps += 1;
-        if t_stick.x.norm() <= self.f * (1.0 + 1e-12) {
-            self.final_mode = Some(if self.halted {
+        let (direction, mode) = if t_stick.x.norm() <= self.f * (1.0 + 1e-12) {
+            let mode = if self.halted {
                 ContactMode::SlipThenStick
             } else {
                 ContactMode::Stick
-            });
-            self.linear_stick(Direction::stick(&t_stick))?;
+            };
+            (Direction::stick(&t_stick), mode)
         } else {
             let ray = slip_ray((&self.w_tt(), &self.w_tt_lo()), (&self.w_tn(), &self.w_tn_lo()), self.f);
-            self.final_mode = Some(if self.halted {
+            let mode = if self.halted {
                 ContactMode::Reversed
             } else {
                 ContactMode::Slip
-            });
-            self.linear(Direction::slip(&ray.x, self.f, ray.error), (f64::INFINITY, 0.0))?;
+            };
+            (Direction::slip(&ray, self.f), mode)
+        };
+        self.add_error(self.rest_cutoff_error(&ut, &direction));
+        self.final_mode = Some(mode);
+        if direction.is_stick() {
+            self.linear_stick(direction)?;
+        } else {
+            self.linear(direction, (f64::INFINITY, 0.0))?;
         }
         Ok(())
+    }
+
+    /// The error of treating the tangential velocity `ut` (at most η) as rest before a segment
+    /// along `dir`. The exact process would first slip along ŝ = u_T/|u_T|; when that slip
+    /// halts (ŝ·(W_Tn − f W_TT ŝ) < 0) it lasts Δp = |u_T|/|ŝ·rate| and changes the tangential
+    /// impulse by at most (f + |d_T|) Δp, and through row n of W the normal impulse by
+    /// |W_nT| (f + |d_T|) Δp / b (not at all when the contact self-locks); when it would not
+    /// halt, the impulse (1 + f)|W_TT⁺ u_T| that stops it at once takes the place of
+    /// (f + |d_T|) Δp.
+    fn rest_cutoff_error(&self, ut: &Vector2<f64>, dir: &Direction) -> f64 {
+        let speed = ut.norm();
+        if speed == 0.0 {
+            return 0.0;
+        }
+        let s_hat = ut / speed;
+        let along = s_hat.dot(&(self.w_tn() - self.w_tt() * s_hat * self.f));
+        let d_t = dir.tangential_norm();
+        let tangential = if along < 0.0 {
+            (self.f + d_t) * speed / -along
+        } else {
+            (1.0 + self.f) * self.block.solve(ut, &Vector2::zeros()).x.norm()
+        };
+        if self.self_locks(dir) {
+            // The normal velocity cannot change along this ratio: no normal impulse moves.
+            return tangential;
+        }
+        let b = self.normal_rate(dir).0.abs();
+        let w_nt = Vector2::new(self.w[(2, 0)], self.w[(2, 1)]).norm();
+        tangential * (1.0 + w_nt * (1.0 + d_t) / b.max(f64::MIN_POSITIVE))
     }
 
     /// The termination event function: negative before the event, ≥ 0 at and after it.
@@ -265,17 +339,36 @@ impl Process {
         let u_n = self.velocity(p, q).z;
         match self.compression {
             None => u_n,
-            Some((p_c, work_c, _)) => match self.law {
+            Some(c) => match self.law {
                 RestitutionLaw::Newton => u_n + self.e * self.u0.z,
-                RestitutionLaw::Poisson => p - (1.0 + self.e) * p_c,
-                RestitutionLaw::Stronge => work - (1.0 - self.e * self.e) * work_c,
+                RestitutionLaw::Poisson => p - (1.0 + self.e) * c.p,
+                RestitutionLaw::Stronge => work + self.e * self.e * c.work,
             },
         }
     }
 
-    /// Marks the end of compression at the current state; true when the impact also ends here.
+    /// Adds `error` to the bounds of the impulse and of the normal impulse.
+    fn add_error(&mut self, error: f64) {
+        self.error += error;
+        self.p_error += error;
+    }
+
+    /// Records the current state as the end of compression.
+    fn mark_compression(&mut self) {
+        self.compression = Some(Compression {
+            p: self.p,
+            work: self.work,
+            work_error: self.work_error,
+            p_error: self.p_error,
+        });
+    }
+
+    /// Marks the end of compression at the current state and starts the restitution work at
+    /// zero; true when the impact also ends here.
     fn compress_here(&mut self) -> bool {
-        self.compression = Some((self.p, self.work, self.work_error));
+        self.mark_compression();
+        self.work = 0.0;
+        self.work_error = 0.0;
         self.event(self.p, &self.q, self.work) >= 0.0
     }
 }

@@ -90,9 +90,17 @@ impl Process {
                 // Halting cut-off: the rest of the slip (≈ speed/|rate| in p) is replaced by
                 // the stick or ray segment; bound the impulse difference by 2 f Δp (+ 1 for p).
                 if along < 0.0 {
-                    self.error += (2.0 * self.f + 1.0) * speed / -along;
+                    self.add_error((2.0 * self.f + 1.0) * speed / -along);
                 }
                 return Ok(SegmentEnd::Halted);
+            }
+            // A halting slip whose direction would turn by less than the tolerance before it
+            // halts (angle ≈ |swerve|/|along|) is finished as a straight slip; the friction
+            // impulse it misdirects, f Δp·angle, is added to the error.
+            let swerve = rate.x * s_hat.y - rate.y * s_hat.x;
+            if along < 0.0 && swerve.abs() <= self.tolerance * -along {
+                self.add_error(2.0 * self.f * (speed / -along) * (swerve.abs() / -along));
+                return self.straight_slip(&s_hat, speed, swerve.abs() / -along);
             }
             // Cap the step at 80 % of the linearly predicted halting distance, and so that u_T
             // cannot change by more than half its length in one step whatever its direction
@@ -124,7 +132,7 @@ impl Process {
             } else {
                 (h, y_new, err, false)
             };
-            self.error += err_acc.x.hypot(err_acc.y) + err_acc.z.abs() / speed_scale.max(f64::MIN_POSITIVE);
+            self.add_error(err_acc.x.hypot(err_acc.y) + err_acc.z.abs() / speed_scale.max(f64::MIN_POSITIVE));
             self.p += h_acc;
             self.q = Vector2::new(y_acc.x, y_acc.y);
             self.work = y_acc.z;

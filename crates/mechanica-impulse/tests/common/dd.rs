@@ -68,7 +68,10 @@ impl Add for Dd {
 impl Neg for Dd {
     type Output = Dd;
     fn neg(self) -> Dd {
-        Dd { hi: -self.hi, lo: -self.lo }
+        Dd {
+            hi: -self.hi,
+            lo: -self.lo,
+        }
     }
 }
 
@@ -115,51 +118,25 @@ pub fn mat(m: &nalgebra::Matrix3<f64>) -> Dd3 {
     r
 }
 
-pub fn mul(a: &Dd3, b: &Dd3) -> Dd3 {
-    let mut r = [[Dd::ZERO; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            for k in 0..3 {
-                r[i][j] = r[i][j] + a[i][k] * b[k][j];
-            }
-        }
-    }
-    r
-}
-
-pub fn mul_vec(a: &Dd3, x: &[Dd; 3]) -> [Dd; 3] {
-    let mut r = [Dd::ZERO; 3];
-    for i in 0..3 {
-        for k in 0..3 {
-            r[i] = r[i] + a[i][k] * x[k];
-        }
-    }
-    r
-}
-
-/// The inverse by the adjugate: exact to about 1e-32·κ relative.
-pub fn inverse(a: &Dd3) -> Dd3 {
-    let c = |i: usize, j: usize| {
-        let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
-        let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
-        a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]
-    };
-    let det = a[0][0] * c(0, 0) + a[0][1] * c(0, 1) + a[0][2] * c(0, 2);
-    let mut r = [[Dd::ZERO; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            r[j][i] = c(i, j) / det;
-        }
-    }
-    r
-}
-
-/// [d]×, the cross-product matrix.
-pub fn cross_matrix(d: &[Dd; 3]) -> Dd3 {
-    let z = Dd::ZERO;
-    [[z, -d[2], d[1]], [d[2], z, -d[0]], [-d[1], d[0], z]]
-}
-
-pub fn vec(v: &nalgebra::Vector3<f64>) -> [Dd; 3] {
+pub fn vec3(v: &nalgebra::Vector3<f64>) -> [Dd; 3] {
     [Dd::new(v.x), Dd::new(v.y), Dd::new(v.z)]
+}
+
+pub fn cross(a: &[Dd; 3], b: &[Dd; 3]) -> [Dd; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub fn normalize(a: &[Dd; 3]) -> [Dd; 3] {
+    let norm = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    [a[0] / norm, a[1] / norm, a[2] / norm]
+}
+
+/// The inverse of a 2×2 matrix by its adjugate.
+pub fn inverse2(m: &[[Dd; 2]; 2]) -> [[Dd; 2]; 2] {
+    let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    [[m[1][1] / det, -(m[0][1] / det)], [-(m[1][0] / det), m[0][0] / det]]
 }
