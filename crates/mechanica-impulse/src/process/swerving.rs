@@ -57,6 +57,50 @@ impl Process {
         (y5, err)
     }
 
+    /// Fails when the step budget is spent or the normal impulse exceeds `p_max`.
+    fn check_budget(&self, p_max: f64) -> Result<(), ImpulseError> {
+        let reason = if self.steps >= self.max_steps {
+            "step budget exhausted in swerving slip"
+        } else if self.p > p_max {
+            "the normal impulse grows without bound (frictional jam)"
+        } else {
+            return Ok(());
+        };
+        Err(ImpulseError::NotConverged {
+            reason,
+            steps: self.steps,
+            normal_impulse: self.p,
+        })
+    }
+
+    /// The end of the swerving slip at the current state (direction `s_hat`, slip speed
+    /// `speed`, du_T/dp = `rate`), if any: the slip has halted (speed ≤ η), or it halts so soon
+    /// that its direction turns by less than the tolerance before (angle ≈ |swerve|/|along|),
+    /// and is finished as a straight slip.
+    fn halting_end(
+        &mut self,
+        s_hat: &Vector2<f64>,
+        speed: f64,
+        rate: &Vector2<f64>,
+    ) -> Option<Result<SegmentEnd, ImpulseError>> {
+        let along = s_hat.dot(rate);
+        if speed <= self.eta {
+            // Halting cut-off: the rest of the slip (≈ speed/|rate| in p) is replaced by the
+            // stick or ray segment; bound the impulse difference by 2 f Δp (+ 1 for p).
+            if along < 0.0 {
+                self.add_error((2.0 * self.f + 1.0) * speed / -along);
+            }
+            return Some(Ok(SegmentEnd::Halted));
+        }
+        // The friction impulse a straight finish misdirects, f Δp·angle, is added to the error.
+        let swerve = rate.x * s_hat.y - rate.y * s_hat.x;
+        if along < 0.0 && swerve.abs() <= self.tolerance * -along {
+            self.add_error(2.0 * self.f * (speed / -along) * (swerve.abs() / -along));
+            return Some(self.straight_slip(s_hat, speed, swerve.abs() / -along));
+        }
+        None
+    }
+
     /// Integrates a slip whose direction swerves, until the impact terminates or the slip halts.
     pub(super) fn integrate_swerving(&mut self) -> Result<SegmentEnd, ImpulseError> {
         let speed_scale = self.u0.norm();
@@ -66,41 +110,15 @@ impl Process {
         let mut h = 1e-2 * self.p_scale;
         let max_rate = self.w_tn().norm() + self.f * self.w_tt().norm();
         loop {
-            if self.steps >= self.max_steps {
-                return Err(ImpulseError::NotConverged {
-                    reason: "step budget exhausted in swerving slip",
-                    steps: self.steps,
-                    normal_impulse: self.p,
-                });
-            }
-            if self.p > p_max {
-                return Err(ImpulseError::NotConverged {
-                    reason: "the normal impulse grows without bound (frictional jam)",
-                    steps: self.steps,
-                    normal_impulse: self.p,
-                });
-            }
+            self.check_budget(p_max)?;
             let u = self.velocity(self.p, &self.q);
             let ut = Vector2::new(u.x, u.y);
             let speed = ut.norm();
             let s_hat = ut / speed;
             let rate = self.w_tn() - self.f * self.w_tt() * s_hat;
             let along = s_hat.dot(&rate);
-            if speed <= self.eta {
-                // Halting cut-off: the rest of the slip (≈ speed/|rate| in p) is replaced by
-                // the stick or ray segment; bound the impulse difference by 2 f Δp (+ 1 for p).
-                if along < 0.0 {
-                    self.add_error((2.0 * self.f + 1.0) * speed / -along);
-                }
-                return Ok(SegmentEnd::Halted);
-            }
-            // A halting slip whose direction would turn by less than the tolerance before it
-            // halts (angle ≈ |swerve|/|along|) is finished as a straight slip; the friction
-            // impulse it misdirects, f Δp·angle, is added to the error.
-            let swerve = rate.x * s_hat.y - rate.y * s_hat.x;
-            if along < 0.0 && swerve.abs() <= self.tolerance * -along {
-                self.add_error(2.0 * self.f * (speed / -along) * (swerve.abs() / -along));
-                return self.straight_slip(&s_hat, speed, swerve.abs() / -along);
+            if let Some(end) = self.halting_end(&s_hat, speed, &rate) {
+                return end;
             }
             // Cap the step at 80 % of the linearly predicted halting distance, and so that u_T
             // cannot change by more than half its length in one step whatever its direction
