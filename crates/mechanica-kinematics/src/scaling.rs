@@ -20,6 +20,63 @@ pub fn power_of_two_above(max_abs: f64) -> f64 {
     f64::from_bits(((k + 1023) as u64) << 52)
 }
 
+/// 2^k for an exponent k in the normal range [−1022, 1023].
+fn two_to(k: i64) -> f64 {
+    f64::from_bits(((k.clamp(-1022, 1023) + 1023) as u64) << 52)
+}
+
+/// x = m·2^e with |m| ∈ [1, 2) for a finite non-zero x (subnormals included).
+fn split_exponent(x: f64) -> (f64, i64) {
+    let (x, shift) = if x.abs() < f64::MIN_POSITIVE {
+        (x * two_to(64), -64)
+    } else {
+        (x, 0)
+    };
+    let bits = x.to_bits();
+    let exponent = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let mantissa = f64::from_bits((bits & !(0x7ff << 52)) | (1023 << 52));
+    (mantissa, exponent + shift)
+}
+
+/// m·2^e, rounded once unless the result is subnormal (then possibly twice).
+fn with_exponent(mut m: f64, mut e: i64) -> f64 {
+    while e > 1023 {
+        m *= two_to(1023);
+        e -= 1023;
+        if !m.is_finite() {
+            return m;
+        }
+    }
+    while e < -1022 {
+        m *= two_to(-1022);
+        e += 1022;
+        if m == 0.0 {
+            return m;
+        }
+    }
+    m * two_to(e)
+}
+
+/// The product of `factors` with the exponents kept apart: each factor is split into a
+/// mantissa in [1, 2) and a power of two, the mantissas are multiplied and renormalised and
+/// the exponents summed, and the result is assembled once. It overflows to ±∞ or underflows
+/// to 0 only when the exact product does, and carries the rounding of n − 1 multiplications
+/// (plus one more in the subnormal range). A zero factor gives 0, a non-finite one the plain
+/// product.
+pub fn product(factors: &[f64]) -> f64 {
+    if factors.iter().any(|f| !f.is_finite() || *f == 0.0) {
+        return factors.iter().product();
+    }
+    let (mut m, mut e) = (1.0, 0_i64);
+    for &f in factors {
+        let (fm, fe) = split_exponent(f);
+        let (pm, pe) = split_exponent(m * fm);
+        m = pm;
+        e += fe + pe;
+    }
+    with_exponent(m, e)
+}
+
 /// The Euclidean norm of `v` computed on v/2^k (k from its largest entry) and scaled back:
 /// exact to a few ulps whenever the result is representable; +∞ only when it exceeds
 /// f64::MAX.
@@ -64,5 +121,21 @@ mod tests {
         assert_eq!(power_of_two_above(0.75), 1.0);
         assert_eq!(power_of_two_above(1.0), 2.0);
         assert_eq!(power_of_two_above(f64::MAX), 2f64.powi(1023));
+    }
+
+    #[test]
+    fn products_overflow_and_underflow_only_when_their_value_does() {
+        // 1e200·1e200·1e-300 = 1e100 (the plain left-to-right product overflows first);
+        // 1e-200·1e-200·1e300 = 1e-100 (the plain product underflows first).
+        assert!((product(&[1e200, 1e200, 1e-300]) / 1e100 - 1.0).abs() <= 4.0 * f64::EPSILON);
+        assert!((product(&[1e-200, 1e-200, 1e300]) / 1e-100 - 1.0).abs() <= 4.0 * f64::EPSILON);
+        // Exact powers of two land exactly, down into the subnormals.
+        assert_eq!(product(&[2f64.powi(-600), 2f64.powi(-470)]), 2f64.powi(-1070));
+        assert_eq!(product(&[2f64.powi(600), 2f64.powi(423)]), 2f64.powi(1023));
+        assert_eq!(product(&[f64::MAX, 2.0]), f64::INFINITY);
+        assert_eq!(product(&[f64::MIN_POSITIVE, 2f64.powi(-60)]), 0.0);
+        assert_eq!(product(&[-3.0, 0.5, -2.0]), 3.0);
+        assert_eq!(product(&[]), 1.0);
+        assert_eq!(product(&[5.0, 0.0, f64::MAX]), 0.0);
     }
 }
