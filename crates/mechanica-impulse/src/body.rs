@@ -23,7 +23,7 @@
 //! All vectors are expressed in the world frame W; `p_WC` is the centre of mass C.
 
 use crate::ImpulseError;
-use crate::error::{check_all_finite, check_finite};
+use crate::error::{check_all_finite, check_finite, check_result};
 use mechanica_mass::MassProperties;
 use nalgebra::{DMatrix, Matrix3, Matrix6, SMatrix, Vector3, Vector6};
 
@@ -84,6 +84,15 @@ pub struct BodyResponse {
     pub energy_change: f64,
 }
 
+impl BodyResponse {
+    /// Fails with [`ImpulseError::NonFiniteResult`] naming the first result that is not finite.
+    pub(crate) fn check_finite(&self) -> Result<(), ImpulseError> {
+        check_result("velocity after the impulse", self.v_wc_after.iter())?;
+        check_result("angular velocity after the impulse", self.w_w_after.iter())?;
+        check_result("energy change", [self.energy_change].iter())
+    }
+}
+
 impl RigidBody {
     /// A free body with the mass properties `props`, **expressed in the world frame W**
     /// (`props.p_oc` is p_WC and `props.inertia_c` the central inertia J₀ in W axes), moving
@@ -105,6 +114,10 @@ impl RigidBody {
         check_all_finite("centre of mass", props.p_oc.iter())?;
         check_all_finite("central inertia", props.inertia_c.iter())?;
         let (inverse, axes, count) = symmetric_pseudo_inverse("central inertia", &props.inertia_c)?;
+        check_result(
+            "inverse mass and inertia (mass or inertia too small)",
+            [1.0 / props.mass].iter().chain(inverse.iter()),
+        )?;
         let mut body = Self::with_mobility(props.p_oc, v_wc, w_w, 1.0 / props.mass, &inverse)?;
         body.zero_inertia_axes = axes;
         body.zero_inertia_count = count;
@@ -223,6 +236,7 @@ impl RigidBody {
         })?;
         let largest = svd.singular_values.max();
         let mut mobility = Matrix6::zeros();
+        check_result("hinged mobility", l.iter())?;
         for k in 0..6 {
             if svd.singular_values[k] <= 1e-12 * largest {
                 let q = Vector6::from_iterator(v_t.row(k).iter().copied());
@@ -321,7 +335,9 @@ impl RigidBody {
         check_all_finite("impulse", s_w.iter())?;
         check_all_finite("impulsive moment", m_cs_w.iter())?;
         self.check_moment(m_cs_w)?;
-        Ok(self.respond(s_w, m_cs_w))
+        let response = self.respond(s_w, m_cs_w);
+        response.check_finite()?;
+        Ok(response)
     }
 
     /// Applies the impulse `s_w` acting at the point `p_wr` together with the impulsive moment
@@ -337,8 +353,11 @@ impl RigidBody {
         check_all_finite("point of application", p_wr.iter())?;
         check_all_finite("impulsive moment", m_rs_w.iter())?;
         let m_cs = m_rs_w + (p_wr - self.p_wc).cross(s_w);
+        check_result("impulsive moment about the centre of mass", m_cs.iter())?;
         self.check_moment(&m_cs)?;
-        Ok(self.respond(s_w, &m_cs))
+        let response = self.respond(s_w, &m_cs);
+        response.check_finite()?;
+        Ok(response)
     }
 
     /// The response to a validated impulse (S, M₀S).

@@ -9,7 +9,7 @@
 use crate::ImpulseError;
 use crate::body::{BodyResponse, RigidBody, unit_vector};
 use crate::contact_space::{ContactImpulse, ContactLaw, ImpactOptions, resolve_validated};
-use crate::error::check_all_finite;
+use crate::error::{check_all_finite, check_result};
 use nalgebra::{Matrix3, Vector3};
 
 /// The outcome of a two-body point impact (world frame W).
@@ -52,6 +52,9 @@ pub fn resolve_contact(
     let p = contact.impulse_w;
     let body2_response = body2.respond(&p, &(p_wr - body2.p_wc()).cross(&p));
     let body1_response = body1.respond(&-p, &(p_wr - body1.p_wc()).cross(&-p));
+    body1_response.check_finite()?;
+    body2_response.check_finite()?;
+    check_result("contact mobility", w.iter())?;
     Ok(TwoBodyImpact {
         contact,
         body1: body1_response,

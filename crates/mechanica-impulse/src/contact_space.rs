@@ -13,9 +13,26 @@
 //!   impacts, decoupled W) the slip direction is constant and the segment is solved exactly;
 //! - when the slip halts (|u_T| reaches 0) the contact sticks if the impulse ratio needed to
 //!   keep u_T = 0, t = −W_TT⁻¹ W_Tn, lies in the friction cone |t| ≤ f (7.98); otherwise slip
-//!   resumes along the unique ray ŝ with (W_Tn − f W_TT ŝ) ∥ ŝ ("reversed" slip);
+//!   resumes along the unique ray ŝ with (W_Tn − f W_TT ŝ) ∥ ŝ ("reversed" slip). Both are
+//!   solved on the tangential block W_TT factored by LDLᵀ with pivoting and a rank check
+//!   (a block of condition above 1e12 is singular: its minimum-norm solution is taken), and
+//!   refined in compensated arithmetic;
 //! - compression ends when u_n = 0, at p = p_c;
 //! - restitution ends the impact at p_f, by the selected [`RestitutionLaw`].
+//!
+//! # Self-locking
+//! When the stick ratio t makes d = (t, 1) a null vector of W (a hinged body whose contact
+//! point moves on a line, with f γ > |g_n| in the notation of docs/theory.md), sticking keeps
+//! u_n at zero whatever the normal impulse: the contact self-locks. Compression ends there;
+//! Poisson's law is met by continuing along d to p_f = (1 + e) p_c, which changes no
+//! velocity; Newton's and Stronge's laws with e > 0 cannot be met, and the impact is reported
+//! as a frictional jam ([`ImpulseError::NotConverged`]). With e = 0 every law ends at p_c.
+//!
+//! # Accuracy
+//! W and u⁻ are taken into a contact frame kept to twice the working precision, velocities
+//! and normal rates are evaluated in compensated arithmetic, and closed-form segments are
+//! located from their start; `integration_error` bounds |P − P*| against the exact process on
+//! the given W, u⁻ and normal (docs/theory.md, "Error of the impact process").
 //!
 //! # Restitution laws and energy
 //! - **Newton** (kinematic, 7.94): u_n⁺ = −e u_n⁻. With friction it can *gain* energy when the
@@ -149,8 +166,11 @@ pub struct ContactImpulse {
     pub mode: ContactMode,
     /// Energy change ΔT = P·(u⁻ + ½ W P), J.
     pub energy_change: f64,
-    /// Estimated error of the impulse (N·s) from the swerving-slip integration and the slip
-    /// halting cut-off; 0 when every segment was solved in closed form.
+    /// A bound on the error of the impulse (N·s) against the exact process for the given W, u⁻
+    /// and normal: the local error estimates of the swerving-slip integration, the slip-halting
+    /// and rest cut-offs, and the rounding of every closed-form segment and tangential solve,
+    /// propagated through the slopes of the events (docs/theory.md, "Error of the impact
+    /// process"). A few ulps of |P| when no segment was integrated.
     pub integration_error: f64,
     /// Number of integration steps (accepted and rejected) plus closed-form segments.
     pub steps: usize,
@@ -160,12 +180,15 @@ pub struct ContactImpulse {
 /// semidefinite, W frame), `u_w` the relative velocity u⁻ of body 2's contact point with
 /// respect to body 1's, `n_w` the unit normal pointing into body 2 (7.72). Approach means
 /// u⁻·n < 0; a grazing or separating contact receives no impulse. The accuracy of the
-/// impulse is reported as [`ContactImpulse::integration_error`] (0 for closed-form segments).
+/// impulse is bounded by [`ContactImpulse::integration_error`].
 ///
 /// Errors: non-finite input, a W that is not symmetric PSD, a normal that is not a unit
 /// vector, an invalid [`ContactLaw`], [`ImpulseError::Singular`] when no impulse can stop the
-/// approach (W_nn ≈ 0) or the tolerance is not positive, and [`ImpulseError::NotConverged`] when the process jams or exceeds
-/// [`ImpactOptions::max_steps`].
+/// approach (W_nn ≈ 0) or the tolerance is not positive, [`ImpulseError::NotConverged`] when
+/// the process jams (the normal velocity cannot grow along the way the contact must go: a
+/// slip with a non-positive normal rate, or a self-locked stick under Newton's or Stronge's
+/// law with e > 0) or exceeds [`ImpactOptions::max_steps`], and
+/// [`ImpulseError::NonFiniteResult`] when the impulse or a velocity overflows f64.
 pub fn resolve_in_contact_space(
     w_w: &Matrix3<f64>,
     u_w: &Vector3<f64>,

@@ -15,6 +15,10 @@
 //!   single frictional contact by the impulse process;
 //! - [`multi_contact`]: simultaneous frictional impacts at several contacts;
 //! - [`showcase`]: Kane's double pendulum striking a rough floor under each restitution law.
+//!
+//! Every function that returns a `Result` checks its results: an impulse, velocity or energy
+//! that overflows f64 is [`ImpulseError::NonFiniteResult`] naming it, never a NaN or an
+//! infinity.
 
 pub mod body;
 mod compensated;

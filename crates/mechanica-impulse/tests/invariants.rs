@@ -342,7 +342,7 @@ fn bad_input_gives_typed_errors() {
     ));
     // An impulse beyond f64 range is an error, never an infinity or NaN in the result.
     let huge = resolve_in_contact_space(&(w * 1e-300), &(u * 1e300), &Vector3::z(), &law, &opts);
-    assert!(matches!(huge, Err(ImpulseError::NotConverged { .. })), "{huge:?}");
+    assert_eq!(huge, Err(ImpulseError::NonFiniteResult { quantity: "impulse" }));
     // Both bodies static and approaching: nothing can stop them.
     let g1 = RigidBody::fixed(Vector3::zeros()).expect("ok");
     let g2 = RigidBody::from_inverse(
@@ -418,4 +418,27 @@ fn a_slip_that_stops_swerving_long_before_it_halts_finishes() {
     assert!(b.energy_after(&out.body2) <= b.energy_before());
     // The contact stops slipping (e = 0: the normal velocity ends at zero too).
     assert!(out.contact.u_after_w.norm() <= 1e-8 * out.u_before_w.norm());
+}
+
+/// Results beyond the range of f64 are typed errors naming the quantity, never NaN or ∞.
+#[test]
+fn overflowing_results_are_typed_errors() {
+    use mechanica_impulse::point::{collide_collinear, impulse_on_point};
+    let overflow = |quantity| Some(ImpulseError::NonFiniteResult { quantity });
+    // V = v + S/m with S/m = 1e310.
+    assert_eq!(
+        impulse_on_point(1e-300, &Vector3::zeros(), &Vector3::new(1e10, 0.0, 0.0)).err(),
+        overflow("velocity after the impulse")
+    );
+    // An approach speed of 2e308.
+    assert_eq!(
+        collide_collinear(1.0, 1e308, 1.0, -1e308, 0.5).err(),
+        overflow("velocities after the collision")
+    );
+    // A body so light that its inverse mass overflows.
+    let props = mechanica_mass::MassProperties::point(1e-310, Vector3::zeros()).expect("positive mass");
+    assert!(matches!(
+        RigidBody::from_mass_properties(&props, Vector3::zeros(), Vector3::zeros()),
+        Err(ImpulseError::NonFiniteResult { .. })
+    ));
 }

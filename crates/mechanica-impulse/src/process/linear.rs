@@ -205,6 +205,10 @@ impl Process {
             let a = rate.0.mul_add(local, velocity.0);
             let a_error = velocity.1 + local * rate.1 + 2.0 * UNIT_ROUNDOFF * a.abs();
             let (s, s_error) = self.event_length((a, a_error), rate);
+            if s.is_infinite() && rate.0 > 0.0 {
+                // The normal velocity does grow; the impulse to the event overflows f64.
+                return Err(ImpulseError::NonFiniteResult { quantity: "impulse" });
+            }
             if s.is_infinite() || done + s > limit.0 {
                 if limit.0.is_infinite() {
                     return Err(ImpulseError::NotConverged {
