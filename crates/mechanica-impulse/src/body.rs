@@ -23,6 +23,8 @@
 //! All vectors are expressed in the world frame W; `p_WC` is the centre of mass C.
 
 use crate::ImpulseError;
+use crate::compensated::{Dd, inverse3, two_sum};
+use crate::contact_frame::{ContactFrame, FrameMatrix, FrameVector};
 use crate::error::{check_all_finite, check_finite, check_result};
 use mechanica_mass::MassProperties;
 use nalgebra::{DMatrix, Matrix3, Matrix6, SMatrix, Vector3, Vector6};
@@ -68,6 +70,12 @@ pub struct RigidBody {
     v_wc: Vector3<f64>,
     w_w: Vector3<f64>,
     mobility: Matrix6<f64>,
+    /// The remainder of the mobility beyond one rounding (G = mobility + mobility_lo), when it
+    /// was computed rather than given: the inverse mass and inertia of a free body.
+    mobility_lo: Matrix6<f64>,
+    /// For a hinged body, the columns b_k of the factor G = Σ b_k b_kᵀ: a contact mobility
+    /// formed from them is exactly of the rank of the allowed motions.
+    mobility_factor: Vec<Vector6<f64>>,
     zero_inertia_axes: [Vector3<f64>; 3],
     zero_inertia_count: usize,
 }
@@ -121,7 +129,30 @@ impl RigidBody {
         let mut body = Self::with_mobility(props.p_oc, v_wc, w_w, 1.0 / props.mass, &inverse)?;
         body.zero_inertia_axes = axes;
         body.zero_inertia_count = count;
+        body.set_exact_inverse(props)?;
         Ok(body)
+    }
+
+    /// For a free body without zero-inertia axes: the inverse mass and the inverse central
+    /// inertia recomputed in double-double, J⁻¹ by the adjugate (accurate beyond one rounding
+    /// for any condition the pseudo-inverse keeps), stored as mobility + mobility_lo.
+    fn set_exact_inverse(&mut self, props: &MassProperties) -> Result<(), ImpulseError> {
+        if self.zero_inertia_count > 0 {
+            return Ok(());
+        }
+        let sym = props.inertia_c * 0.5 + props.inertia_c.transpose() * 0.5;
+        let Some((inverse, inverse_lo)) = inverse3(&sym) else {
+            return Ok(());
+        };
+        check_result("inverse inertia", inverse.iter())?;
+        let inverse_mass = Dd::new(1.0).div(Dd::new(props.mass));
+        for k in 0..3 {
+            self.mobility[(k, k)] = inverse_mass.hi;
+            self.mobility_lo[(k, k)] = inverse_mass.lo;
+        }
+        self.mobility.fixed_view_mut::<3, 3>(3, 3).copy_from(&inverse);
+        self.mobility_lo.fixed_view_mut::<3, 3>(3, 3).copy_from(&inverse_lo);
+        Ok(())
     }
 
     /// A body given by its inverse mass `inverse_mass` ≥ 0 and inverse central inertia
@@ -174,6 +205,8 @@ impl RigidBody {
             v_wc,
             w_w,
             mobility,
+            mobility_lo: Matrix6::zeros(),
+            mobility_factor: Vec::new(),
             zero_inertia_axes: [Vector3::zeros(); 3],
             zero_inertia_count: 0,
         })
@@ -237,15 +270,19 @@ impl RigidBody {
         let largest = svd.singular_values.max();
         let mut mobility = Matrix6::zeros();
         check_result("hinged mobility", l.iter())?;
+        let mut factor = Vec::new();
         for k in 0..6 {
             if svd.singular_values[k] <= 1e-12 * largest {
                 let q = Vector6::from_iterator(v_t.row(k).iter().copied());
                 let b = l * q;
                 mobility += b * b.transpose();
+                factor.push(b);
             }
         }
         Ok(Self {
             mobility,
+            mobility_lo: Matrix6::zeros(),
+            mobility_factor: factor,
             ..self.clone()
         })
     }
@@ -281,6 +318,21 @@ impl RigidBody {
     /// Velocity of the body point at `p_wp`: v₀ + ω × (p − x₀) (7.92).
     pub fn velocity_at(&self, p_wp: &Vector3<f64>) -> Vector3<f64> {
         self.v_wc + self.w_w.cross(&(p_wp - self.p_wc))
+    }
+
+    /// This body's share (W, u) of a contact at `p_wp` in the contact frame `frame`, each to
+    /// about twice the working precision ([`ContactFrame::body_terms`]); the lever p − x₀ is
+    /// split exactly.
+    pub(crate) fn contact_terms(&self, frame: &ContactFrame, p_wp: &Vector3<f64>) -> (FrameMatrix, FrameVector) {
+        let (mut d, mut d_lo) = (Vector3::zeros(), Vector3::zeros());
+        for k in 0..3 {
+            (d[k], d_lo[k]) = two_sum(p_wp[k], -self.p_wc[k]);
+        }
+        if self.mobility_factor.is_empty() {
+            frame.body_terms((&self.mobility, &self.mobility_lo), &self.state(), (&d, &d_lo))
+        } else {
+            frame.factored_body_terms(&self.mobility_factor, &self.state(), (&d, &d_lo))
+        }
     }
 
     /// The 3×3 point mobility W_P = J_P G J_Pᵀ: Δv_P = W_P S for an impulse S at `p_wp`.

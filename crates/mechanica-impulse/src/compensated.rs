@@ -9,7 +9,7 @@
 //! b = (W d)_n with it, because both cancel heavily when W has a large entry along a
 //! direction in which the impulse barely moves (a needle's spin about its own axis).
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Matrix3;
 
 /// The unit roundoff u = 2⁻⁵³ of binary64.
 pub(crate) const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
@@ -46,15 +46,6 @@ pub(crate) fn dot2_split(x: &[f64], y: &[f64]) -> (f64, f64) {
         error += e_p + e_s;
     }
     two_sum(sum, error)
-}
-
-/// The matrix–vector product M x as hi + lo, each component in compensated arithmetic.
-pub(crate) fn mul_vec(m: &Matrix3<f64>, x: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    let (mut hi, mut lo) = (Vector3::zeros(), Vector3::zeros());
-    for i in 0..3 {
-        (hi[i], lo[i]) = dot2_split(&[m[(i, 0)], m[(i, 1)], m[(i, 2)]], x.as_slice());
-    }
-    (hi, lo)
 }
 
 /// A double-double number hi + lo (|lo| ≤ ½ ulp(hi)), about 32 significant digits: just the
@@ -114,6 +105,29 @@ impl Dd {
     }
 }
 
+/// The inverse of a 3×3 matrix by its adjugate in double-double, as hi + lo: accurate to
+/// about 1e-32·κ(m) relative, so beyond one rounding for κ up to 1e15. `None` when the
+/// determinant is zero.
+pub(crate) fn inverse3(m: &Matrix3<f64>) -> Option<(Matrix3<f64>, Matrix3<f64>)> {
+    let x = |i: usize, j: usize| Dd::new(m[(i, j)]);
+    let cofactor = |i: usize, j: usize| {
+        let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
+        x(i1, j1).mul(x(i2, j2)).add(x(i1, j2).mul(x(i2, j1)).neg())
+    };
+    let det = (0..3).fold(Dd::new(0.0), |acc, k| acc.add(x(0, k).mul(cofactor(0, k))));
+    if det.hi == 0.0 || !det.hi.is_finite() {
+        return None;
+    }
+    let (mut hi, mut lo) = (Matrix3::zeros(), Matrix3::zeros());
+    for i in 0..3 {
+        for j in 0..3 {
+            let entry = cofactor(j, i).div(det);
+            (hi[(i, j)], lo[(i, j)]) = (entry.hi, entry.lo);
+        }
+    }
+    Some((hi, lo))
+}
+
 /// Σ |xᵢ yᵢ|: the magnitude against which the rounding of a plain dot product is measured.
 pub(crate) fn abs_dot(x: &[f64], y: &[f64]) -> f64 {
     x.iter().zip(y).map(|(a, b)| (a * b).abs()).sum()
@@ -149,11 +163,25 @@ mod tests {
     }
 
     #[test]
+    fn the_double_double_inverse_is_exact_beyond_one_rounding() {
+        // M = diag(1e-9, 3, 7): (hi + lo)·d = 1 to about 1e-32 on the diagonal of M⁻¹, and the
+        // off-diagonal entries vanish.
+        let m = Matrix3::new(1e-9, 0.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 7.0);
+        let (hi, lo) = inverse3(&m).expect("invertible");
+        assert_eq!(hi - Matrix3::from_diagonal(&hi.diagonal()), Matrix3::zeros());
+        for (k, d) in [1e-9f64, 3.0, 7.0].into_iter().enumerate() {
+            let (p, e) = two_product(hi[(k, k)], d);
+            assert!((p - 1.0 + e + lo[(k, k)] * d).abs() <= 1e-30);
+        }
+        assert!(inverse3(&Matrix3::zeros()).is_none());
+    }
+
+    #[test]
     fn the_compensated_product_keeps_what_the_rows_cancel() {
-        // Row 0: 1e16 + 1 − 1e16 = 1; row 1: 0.1 + 0.2 − 0.3 = 2⁻⁵⁵ exactly for these doubles
-        // (plain summation gives 2⁻⁵⁴).
-        let m = Matrix3::new(1e16, 1.0, -1e16, 0.1, 0.2, -0.3, 0.0, 0.0, 1.0);
-        let (hi, lo) = mul_vec(&m, &Vector3::new(1.0, 1.0, 1.0));
-        assert_eq!(hi + lo, Vector3::new(1.0, 2f64.powi(-55), 1.0));
+        // 1e16 + 1 − 1e16 = 1 and 0.1 + 0.2 − 0.3 = 2⁻⁵⁵ exactly for these doubles (plain
+        // summation gives 0 and 2⁻⁵⁴), each as hi + lo.
+        assert_eq!(dot2_split(&[1e16, 1.0, -1e16], &[1.0; 3]), (1.0, 0.0));
+        let (hi, lo) = dot2_split(&[0.1, 0.2, -0.3], &[1.0; 3]);
+        assert_eq!(hi + lo, 2f64.powi(-55));
     }
 }

@@ -48,8 +48,8 @@
 
 use crate::ImpulseError;
 use crate::body::{check_symmetric_psd, unit_vector};
-use crate::compensated::{dot2, mul_vec};
-use crate::contact_frame::ContactFrame;
+use crate::compensated::dot2;
+use crate::contact_frame::{ContactFrame, FrameMatrix, FrameVector};
 use crate::error::{check_all_finite, check_finite, check_result};
 use crate::process::Process;
 use nalgebra::{Matrix3, Vector3};
@@ -216,7 +216,38 @@ pub(crate) fn resolve_validated(
     law: &ContactLaw,
     options: &ImpactOptions,
 ) -> Result<ContactImpulse, ImpulseError> {
-    let n = n_raw / n_raw.norm();
+    let frame = ContactFrame::new(n_raw);
+    let w_sym = (w_w + w_w.transpose()) * 0.5;
+    let contact = FramedContact {
+        w: frame.congruence(&w_sym),
+        u: frame.components(u_w),
+        frame,
+        u_w: *u_w,
+    };
+    resolve_framed(&contact, law, options)
+}
+
+/// A contact expressed in its frame: W and u⁻ there as (hi, lo) pairs, and u⁻ in world
+/// components for the report of a contact that does not approach.
+pub(crate) struct FramedContact {
+    /// The contact frame.
+    pub frame: ContactFrame,
+    /// RᵀWR.
+    pub w: FrameMatrix,
+    /// Rᵀu⁻.
+    pub u: FrameVector,
+    /// u⁻ (world).
+    pub u_w: Vector3<f64>,
+}
+
+/// Resolves the impact of a contact given in its frame (validated law and tolerance checked
+/// here): the process of [`crate::process`], and the results in world components, with
+/// u⁺ = u⁻ + W P and ΔT = ½ P·(u⁻ + u⁺) evaluated in the frame in compensated arithmetic.
+pub(crate) fn resolve_framed(
+    contact: &FramedContact,
+    law: &ContactLaw,
+    options: &ImpactOptions,
+) -> Result<ContactImpulse, ImpulseError> {
     check_finite("tolerance", options.tolerance)?;
     if options.tolerance <= 0.0 {
         return Err(ImpulseError::Singular {
@@ -224,37 +255,48 @@ pub(crate) fn resolve_validated(
             value: options.tolerance,
         });
     }
-    let u_n = u_w.dot(&n);
-    if u_n >= 0.0 {
+    let (w, u) = (&contact.w, &contact.u);
+    if u.0.z + u.1.z >= 0.0 {
         return Ok(ContactImpulse {
             impulse_w: Vector3::zeros(),
             normal_impulse: 0.0,
             tangential_impulse_w: Vector3::zeros(),
             compression_impulse: 0.0,
-            u_after_w: *u_w,
+            u_after_w: contact.u_w,
             mode: ContactMode::NoImpact,
             energy_change: 0.0,
             integration_error: 0.0,
             steps: 0,
         });
     }
-    let frame = ContactFrame::new(n_raw);
-    let w_sym = (w_w + w_w.transpose()) * 0.5;
-    let mut process = Process::new(frame.congruence(&w_sym), frame.components(u_w), law, options)?;
+    let mut process = Process::new(*w, *u, law, options)?;
     process.run()?;
     let p_c = Vector3::new(process.q.x, process.q.y, process.p);
-    let impulse_w = frame.hi * p_c;
-    let normal_impulse = process.p;
-    let (w_p, w_p_lo) = mul_vec(&w_sym, &impulse_w);
-    let u_after_w = Vector3::from_fn(|i, _| dot2(&[u_w[i], w_p[i], w_p_lo[i]], &[1.0, 1.0, 1.0]));
+    let r = contact.frame.hi;
+    let impulse_w = r * p_c;
+    let u_after_c = Vector3::from_fn(|i, _| {
+        dot2(
+            &[
+                u.0[i],
+                u.1[i],
+                w.0[(i, 0)],
+                w.0[(i, 1)],
+                w.0[(i, 2)],
+                w.1[(i, 0)],
+                w.1[(i, 1)],
+                w.1[(i, 2)],
+            ],
+            &[1.0, 1.0, p_c.x, p_c.y, p_c.z, p_c.x, p_c.y, p_c.z],
+        )
+    });
     // ΔT = P·(u⁻ + ½ W P) = ½ P·(u⁻ + u⁺), at the scale of |P|·|u| however W cancels.
-    let energy_change = 0.5 * dot2(impulse_w.as_slice(), (u_w + u_after_w).as_slice());
+    let energy_change = 0.5 * dot2(p_c.as_slice(), (u.0 + u.1 + u_after_c).as_slice());
     let result = ContactImpulse {
         impulse_w,
-        normal_impulse,
-        tangential_impulse_w: impulse_w - n * normal_impulse,
+        normal_impulse: process.p,
+        tangential_impulse_w: r.column(0) * p_c.x + r.column(1) * p_c.y,
         compression_impulse: process.compression_impulse(),
-        u_after_w,
+        u_after_w: r * u_after_c,
         mode: process.mode(),
         energy_change,
         integration_error: process.error,

@@ -140,3 +140,44 @@ pub fn inverse2(m: &[[Dd; 2]; 2]) -> [[Dd; 2]; 2] {
     let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
     [[m[1][1] / det, -(m[0][1] / det)], [-(m[1][0] / det), m[0][0] / det]]
 }
+
+/// The inverse of a 3×3 matrix by its adjugate: exact to about 1e-32·κ relative.
+pub fn inverse3(a: &Dd3) -> Dd3 {
+    let c = |i: usize, j: usize| {
+        let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+        let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+        a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]
+    };
+    let det = a[0][0] * c(0, 0) + a[0][1] * c(0, 1) + a[0][2] * c(0, 2);
+    let mut r = [[Dd::ZERO; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            r[j][i] = c(i, j) / det;
+        }
+    }
+    r
+}
+
+/// The point mobility m⁻¹ I + [d]×ᵀ J⁻¹ [d]× of a free body of mass `m` and central inertia
+/// `j` at the lever `d`, J⁻¹ by the adjugate: the exact W of the stored data to about 1e-32·κ.
+pub fn point_mobility(m: f64, j: &nalgebra::Matrix3<f64>, d: &nalgebra::Vector3<f64>) -> Dd3 {
+    let j_inv = inverse3(&mat(j));
+    let dd = vec3(d);
+    let z = Dd::ZERO;
+    let k = [[z, -dd[2], dd[1]], [dd[2], z, -dd[0]], [-dd[1], dd[0], z]];
+    let mut w = [[Dd::ZERO; 3]; 3];
+    for i in 0..3 {
+        for l in 0..3 {
+            // ([d]ᵀ J⁻¹ [d])_il = Σ_ab k_ai J⁻¹_ab k_bl.
+            let mut sum = Dd::ZERO;
+            for a in 0..3 {
+                for b in 0..3 {
+                    sum = sum + k[a][i] * j_inv[a][b] * k[b][l];
+                }
+            }
+            w[i][l] = sum;
+        }
+        w[i][i] = w[i][i] + Dd::new(1.0) / Dd::new(m);
+    }
+    w
+}
