@@ -379,7 +379,10 @@ typedef struct mech_impact_result_t {
      */
     double energy_change;
     /**
-     * Estimated error of the impulse from the swerving-slip integration (N·s); 0 if exact.
+     * A bound on the error of the impulse (N·s) against the exact impact process: the
+     * swerving-slip integration, the slip-halting cut-off and the rounding of every
+     * closed-form segment through the conditioning of the contact mobility; a few ulps of
+     * |impulse| when nothing was integrated.
      */
     double integration_error;
     /**
@@ -546,7 +549,8 @@ typedef struct mech_mechanism_impact_t {
      */
     double complementarity_residual;
     /**
-     * Impulse error of the single-contact process (N·s); 0 for several contacts.
+     * Error bound of the single-contact process's impulse (N·s, see
+     * mech_impact_result_t::integration_error); 0 for several contacts.
      */
     double integration_error;
     /**
@@ -1420,6 +1424,13 @@ typedef struct mech_modal_sparse_details_t {
 #define MECH_STATUS_PARSE_ERROR 12
 
 /**
+ * The inputs were valid but a result is not representable in double precision: it exceeds
+ * the largest double (e.g. the inertia of a sphere of radius 1e308), or a mass computed from
+ * a density underflows to zero. No output was written; mech_last_error names the quantity.
+ */
+#define MECH_STATUS_OUT_OF_RANGE 13
+
+/**
  * A panic inside the library was caught at the boundary. This is a library bug; please
  * report it with the inputs. No output was written.
  */
@@ -2146,7 +2157,11 @@ mech_status_t mech_impulse_fix_point(const struct mech_impulse_body_t *body,
  * unknown law or constraint; MECH_STATUS_INVALID_ARGUMENT for a non-unit normal, restitution
  * outside [0, 1], negative friction, a non-positive tolerance or an invalid body (see
  * mech_impulse_apply); MECH_STATUS_SINGULAR when neither body can move along the normal;
- * MECH_STATUS_NOT_CONVERGED for a frictional jam.
+ * MECH_STATUS_NOT_CONVERGED for a frictional jam, including a contact that self-locks (friction
+ * holds it at rest, so the normal velocity stays zero) under MECH_RESTITUTION_NEWTON or
+ * MECH_RESTITUTION_STRONGE with restitution > 0 (under MECH_RESTITUTION_POISSON the impact
+ * ends at (1 + e) times the compression impulse with the contact at rest);
+ * MECH_STATUS_OUT_OF_RANGE when the impulse or a velocity overflows.
  *
  * # Safety
  * `body1`, `body2` and `contact` must be readable, `out` writable.
@@ -2216,7 +2231,9 @@ mech_status_t mech_multi_contact_options_default(struct mech_multi_contact_optio
  * of range, or a tree that is not finalized or has no state; MECH_STATUS_SINGULAR when an
  * approaching contact cannot move along its normal; MECH_STATUS_NOT_POSITIVE_DEFINITE for a
  * singular mass matrix; MECH_STATUS_NOT_CONVERGED for a frictional jam of the single-contact
- * process (an unconverged simultaneous solve is reported by `converged` = 0, not an error).
+ * process, a self-locking contact under Newton's or Stronge's law included (an unconverged
+ * simultaneous solve is reported by `converged` = 0, not an error); MECH_STATUS_OUT_OF_RANGE
+ * when an impulse, velocity or energy overflows.
  *
  * # Safety
  * `tree` must be a live handle; `bodies` must point to `body_count` readable values,
@@ -2437,7 +2454,8 @@ mech_status_t mech_tree_jacobian(struct mech_tree_t *tree,
  * `x` (m) in the rigid motion `motion`, written to `velocity_out` (world components).
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
- * `motion->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+ * `motion->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12; MECH_STATUS_OUT_OF_RANGE
+ * when the result overflows.
  *
  * # Safety
  * `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
@@ -2472,7 +2490,8 @@ mech_status_t mech_acceleration_field(const struct mech_rigid_motion_t *motion,
  * Coriolis and relative parts (syllabus 2.22–2.32), written to `decomposition_out`.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
- * `frame->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+ * `frame->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12; MECH_STATUS_OUT_OF_RANGE
+ * when a part of the result overflows.
  *
  * # Safety
  * `frame` must point to a readable mech_rigid_motion_t, `xi`, `xi_dot`, `xi_ddot` to readable
@@ -2509,7 +2528,8 @@ mech_status_t mech_quat_from_rotation_matrix(const struct mech_mat3_t *rotation,
  * rounding leaves in Ṙ Rᵀ is discarded by averaging the two off-diagonal entries.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT
- * when `rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+ * when `rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12; MECH_STATUS_OUT_OF_RANGE when
+ * ω overflows.
  *
  * # Safety
  * `rotation` and `rotation_rate` must point to readable mech_mat3_t values and `omega_out` to a
@@ -2542,9 +2562,12 @@ mech_status_t mech_rotation_matrix_from_quat(const struct mech_quat_t *quaternio
 /**
  * The rotation matrix exp([φ]×) (column-major) of the rotation vector φ = `rotation_vector`
  * (rad; the rotation by |φ| about φ/|φ|), by Rodrigues' formula, written to `rotation_out`.
- * Exact to rounding for every |φ|, including |φ| → 0 and |φ| ≥ π.
+ * |φ| is computed on φ scaled by a power of two (no overflow or underflow). Exact to rounding
+ * for every |φ| up to 2⁵³ rad, including |φ| → 0 and |φ| ≥ π.
  *
- * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite component.
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite component; MECH_STATUS_INVALID_ARGUMENT
+ * for |φ| > 2⁵³ rad (9.0e15), where one rounding of |φ| exceeds a radian and the rotation is
+ * not determined by φ.
  *
  * # Safety
  * `rotation_vector` must point to a readable mech_vec3_t and `rotation_out` to a writable mech_mat3_t.
@@ -2572,7 +2595,9 @@ mech_status_t mech_rotation_log(const struct mech_mat3_t *rotation,
 #if defined(MECH_FEATURE_KINEMATICS)
 /**
  * The rotation matrix (column-major) of the rotation by `angle` (rad, right-handed) about the
- * unit vector `axis`, written to `rotation_out`.
+ * unit vector `axis`, written to `rotation_out`. Every finite angle is reduced modulo 2π
+ * exactly: the result is the rotation by the angle the double holds (beyond 2⁵³ rad adjacent
+ * doubles are more than a radian apart, so only an exactly known angle is meaningful there).
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT
  * for a zero or non-unit axis (|‖a‖ − 1| > 1e-12).
@@ -2592,7 +2617,8 @@ mech_status_t mech_rotation_from_axis_angle(const struct mech_vec3_t *axis,
  * `correction_out` receives the size of the repair ‖matrix − rotation‖_F.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT for
- * det(matrix) ≤ 0 (a reflection or a singular matrix is not a drifted rotation).
+ * det(matrix) ≤ 0 (a reflection or a singular matrix is not a drifted rotation);
+ * MECH_STATUS_OUT_OF_RANGE when the correction exceeds the largest double.
  *
  * # Safety
  * `matrix` must point to a readable mech_mat3_t, `rotation_out` to a writable mech_mat3_t and
@@ -2803,7 +2829,7 @@ mech_status_t mech_tree_body_acceleration(struct mech_tree_t *tree,
  * in which B has this pose. Written to `out`.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0 or a non-unit quaternion.
+ * a mass ≤ 0 or a non-unit quaternion; MECH_STATUS_OUT_OF_RANGE when the result overflows.
  *
  * # Safety
  * All pointers must be readable (inputs) or writable (`out`).
@@ -2824,7 +2850,8 @@ mech_status_t mech_mass_transform(const struct mech_mass_properties_t *propertie
  *
  * Errors: MECH_STATUS_BAD_DIMENSION for count = 0; MECH_STATUS_NULL_POINTER when only one of
  * `rotations` and `translations` is NULL; MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT
- * for a part with mass ≤ 0 (the message names it) or a non-unit quaternion.
+ * for a part with mass ≤ 0 (the message names it) or a non-unit quaternion;
+ * MECH_STATUS_OUT_OF_RANGE when the total mass, centre or tensor overflows.
  *
  * # Safety
  * `parts` (and, when non-NULL, `rotations` and `translations`) must point to `count` readable
@@ -2845,7 +2872,7 @@ mech_status_t mech_mass_combine(const struct mech_mass_properties_t *parts,
  * Errors: MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0 or a hole at
  * least as heavy as the body; MECH_STATUS_NOT_POSITIVE_DEFINITE or
  * MECH_STATUS_INVALID_ARGUMENT when the remainder is not a valid body (a hole that does not fit
- * inside).
+ * inside); MECH_STATUS_OUT_OF_RANGE when the remainder overflows.
  *
  * # Safety
  * `body` and `hole` must be readable and `out` writable.
@@ -2862,7 +2889,7 @@ mech_status_t mech_mass_subtract(const struct mech_mass_properties_t *body,
  * 3.27–3.29), written to `inertia_out`.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0.
+ * a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when an entry of J_A overflows.
  *
  * # Safety
  * `properties` and `point` must be readable and `inertia_out` writable.
@@ -2897,11 +2924,14 @@ mech_status_t mech_mass_moment_about_line(const struct mech_mass_properties_t *p
  * `properties`, as the columns of a right-handed rotation matrix R (column-major) with
  * J = R diag(I) Rᵀ into `axes_out`. Repeated moments (relative gap ≤ 1e-10) give a canonical
  * frame: the identity for three equal moments; the exact symmetry axis and the coordinate axis
- * least aligned with it for two. The symmetric part of the tensor is decomposed; its validity
- * is not checked (see mech_mass_check).
+ * least aligned with it for two. The tensor must be symmetric within the validity tolerance,
+ * |J_ij − J_ji| ≤ 1e-9·(|J_00| + |J_11| + |J_22|); its symmetric part is decomposed, scaled
+ * by a power of two, so that any finite tensor whose moments are representable works. Its
+ * other validity conditions are not checked (see mech_mass_check).
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0.
+ * a mass ≤ 0 or a tensor outside the symmetry tolerance; MECH_STATUS_OUT_OF_RANGE when a
+ * moment exceeds the largest double.
  *
  * # Safety
  * `properties` must be readable and `moments_out`, `axes_out` writable.
@@ -2990,7 +3020,7 @@ mech_status_t mech_mass_mesh_same_connectivity(const double *vertices,
  * angular velocity `omega` (rad/s), both in that frame. Written to `angular_momentum_out`.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0.
+ * a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when the angular momentum overflows.
  *
  * # Safety
  * The inputs must be readable and `angular_momentum_out` writable.
@@ -3009,8 +3039,8 @@ mech_status_t mech_mass_angular_momentum(const struct mech_mass_properties_t *pr
  * centre velocity `com_velocity` (m/s) and angular velocity `omega` (rad/s), both in the frame
  * of `properties`.
  *
- * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input or an energy that overflows;
- * MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0.
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when the energy or the momentum overflows.
  *
  * # Safety
  * The inputs must be readable, `energy_out` writable, `momentum_out` NULL or writable.
@@ -3049,7 +3079,11 @@ mech_status_t mech_mass_point(double mass,
  * Errors: MECH_STATUS_BAD_ENUM for an unknown `kind` or `amount_kind`;
  * MECH_STATUS_BAD_DIMENSION when `dimension_count` is not the count of `kind`;
  * MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a non-positive dimension, mass or
- * density, or a torus tube radius above its ring radius.
+ * density, or a torus tube radius above its ring radius; MECH_STATUS_OUT_OF_RANGE when the
+ * mass or a moment of inertia is not representable (it overflows, or a mass from a density
+ * underflows to zero; mech_last_error names the quantity). Masses and moments are formed as
+ * products with the exponents kept apart, so that only a result that is itself out of range
+ * fails.
  *
  * # Safety
  * `dimensions` must point to `dimension_count` readable doubles (it may be NULL when the count

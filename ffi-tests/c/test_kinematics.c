@@ -453,8 +453,42 @@ static void test_tree(void) {
     CHECK_STATUS(mech_tree_create(NULL), MECH_STATUS_NULL_POINTER);
 }
 
+/* Extreme inputs: huge angles reduced exactly, rotation vectors beyond 2^53 refused, results
+ * that overflow reported as MECH_STATUS_OUT_OF_RANGE. */
+static void test_extreme_inputs(void) {
+    mech_mat3_t r;
+    /* sin and cos of the double 1e308, computed with mpmath at 1200 bits. */
+    mech_vec3_t z = {0, 0, 1};
+    CHECK_STATUS(mech_rotation_from_axis_angle(&z, 1e308, &r), MECH_STATUS_OK);
+    CHECK_NEAR(r.m[0], -0.8913089376870335, 4 * 2.2e-16);
+    CHECK_NEAR(r.m[1], 0.4533964905016491, 4 * 2.2e-16);
+    CHECK_NEAR(r.m[3], -0.4533964905016491, 4 * 2.2e-16);
+    CHECK(r.m[8] == 1.0);
+    /* A rotation vector of 1e308 components: |phi| = 1.7e308, refused, nothing written. */
+    mech_vec3_t phi = {1e308, 1e308, 1e308};
+    FILL_SENTINEL(&r, sizeof r);
+    CHECK_STATUS(mech_rotation_exp(&phi, &r), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(&r, sizeof r));
+    /* Tiny rotation vectors: the identity plus [phi]x to rounding. */
+    mech_vec3_t small = {3e-300, -4e-300, 0};
+    CHECK_STATUS(mech_rotation_exp(&small, &r), MECH_STATUS_OK);
+    CHECK(r.m[0] == 1.0 && r.m[4] == 1.0 && r.m[8] == 1.0);
+    CHECK_NEAR(r.m[2], 4e-300, 1e-315); /* R(2,0) = -phi_y */
+    /* A velocity field whose value overflows: omega x (x - c) = 1e308 * 1e308. */
+    mech_rigid_motion_t m;
+    memset(&m, 0, sizeof m);
+    m.rotation = identity3();
+    m.omega.z = 1e308;
+    mech_vec3_t x = {1e308, 0, 0};
+    mech_vec3_t v;
+    FILL_SENTINEL(&v, sizeof v);
+    CHECK_STATUS(mech_velocity_field(&m, &x, &v), MECH_STATUS_OUT_OF_RANGE);
+    CHECK(mech_untouched(&v, sizeof v));
+}
+
 int main(void) {
     test_existing_and_exp_log();
+    test_extreme_inputs();
     test_axis_angle_and_orthonormalize();
     test_euler();
     test_fields_and_relative_motion();

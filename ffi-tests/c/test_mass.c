@@ -295,7 +295,7 @@ static void momenta_and_energy(void) {
     CHECK_STATUS(mech_mass_kinetic_energy(&s, &bad, &w, &ts, NULL), MECH_STATUS_NON_FINITE);
     CHECK_STATUS(mech_mass_kinetic_energy(&s, &v, &w, NULL, NULL), MECH_STATUS_NULL_POINTER);
     mech_vec3_t huge = {1e200, 0, 0};
-    CHECK_STATUS(mech_mass_kinetic_energy(&s, &huge, &w, &ts, NULL), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_mass_kinetic_energy(&s, &huge, &w, &ts, NULL), MECH_STATUS_OUT_OF_RANGE);
     CHECK_STATUS(mech_mass_angular_momentum(&s, &a, &v, &bad, &ds), MECH_STATUS_NON_FINITE);
     CHECK_STATUS(mech_mass_angular_momentum(&s, NULL, &v, &w, &ds), MECH_STATUS_NULL_POINTER);
     CHECK(mech_untouched(&ts, sizeof ts) && mech_untouched(&ds, sizeof ds));
@@ -709,8 +709,56 @@ static void tree_mechanism(void) {
     mech_tree_destroy(tree);
 }
 
+/* Results outside the double range: a typed status naming the quantity, never NaN or inf. */
+static void extreme_inputs(void) {
+    char msg[256];
+    mech_mass_properties_t p;
+    FILL_SENTINEL(&p, sizeof p);
+    /* A sphere of radius 1e308: its moment 0.4 m r^2 is not representable. */
+    double big = 1e308;
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &big, 1, MECH_AMOUNT_MASS, 1.0, &p), MECH_STATUS_OUT_OF_RANGE);
+    CHECK(mech_untouched(&p, sizeof p));
+    mech_last_error(msg, sizeof msg);
+    CHECK(strstr(msg, "sphere moment of inertia") != NULL);
+    /* A tiny sphere by density: the mass underflows, and the message says so. */
+    double tiny = 1e-120;
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &tiny, 1, MECH_AMOUNT_DENSITY, 1.0, &p), MECH_STATUS_OUT_OF_RANGE);
+    mech_last_error(msg, sizeof msg);
+    CHECK(strstr(msg, "underflows to zero") != NULL && strstr(msg, "not finite") == NULL);
+    /* Radius 1e103 at density 1e-300: r^3 = 1e309 overflows, the mass 4.19e9 does not. */
+    double r = 1e103;
+    CHECK_STATUS(mech_mass_primitive(MECH_PRIMITIVE_SPHERE, &r, 1, MECH_AMOUNT_DENSITY, 1e-300, &p), MECH_STATUS_OK);
+    CHECK_NEAR(p.mass / (4.0 / 3.0 * 3.14159265358979323846 * 1e9), 1.0, 1e-14);
+    CHECK_NEAR(entry(&p.inertia_about_com, 0, 0) / (0.4 * p.mass * 1e206), 1.0, 1e-14);
+    /* Principal axes of a tensor with entries near 1e308 (moments representable). */
+    mech_mass_properties_t h = make_box(1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0);
+    memset(&h.inertia_about_com, 0, sizeof h.inertia_about_com);
+    h.inertia_about_com.m[0] = 0.5e308;
+    h.inertia_about_com.m[4] = 0.6e308;
+    h.inertia_about_com.m[8] = 1.1e308;
+    h.inertia_about_com.m[1] = h.inertia_about_com.m[3] = 0.2e308;
+    mech_vec3_t moments;
+    mech_mat3_t axes;
+    CHECK_STATUS(mech_mass_principal_axes(&h, &moments, &axes), MECH_STATUS_OK);
+    CHECK(isfinite(moments.x) && isfinite(moments.y) && isfinite(moments.z));
+    /* Eigenvalues of [[0.5, 0.2], [0.2, 0.6]]·1e308 are (1.1 ∓ √0.17)/2·1e308, and 1.1e308. */
+    CHECK_NEAR(moments.x / 1e308, (1.1 - sqrt(0.17)) / 2.0, 1e-14);
+    CHECK_NEAR(moments.y / 1e308, (1.1 + sqrt(0.17)) / 2.0, 1e-14);
+    CHECK_NEAR(moments.z / 1e308, 1.1, 1e-14);
+    /* An asymmetric tensor is refused. */
+    mech_mass_properties_t asym = make_box(1.0, 1.0, 2.0, 3.0, 0.0, 0.0, 0.0);
+    asym.inertia_about_com.m[3] += 1e-3;
+    FILL_SENTINEL(&moments, sizeof moments);
+    CHECK_STATUS(mech_mass_principal_axes(&asym, &moments, &axes), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK(mech_untouched(&moments, sizeof moments));
+    mech_last_error(msg, sizeof msg);
+    CHECK(strstr(msg, "not symmetric") != NULL);
+    CHECK(strcmp(mech_status_str(MECH_STATUS_OUT_OF_RANGE), "unknown status") != 0);
+}
+
 int main(void) {
     point_and_steiner();
+    extreme_inputs();
     primitives();
     combine_subtract_transform();
     lines_and_principal_axes();

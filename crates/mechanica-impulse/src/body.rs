@@ -23,7 +23,9 @@
 //! All vectors are expressed in the world frame W; `p_WC` is the centre of mass C.
 
 use crate::ImpulseError;
-use crate::error::{check_all_finite, check_finite};
+use crate::compensated::{Dd, inverse3, two_sum};
+use crate::contact_frame::{ContactFrame, FrameMatrix, FrameVector};
+use crate::error::{check_all_finite, check_finite, check_result};
 use mechanica_mass::MassProperties;
 use nalgebra::{DMatrix, Matrix3, Matrix6, SMatrix, Vector3, Vector6};
 
@@ -68,6 +70,12 @@ pub struct RigidBody {
     v_wc: Vector3<f64>,
     w_w: Vector3<f64>,
     mobility: Matrix6<f64>,
+    /// The remainder of the mobility beyond one rounding (G = mobility + mobility_lo), when it
+    /// was computed rather than given: the inverse mass and inertia of a free body.
+    mobility_lo: Matrix6<f64>,
+    /// For a hinged body, the columns b_k of the factor G = Σ b_k b_kᵀ: a contact mobility
+    /// formed from them is exactly of the rank of the allowed motions.
+    mobility_factor: Vec<Vector6<f64>>,
     zero_inertia_axes: [Vector3<f64>; 3],
     zero_inertia_count: usize,
 }
@@ -82,6 +90,15 @@ pub struct BodyResponse {
     /// Kinetic-energy change ΔT = ½ S·(V₀ + v₀) + ½ M₀S·(Ω + ω) (7.107), J. For a body of
     /// infinite mass that moves this is the work the impulse does on its driver.
     pub energy_change: f64,
+}
+
+impl BodyResponse {
+    /// Fails with [`ImpulseError::NonFiniteResult`] naming the first result that is not finite.
+    pub(crate) fn check_finite(&self) -> Result<(), ImpulseError> {
+        check_result("velocity after the impulse", self.v_wc_after.iter())?;
+        check_result("angular velocity after the impulse", self.w_w_after.iter())?;
+        check_result("energy change", [self.energy_change].iter())
+    }
 }
 
 impl RigidBody {
@@ -105,10 +122,37 @@ impl RigidBody {
         check_all_finite("centre of mass", props.p_oc.iter())?;
         check_all_finite("central inertia", props.inertia_c.iter())?;
         let (inverse, axes, count) = symmetric_pseudo_inverse("central inertia", &props.inertia_c)?;
+        check_result(
+            "inverse mass and inertia (mass or inertia too small)",
+            [1.0 / props.mass].iter().chain(inverse.iter()),
+        )?;
         let mut body = Self::with_mobility(props.p_oc, v_wc, w_w, 1.0 / props.mass, &inverse)?;
         body.zero_inertia_axes = axes;
         body.zero_inertia_count = count;
+        body.set_exact_inverse(props)?;
         Ok(body)
+    }
+
+    /// For a free body without zero-inertia axes: the inverse mass and the inverse central
+    /// inertia recomputed in double-double, J⁻¹ by the adjugate (accurate beyond one rounding
+    /// for any condition the pseudo-inverse keeps), stored as mobility + mobility_lo.
+    fn set_exact_inverse(&mut self, props: &MassProperties) -> Result<(), ImpulseError> {
+        if self.zero_inertia_count > 0 {
+            return Ok(());
+        }
+        let sym = props.inertia_c * 0.5 + props.inertia_c.transpose() * 0.5;
+        let Some((inverse, inverse_lo)) = inverse3(&sym) else {
+            return Ok(());
+        };
+        check_result("inverse inertia", inverse.iter())?;
+        let inverse_mass = Dd::new(1.0).div(Dd::new(props.mass));
+        for k in 0..3 {
+            self.mobility[(k, k)] = inverse_mass.hi;
+            self.mobility_lo[(k, k)] = inverse_mass.lo;
+        }
+        self.mobility.fixed_view_mut::<3, 3>(3, 3).copy_from(&inverse);
+        self.mobility_lo.fixed_view_mut::<3, 3>(3, 3).copy_from(&inverse_lo);
+        Ok(())
     }
 
     /// A body given by its inverse mass `inverse_mass` ≥ 0 and inverse central inertia
@@ -161,6 +205,8 @@ impl RigidBody {
             v_wc,
             w_w,
             mobility,
+            mobility_lo: Matrix6::zeros(),
+            mobility_factor: Vec::new(),
             zero_inertia_axes: [Vector3::zeros(); 3],
             zero_inertia_count: 0,
         })
@@ -194,8 +240,12 @@ impl RigidBody {
         self.constrained(c, "hinge axis")
     }
 
-    /// Restricts the mobility to the null space of the constraint rows `c` (C x = 0):
-    /// G' = G − G Cᵀ (C G Cᵀ)⁺ C G, the mobility with the constraint impulse eliminated.
+    /// Restricts the mobility to the null space of the constraint rows `c` (C x = 0), with the
+    /// constraint impulse eliminated: G' = G − G Cᵀ (C G Cᵀ)⁺ C G. It is formed as
+    /// G' = (L Q)(L Q)ᵀ with G = L Lᵀ and Q an orthonormal basis of null(C L), so that G' is
+    /// positive semidefinite with the exact rank of the allowed motions (a revolute hinge
+    /// leaves rank one) up to the rounding of its entries; the difference form leaves the
+    /// constrained directions at the rounding of G times the condition of C G Cᵀ.
     fn constrained(&self, c: DMatrix<f64>, what: &'static str) -> Result<Self, ImpulseError> {
         let x = self.state();
         let residual = (&c * DMatrix::from_column_slice(6, 1, x.as_slice())).norm();
@@ -208,30 +258,31 @@ impl RigidBody {
                 tolerance,
             });
         }
-        let g = DMatrix::from_column_slice(6, 6, self.mobility.as_slice());
-        let gct = &g * c.transpose();
-        let cgct = &c * &gct;
-        let scale = cgct.amax();
-        let pinv = if scale > 0.0 {
-            cgct.clone()
-                .svd(true, true)
-                .pseudo_inverse(scale * 1e-12)
-                .map_err(|_| ImpulseError::Singular {
-                    what: "hinge constraint (SVD did not converge)",
-                    value: scale,
-                })?
-        } else {
-            DMatrix::zeros(cgct.nrows(), cgct.ncols())
-        };
-        let reduced = &g - &gct * pinv * gct.transpose();
+        let l = mobility_square_root(&self.mobility);
+        let mut cl = DMatrix::zeros(6, 6);
+        cl.rows_mut(0, c.nrows())
+            .copy_from(&(&c * DMatrix::from_column_slice(6, 6, l.as_slice())));
+        let svd = cl.svd(false, true);
+        let v_t = svd.v_t.ok_or(ImpulseError::Singular {
+            what: "hinge constraint (SVD did not converge)",
+            value: 0.0,
+        })?;
+        let largest = svd.singular_values.max();
         let mut mobility = Matrix6::zeros();
-        for i in 0..6 {
-            for j in 0..6 {
-                mobility[(i, j)] = 0.5 * (reduced[(i, j)] + reduced[(j, i)]);
+        check_result("hinged mobility", l.iter())?;
+        let mut factor = Vec::new();
+        for k in 0..6 {
+            if svd.singular_values[k] <= 1e-12 * largest {
+                let q = Vector6::from_iterator(v_t.row(k).iter().copied());
+                let b = l * q;
+                mobility += b * b.transpose();
+                factor.push(b);
             }
         }
         Ok(Self {
             mobility,
+            mobility_lo: Matrix6::zeros(),
+            mobility_factor: factor,
             ..self.clone()
         })
     }
@@ -267,6 +318,21 @@ impl RigidBody {
     /// Velocity of the body point at `p_wp`: v₀ + ω × (p − x₀) (7.92).
     pub fn velocity_at(&self, p_wp: &Vector3<f64>) -> Vector3<f64> {
         self.v_wc + self.w_w.cross(&(p_wp - self.p_wc))
+    }
+
+    /// This body's share (W, u) of a contact at `p_wp` in the contact frame `frame`, each to
+    /// about twice the working precision ([`ContactFrame::body_terms`]); the lever p − x₀ is
+    /// split exactly.
+    pub(crate) fn contact_terms(&self, frame: &ContactFrame, p_wp: &Vector3<f64>) -> (FrameMatrix, FrameVector) {
+        let (mut d, mut d_lo) = (Vector3::zeros(), Vector3::zeros());
+        for k in 0..3 {
+            (d[k], d_lo[k]) = two_sum(p_wp[k], -self.p_wc[k]);
+        }
+        if self.mobility_factor.is_empty() {
+            frame.body_terms((&self.mobility, &self.mobility_lo), &self.state(), (&d, &d_lo))
+        } else {
+            frame.factored_body_terms(&self.mobility_factor, &self.state(), (&d, &d_lo))
+        }
     }
 
     /// The 3×3 point mobility W_P = J_P G J_Pᵀ: Δv_P = W_P S for an impulse S at `p_wp`.
@@ -321,7 +387,9 @@ impl RigidBody {
         check_all_finite("impulse", s_w.iter())?;
         check_all_finite("impulsive moment", m_cs_w.iter())?;
         self.check_moment(m_cs_w)?;
-        Ok(self.respond(s_w, m_cs_w))
+        let response = self.respond(s_w, m_cs_w);
+        response.check_finite()?;
+        Ok(response)
     }
 
     /// Applies the impulse `s_w` acting at the point `p_wr` together with the impulsive moment
@@ -337,8 +405,11 @@ impl RigidBody {
         check_all_finite("point of application", p_wr.iter())?;
         check_all_finite("impulsive moment", m_rs_w.iter())?;
         let m_cs = m_rs_w + (p_wr - self.p_wc).cross(s_w);
+        check_result("impulsive moment about the centre of mass", m_cs.iter())?;
         self.check_moment(&m_cs)?;
-        Ok(self.respond(s_w, &m_cs))
+        let response = self.respond(s_w, &m_cs);
+        response.check_finite()?;
+        Ok(response)
     }
 
     /// The response to a validated impulse (S, M₀S).
@@ -396,6 +467,18 @@ pub(crate) fn check_symmetric_psd(what: &'static str, m: &Matrix3<f64>) -> Resul
         });
     }
     Ok(())
+}
+
+/// A square root L of a symmetric positive semidefinite 6×6 mobility, G = L Lᵀ, from its
+/// eigen-decomposition (eigenvalues below zero by rounding are taken as zero).
+fn mobility_square_root(g: &Matrix6<f64>) -> Matrix6<f64> {
+    let eig = ((g + g.transpose()) * 0.5).symmetric_eigen();
+    let mut l = eig.eigenvectors;
+    for k in 0..6 {
+        let root = eig.eigenvalues[k].max(0.0).sqrt();
+        l.column_mut(k).scale_mut(root);
+    }
+    l
 }
 
 /// A pseudo-inverse, the unit vectors spanning the null space, and how many there are.

@@ -8,8 +8,10 @@
 
 use crate::ImpulseError;
 use crate::body::{BodyResponse, RigidBody, unit_vector};
-use crate::contact_space::{ContactImpulse, ContactLaw, ImpactOptions, resolve_validated};
-use crate::error::check_all_finite;
+use crate::compensated::two_sum;
+use crate::contact_frame::ContactFrame;
+use crate::contact_space::{ContactImpulse, ContactLaw, FramedContact, ImpactOptions, resolve_framed};
+use crate::error::{check_all_finite, check_result};
 use nalgebra::{Matrix3, Vector3};
 
 /// The outcome of a two-body point impact (world frame W).
@@ -42,16 +44,19 @@ pub fn resolve_contact(
     options: &ImpactOptions,
 ) -> Result<TwoBodyImpact, ImpulseError> {
     check_all_finite("contact point", p_wr.iter())?;
-    let n = unit_vector("contact normal", n_w)?;
+    unit_vector("contact normal", n_w)?;
     law.validate()?;
     body1.check_impulse_point("body 1 contact", p_wr)?;
     body2.check_impulse_point("body 2 contact", p_wr)?;
     let w = body1.point_mobility(p_wr) + body2.point_mobility(p_wr);
     let u = body2.velocity_at(p_wr) - body1.velocity_at(p_wr);
-    let contact = resolve_validated(&w, &u, &n, law, options)?;
+    let contact = resolve_framed(&framed_contact(body1, body2, p_wr, n_w, &u), law, options)?;
     let p = contact.impulse_w;
     let body2_response = body2.respond(&p, &(p_wr - body2.p_wc()).cross(&p));
     let body1_response = body1.respond(&-p, &(p_wr - body1.p_wc()).cross(&-p));
+    body1_response.check_finite()?;
+    body2_response.check_finite()?;
+    check_result("contact mobility", w.iter())?;
     Ok(TwoBodyImpact {
         contact,
         body1: body1_response,
@@ -59,4 +64,37 @@ pub fn resolve_contact(
         mobility_w: w,
         u_before_w: u,
     })
+}
+
+/// The contact in its frame, W = W₁ + W₂ and u⁻ = v₂(R) − v₁(R) formed from the bodies to about
+/// twice the working precision ([`RigidBody::contact_terms`]), so that the impulse does not
+/// inherit the rounding of a W that is large along a direction the contact barely moves in.
+fn framed_contact(
+    body1: &RigidBody,
+    body2: &RigidBody,
+    p_wr: &Vector3<f64>,
+    n_w: &Vector3<f64>,
+    u_w: &Vector3<f64>,
+) -> FramedContact {
+    let frame = ContactFrame::new(n_w);
+    let ((w1, w1_lo), (u1, u1_lo)) = body1.contact_terms(&frame, p_wr);
+    let ((w2, w2_lo), (u2, u2_lo)) = body2.contact_terms(&frame, p_wr);
+    let (mut w, mut w_lo) = (Matrix3::zeros(), Matrix3::zeros());
+    for k in 0..9 {
+        let (h, e) = two_sum(w1[k], w2[k]);
+        let (hi, lo) = two_sum(h, e + w1_lo[k] + w2_lo[k]);
+        (w[k], w_lo[k]) = (hi, lo);
+    }
+    let (mut u, mut u_lo) = (Vector3::zeros(), Vector3::zeros());
+    for k in 0..3 {
+        let (h, e) = two_sum(u2[k], -u1[k]);
+        let (hi, lo) = two_sum(h, e + u2_lo[k] - u1_lo[k]);
+        (u[k], u_lo[k]) = (hi, lo);
+    }
+    FramedContact {
+        frame,
+        w: (w, w_lo),
+        u: (u, u_lo),
+        u_w: *u_w,
+    }
 }

@@ -153,6 +153,13 @@ pub enum ImpulseError {
         /// What was wrong with it.
         source: Box<ImpulseError>,
     },
+    /// A result would be NaN or infinite although every input is finite: it overflows the
+    /// range of f64 (inputs of extreme magnitude).
+    #[error("the {quantity} is not representable: it overflows the range of f64 (inputs of extreme magnitude)")]
+    NonFiniteResult {
+        /// Which output overflowed.
+        quantity: &'static str,
+    },
     /// The kinematic tree rejected a computation (workspace not updated, wrong lengths...).
     #[error(transparent)]
     Kinematics(#[from] mechanica_kinematics::KinematicsError),
@@ -167,6 +174,19 @@ pub(crate) fn check_finite(what: &'static str, value: f64) -> Result<(), Impulse
         Ok(())
     } else {
         Err(ImpulseError::NonFinite { what, value })
+    }
+}
+
+/// Fails with [`ImpulseError::NonFiniteResult`] naming `quantity` if any of the computed
+/// `values` is NaN or ±∞.
+pub(crate) fn check_result<'a>(
+    quantity: &'static str,
+    mut values: impl Iterator<Item = &'a f64>,
+) -> Result<(), ImpulseError> {
+    if values.all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(ImpulseError::NonFiniteResult { quantity })
     }
 }
 

@@ -9,7 +9,7 @@
 
 use crate::ImpulseError;
 use crate::body::RigidBody;
-use crate::error::check_all_finite;
+use crate::error::{check_all_finite, check_result};
 use nalgebra::Vector3;
 
 /// The outcome of fixing a body point.
@@ -63,13 +63,17 @@ pub fn fix_point(body: &RigidBody, p_wx: &Vector3<f64>) -> Result<Fixation, Impu
             s
         }
     };
+    check_result("fixation impulse", impulse.iter())?;
     let response = body.respond(&impulse, &(p_wx - body.p_wc()).cross(&impulse));
+    response.check_finite()?;
     let residual = (response.v_wc_after + response.w_w_after.cross(&(p_wx - body.p_wc()))).norm();
+    let energy_change = 0.5 * impulse.dot(&v);
+    check_result("energy change", [energy_change, residual].iter())?;
     Ok(Fixation {
         impulse_w: impulse,
         v_wc_after: response.v_wc_after,
         w_w_after: response.w_w_after,
-        energy_change: 0.5 * impulse.dot(&v),
+        energy_change,
         residual,
     })
 }

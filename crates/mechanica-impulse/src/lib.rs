@@ -15,9 +15,15 @@
 //!   single frictional contact by the impulse process;
 //! - [`multi_contact`]: simultaneous frictional impacts at several contacts;
 //! - [`showcase`]: Kane's double pendulum striking a rough floor under each restitution law.
+//!
+//! Every function that returns a `Result` checks its results: an impulse, velocity or energy
+//! that overflows f64 is [`ImpulseError::NonFiniteResult`] naming it, never a NaN or an
+//! infinity.
 
 pub mod body;
+mod compensated;
 pub mod contact;
+mod contact_frame;
 pub mod contact_space;
 pub mod error;
 pub mod fixation;
@@ -25,7 +31,9 @@ pub mod mechanism;
 pub mod mechanism_contact;
 pub mod multi_contact;
 pub mod point;
+mod process;
 pub mod showcase;
+mod tangent_block;
 
 pub use body::{BodyResponse, RigidBody};
 pub use contact::{TwoBodyImpact, resolve_contact};

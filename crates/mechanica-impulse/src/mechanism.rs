@@ -21,7 +21,7 @@
 //! instead of a spherical one), or give them a small physical axial inertia.
 
 use crate::ImpulseError;
-use crate::error::check_all_finite;
+use crate::error::{check_all_finite, check_result};
 use mechanica_kinematics::tree::{KinematicTree, Workspace};
 use mechanica_mass::mechanism::TreeMass;
 use nalgebra::Vector3;
@@ -194,7 +194,7 @@ impl MechanismInertia {
         self.check_len("right-hand side", b.len())?;
         self.forward_in_place(b);
         self.backward_in_place(b);
-        Ok(())
+        check_result("solution of A x = b", b.iter())
     }
 
     /// A x (n entries) into `out`.
@@ -214,7 +214,9 @@ impl MechanismInertia {
         self.check_len("q_dot", q_dot.len())?;
         let mut aq = vec![0.0; self.n];
         self.multiply(q_dot, &mut aq);
-        Ok(0.5 * dot(q_dot, &aq))
+        let energy = 0.5 * dot(q_dot, &aq);
+        check_result("kinetic energy", [energy].iter())?;
+        Ok(energy)
     }
 
     /// The normwise backward error of a solution x of A x = b:
@@ -323,7 +325,10 @@ pub fn apply_point_impulses(
     let backward_error = inertia.backward_error(&dq, &q);
     let energy_before = inertia.kinetic_energy(q_dot)?;
     let energy_change = q.iter().zip(q_dot).zip(&dq).map(|((s, v), d)| s * (v + 0.5 * d)).sum();
-    let q_dot_after = q_dot.iter().zip(&dq).map(|(v, d)| v + d).collect();
+    let q_dot_after: Vec<f64> = q_dot.iter().zip(&dq).map(|(v, d)| v + d).collect();
+    check_result("generalized impulse", q.iter())?;
+    check_result("velocities after the impulse", q_dot_after.iter())?;
+    check_result("energy change", [energy_change, backward_error].iter())?;
     Ok(GeneralizedImpulseResponse {
         generalized_impulse: q,
         delta_q_dot: dq,

@@ -20,7 +20,7 @@
 use crate::ImpulseError;
 use crate::body::{orthonormal_complement, unit_vector};
 use crate::contact_space::{ContactLaw, ContactMode, ImpactOptions, resolve_validated};
-use crate::error::check_all_finite;
+use crate::error::{check_all_finite, check_result};
 use crate::mechanism::{BodyPoint, MechanismInertia, dot, point_jacobian_into};
 use mechanica_kinematics::tree::{KinematicTree, Workspace};
 use nalgebra::{Matrix3, Vector3};
@@ -116,24 +116,10 @@ impl ContactSpace {
             }
             frames.push(frame);
         }
-        // X = L⁻¹ Jᵀ, column by column (column r of X solves L x = row r of J).
         let rows = 3 * m;
-        let mut x = vec![0.0; n * rows];
-        for r in 0..rows {
-            let col = &mut x[n * r..n * r + n];
-            for k in 0..n {
-                col[k] = jacobian[r + rows * k];
-            }
-            inertia.forward_in_place(col);
-        }
-        let mut delassus = vec![0.0; rows * rows];
-        for c in 0..rows {
-            for r in c..rows {
-                let value = dot(&x[n * r..n * r + n], &x[n * c..n * c + n]);
-                delassus[r + rows * c] = value;
-                delassus[c + rows * r] = value;
-            }
-        }
+        let (x, delassus) = delassus(inertia, &jacobian, n, rows);
+        check_result("contact velocity before the impact", u_before.iter())?;
+        check_result("Delassus matrix W", delassus.iter())?;
         let rank = numerical_rank(rows, &delassus);
         Ok(Self {
             m,
@@ -282,6 +268,28 @@ pub struct ContactOutcome {
     pub mode: ContactMode,
 }
 
+/// X = L⁻¹ Jᵀ (n × `rows`, column r solves L x = row r of J) and W = Xᵀ X (`rows` × `rows`),
+/// both column-major, for the contact Jacobian `jacobian` (`rows` × n, column-major).
+fn delassus(inertia: &MechanismInertia, jacobian: &[f64], n: usize, rows: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut x = vec![0.0; n * rows];
+    for r in 0..rows {
+        let col = &mut x[n * r..n * r + n];
+        for k in 0..n {
+            col[k] = jacobian[r + rows * k];
+        }
+        inertia.forward_in_place(col);
+    }
+    let mut w = vec![0.0; rows * rows];
+    for c in 0..rows {
+        for r in c..rows {
+            let value = dot(&x[n * r..n * r + n], &x[n * c..n * c + n]);
+            w[r + rows * c] = value;
+            w[c + rows * r] = value;
+        }
+    }
+    (x, w)
+}
+
 /// The outcome of an impact of a mechanism at one or more contacts.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MechanismImpact {
@@ -348,18 +356,7 @@ pub(crate) fn assemble_impact(
     }
     let energy_before = inertia.kinetic_energy(q_dot)?;
     let energy_change = space.energy_change(p);
-    if let Some(value) = delta_q_dot
-        .iter()
-        .chain(std::iter::once(&energy_change))
-        .find(|v| !v.is_finite())
-    {
-        return Err(ImpulseError::NotConverged {
-            reason: "the impulse overflowed (inputs too large for f64)",
-            steps: 0,
-            normal_impulse: *value,
-        });
-    }
-    Ok(MechanismImpact {
+    let impact = MechanismImpact {
         contacts,
         delta_q_dot,
         q_dot_after,
@@ -372,7 +369,35 @@ pub(crate) fn assemble_impact(
         delassus_rank: space.rank,
         restitution_scale: 1.0,
         model: ImpactModel::Process,
-    })
+    };
+    impact.check_finite()?;
+    Ok(impact)
+}
+
+impl MechanismImpact {
+    /// Fails with [`ImpulseError::NonFiniteResult`] naming the first result that is not finite.
+    pub(crate) fn check_finite(&self) -> Result<(), ImpulseError> {
+        for c in &self.contacts {
+            check_result(
+                "contact impulse",
+                c.impulse_w.iter().chain(c.tangential_impulse_w.iter()),
+            )?;
+            check_result("normal impulse", [c.normal_impulse, c.compression_impulse].iter())?;
+            check_result("contact velocity after the impact", c.u_after_w.iter())?;
+        }
+        check_result("velocity jump Δq̇", self.delta_q_dot.iter())?;
+        check_result("velocities after the impact", self.q_dot_after.iter())?;
+        check_result("kinetic energy", [self.energy_before, self.energy_change].iter())?;
+        check_result(
+            "accuracy report",
+            [
+                self.complementarity_residual,
+                self.integration_error,
+                self.restitution_scale,
+            ]
+            .iter(),
+        )
+    }
 }
 
 /// Resolves the impact of a mechanism at a single contact with the impulse-parameterised
@@ -422,5 +447,6 @@ pub(crate) fn resolve_single_in_space(
     )?;
     impact.iterations = result.steps;
     impact.integration_error = result.integration_error;
+    impact.check_finite()?;
     Ok(impact)
 }

@@ -205,6 +205,7 @@ fn simultaneous(
     impact.converged = compression.converged && restitution.converged;
     impact.restitution_scale = scale;
     impact.model = ImpactModel::Simultaneous;
+    impact.check_finite()?;
     Ok(impact)
 }
 

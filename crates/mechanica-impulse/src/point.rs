@@ -3,7 +3,7 @@
 
 use crate::ImpulseError;
 use crate::body::unit_vector;
-use crate::error::{check_all_finite, check_finite};
+use crate::error::{check_all_finite, check_finite, check_result};
 use nalgebra::Vector3;
 
 /// The response of a point mass to an impulse.
@@ -28,10 +28,13 @@ pub fn impulse_on_point(mass: f64, v: &Vector3<f64>, s: &Vector3<f64>) -> Result
     check_all_finite("velocity", v.iter())?;
     check_all_finite("impulse", s.iter())?;
     let v_after = v + s / mass;
-    Ok(PointImpulse {
+    let result = PointImpulse {
         v_after,
         energy_change: 0.5 * s.dot(&(v_after + v)),
-    })
+    };
+    check_result("velocity after the impulse", result.v_after.iter())?;
+    check_result("energy change", [result.energy_change].iter())?;
+    Ok(result)
 }
 
 /// The outcome of a 3-D collision of two smooth point masses (spheres) along a normal.
@@ -65,12 +68,18 @@ pub fn collide_points(
     let n = unit_vector("normal", n)?;
     let line = collide_collinear(m1, v1.dot(&n), m2, v2.dot(&n), restitution)?;
     let impulse_on_2 = n * line.impulse_on_2;
-    Ok(PointImpact {
+    let result = PointImpact {
         v1_after: v1 - impulse_on_2 / m1,
         v2_after: v2 + impulse_on_2 / m2,
         impulse_on_2,
         energy_change: line.energy_change,
-    })
+    };
+    check_result(
+        "velocities after the collision",
+        result.v1_after.iter().chain(result.v2_after.iter()),
+    )?;
+    check_result("impulse", result.impulse_on_2.iter())?;
+    Ok(result)
 }
 
 /// The outcome of a collinear two-point collision.
@@ -129,12 +138,19 @@ pub fn collide_collinear(
     // Reduced mass written so that a 1e12 mass ratio loses no digits: μ = m₁ m₂ / (m₁ + m₂).
     let reduced_mass = m1 / (1.0 + m1 / m2);
     let impulse_on_2 = (1.0 + restitution) * reduced_mass * approach;
-    Ok(CollinearImpact {
+    let result = CollinearImpact {
         v1_after: v1 - impulse_on_2 / m1,
         v2_after: v2 + impulse_on_2 / m2,
         impulse_on_2,
         energy_change: -0.5 * (1.0 - restitution * restitution) * reduced_mass * approach * approach,
-    })
+    };
+    check_result(
+        "velocities after the collision",
+        [result.v1_after, result.v2_after].iter(),
+    )?;
+    check_result("impulse", [result.impulse_on_2].iter())?;
+    check_result("energy change", [result.energy_change].iter())?;
+    Ok(result)
 }
 
 #[cfg(test)]

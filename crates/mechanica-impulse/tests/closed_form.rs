@@ -129,7 +129,9 @@ fn spinning_sphere_hitting_a_wall_rolls_or_slides() {
             } else {
                 assert_eq!(out.contact.mode, ContactMode::Slip);
             }
-            assert_eq!(out.contact.integration_error, 0.0);
+            // Closed-form segments report only their rounding: a few ulps of the impulse.
+            let bound = out.contact.integration_error;
+            assert!(bound > 0.0 && bound <= 64.0 * f64::EPSILON * p, "{law:?}: {bound:e}");
         }
     }
 }

@@ -117,6 +117,26 @@ pub enum KinematicsError {
         /// The number of bodies.
         bodies: usize,
     },
+    /// A result would be NaN or infinite although every input is finite: it overflows the
+    /// range of f64 (inputs of extreme magnitude).
+    #[error("the {quantity} is not representable: it overflows the range of f64 (inputs of extreme magnitude)")]
+    NonFiniteResult {
+        /// Which output overflowed.
+        quantity: &'static str,
+    },
+    /// A rotation vector so long that one rounding of its length exceeds a radian: the
+    /// rotation it stands for is not determined by any computation in f64.
+    #[error(
+        "{what} has length {angle:e} rad, above {limit:e} rad: one rounding of the angle exceeds a radian there, so the rotation is not determined"
+    )]
+    RotationAngleUnresolved {
+        /// Which rotation vector.
+        what: &'static str,
+        /// Its length |φ| (rad).
+        angle: f64,
+        /// The largest accepted length, [`crate::rotation::ROTATION_VECTOR_LIMIT`].
+        limit: f64,
+    },
     /// A workspace was used with a tree it was not made for, or before the stage it needs
     /// (positions before velocities before accelerations) was computed.
     #[error("workspace not ready: {what}")]

@@ -18,7 +18,8 @@
 //! a few ulps even very close to the lock.
 
 use crate::KinematicsError;
-use crate::rotation::{check_finite, check_finite_vec};
+use crate::rotation::{check_finite, check_finite_vec, check_result};
+use crate::scaling::power_of_two_above;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 /// Below this value of |cos b| (Tait–Bryan) or |sin b| (proper Euler) a rotation is treated
@@ -249,7 +250,8 @@ pub fn euler_rate_matrix(seq: EulerSequence, angles: &[f64; 3], frame: AngularVe
 
 /// The angular velocity ω (rad/s) from Euler angles (rad) and their rates (rad/s),
 /// ω = E(angles) rates (see [`euler_rate_matrix`]), in the components chosen by `frame`.
-/// Fails on a non-finite input.
+/// Fails on a non-finite input, and with [`KinematicsError::NonFiniteResult`] when ω
+/// overflows (the product is formed on the rates scaled by a power of two).
 pub fn angular_velocity_from_euler_rates(
     seq: EulerSequence,
     angles: &[f64; 3],
@@ -258,7 +260,11 @@ pub fn angular_velocity_from_euler_rates(
 ) -> Result<Vector3<f64>, KinematicsError> {
     check_angles(angles, "Euler angles")?;
     check_angles(rates, "Euler rates")?;
-    Ok(euler_rate_matrix(seq, angles, frame) * Vector3::from(*rates))
+    let rates = Vector3::from(*rates);
+    let scale = power_of_two_above(rates.amax());
+    let omega = euler_rate_matrix(seq, angles, frame) * (rates / scale) * scale;
+    check_result(omega.iter(), "angular velocity")?;
+    Ok(omega)
 }
 
 /// Euler rates recovered from ω, with the conditioning of the inversion.
@@ -272,7 +278,8 @@ pub struct EulerRates {
 
 /// The Euler rates [ȧ, ḃ, ċ] that produce the angular velocity ω at `angles` (inverse of
 /// [`angular_velocity_from_euler_rates`]). Fails with [`KinematicsError::EulerRateSingular`]
-/// when |cos b| (Tait–Bryan) or |sin b| (proper) ≤ [`EULER_SINGULARITY_TOLERANCE`].
+/// when |cos b| (Tait–Bryan) or |sin b| (proper) ≤ [`EULER_SINGULARITY_TOLERANCE`], and with
+/// [`KinematicsError::NonFiniteResult`] when a rate overflows (up to about |ω|/distance).
 pub fn euler_rates_from_angular_velocity(
     seq: EulerSequence,
     angles: &[f64; 3],
@@ -293,7 +300,9 @@ pub fn euler_rates_from_angular_velocity(
     }
     let e = euler_rate_matrix(seq, angles, frame);
     let inv = e.try_inverse().ok_or(singular)?;
-    let r = inv * omega;
+    let scale = power_of_two_above(omega.amax());
+    let r = inv * (omega / scale) * scale;
+    check_result(r.iter(), "Euler rates")?;
     Ok(EulerRates {
         rates: [r.x, r.y, r.z],
         singularity_distance: distance,
@@ -343,7 +352,8 @@ impl Eb1911Angles {
 
 /// The body-axis angular velocity (p, q, r) from EB1911 (13):
 /// p = θ̇ sin φ − sin θ cos φ ψ̇, q = θ̇ cos φ + sin θ sin φ ψ̇, r = φ̇ + cos θ ψ̇.
-/// `rates` holds (θ̇, φ̇, ψ̇).
+/// `rates` holds (θ̇, φ̇, ψ̇). Fails on a non-finite input and with
+/// [`KinematicsError::NonFiniteResult`] when the result overflows.
 pub fn eb1911_body_angular_velocity(
     angles: &Eb1911Angles,
     rates: &Eb1911Angles,
@@ -360,16 +370,21 @@ pub fn eb1911_body_angular_velocity(
     }
     let (st, ct) = angles.theta.sin_cos();
     let (sp, cp) = angles.phi.sin_cos();
-    Ok(Vector3::new(
-        rates.theta * sp - st * cp * rates.psi,
-        rates.theta * cp + st * sp * rates.psi,
-        rates.phi + ct * rates.psi,
-    ))
+    let scale = power_of_two_above(rates.theta.abs().max(rates.phi.abs()).max(rates.psi.abs()));
+    let (theta_dot, phi_dot, psi_dot) = (rates.theta / scale, rates.phi / scale, rates.psi / scale);
+    let omega = Vector3::new(
+        theta_dot * sp - st * cp * psi_dot,
+        theta_dot * cp + st * sp * psi_dot,
+        phi_dot + ct * psi_dot,
+    ) * scale;
+    check_result(omega.iter(), "angular velocity")?;
+    Ok(omega)
 }
 
 /// The inverse of (13): (θ̇, φ̇, ψ̇) from the body components (p, q, r). Singular at sin θ = 0
 /// (the spin and precession axes coincide); fails there with
-/// [`KinematicsError::EulerRateSingular`] when |sin θ| ≤ [`EULER_SINGULARITY_TOLERANCE`].
+/// [`KinematicsError::EulerRateSingular`] when |sin θ| ≤ [`EULER_SINGULARITY_TOLERANCE`], and
+/// with [`KinematicsError::NonFiniteResult`] when a rate overflows.
 ///
 /// From (13): θ̇ = p sin φ + q cos φ, ψ̇ = (q sin φ − p cos φ)/sin θ, φ̇ = r − cos θ ψ̇.
 pub fn eb1911_rates_from_body_angular_velocity(
@@ -390,13 +405,16 @@ pub fn eb1911_rates_from_body_angular_velocity(
         });
     }
     let (sp, cp) = angles.phi.sin_cos();
-    let (p, q, r) = (omega_b.x, omega_b.y, omega_b.z);
+    let scale = power_of_two_above(omega_b.amax());
+    let (p, q, r) = (omega_b.x / scale, omega_b.y / scale, omega_b.z / scale);
     let psi_dot = (q * sp - p * cp) / st;
-    Ok(Eb1911Angles {
-        theta: p * sp + q * cp,
-        phi: r - ct * psi_dot,
-        psi: psi_dot,
-    })
+    let rates = Eb1911Angles {
+        theta: (p * sp + q * cp) * scale,
+        phi: (r - ct * psi_dot) * scale,
+        psi: psi_dot * scale,
+    };
+    check_result([rates.theta, rates.phi, rates.psi].iter(), "Euler rates")?;
+    Ok(rates)
 }
 
 #[cfg(test)]

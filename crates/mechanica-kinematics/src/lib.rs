@@ -13,12 +13,18 @@
 //! - [`rigid_motion`]: x = R X + c and the velocity/acceleration fields (2.13–2.19).
 //! - [`relative_motion`]: drag, Coriolis and relative parts (2.22–2.35).
 //! - [`tree`]: kinematic trees, forward kinematics, Jacobians and their rates.
+//! - [`scaling`]: exact power-of-two scaling and norms without overflow or underflow.
+//!
+//! Every function that returns a `Result` checks its outputs: a result that is not
+//! representable (it overflows f64) is [`KinematicsError::NonFiniteResult`], never a NaN or
+//! an infinity.
 
 pub mod error;
 pub mod euler;
 pub mod relative_motion;
 pub mod rigid_motion;
 pub mod rotation;
+pub mod scaling;
 pub mod tree;
 
 pub use error::KinematicsError;

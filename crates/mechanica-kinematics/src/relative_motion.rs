@@ -6,7 +6,7 @@
 
 use crate::KinematicsError;
 use crate::rigid_motion::RigidMotion;
-use crate::rotation::check_finite_vec;
+use crate::rotation::{check_finite_vec, check_result};
 use nalgebra::Vector3;
 
 /// A point's motion relative to a moving frame, in that frame's components.
@@ -49,20 +49,35 @@ impl DecomposedMotion {
 }
 
 /// Decomposes the absolute motion of a point moving relative to `frame` (2.22–2.32).
+/// Fails on a non-finite input and with [`KinematicsError::NonFiniteResult`] naming the
+/// first part that overflows f64.
 pub fn decompose(frame: &RigidMotion, rel: &RelativeMotion) -> Result<DecomposedMotion, KinematicsError> {
     check_finite_vec(&rel.xi, "relative position")?;
     check_finite_vec(&rel.xi_dot, "relative velocity")?;
     check_finite_vec(&rel.xi_ddot, "relative acceleration")?;
     let x = frame.rotation * rel.xi + frame.c;
     let v_rel = frame.rotation * rel.xi_dot;
-    Ok(DecomposedMotion {
+    let d = DecomposedMotion {
         position: x,
         v_drag: frame.velocity_at(&x),
         v_rel,
         a_drag: frame.acceleration_at(&x),
         a_coriolis: 2.0 * frame.omega.cross(&v_rel),
         a_rel: frame.rotation * rel.xi_ddot,
-    })
+    };
+    for (part, quantity) in [
+        (&d.position, "position"),
+        (&d.v_drag, "drag velocity"),
+        (&d.v_rel, "relative velocity"),
+        (&d.a_drag, "drag acceleration"),
+        (&d.a_coriolis, "Coriolis acceleration"),
+        (&d.a_rel, "relative acceleration"),
+        (&d.velocity(), "absolute velocity"),
+        (&d.acceleration(), "absolute acceleration"),
+    ] {
+        check_result(part.iter(), quantity)?;
+    }
+    Ok(d)
 }
 
 /// The rate-of-change rule for any vector q = R η carried by a frame rotating at ω (2.36):

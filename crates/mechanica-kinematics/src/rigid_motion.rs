@@ -4,6 +4,9 @@
 //! of the body's reference point (the origin of the body frame), ω the angular velocity, which
 //! is the same whichever body point is taken as reference (2.14–2.16). Units are SI (m, m/s,
 //! m/s², rad/s, rad/s²); the fields are evaluated by their closed forms, exact up to rounding.
+//! They are plain formulas: a result whose exact value exceeds f64::MAX comes out as ±∞.
+//! [`crate::relative_motion::decompose`] and the C functions built on them check their
+//! results and report such an overflow as [`KinematicsError::NonFiniteResult`].
 
 use crate::KinematicsError;
 use crate::rotation::check_finite_vec;

@@ -7,6 +7,7 @@
 //! logarithm goes through Shepperd's quaternion extraction and `2 atan2(‖v‖, w)`.
 
 use crate::KinematicsError;
+use crate::scaling::{self, power_of_two_above};
 use nalgebra::{Matrix3, Quaternion, Rotation3, Unit, UnitQuaternion, Vector3};
 
 /// Tolerance on ‖RᵀR − I‖_F for accepting a matrix as a rotation: a few hundred ulps,
@@ -18,18 +19,39 @@ pub const ROTATION_TOLERANCE: f64 = 1e-12;
 /// [`ROTATION_TOLERANCE`]).
 pub const AXIS_TOLERANCE: f64 = 1e-12;
 
+/// The largest rotation-vector length |φ| that [`exp_map`] accepts: 2⁵³ rad. Above it one
+/// rounding of |φ| (which no computation in f64 avoids) exceeds a radian, so the rotation is
+/// not determined by φ; [`exp_map`] refuses it with
+/// [`KinematicsError::RotationAngleUnresolved`]. An angle given on its own
+/// ([`rotation_from_axis_angle`]) is exact as a double and has no such limit.
+pub const ROTATION_VECTOR_LIMIT: f64 = 9_007_199_254_740_992.0;
+
 /// The skew-symmetric matrix Ω with Ω x = ω × x (2.10, 2.12).
 pub fn skew(w: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0)
 }
 
 /// The vector ω of the skew-symmetric part of `m`: ω = vee((m − mᵀ)/2), the inverse of [`skew`].
+/// Halved before the difference, so that it never overflows for finite `m`.
 pub fn vee(m: &Matrix3<f64>) -> Vector3<f64> {
     Vector3::new(
-        0.5 * (m[(2, 1)] - m[(1, 2)]),
-        0.5 * (m[(0, 2)] - m[(2, 0)]),
-        0.5 * (m[(1, 0)] - m[(0, 1)]),
+        0.5 * m[(2, 1)] - 0.5 * m[(1, 2)],
+        0.5 * m[(0, 2)] - 0.5 * m[(2, 0)],
+        0.5 * m[(1, 0)] - 0.5 * m[(0, 1)],
     )
+}
+
+/// Fails with [`KinematicsError::NonFiniteResult`] naming `quantity` unless every entry of
+/// the computed `values` is finite.
+pub(crate) fn check_result<'a>(
+    mut values: impl Iterator<Item = &'a f64>,
+    quantity: &'static str,
+) -> Result<(), KinematicsError> {
+    if values.all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(KinematicsError::NonFiniteResult { quantity })
+    }
 }
 
 pub(crate) fn check_finite_vec(v: &Vector3<f64>, what: &'static str) -> Result<(), KinematicsError> {
@@ -124,30 +146,46 @@ pub fn rotation_from_quaternion(q: &UnitQuaternion<f64>) -> Rotation3<f64> {
     q.to_rotation_matrix()
 }
 
-/// The exponential map of SO(3): the rotation by |φ| about φ/|φ| (Rodrigues),
-/// R = I + (sin θ/θ) \[φ\]× + (2 sin²(θ/2)/θ²) \[φ\]×², θ = |φ|. Exact to rounding for all θ,
-/// including θ → 0 (no cancellation) and θ ≥ π.
+/// The exponential map of SO(3): the rotation by θ = |φ| about n = φ/|φ| (Rodrigues),
+/// R = I + sin θ \[n\]× + 2 sin²(θ/2) \[n\]×², with |φ| computed on φ scaled by a power of
+/// two (it neither overflows nor underflows). Exact to rounding for all θ up to
+/// [`ROTATION_VECTOR_LIMIT`], including θ → 0 (no cancellation) and θ ≥ π; above it
+/// [`KinematicsError::RotationAngleUnresolved`].
 pub fn exp_map(phi: &Vector3<f64>) -> Result<Rotation3<f64>, KinematicsError> {
     check_finite_vec(phi, "rotation vector component")?;
+    check_rotation_vector(phi, "rotation vector")?;
     Ok(exp_unchecked(phi))
 }
 
-/// The coefficients (sin θ/θ, (1 − cos θ)/θ²) of Rodrigues' formula, without cancellation.
-pub(crate) fn rodrigues_coefficients(theta: f64) -> (f64, f64) {
-    if theta == 0.0 {
-        (1.0, 0.5)
-    } else {
-        let h = (0.5 * theta).sin() / theta;
-        (theta.sin() / theta, 2.0 * h * h)
+/// Fails with [`KinematicsError::RotationAngleUnresolved`] when |φ| > [`ROTATION_VECTOR_LIMIT`].
+pub(crate) fn check_rotation_vector(phi: &Vector3<f64>, what: &'static str) -> Result<(), KinematicsError> {
+    let angle = scaling::norm(phi);
+    if angle > ROTATION_VECTOR_LIMIT {
+        return Err(KinematicsError::RotationAngleUnresolved {
+            what,
+            angle,
+            limit: ROTATION_VECTOR_LIMIT,
+        });
     }
+    Ok(())
 }
 
-/// [`exp_map`] for an input already known to be finite.
+/// R = I + sin θ \[n\]× + 2 sin²(θ/2) \[n\]×² for a unit `n` and any finite angle: the sine
+/// and cosine reduce the angle modulo 2π exactly (as the platform's libm does: correctly
+/// rounded on glibc, macOS and MSVC), so the result is the rotation by the exact double θ.
+pub(crate) fn axis_angle_matrix(n: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
+    let k = skew(n);
+    let half = (0.5 * theta).sin();
+    Matrix3::identity() + k * theta.sin() + k * k * (2.0 * half * half)
+}
+
+/// [`exp_map`] for an input already known to be finite and within [`ROTATION_VECTOR_LIMIT`].
 pub(crate) fn exp_unchecked(phi: &Vector3<f64>) -> Rotation3<f64> {
-    let theta = phi.norm();
-    let (a, b) = rodrigues_coefficients(theta);
-    let k = skew(phi);
-    Rotation3::from_matrix_unchecked(Matrix3::identity() + k * a + k * k * b)
+    let theta = scaling::norm(phi);
+    if theta == 0.0 {
+        return Rotation3::identity();
+    }
+    Rotation3::from_matrix_unchecked(axis_angle_matrix(&(phi / theta), theta))
 }
 
 /// Series Σ_{n≥0} (−1)ⁿ x^n / (2n + m)! in x = θ², for the small-angle branches below.
@@ -208,21 +246,47 @@ fn jacobian_coefficients(theta: f64) -> (f64, f64, f64, f64) {
 
 /// The right Jacobian of SO(3): with R(t) = exp(φ(t)), the body-frame angular velocity is
 /// ω_B = J_r(φ) φ̇, J_r = I − ((1 − cos θ)/θ²)\[φ\]× + ((θ − sin θ)/θ³)\[φ\]×², θ = |φ|.
-/// det J_r = 2(1 − cos θ)/θ², so J_r is invertible for θ < 2π.
+/// det J_r = 2(1 − cos θ)/θ², so J_r is invertible for θ < 2π. From θ = 2 on it is evaluated
+/// with the unit axis n = φ/θ, J_r = I − ((1 − cos θ)/θ)\[n\]× + (1 − sin θ/θ)\[n\]×², whose
+/// coefficients are bounded: finite for every finite φ.
 pub fn right_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
-    let (alpha, beta, _, _) = jacobian_coefficients(phi.norm());
-    let k = skew(phi);
-    Matrix3::identity() - k * alpha + k * k * beta
+    let theta = scaling::norm(phi);
+    if theta < 2.0 {
+        let (alpha, beta, _, _) = jacobian_coefficients(theta);
+        let k = skew(phi);
+        return Matrix3::identity() - k * alpha + k * k * beta;
+    }
+    let theta = theta.min(f64::MAX);
+    let k = skew(&(phi / theta));
+    let half = (0.5 * theta).sin();
+    Matrix3::identity() - k * (2.0 * half * half / theta) + k * k * (1.0 - theta.sin() / theta)
 }
 
 /// The time derivative dJ_r/dt of [`right_jacobian`] along φ(t) with rate φ̇:
 /// −α̇\[φ\] − α\[φ̇\] + β̇\[φ\]² + β(\[φ̇\]\[φ\] + \[φ\]\[φ̇\]), α̇ = (α′/θ)(φ·φ̇), β̇ = (β′/θ)(φ·φ̇).
+/// From θ = 2 on in terms of n = φ/θ and θ̇ = n·φ̇ with bounded coefficients (see the
+/// source), so that it overflows only when φ̇ is of the order of f64::MAX.
 pub fn right_jacobian_rate(phi: &Vector3<f64>, phi_dot: &Vector3<f64>) -> Matrix3<f64> {
-    let (alpha, beta, dalpha, dbeta) = jacobian_coefficients(phi.norm());
-    let d = phi.dot(phi_dot);
-    let k = skew(phi);
+    let theta = scaling::norm(phi);
     let kd = skew(phi_dot);
-    -k * (dalpha * d) - kd * alpha + k * k * (dbeta * d) + (kd * k + k * kd) * beta
+    if theta < 2.0 {
+        let (alpha, beta, dalpha, dbeta) = jacobian_coefficients(theta);
+        let d = phi.dot(phi_dot);
+        let k = skew(phi);
+        return -k * (dalpha * d) - kd * alpha + k * k * (dbeta * d) + (kd * k + k * kd) * beta;
+    }
+    let theta = theta.min(f64::MAX);
+    let n = phi / theta;
+    let (k, theta_dot) = (skew(&n), n.dot(phi_dot));
+    let (s, c) = theta.sin_cos();
+    let half = (0.5 * theta).sin();
+    let one_minus_cos = 2.0 * half * half;
+    // α′θ, α, β′θ², βθ with α = (1 − cos θ)/θ², β = (θ − sin θ)/θ³.
+    let d_alpha = (s - 2.0 * one_minus_cos / theta) / theta;
+    let alpha = one_minus_cos / theta / theta;
+    let d_beta = ((1.0 - c) - 3.0 * (1.0 - s / theta)) / theta;
+    let beta = (1.0 - s / theta) / theta;
+    -k * (d_alpha * theta_dot) - kd * alpha + k * k * (d_beta * theta_dot) + (kd * k + k * kd) * beta
 }
 
 /// The logarithm map of SO(3): the rotation vector φ with exp(φ) = R and |φ| ∈ [0, π].
@@ -281,11 +345,17 @@ pub fn unit_axis(axis: &Vector3<f64>, what: &'static str) -> Result<Unit<Vector3
     Ok(Unit::new_normalize(*axis))
 }
 
-/// The rotation by `angle` about the unit vector `axis` (rejects non-unit, zero or non-finite axes).
+/// The rotation by `angle` (rad) about the unit vector `axis` (rejects non-unit, zero or
+/// non-finite axes), R = I + sin θ \[a\]× + 2 sin²(θ/2) \[a\]×².
+///
+/// Every finite angle is accepted and reduced modulo 2π exactly: the result is the rotation
+/// by the angle the double holds, to a few ulps. Beyond 2⁵³ rad adjacent doubles are more
+/// than a radian apart, so an angle computed with any rounding no longer determines the
+/// rotation; the result is still the exact one for the double given.
 pub fn rotation_from_axis_angle(axis: &Vector3<f64>, angle: f64) -> Result<Rotation3<f64>, KinematicsError> {
     let axis = unit_axis(axis, "rotation axis")?;
     check_finite(angle, "rotation angle")?;
-    Ok(exp_unchecked(&(axis.into_inner() * angle)))
+    Ok(Rotation3::from_matrix_unchecked(axis_angle_matrix(&axis, angle)))
 }
 
 /// A rotation repaired from a drifted input, with the size of the repair.
@@ -298,18 +368,22 @@ pub struct Orthonormalized {
 }
 
 /// The rotation nearest to `m` in the Frobenius norm: the orthogonal polar factor U Vᵀ of the
-/// SVD m = U Σ Vᵀ. Fails for non-finite input and for det m ≤ 0 (a reflection or a singular
-/// matrix is not a drifted rotation).
+/// SVD m = U Σ Vᵀ, computed on m scaled by a power of two (the polar factor of a positive
+/// multiple is the same), so that any finite m works. Fails for non-finite input, for
+/// det m ≤ 0 (a reflection or a singular matrix is not a drifted rotation), and with
+/// [`KinematicsError::NonFiniteResult`] when the correction ‖m − R‖_F exceeds f64::MAX.
 pub fn orthonormalize_matrix(m: &Matrix3<f64>) -> Result<Orthonormalized, KinematicsError> {
     check_finite_mat(m, "matrix entry")?;
-    let determinant = m.determinant();
+    let scale = power_of_two_above(m.amax());
+    let scaled = m / scale;
+    let determinant = scaled.determinant();
     if determinant <= 0.0 {
         return Err(KinematicsError::NotARotation {
             orthogonality_error: (m.transpose() * m - Matrix3::identity()).norm(),
-            determinant,
+            determinant: determinant * scale * scale * scale,
         });
     }
-    let svd = m.svd(true, true);
+    let svd = scaled.svd(true, true);
     let (Some(u), Some(v_t)) = (svd.u, svd.v_t) else {
         return Err(KinematicsError::NotARotation {
             orthogonality_error: f64::INFINITY,
@@ -317,9 +391,11 @@ pub fn orthonormalize_matrix(m: &Matrix3<f64>) -> Result<Orthonormalized, Kinema
         });
     };
     let r = u * v_t;
+    let correction = scaling::frobenius_norm(&(m - r));
+    check_result([correction].iter(), "correction ‖m − R‖")?;
     Ok(Orthonormalized {
         rotation: Rotation3::from_matrix_unchecked(r),
-        correction: (m - r).norm(),
+        correction,
     })
 }
 
@@ -329,29 +405,42 @@ pub fn orthonormalize_quaternion(q: &Quaternion<f64>) -> Result<(UnitQuaternion<
     for value in q.coords.iter().copied() {
         check_finite(value, "quaternion component")?;
     }
-    let norm = q.norm();
-    if norm == 0.0 || !norm.is_finite() {
+    let scale = power_of_two_above(q.coords.amax());
+    let scaled = q / scale;
+    let norm = scaled.norm() * scale;
+    if scaled.norm() == 0.0 {
         return Err(KinematicsError::NotAUnitQuaternion { norm });
     }
-    Ok((UnitQuaternion::new_unchecked(q / norm), (norm - 1.0).abs()))
+    let correction = (norm - 1.0).abs();
+    check_result([correction].iter(), "quaternion norm")?;
+    Ok((UnitQuaternion::new_unchecked(scaled / scaled.norm()), correction))
 }
 
 /// The angular velocity ω, expressed in the fixed frame, from R and Ṙ: Ω = Ṙ Rᵀ (2.7–2.12).
 ///
 /// Ω is skew-symmetric for an exact rotation; the symmetric part that rounding leaves is
-/// discarded by averaging the two off-diagonal entries.
+/// discarded by averaging the two off-diagonal entries. Ṙ is scaled by a power of two for the
+/// product, so the result overflows only when ω itself exceeds f64::MAX
+/// ([`KinematicsError::NonFiniteResult`]).
 pub fn angular_velocity_from_rate(r: &Rotation3<f64>, r_dot: &Matrix3<f64>) -> Result<Vector3<f64>, KinematicsError> {
     check_finite_mat(r_dot, "rotation rate entry")?;
-    Ok(vee(&(r_dot * r.matrix().transpose())))
+    let scale = power_of_two_above(r_dot.amax());
+    let omega = vee(&(r_dot / scale * r.matrix().transpose())) * scale;
+    check_result(omega.iter(), "angular velocity")?;
+    Ok(omega)
 }
 
-/// The angular velocity expressed in the body frame, ω_B = Rᵀ ω = vee(Rᵀ Ṙ).
+/// The angular velocity expressed in the body frame, ω_B = Rᵀ ω = vee(Rᵀ Ṙ) (scaled as
+/// [`angular_velocity_from_rate`]).
 pub fn body_angular_velocity_from_rate(
     r: &Rotation3<f64>,
     r_dot: &Matrix3<f64>,
 ) -> Result<Vector3<f64>, KinematicsError> {
     check_finite_mat(r_dot, "rotation rate entry")?;
-    Ok(vee(&(r.matrix().transpose() * r_dot)))
+    let scale = power_of_two_above(r_dot.amax());
+    let omega = vee(&(r.matrix().transpose() * (r_dot / scale))) * scale;
+    check_result(omega.iter(), "angular velocity")?;
+    Ok(omega)
 }
 
 /// How a quaternion that is not exactly of unit length is treated.
@@ -378,15 +467,18 @@ pub fn unit_quaternion(
         });
     }
     let q = nalgebra::Quaternion::new(w, x, y, z);
-    let norm = q.norm();
+    // Normalised on q/2^k, so that any non-zero finite q works under `Normalize`.
+    let scale = power_of_two_above(q.coords.amax());
+    let scaled = q / scale;
+    let norm = scaled.norm() * scale;
     let acceptable = match policy {
         QuaternionNorm::RequireUnit => (norm - 1.0).abs() <= ROTATION_TOLERANCE,
-        QuaternionNorm::Normalize => norm > 0.0 && norm.is_finite(),
+        QuaternionNorm::Normalize => scaled.norm() > 0.0,
     };
     if !acceptable {
         return Err(KinematicsError::NotAUnitQuaternion { norm });
     }
-    Ok(UnitQuaternion::new_normalize(q))
+    Ok(UnitQuaternion::new_normalize(scaled))
 }
 
 #[cfg(test)]

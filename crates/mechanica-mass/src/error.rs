@@ -18,6 +18,24 @@ pub enum MassError {
     /// A mass that must be positive was zero or negative.
     #[error("mass must be positive, got {0}")]
     NonPositiveMass(f64),
+    /// The mass from a density, density × measure, is below the smallest positive double: the
+    /// body is too small (or too thin) for its mass to be represented.
+    #[error(
+        "the mass density × measure underflows to zero (density {density}, measure {measure}): the body is too small for a representable mass"
+    )]
+    MassUnderflow {
+        /// The density given.
+        density: f64,
+        /// The body's length, area or volume (itself possibly rounded to zero).
+        measure: f64,
+    },
+    /// A result would be NaN or infinite although every input is finite: it overflows the
+    /// range of f64 (inputs of extreme magnitude).
+    #[error("the {quantity} is not representable: it overflows the range of f64 (inputs of extreme magnitude)")]
+    NonFiniteResult {
+        /// Which output overflowed.
+        quantity: &'static str,
+    },
     /// A density (line, area or volume) that must be positive was zero or negative.
     #[error("density must be positive, got {0}")]
     NonPositiveDensity(f64),
@@ -159,6 +177,19 @@ pub(crate) fn check_all_finite<'a>(
     match values.into_iter().copied().find(|v| !v.is_finite()) {
         Some(value) => Err(MassError::NonFinite { what, value }),
         None => Ok(()),
+    }
+}
+
+/// Fails with [`MassError::NonFiniteResult`] naming `quantity` unless every computed value is
+/// finite.
+pub(crate) fn check_result<'a>(
+    values: impl IntoIterator<Item = &'a f64>,
+    quantity: &'static str,
+) -> Result<(), MassError> {
+    if values.into_iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(MassError::NonFiniteResult { quantity })
     }
 }
 

@@ -10,6 +10,11 @@
 //! - [`mesh`], [`topology`] and [`io`]: triangle meshes, their edge checks and file formats;
 //! - [`mechanism`]: the mass matrix A(q) of a kinematic tree (composite-rigid-body recursion);
 //! - [`momenta`]: momentum, angular momentum and kinetic energy of a rigid body.
+//!
+//! Every function that returns a `Result` checks its results: a mass, moment, tensor or
+//! matrix entry that is not representable is [`MassError::NonFiniteResult`] (overflow) or
+//! [`MassError::MassUnderflow`] (a mass from a density that rounds to zero), never a NaN, an
+//! infinity or a zero mass.
 
 pub mod error;
 #[cfg(feature = "io")]

@@ -13,7 +13,11 @@
 //! T = T₀ + T₁ + T₂ (9.7–9.10): the drag field ∂x/∂t = v₀ + ω₀ × (x − p₀) of the base is a rigid
 //! velocity field, so T₀ and b_k = ∫ρ ∂x/∂q_k·∂x/∂t dV collapse onto composite mass properties
 //! exactly like α_kl.
+//!
+//! Every result is checked: an entry of A, a momentum, an energy or a centre of mass that
+//! overflows f64 is [`MassError::NonFiniteResult`].
 
+use crate::error::check_result;
 use crate::{MassError, MassProperties};
 use mechanica_kinematics::tree::{BaseState, KinematicTree, Workspace};
 use nalgebra::{Matrix3, Vector3};
@@ -167,7 +171,7 @@ impl TreeMass {
             self.composite[i] = MassProperties {
                 mass: body.mass,
                 p_oc: r * body.p_oc + ws.position(i)?,
-                inertia_c: (j + j.transpose()) * 0.5,
+                inertia_c: j * 0.5 + j.transpose() * 0.5,
             };
         }
         for &i in tree.topological_order().iter().rev() {
@@ -235,7 +239,7 @@ impl TreeMass {
                 }
             }
         }
-        Ok(())
+        check_result(out.iter(), "mass matrix")
     }
 
     /// The generalized momenta ∂T/∂q̇ = A q̇ (7.113; EB1911 §22 (16)) and the kinetic energy
@@ -271,6 +275,8 @@ impl TreeMass {
             momenta_out[k] = s;
             t += 0.5 * q_dot[k] * s;
         }
+        check_result(momenta_out.iter(), "generalized momenta")?;
+        check_result([t].iter(), "kinetic energy")?;
         Ok(t)
     }
 
@@ -347,12 +353,9 @@ impl TreeMass {
             momenta_out[k] = s + b_out[k];
         }
         let split = EnergySplit { t0, t1, t2 };
-        if !split.total().is_finite() {
-            return Err(MassError::NonFinite {
-                what: "kinetic energy (overflow)",
-                value: split.total(),
-            });
-        }
+        check_result(b_out.iter(), "velocity coupling b")?;
+        check_result(momenta_out.iter(), "generalized momenta")?;
+        check_result([t0, t1, t2, split.total()].iter(), "kinetic energy")?;
         Ok(split)
     }
 
@@ -376,9 +379,14 @@ impl TreeMass {
         self.update_composites(tree, ws)?;
         let root = (0..tree.body_count()).find(|&b| tree.parent(b).is_none()).unwrap_or(0);
         let total = self.composite[root];
-        if total.mass.is_nan() || total.mass <= 0.0 {
+        check_result([total.mass].iter(), "total mass")?;
+        if total.mass <= 0.0 {
             return Err(MassError::NonPositiveTotalMass(total.mass));
         }
+        check_result(
+            total.p_oc.iter().chain(total.inertia_c.iter()),
+            "system mass properties",
+        )?;
         for i in 0..tree.body_count() {
             let c = self.composite[i];
             let o_i = ws.position(i)?;
@@ -388,6 +396,7 @@ impl TreeMass {
                 jacobian_out[3 * k..3 * k + 3].copy_from_slice(col.as_slice());
             }
         }
+        check_result(jacobian_out.iter(), "centre-of-mass Jacobian")?;
         Ok(total)
     }
 }

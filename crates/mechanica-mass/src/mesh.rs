@@ -13,7 +13,7 @@
 //! Meshes of at least [`PARALLEL_MIN_TRIANGLES`] triangles use all available cores (scoped
 //! standard threads) for both the edge-topology check and the integrals.
 
-use crate::error::check_finite;
+use crate::error::{check_finite, check_result};
 use crate::primitives::Amount;
 use crate::{MassError, MassProperties};
 use nalgebra::{Matrix3, Vector3};
@@ -185,7 +185,9 @@ fn reference_point(vertices: &[[f64; 3]]) -> Result<([f64; 3], f64), MassError> 
 /// [`MassError::IndexOutOfRange`], [`MassError::TooManyVertices`], [`MassError::TooManyTriangles`],
 /// [`MassError::DegenerateTriangles`] (policy Reject), [`MassError::OpenMesh`] (policy Reject),
 /// [`MassError::InconsistentOrientation`], [`MassError::InsideOut`] (policy Reject),
-/// [`MassError::ZeroVolume`], and the density/mass errors of [`Amount::mass_for`].
+/// [`MassError::ZeroVolume`], the density/mass errors of [`Amount::mass_for`] (including
+/// [`MassError::MassUnderflow`]), and [`MassError::NonFiniteResult`] when an integral or a
+/// result overflows (vertex coordinates of extreme magnitude).
 pub fn mesh_mass_properties(
     vertices: &[[f64; 3]],
     triangles: &[[u32; 3]],
@@ -300,6 +302,7 @@ fn check_measure(
     inside_out: InsideOutPolicy,
 ) -> Result<bool, MassError> {
     let mut flipped = false;
+    check_result(sums.v.iter(), "mesh integrals (vertex coordinates too large)")?;
     if model == MeshModel::Solid {
         let volume = sums.v[0];
         let cube = diag * diag * diag;
@@ -339,17 +342,7 @@ fn properties_from_sums(sums: &Sums, r: &[f64; 3], amount: Amount) -> Result<Mas
         p_oc: Vector3::new(r[0] + c.x, r[1] + c.y, r[2] + c.z),
         inertia_c: inertia,
     };
-    if let Some(value) = properties
-        .inertia_c
-        .iter()
-        .chain(properties.p_oc.iter())
-        .copied()
-        .find(|x| !x.is_finite())
-    {
-        return Err(MassError::NonFinite {
-            what: "mesh integral (overflow)",
-            value,
-        });
-    }
+    check_result(properties.p_oc.iter(), "mesh centre of mass")?;
+    check_result(properties.inertia_c.iter(), "mesh inertia tensor")?;
     Ok(properties)
 }

@@ -4,10 +4,15 @@
 //! origin and axes of B lie. Rods, laminae and points have semidefinite (or planar) inertia
 //! (remark after 3.14). Integrals are those of 3.17–3.18 evaluated in closed form, so the
 //! results are exact up to rounding. Non-finite or non-positive dimensions, masses and densities
-//! are refused with a [`MassError`] naming the input.
+//! are refused with a [`MassError`] naming the input. Masses and moments are formed as
+//! products with the exponents kept apart (m·L²·f with a shape factor f of order one), so a
+//! result over- or underflows only when its exact value does: a mass that underflows is
+//! [`MassError::MassUnderflow`], a mass or moment that overflows
+//! [`MassError::NonFiniteResult`] naming it.
 
-use crate::error::{check_dimension, check_finite};
+use crate::error::{check_dimension, check_finite, check_result};
 use crate::{MassError, MassProperties};
+use mechanica_kinematics::scaling;
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::PI;
 
@@ -23,8 +28,16 @@ pub enum Amount {
 
 impl Amount {
     /// The mass of a body of measure (length, area or volume) `measure`, checking that the
-    /// mass or density is finite and positive.
+    /// mass or density is finite and positive, and that density × measure neither underflows
+    /// to zero ([`MassError::MassUnderflow`]) nor overflows ([`MassError::NonFiniteResult`]).
     pub fn mass_for(&self, measure: f64) -> Result<f64, MassError> {
+        self.mass_for_product(&[measure])
+    }
+
+    /// [`Amount::mass_for`] for the measure Π `factors` (a constant and the dimensions), the
+    /// product ρ·Π factors formed with the exponents kept apart, so that it over- or underflows
+    /// only when the mass itself does.
+    pub(crate) fn mass_for_product(&self, factors: &[f64]) -> Result<f64, MassError> {
         match *self {
             Amount::Mass(m) => {
                 check_finite(m, "mass")?;
@@ -36,45 +49,54 @@ impl Amount {
             }
             Amount::Density(rho) => {
                 check_finite(rho, "density")?;
-                if rho > 0.0 {
-                    let m = rho * measure;
-                    if m.is_finite() && m > 0.0 {
-                        Ok(m)
-                    } else {
-                        Err(MassError::NonFinite {
-                            what: "mass from density × measure",
-                            value: m,
-                        })
-                    }
-                } else {
-                    Err(MassError::NonPositiveDensity(rho))
+                if rho <= 0.0 {
+                    return Err(MassError::NonPositiveDensity(rho));
                 }
+                let mut all = vec![rho];
+                all.extend_from_slice(factors);
+                let m = scaling::product(&all);
+                if m == 0.0 {
+                    return Err(MassError::MassUnderflow {
+                        density: rho,
+                        measure: factors.iter().product(),
+                    });
+                }
+                check_result([m].iter(), "mass")?;
+                Ok(m)
             }
         }
     }
 }
 
-fn centred(mass: f64, ixx: f64, iyy: f64, izz: f64) -> MassProperties {
-    MassProperties {
+/// m·L²·f, the product kept apart: a moment of inertia with length scale L and a
+/// dimensionless shape factor f = O(1).
+fn moment(m: f64, length: f64, f: f64) -> f64 {
+    scaling::product(&[m, length, length, f])
+}
+
+/// Principal moments (I_xx, I_yy, I_zz) about the centre of mass, checked finite.
+fn centred(mass: f64, moments: [f64; 3], quantity: &'static str) -> Result<MassProperties, MassError> {
+    check_result(moments.iter(), quantity)?;
+    Ok(MassProperties {
         mass,
         p_oc: Vector3::zeros(),
-        inertia_c: Matrix3::from_diagonal(&Vector3::new(ixx, iyy, izz)),
-    }
+        inertia_c: Matrix3::from_diagonal(&Vector3::from(moments)),
+    })
 }
 
 /// A point mass at the origin of B. `Amount::Density` is taken as the mass itself.
 pub fn point(amount: Amount) -> Result<MassProperties, MassError> {
     let m = amount.mass_for(1.0)?;
-    Ok(centred(m, 0.0, 0.0, 0.0))
+    centred(m, [0.0; 3], "point moment of inertia")
 }
 
 /// A thin straight rod of length `length` along the z axis of B, centred at the origin;
 /// density per metre. I_xx = I_yy = m L²/12, I_zz = 0 (semidefinite).
 pub fn rod(length: f64, amount: Amount) -> Result<MassProperties, MassError> {
     let l = check_dimension(length, "rod length")?;
-    let m = amount.mass_for(l)?;
-    let i = m * l * l / 12.0;
-    Ok(centred(m, i, i, 0.0))
+    let m = amount.mass_for_product(&[l])?;
+    let i = moment(m, l, 1.0 / 12.0);
+    centred(m, [i, i, 0.0], "rod moment of inertia")
 }
 
 /// A rectangular lamina with sides `size_x` × `size_y` in the xy plane of B, centred at the
@@ -82,29 +104,28 @@ pub fn rod(length: f64, amount: Amount) -> Result<MassProperties, MassError> {
 pub fn rectangle_lamina(size_x: f64, size_y: f64, amount: Amount) -> Result<MassProperties, MassError> {
     let a = check_dimension(size_x, "rectangle size_x")?;
     let b = check_dimension(size_y, "rectangle size_y")?;
-    let m = amount.mass_for(a * b)?;
-    Ok(centred(
-        m,
-        m * b * b / 12.0,
-        m * a * a / 12.0,
-        m * (a * a + b * b) / 12.0,
-    ))
+    let m = amount.mass_for_product(&[a, b])?;
+    let l = a.max(b);
+    let (a, b) = (a / l, b / l);
+    let moments = [b * b, a * a, a * a + b * b].map(|f| moment(m, l, f / 12.0));
+    centred(m, moments, "rectangle moment of inertia")
 }
 
 /// A disc lamina of radius `radius` in the xy plane of B, centred at the origin; density per
 /// m². I_xx = I_yy = m r²/4, I_zz = m r²/2.
 pub fn disc_lamina(radius: f64, amount: Amount) -> Result<MassProperties, MassError> {
     let r = check_dimension(radius, "disc radius")?;
-    let m = amount.mass_for(PI * r * r)?;
-    Ok(centred(m, m * r * r / 4.0, m * r * r / 4.0, m * r * r / 2.0))
+    let m = amount.mass_for_product(&[PI, r, r])?;
+    let (i, j) = (moment(m, r, 0.25), moment(m, r, 0.5));
+    centred(m, [i, i, j], "disc moment of inertia")
 }
 
 /// A solid sphere of radius `radius` centred at the origin of B. I = 2/5 m r².
 pub fn sphere(radius: f64, amount: Amount) -> Result<MassProperties, MassError> {
     let r = check_dimension(radius, "sphere radius")?;
-    let m = amount.mass_for(4.0 / 3.0 * PI * r * r * r)?;
-    let i = 0.4 * m * r * r;
-    Ok(centred(m, i, i, i))
+    let m = amount.mass_for_product(&[4.0 / 3.0 * PI, r, r, r])?;
+    let i = moment(m, r, 0.4);
+    centred(m, [i, i, i], "sphere moment of inertia")
 }
 
 /// A solid ellipsoid with semi-axes `a`, `b`, `c` along x, y, z of B, centred at the origin.
@@ -113,13 +134,11 @@ pub fn ellipsoid(a: f64, b: f64, c: f64, amount: Amount) -> Result<MassPropertie
     let a = check_dimension(a, "ellipsoid semi-axis a")?;
     let b = check_dimension(b, "ellipsoid semi-axis b")?;
     let c = check_dimension(c, "ellipsoid semi-axis c")?;
-    let m = amount.mass_for(4.0 / 3.0 * PI * a * b * c)?;
-    Ok(centred(
-        m,
-        m * (b * b + c * c) / 5.0,
-        m * (a * a + c * c) / 5.0,
-        m * (a * a + b * b) / 5.0,
-    ))
+    let m = amount.mass_for_product(&[4.0 / 3.0 * PI, a, b, c])?;
+    let l = a.max(b).max(c);
+    let (a, b, c) = (a / l, b / l, c / l);
+    let moments = [b * b + c * c, a * a + c * c, a * a + b * b].map(|f| moment(m, l, f / 5.0));
+    centred(m, moments, "ellipsoid moment of inertia")
 }
 
 /// A solid box with edge lengths `size_x`, `size_y`, `size_z` centred at the origin of B.
@@ -128,13 +147,11 @@ pub fn solid_box(size_x: f64, size_y: f64, size_z: f64, amount: Amount) -> Resul
     let a = check_dimension(size_x, "box size_x")?;
     let b = check_dimension(size_y, "box size_y")?;
     let c = check_dimension(size_z, "box size_z")?;
-    let m = amount.mass_for(a * b * c)?;
-    Ok(centred(
-        m,
-        m * (b * b + c * c) / 12.0,
-        m * (a * a + c * c) / 12.0,
-        m * (a * a + b * b) / 12.0,
-    ))
+    let m = amount.mass_for_product(&[a, b, c])?;
+    let l = a.max(b).max(c);
+    let (a, b, c) = (a / l, b / l, c / l);
+    let moments = [b * b + c * c, a * a + c * c, a * a + b * b].map(|f| moment(m, l, f / 12.0));
+    centred(m, moments, "box moment of inertia")
 }
 
 /// A solid circular cylinder of radius `radius` and height `height` along z of B, centred at
@@ -142,9 +159,11 @@ pub fn solid_box(size_x: f64, size_y: f64, size_z: f64, amount: Amount) -> Resul
 pub fn cylinder(radius: f64, height: f64, amount: Amount) -> Result<MassProperties, MassError> {
     let r = check_dimension(radius, "cylinder radius")?;
     let h = check_dimension(height, "cylinder height")?;
-    let m = amount.mass_for(PI * r * r * h)?;
-    let ixx = m * (3.0 * r * r + h * h) / 12.0;
-    Ok(centred(m, ixx, ixx, m * r * r / 2.0))
+    let m = amount.mass_for_product(&[PI, r, r, h])?;
+    let l = r.max(h);
+    let (rr, hh) = (r / l, h / l);
+    let ixx = moment(m, l, (3.0 * rr * rr + hh * hh) / 12.0);
+    centred(m, [ixx, ixx, moment(m, l, rr * rr / 2.0)], "cylinder moment of inertia")
 }
 
 /// A solid right circular cone of base radius `radius` and height `height`: the origin of B
@@ -153,11 +172,13 @@ pub fn cylinder(radius: f64, height: f64, amount: Amount) -> Result<MassProperti
 pub fn cone(radius: f64, height: f64, amount: Amount) -> Result<MassProperties, MassError> {
     let r = check_dimension(radius, "cone radius")?;
     let h = check_dimension(height, "cone height")?;
-    let m = amount.mass_for(PI * r * r * h / 3.0)?;
-    let ixx = m * (3.0 * r * r / 20.0 + 3.0 * h * h / 80.0);
+    let m = amount.mass_for_product(&[PI / 3.0, r, r, h])?;
+    let l = r.max(h);
+    let (rr, hh) = (r / l, h / l);
+    let ixx = moment(m, l, 3.0 * rr * rr / 20.0 + 3.0 * hh * hh / 80.0);
     Ok(MassProperties {
         p_oc: Vector3::new(0.0, 0.0, h / 4.0),
-        ..centred(m, ixx, ixx, 0.3 * m * r * r)
+        ..centred(m, [ixx, ixx, moment(m, l, 0.3 * rr * rr)], "cone moment of inertia")?
     })
 }
 
@@ -166,30 +187,34 @@ pub fn cone(radius: f64, height: f64, amount: Amount) -> Result<MassProperties, 
 /// I_zz = 2/5 m r².
 pub fn hemisphere(radius: f64, amount: Amount) -> Result<MassProperties, MassError> {
     let r = check_dimension(radius, "hemisphere radius")?;
-    let m = amount.mass_for(2.0 / 3.0 * PI * r * r * r)?;
-    let ixx = 83.0 / 320.0 * m * r * r;
+    let m = amount.mass_for_product(&[2.0 / 3.0 * PI, r, r, r])?;
+    let ixx = moment(m, r, 83.0 / 320.0);
     Ok(MassProperties {
         p_oc: Vector3::new(0.0, 0.0, 3.0 * r / 8.0),
-        ..centred(m, ixx, ixx, 0.4 * m * r * r)
+        ..centred(m, [ixx, ixx, moment(m, r, 0.4)], "hemisphere moment of inertia")?
     })
 }
 
 /// A solid capsule: a cylinder of radius `radius` and length `cylinder_length` along z with a
 /// hemispherical cap of the same radius on each end, centred at the origin of B. Composed from
-/// the cylinder and the two hemispheres by Steiner (3.27–3.29).
+/// the cylinder and the two hemispheres by Steiner (3.27–3.29), in lengths relative to the
+/// larger of r and l.
 pub fn capsule(radius: f64, cylinder_length: f64, amount: Amount) -> Result<MassProperties, MassError> {
     let r = check_dimension(radius, "capsule radius")?;
     let l = check_dimension(cylinder_length, "capsule cylinder length")?;
-    let v_cyl = PI * r * r * l;
-    let v_caps = 4.0 / 3.0 * PI * r * r * r;
-    let m = amount.mass_for(v_cyl + v_caps)?;
-    let m_cyl = m * v_cyl / (v_cyl + v_caps);
-    let m_cap = 0.5 * (m - m_cyl);
+    let scale = r.max(l);
+    let (rr, ll) = (r / scale, l / scale);
+    // Volume = π r² (l + 4r/3) = π scale³ r̂² (l̂ + 4r̂/3).
+    let m = amount.mass_for_product(&[PI, scale, scale, scale, rr * rr * (ll + 4.0 * rr / 3.0)])?;
+    // Mass fractions of the cylinder and of each cap.
+    let f_cyl = ll / (ll + 4.0 * rr / 3.0);
+    let f_cap = 0.5 * (1.0 - f_cyl);
     // Each cap's centre lies at l/2 + 3r/8 from the capsule centre.
-    let d = l / 2.0 + 3.0 * r / 8.0;
-    let ixx = m_cyl * (3.0 * r * r + l * l) / 12.0 + 2.0 * (83.0 / 320.0 * m_cap * r * r + m_cap * d * d);
-    let izz = m_cyl * r * r / 2.0 + 2.0 * (0.4 * m_cap * r * r);
-    Ok(centred(m, ixx, ixx, izz))
+    let d = ll / 2.0 + 3.0 * rr / 8.0;
+    let fxx = f_cyl * (3.0 * rr * rr + ll * ll) / 12.0 + 2.0 * f_cap * (83.0 / 320.0 * rr * rr + d * d);
+    let fzz = f_cyl * rr * rr / 2.0 + 2.0 * f_cap * 0.4 * rr * rr;
+    let ixx = moment(m, scale, fxx);
+    centred(m, [ixx, ixx, moment(m, scale, fzz)], "capsule moment of inertia")
 }
 
 /// A solid torus with ring (major) radius `ring_radius` and tube (minor) radius
@@ -203,9 +228,14 @@ pub fn torus(ring_radius: f64, tube_radius: f64, amount: Amount) -> Result<MassP
             "torus tube radius exceeds its ring radius (self-intersecting)",
         ));
     }
-    let m = amount.mass_for(2.0 * PI * PI * big * r * r)?;
-    let ixx = m * (big * big / 2.0 + 5.0 * r * r / 8.0);
-    Ok(centred(m, ixx, ixx, m * (big * big + 0.75 * r * r)))
+    let m = amount.mass_for_product(&[2.0 * PI * PI, big, r, r])?;
+    let rr = r / big;
+    let ixx = moment(m, big, 0.5 + 5.0 * rr * rr / 8.0);
+    centred(
+        m,
+        [ixx, ixx, moment(m, big, 1.0 + 0.75 * rr * rr)],
+        "torus moment of inertia",
+    )
 }
 
 #[cfg(test)]
@@ -397,9 +427,9 @@ mod tests {
             torus(1.0, 2.0, RHO),
             Err(MassError::InconsistentDimensions(_))
         ));
-        assert!(matches!(
+        assert_eq!(
             sphere(1e200, Amount::Density(1e200)),
-            Err(MassError::NonFinite { .. })
-        ));
+            Err(MassError::NonFiniteResult { quantity: "mass" })
+        );
     }
 }

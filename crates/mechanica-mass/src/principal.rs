@@ -10,8 +10,9 @@
 
 use crate::MassError;
 use crate::MassProperties;
-use crate::error::check_all_finite;
-use crate::validity::symmetric_part;
+use crate::error::{check_all_finite, check_result};
+use crate::validity::{InertiaIssue, ValidityTolerance, symmetric_part};
+use mechanica_kinematics::scaling::power_of_two_above;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 /// Default relative tolerance (to the largest |moment|) below which two moments count as equal.
@@ -50,16 +51,57 @@ fn canonical_sign(v: Vector3<f64>) -> Vector3<f64> {
     if v[k] < 0.0 { -v } else { v }
 }
 
-/// Principal axes of the symmetric part of `j` with [`DEFAULT_REPEATED_TOLERANCE`].
+/// Principal axes of `j` with [`DEFAULT_REPEATED_TOLERANCE`] (see
+/// [`principal_axes_with_tolerance`]).
 pub fn principal_axes(j: &Matrix3<f64>) -> Result<PrincipalAxes, MassError> {
     principal_axes_with_tolerance(j, DEFAULT_REPEATED_TOLERANCE)
 }
 
-/// Principal axes of the symmetric part of `j`; moments closer than `relative_tolerance` ×
-/// the largest |moment| are treated as equal (see the module documentation).
+/// Principal axes of the tensor `j`; moments closer than `relative_tolerance` × the largest
+/// |moment| are treated as equal (see the module documentation).
+///
+/// `j` must be symmetric within the validity tolerance, |J_ij − J_ji| ≤ 1e-9·Σ|J_kk|
+/// ([`ValidityTolerance::default`]); its symmetric part is decomposed. The decomposition runs
+/// on J/2^k, 2^k the power of two above its largest entry, and the moments are scaled back, so
+/// every finite tensor works whose moments are representable.
+///
+/// Errors: [`MassError::NonFinite`] for a NaN or infinite entry; [`MassError::InvalidInertia`]
+/// with [`InertiaIssue::NotSymmetric`] for a tensor outside the symmetry tolerance;
+/// [`MassError::NonFiniteResult`] when a moment exceeds f64::MAX.
 pub fn principal_axes_with_tolerance(j: &Matrix3<f64>, relative_tolerance: f64) -> Result<PrincipalAxes, MassError> {
     check_all_finite(j.iter(), "inertia tensor")?;
-    let j = symmetric_part(j);
+    let scale = power_of_two_above(j.amax());
+    let scaled = j / scale;
+    check_symmetry(&scaled, scale)?;
+    let mut axes = scaled_principal_axes(&symmetric_part(&scaled), relative_tolerance);
+    axes.moments *= scale;
+    check_result(axes.moments.iter(), "principal moments")?;
+    Ok(axes)
+}
+
+/// Fails with [`InertiaIssue::NotSymmetric`] (the largest difference, in the units of the
+/// unscaled tensor) when the scaled tensor `j` is not symmetric within the validity tolerance.
+fn check_symmetry(j: &Matrix3<f64>, scale: f64) -> Result<(), MassError> {
+    let tolerance = ValidityTolerance::default().relative * (0..3).map(|i| j[(i, i)].abs()).sum::<f64>();
+    let mut worst: Option<(usize, usize, f64)> = None;
+    for (row, col) in [(0, 1), (0, 2), (1, 2)] {
+        let difference = j[(row, col)] - j[(col, row)];
+        if difference.abs() > tolerance && worst.is_none_or(|w| difference.abs() > w.2.abs()) {
+            worst = Some((row, col, difference));
+        }
+    }
+    match worst {
+        Some((row, col, difference)) => Err(MassError::InvalidInertia(vec![InertiaIssue::NotSymmetric {
+            row,
+            col,
+            difference: difference * scale,
+        }])),
+        None => Ok(()),
+    }
+}
+
+/// The principal axes of a symmetric tensor with entries of order one.
+fn scaled_principal_axes(j: &Matrix3<f64>, relative_tolerance: f64) -> PrincipalAxes {
     let eig = j.symmetric_eigen();
     let mut order = [0usize, 1, 2];
     order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
@@ -69,35 +111,11 @@ pub fn principal_axes_with_tolerance(j: &Matrix3<f64>, relative_tolerance: f64) 
         eig.eigenvalues[order[2]],
     );
     let tol = relative_tolerance.max(0.0) * l[0].abs().max(l[2].abs());
-    let low_pair = l[1] - l[0] <= tol;
-    let high_pair = l[2] - l[1] <= tol;
+    let (low_pair, high_pair) = (l[1] - l[0] <= tol, l[2] - l[1] <= tol);
     let (multiplicity, columns) = if low_pair && high_pair {
         (Multiplicity::Triple, [Vector3::x(), Vector3::y(), Vector3::z()])
     } else if low_pair || high_pair {
-        let (pair_value, multiplicity) = if low_pair {
-            (0.5 * (l[0] + l[1]), Multiplicity::SmallestPair)
-        } else {
-            (0.5 * (l[1] + l[2]), Multiplicity::LargestPair)
-        };
-        let m = j - Matrix3::identity() * pair_value;
-        let (mut best, mut best_norm) = (0, -1.0);
-        for c in 0..3 {
-            let n = m.column(c).norm_squared();
-            if n > best_norm {
-                best = c;
-                best_norm = n;
-            }
-        }
-        let u = canonical_sign(m.column(best).normalize());
-        let k = u.iamin();
-        let e_k = Vector3::ith(k, 1.0);
-        let v = (e_k - u * u[k]).normalize();
-        let w = u.cross(&v);
-        if low_pair {
-            (multiplicity, [v, w, u])
-        } else {
-            (multiplicity, [u, v, w])
-        }
+        symmetric_top_frame(j, &l, low_pair)
     } else {
         let a = canonical_sign(eig.eigenvectors.column(order[0]).into_owned());
         let b = canonical_sign(eig.eigenvectors.column(order[1]).into_owned());
@@ -107,6 +125,53 @@ pub fn principal_axes_with_tolerance(j: &Matrix3<f64>, relative_tolerance: f64) 
     };
     let r = Matrix3::from_columns(&columns);
     let d = r.transpose() * j * r;
+    let moments = rayleigh_moments(&d, multiplicity);
+    let norm = j.norm();
+    let relative_residual = if norm > 0.0 {
+        (d - Matrix3::from_diagonal(&moments)).norm() / norm
+    } else {
+        0.0
+    };
+    PrincipalAxes {
+        moments,
+        r_fp: Rotation3::from_matrix_unchecked(r),
+        multiplicity,
+        relative_residual,
+    }
+}
+
+/// The frame of a symmetric top with sorted eigenvalues `l`: the symmetry axis u from the
+/// rank-one J − I_pair·I, the others from the coordinate axis least aligned with u.
+fn symmetric_top_frame(j: &Matrix3<f64>, l: &Vector3<f64>, low_pair: bool) -> (Multiplicity, [Vector3<f64>; 3]) {
+    let (pair_value, multiplicity) = if low_pair {
+        (0.5 * (l[0] + l[1]), Multiplicity::SmallestPair)
+    } else {
+        (0.5 * (l[1] + l[2]), Multiplicity::LargestPair)
+    };
+    let m = j - Matrix3::identity() * pair_value;
+    let (mut best, mut best_norm) = (0, -1.0);
+    for c in 0..3 {
+        let n = m.column(c).norm_squared();
+        if n > best_norm {
+            best = c;
+            best_norm = n;
+        }
+    }
+    let u = canonical_sign(m.column(best).normalize());
+    let k = u.iamin();
+    let e_k = Vector3::ith(k, 1.0);
+    let v = (e_k - u * u[k]).normalize();
+    let w = u.cross(&v);
+    if low_pair {
+        (multiplicity, [v, w, u])
+    } else {
+        (multiplicity, [u, v, w])
+    }
+}
+
+/// The moments as the Rayleigh quotients on the diagonal of `d` = Rᵀ J R, made equal within
+/// a repeated pair or triple.
+fn rayleigh_moments(d: &Matrix3<f64>, multiplicity: Multiplicity) -> Vector3<f64> {
     let mut moments = Vector3::new(d[(0, 0)], d[(1, 1)], d[(2, 2)]);
     match multiplicity {
         Multiplicity::Triple => {
@@ -127,18 +192,7 @@ pub fn principal_axes_with_tolerance(j: &Matrix3<f64>, relative_tolerance: f64) 
         }
         Multiplicity::Distinct => {}
     }
-    let norm = j.norm();
-    let relative_residual = if norm > 0.0 {
-        (d - Matrix3::from_diagonal(&moments)).norm() / norm
-    } else {
-        0.0
-    };
-    Ok(PrincipalAxes {
-        moments,
-        r_fp: Rotation3::from_matrix_unchecked(r),
-        multiplicity,
-        relative_residual,
-    })
+    moments
 }
 
 impl MassProperties {

@@ -1,8 +1,14 @@
 //! The mass-properties value: mass, centre of mass and central inertia tensor; composition,
 //! holes, rigid transformation and Steiner's theorem (3.27–3.29).
+//!
+//! The functions that return a `Result` check their results: a mass, centre or tensor that
+//! overflows f64 is [`MassError::NonFiniteResult`]. The infallible ones
+//! ([`steiner_term`], [`MassProperties::inertia_about`],
+//! [`MassProperties::central_inertia_from`], [`MassProperties::transformed`]) are plain
+//! formulas whose result is ±∞ only when its exact value exceeds f64::MAX.
 
 use crate::MassError;
-use crate::error::{check_all_finite, check_finite};
+use crate::error::{check_all_finite, check_finite, check_result};
 use crate::validity::{self, ValidityTolerance};
 use nalgebra::{Isometry3, Matrix3, Vector3};
 
@@ -99,7 +105,10 @@ impl MassProperties {
         check_all_finite(p_oa.iter(), "reference point")?;
         check_all_finite(inertia_a.iter(), "inertia tensor")?;
         check_all_finite(p_oc.iter(), "centre of mass")?;
-        Self::new(mass, p_oc, Self::central_inertia_from(mass, &p_oc, &inertia_a, &p_oa))
+        check_finite(mass, "mass")?;
+        let central = Self::central_inertia_from(mass, &p_oc, &inertia_a, &p_oa);
+        check_result(central.iter(), "central inertia tensor")?;
+        Self::new(mass, p_oc, central)
     }
 
     /// The moment of inertia (e, J_A e) about the line through `p_oa` with direction
@@ -115,7 +124,9 @@ impl MassProperties {
         // Moment about the parallel line through the centre, plus m·(distance between lines)².
         let d = self.p_oc - p_oa;
         let d_perp = d - e * e.dot(&d);
-        Ok(e.dot(&(self.inertia_c * e)) + self.mass * d_perp.norm_squared())
+        let moment = e.dot(&(self.inertia_c * e)) + self.mass * d_perp.norm_squared();
+        check_result([moment].iter(), "moment of inertia about the line")?;
+        Ok(moment)
     }
 
     /// The same body after the rigid motion `pose` (x ↦ R x + t): p_OC ↦ R p_OC + t and
@@ -149,7 +160,8 @@ impl MassProperties {
             mass += p.mass;
             first_moment += p.mass * (p.p_oc - origin);
         }
-        if !mass.is_finite() || mass <= 0.0 {
+        check_result([mass].iter(), "total mass")?;
+        if mass <= 0.0 {
             return Err(MassError::NonPositiveTotalMass(mass));
         }
         let c_rel = first_moment / mass;
@@ -157,17 +169,29 @@ impl MassProperties {
         for p in &parts {
             inertia += p.inertia_c + steiner_term(p.mass, &(p.p_oc - origin - c_rel));
         }
-        Ok(Self {
+        let sum = Self {
             mass,
             p_oc: origin + c_rel,
             inertia_c: inertia,
-        })
+        };
+        sum.check_results()?;
+        Ok(sum)
+    }
+
+    /// Fails with [`MassError::NonFiniteResult`] naming the first part that is not finite.
+    fn check_results(&self) -> Result<(), MassError> {
+        check_result([self.mass].iter(), "total mass")?;
+        check_result(self.p_oc.iter(), "centre of mass")?;
+        check_result(self.inertia_c.iter(), "inertia tensor")
     }
 
     /// The union of bodies placed at poses: each `(X_FB, properties in B)` is moved into the
     /// common frame F by [`MassProperties::transformed`], then summed by [`MassProperties::sum`].
     pub fn compose(parts: &[(Isometry3<f64>, MassProperties)]) -> Result<Self, MassError> {
         let placed: Vec<MassProperties> = parts.iter().map(|(x, p)| p.transformed(x)).collect();
+        for part in &placed {
+            part.check_results()?;
+        }
         Self::sum(&placed)
     }
 
@@ -177,7 +201,8 @@ impl MassProperties {
     /// not fit inside).
     pub fn subtract(&self, hole: &MassProperties) -> Result<Self, MassError> {
         let mass = self.mass - hole.mass;
-        if !mass.is_finite() || mass <= 0.0 {
+        check_result([mass].iter(), "total mass")?;
+        if mass <= 0.0 {
             return Err(MassError::NonPositiveTotalMass(mass));
         }
         let origin = self.p_oc;
@@ -190,6 +215,7 @@ impl MassProperties {
             p_oc: origin + c_rel,
             inertia_c: inertia,
         };
+        props.check_results()?;
         validity::check(&props, &ValidityTolerance::default())?;
         Ok(props)
     }

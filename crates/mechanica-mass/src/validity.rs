@@ -1,7 +1,9 @@
 //! Physical validity of mass properties: what exactly is wrong with a tensor, the kind of body
 //! a valid tensor describes (solid, lamina, rod, point; remark after 3.14), and a repair.
 
+use crate::error::check_result;
 use crate::{MassError, MassProperties};
+use mechanica_kinematics::scaling::{self, power_of_two_above};
 use nalgebra::{Matrix3, Vector3};
 use std::fmt;
 
@@ -108,8 +110,79 @@ pub struct ValidityReport {
 
 /// Checks that `props` could be the mass properties of a real body and reports every problem
 /// found (not only the first) in [`MassError::InvalidInertia`]. Semidefinite tensors of rods,
-/// laminae and points are valid and reported through [`InertiaClass`].
+/// laminae and points are valid and reported through [`InertiaClass`]. The tests run on the
+/// tensor scaled by the power of two above its largest entry (they are all relative), so that
+/// any finite tensor is judged correctly; moments that exceed f64::MAX once scaled back are
+/// [`MassError::NonFiniteResult`].
 pub fn check(props: &MassProperties, tol: &ValidityTolerance) -> Result<ValidityReport, MassError> {
+    let mut issues = non_finite_issues(props);
+    if issues.iter().any(|i| {
+        matches!(
+            i,
+            InertiaIssue::NonFinite {
+                what: "inertia tensor",
+                ..
+            }
+        )
+    }) {
+        return Err(MassError::InvalidInertia(issues));
+    }
+    if props.mass < 0.0 {
+        issues.push(InertiaIssue::NegativeMass(props.mass));
+    }
+    let scale = power_of_two_above(props.inertia_c.amax());
+    let j = props.inertia_c / scale;
+    let trace_scale = (0..3).map(|i| j[(i, i)].abs()).sum::<f64>();
+    let abs_tol = tol.relative * trace_scale;
+    if props.mass == 0.0 && trace_scale > 0.0 {
+        issues.push(InertiaIssue::ZeroMassWithInertia);
+    }
+    if let Some((row, col, difference)) = worst_asymmetry(&j, abs_tol) {
+        issues.push(InertiaIssue::NotSymmetric {
+            row,
+            col,
+            difference: difference * scale,
+        });
+    }
+    let moments = sorted_eigenvalues(&symmetric_part(&j));
+    if moments[0] < -abs_tol {
+        issues.push(InertiaIssue::NotPositiveSemidefinite {
+            min_eigenvalue: moments[0] * scale,
+        });
+    }
+    let excess = moments[2] - moments[0] - moments[1];
+    if excess > abs_tol {
+        issues.push(InertiaIssue::TriangleInequality {
+            moments: [moments[0] * scale, moments[1] * scale, moments[2] * scale],
+            excess: excess * scale,
+        });
+    }
+    if !issues.is_empty() {
+        return Err(MassError::InvalidInertia(issues));
+    }
+    let class = if moments[2] <= abs_tol {
+        InertiaClass::Point
+    } else if moments[0] <= abs_tol {
+        InertiaClass::Linear
+    } else if -excess <= abs_tol {
+        InertiaClass::Planar
+    } else {
+        InertiaClass::Solid
+    };
+    let report = ValidityReport {
+        class,
+        moments: moments * scale,
+        absolute_tolerance: abs_tol * scale,
+    };
+    check_result(
+        report.moments.iter().chain([report.absolute_tolerance].iter()),
+        "principal moments",
+    )?;
+    Ok(report)
+}
+
+/// The NaN and infinities of `props`, one issue per part (mass, centre, tensor).
+fn non_finite_issues(props: &MassProperties) -> Vec<InertiaIssue> {
     let mut issues = Vec::new();
     if !props.mass.is_finite() {
         issues.push(InertiaIssue::NonFinite {
@@ -128,17 +201,12 @@ pub fn check(props: &MassProperties, tol: &ValidityTolerance) -> Result<Validity
             what: "inertia tensor",
             value,
         });
-        return Err(MassError::InvalidInertia(issues));
     }
-    if props.mass < 0.0 {
-        issues.push(InertiaIssue::NegativeMass(props.mass));
-    }
-    let j = &props.inertia_c;
-    let scale = (0..3).map(|i| j[(i, i)].abs()).sum::<f64>();
-    let abs_tol = tol.relative * scale;
-    if props.mass == 0.0 && scale > 0.0 {
-        issues.push(InertiaIssue::ZeroMassWithInertia);
-    }
+    issues
+}
+
+/// The largest asymmetry J_rc − J_cr above `abs_tol`, as (row, col, difference).
+fn worst_asymmetry(j: &Matrix3<f64>, abs_tol: f64) -> Option<(usize, usize, f64)> {
     let mut worst: Option<(usize, usize, f64)> = None;
     for (row, col) in [(0, 1), (0, 2), (1, 2)] {
         let difference = j[(row, col)] - j[(col, row)];
@@ -146,39 +214,7 @@ pub fn check(props: &MassProperties, tol: &ValidityTolerance) -> Result<Validity
             worst = Some((row, col, difference));
         }
     }
-    if let Some((row, col, difference)) = worst {
-        issues.push(InertiaIssue::NotSymmetric { row, col, difference });
-    }
-    let moments = sorted_eigenvalues(&symmetric_part(j));
-    if moments[0] < -abs_tol {
-        issues.push(InertiaIssue::NotPositiveSemidefinite {
-            min_eigenvalue: moments[0],
-        });
-    }
-    let excess = moments[2] - moments[0] - moments[1];
-    if excess > abs_tol {
-        issues.push(InertiaIssue::TriangleInequality {
-            moments: [moments[0], moments[1], moments[2]],
-            excess,
-        });
-    }
-    if !issues.is_empty() {
-        return Err(MassError::InvalidInertia(issues));
-    }
-    let class = if moments[2] <= abs_tol {
-        InertiaClass::Point
-    } else if moments[0] <= abs_tol {
-        InertiaClass::Linear
-    } else if -excess <= abs_tol {
-        InertiaClass::Planar
-    } else {
-        InertiaClass::Solid
-    };
-    Ok(ValidityReport {
-        class,
-        moments,
-        absolute_tolerance: abs_tol,
-    })
+    worst
 }
 
 /// What [`repair`] changed.
@@ -224,8 +260,29 @@ pub fn repair(props: &MassProperties, tol: &ValidityTolerance) -> Result<(MassPr
         }
         Err(other) => return Err(other),
     }
-    let sym = symmetric_part(&props.inertia_c);
-    let eig = sym.symmetric_eigen();
+    let scale = power_of_two_above(props.inertia_c.amax());
+    let j = if props.mass == 0.0 {
+        Matrix3::zeros()
+    } else {
+        physical_part(&(props.inertia_c / scale)) * scale
+    };
+    let change_norm = scaling::frobenius_norm(&(j - props.inertia_c));
+    let given = scaling::frobenius_norm(&props.inertia_c);
+    let report = RepairReport {
+        changed: true,
+        change_norm,
+        relative_change: if given > 0.0 { change_norm / given } else { 0.0 },
+    };
+    check_result(
+        j.iter().chain([change_norm, report.relative_change].iter()),
+        "repaired inertia tensor",
+    )?;
+    Ok((MassProperties { inertia_c: j, ..*props }, report))
+}
+
+/// Steps 1–3 of [`repair`] on a tensor with entries of order one.
+fn physical_part(j: &Matrix3<f64>) -> Matrix3<f64> {
+    let eig = symmetric_part(j).symmetric_eigen();
     let l = eig.eigenvalues;
     let sigma = |k: usize| {
         let (i, j) = ((k + 1) % 3, (k + 2) % 3);
@@ -234,26 +291,12 @@ pub fn repair(props: &MassProperties, tol: &ValidityTolerance) -> Result<(MassPr
     let s = [sigma(0), sigma(1), sigma(2)];
     let repaired_moments = Vector3::new(s[1] + s[2], s[0] + s[2], s[0] + s[1]);
     let v = eig.eigenvectors;
-    let mut j = v * Matrix3::from_diagonal(&repaired_moments) * v.transpose();
-    j = symmetric_part(&j);
-    if props.mass == 0.0 {
-        j = Matrix3::zeros();
-    }
-    let change_norm = (j - props.inertia_c).norm();
-    let given = props.inertia_c.norm();
-    Ok((
-        MassProperties { inertia_c: j, ..*props },
-        RepairReport {
-            changed: true,
-            change_norm,
-            relative_change: if given > 0.0 { change_norm / given } else { 0.0 },
-        },
-    ))
+    symmetric_part(&(v * Matrix3::from_diagonal(&repaired_moments) * v.transpose()))
 }
 
-/// (J + Jᵀ)/2.
+/// (J + Jᵀ)/2, halved before the sum so that it never overflows.
 pub(crate) fn symmetric_part(j: &Matrix3<f64>) -> Matrix3<f64> {
-    (j + j.transpose()) * 0.5
+    j * 0.5 + j.transpose() * 0.5
 }
 
 /// Eigenvalues of a symmetric 3×3 matrix, ascending.

@@ -2,6 +2,8 @@
 //! kinetic energy and momenta computed directly (independently of the crate's ΔT).
 #![allow(dead_code)]
 
+pub mod dd;
+
 use mechanica_impulse::{BodyResponse, RigidBody};
 use mechanica_mass::MassProperties;
 use nalgebra::{Matrix3, Vector3};

@@ -44,6 +44,14 @@
 //! frame's pose, velocity and acceleration at the current time (e.g. from a [`BaseMotion`] such
 //! as [`SteadyRotation`] for the rotating-frame equilibrium of §8e). x = x(q, t) is then
 //! rheonomic and ∂x/∂t at fixed q is the drag velocity of the base ([`Workspace::drag_velocity`]).
+//!
+//! # Errors
+//! Inputs are checked (lengths, finiteness, rotation vectors of spherical and free joints no
+//! longer than [`crate::rotation::ROTATION_VECTOR_LIMIT`]), and so are results: a pose,
+//! velocity, acceleration, Jacobian entry or point quantity that overflows f64 is
+//! [`KinematicsError::NonFiniteResult`]. An update that fails invalidates the stage it was
+//! computing and the later ones (positions before velocities before accelerations), so nothing
+//! computed from overflowed values can be read.
 
 mod joint;
 mod workspace;
@@ -381,10 +389,14 @@ impl KinematicTree {
 
     /// Re-centres the exponential coordinates of every spherical and free joint (see
     /// [`Joint`]): R_ref ← R_ref exp(φ), φ ← 0, and φ̇ ← J_r(φ) φ̇ so that the body velocities
-    /// are unchanged. Poses are unchanged; workspaces must be updated again.
+    /// are unchanged. Poses are unchanged; workspaces must be updated again. Everything is
+    /// computed and checked before anything changes: on an error (a rotation vector beyond
+    /// [`crate::rotation::ROTATION_VECTOR_LIMIT`], a rate that overflows) the tree, `q` and
+    /// `q_dot` are left as they were.
     pub fn rebase(&mut self, q: &mut [f64], q_dot: &mut [f64]) -> Result<(), KinematicsError> {
         self.check_vector(q, "q")?;
         self.check_vector(q_dot, "q_dot")?;
+        let mut updates = Vec::new();
         for body in 0..self.body_count() {
             let joint = self.joint[body];
             if !joint.has_rotation_vector() {
@@ -392,11 +404,15 @@ impl KinematicTree {
             }
             let s = self.dof_start[body] + joint.rotation_offset();
             let phi = Vector3::new(q[s], q[s + 1], q[s + 2]);
+            crate::rotation::check_rotation_vector(&phi, "joint rotation vector")?;
             let phi_dot = Vector3::new(q_dot[s], q_dot[s + 1], q_dot[s + 2]);
             let w = right_jacobian(&phi) * phi_dot;
-            self.r_ref[body] *= exp_unchecked(&phi).matrix();
-            let fixed = crate::rotation::orthonormalize_matrix(&self.r_ref[body])?;
-            self.r_ref[body] = *fixed.rotation.matrix();
+            crate::rotation::check_result(w.iter(), "re-centred joint rate")?;
+            let fixed = crate::rotation::orthonormalize_matrix(&(self.r_ref[body] * exp_unchecked(&phi).matrix()))?;
+            updates.push((body, s, *fixed.rotation.matrix(), w));
+        }
+        for (body, s, r_ref, w) in updates {
+            self.r_ref[body] = r_ref;
             q[s..s + 3].fill(0.0);
             q_dot[s..s + 3].copy_from_slice(w.as_slice());
         }
@@ -452,10 +468,13 @@ pub struct SteadyRotation {
 }
 
 impl BaseMotion for SteadyRotation {
+    /// R_W0 = the rotation by Ω t about the axis (the angle reduced exactly, as
+    /// [`crate::rotation::rotation_from_axis_angle`] does); a product Ω t that overflows gives
+    /// a non-finite rotation, which [`Workspace::set_base`] refuses.
     fn state_at(&self, t: f64) -> BaseState {
         let omega = self.axis.into_inner() * self.rate;
         BaseState {
-            rotation: exp_unchecked(&(omega * t)),
+            rotation: Rotation3::from_matrix_unchecked(crate::rotation::axis_angle_matrix(&self.axis, self.rate * t)),
             omega,
             ..BaseState::default()
         }

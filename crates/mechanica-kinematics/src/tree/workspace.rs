@@ -2,7 +2,9 @@
 
 use super::{BaseState, Joint, KinematicTree};
 use crate::KinematicsError;
-use crate::rotation::{check_finite_vec, exp_unchecked, right_jacobian, right_jacobian_rate};
+use crate::rotation::{
+    check_finite_vec, check_result, check_rotation_vector, exp_unchecked, right_jacobian, right_jacobian_rate,
+};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 /// Which recursions are up to date.
@@ -118,7 +120,7 @@ impl Workspace {
     /// World position x = R_WB p_BQ + p_WB of the body point with body coordinates `p_bq` (1.5).
     pub fn point_position(&self, body: usize, p_bq: &Vector3<f64>) -> Result<Vector3<f64>, KinematicsError> {
         self.check(Stage::Positions, body)?;
-        Ok(self.rotation[body] * p_bq + self.position[body])
+        finite_result(self.rotation[body] * p_bq + self.position[body], "point position")
     }
 
     /// Angular velocity ω of `body` (world).
@@ -136,7 +138,10 @@ impl Workspace {
     /// Velocity of a body point (body coordinates `p_bq`), by (2.13).
     pub fn point_velocity(&self, body: usize, p_bq: &Vector3<f64>) -> Result<Vector3<f64>, KinematicsError> {
         self.check(Stage::Velocities, body)?;
-        Ok(self.velocity[body] + self.omega[body].cross(&(self.rotation[body] * p_bq)))
+        finite_result(
+            self.velocity[body] + self.omega[body].cross(&(self.rotation[body] * p_bq)),
+            "point velocity",
+        )
     }
 
     /// Angular acceleration ω̇ of `body` (world).
@@ -156,7 +161,10 @@ impl Workspace {
         self.check(Stage::Accelerations, body)?;
         let r = self.rotation[body] * p_bq;
         let w = self.omega[body];
-        Ok(self.acceleration[body] + self.omega_dot[body].cross(&r) + w.cross(&w.cross(&r)))
+        finite_result(
+            self.acceleration[body] + self.omega_dot[body].cross(&r) + w.cross(&w.cross(&r)),
+            "point acceleration",
+        )
     }
 
     /// ∂x/∂t at fixed q for a body point: the drag velocity of the prescribed base motion,
@@ -164,7 +172,10 @@ impl Workspace {
     pub fn drag_velocity(&self, body: usize, p_bq: &Vector3<f64>) -> Result<Vector3<f64>, KinematicsError> {
         self.check(Stage::Positions, body)?;
         let x = self.rotation[body] * p_bq + self.position[body];
-        Ok(self.base.velocity + self.base.omega.cross(&(x - self.base.position)))
+        finite_result(
+            self.base.velocity + self.base.omega.cross(&(x - self.base.position)),
+            "drag velocity",
+        )
     }
 
     /// The motion column (w_k, v_k) of coordinate k: angular velocity of its body i and velocity
@@ -190,10 +201,11 @@ impl Workspace {
     ) -> Result<(Vector3<f64>, Vector3<f64>), KinematicsError> {
         self.check_dof(Stage::Positions, k)?;
         let i = tree.dof_body[k];
-        Ok((
-            self.col_w[k],
+        let shifted = finite_result(
             self.col_w[k].cross(&(x - self.position[i])) + self.col_v[k],
-        ))
+            "shifted column",
+        )?;
+        Ok((self.col_w[k], shifted))
     }
 
     fn check_dof(&self, stage: Stage, k: usize) -> Result<(), KinematicsError> {
@@ -208,6 +220,12 @@ impl Workspace {
         Ok(())
     }
 
+    /// Fails with [`KinematicsError::NonFiniteResult`] naming `quantity` unless every vector
+    /// of `stage_values` is finite.
+    fn check_stage(values: &[Vector3<f64>], quantity: &'static str) -> Result<(), KinematicsError> {
+        check_result(values.iter().flat_map(|v| v.iter()), quantity)
+    }
+
     /// The coordinates of the last [`KinematicTree::update_positions`].
     pub fn q(&self) -> &[f64] {
         &self.q
@@ -217,6 +235,12 @@ impl Workspace {
     pub fn q_dot(&self) -> &[f64] {
         &self.q_dot
     }
+}
+
+/// `v` when it is finite, [`KinematicsError::NonFiniteResult`] naming `quantity` otherwise.
+fn finite_result(v: Vector3<f64>, quantity: &'static str) -> Result<Vector3<f64>, KinematicsError> {
+    check_result(v.iter(), quantity)?;
+    Ok(v)
 }
 
 impl KinematicTree {
@@ -233,6 +257,8 @@ impl KinematicTree {
     pub fn update_positions(&self, ws: &mut Workspace, q: &[f64]) -> Result<(), KinematicsError> {
         self.check_workspace(ws)?;
         self.check_vector(q, "q")?;
+        self.check_rotation_vectors(q)?;
+        ws.stage = Stage::None;
         ws.q.copy_from_slice(q);
         let base_r = *ws.base.rotation.matrix();
         let base_p = ws.base.position;
@@ -301,7 +327,21 @@ impl KinematicTree {
             ws.rotation[b] = r_wb;
             ws.position[b] = p_wb;
         }
+        Workspace::check_stage(&ws.position, "body position")?;
+        Workspace::check_stage(&ws.col_v, "motion column")?;
         ws.stage = Stage::Positions;
+        Ok(())
+    }
+
+    /// Fails with [`KinematicsError::RotationAngleUnresolved`] when a spherical or free joint's
+    /// rotation vector in `q` is longer than [`crate::rotation::ROTATION_VECTOR_LIMIT`].
+    fn check_rotation_vectors(&self, q: &[f64]) -> Result<(), KinematicsError> {
+        for body in 0..self.body_count() {
+            if self.joint[body].has_rotation_vector() {
+                let s = self.dof_start[body] + self.joint[body].rotation_offset();
+                check_rotation_vector(&Vector3::new(q[s], q[s + 1], q[s + 2]), "joint rotation vector")?;
+            }
+        }
         Ok(())
     }
 
@@ -312,6 +352,7 @@ impl KinematicTree {
         self.check_workspace(ws)?;
         ws.check(Stage::Positions, 0)?;
         self.check_vector(q_dot, "q_dot")?;
+        ws.stage = Stage::Positions;
         ws.q_dot.copy_from_slice(q_dot);
         for &b in &self.order {
             let (w_p, v_p, o_p) = match self.parent[b] {
@@ -363,6 +404,10 @@ impl KinematicTree {
                 Joint::Fixed => {}
             }
         }
+        Workspace::check_stage(&ws.omega, "body angular velocity")?;
+        Workspace::check_stage(&ws.velocity, "body velocity")?;
+        Workspace::check_stage(&ws.col_w_dot, "motion column rate")?;
+        Workspace::check_stage(&ws.col_v_dot, "motion column rate")?;
         ws.stage = Stage::Velocities;
         Ok(())
     }
@@ -374,6 +419,7 @@ impl KinematicTree {
         self.check_workspace(ws)?;
         ws.check(Stage::Velocities, 0)?;
         self.check_vector(q_ddot, "q_ddot")?;
+        ws.stage = Stage::Velocities;
         for &b in &self.order {
             let (wd_p, a_p, w_p, v_p, o_p) = match self.parent[b] {
                 Some(p) => (
@@ -400,6 +446,8 @@ impl KinematicTree {
             ws.omega_dot[b] = wd;
             ws.acceleration[b] = a;
         }
+        Workspace::check_stage(&ws.omega_dot, "body angular acceleration")?;
+        Workspace::check_stage(&ws.acceleration, "body acceleration")?;
         ws.stage = Stage::Accelerations;
         Ok(())
     }
@@ -433,7 +481,7 @@ impl KinematicTree {
         self.fill_path_columns::<3>(body, out, |i, k| {
             (ws.col_w[k].cross(&(x - ws.position[i])) + ws.col_v[k]).into()
         });
-        Ok(())
+        check_result(out.iter(), "point Jacobian")
     }
 
     /// Zeroes `out` (W×dof, column-major) and writes column k = `column(i, k)` for every
@@ -460,7 +508,7 @@ impl KinematicTree {
         ws.check(Stage::Positions, body)?;
         self.check_jacobian_out(out, 3)?;
         self.fill_path_columns::<3>(body, out, |_, k| ws.col_w[k].into());
-        Ok(())
+        check_result(out.iter(), "angular Jacobian")
     }
 
     /// The 6×dof body Jacobian of `body` (column-major; rows 0–2 angular velocity, rows 3–5
@@ -482,7 +530,7 @@ impl KinematicTree {
             let v = w.cross(&(x - ws.position[i])) + ws.col_v[k];
             [w.x, w.y, w.z, v.x, v.y, v.z]
         });
-        Ok(())
+        check_result(out.iter(), "body Jacobian")
     }
 
     /// The time derivative J̇ of [`KinematicTree::point_jacobian`] along the current (q, q̇)
@@ -506,7 +554,7 @@ impl KinematicTree {
             let (r, r_dot) = (x - ws.position[i], x_dot - ws.velocity[i]);
             (ws.col_w_dot[k].cross(&r) + ws.col_w[k].cross(&r_dot) + ws.col_v_dot[k]).into()
         });
-        Ok(())
+        check_result(out.iter(), "point Jacobian rate")
     }
 
     /// The time derivative J̇_ω of [`KinematicTree::angular_jacobian`] (3×dof, column-major;
@@ -516,7 +564,7 @@ impl KinematicTree {
         ws.check(Stage::Velocities, body)?;
         self.check_jacobian_out(out, 3)?;
         self.fill_path_columns::<3>(body, out, |_, k| ws.col_w_dot[k].into());
-        Ok(())
+        check_result(out.iter(), "angular Jacobian rate")
     }
 
     /// The velocity-product acceleration J̇ q̇ of a body point (plus the base's drag
@@ -554,6 +602,6 @@ impl KinematicTree {
         }
         let r = ws.rotation[body] * p_bq;
         let w = ws.omega[body];
-        Ok(a + wd.cross(&r) + w.cross(&w.cross(&r)))
+        finite_result(a + wd.cross(&r) + w.cross(&w.cross(&r)), "bias acceleration")
     }
 }

@@ -33,6 +33,10 @@ pub const MECH_STATUS_BUFFER_TOO_SMALL: mech_status_t = 10;
 pub const MECH_STATUS_IO_ERROR: mech_status_t = 11;
 /// A file or text could not be parsed.
 pub const MECH_STATUS_PARSE_ERROR: mech_status_t = 12;
+/// The inputs were valid but a result is not representable in double precision: it exceeds
+/// the largest double (e.g. the inertia of a sphere of radius 1e308), or a mass computed from
+/// a density underflows to zero. No output was written; mech_last_error names the quantity.
+pub const MECH_STATUS_OUT_OF_RANGE: mech_status_t = 13;
 /// A panic inside the library was caught at the boundary. This is a library bug; please
 /// report it with the inputs. No output was written.
 pub const MECH_STATUS_PANIC: mech_status_t = 100;
@@ -55,6 +59,7 @@ pub extern "C" fn mech_status_str(status: mech_status_t) -> *const c_char {
         MECH_STATUS_BUFFER_TOO_SMALL => c"a caller buffer is too small",
         MECH_STATUS_IO_ERROR => c"a file could not be read",
         MECH_STATUS_PARSE_ERROR => c"a file or text could not be parsed",
+        MECH_STATUS_OUT_OF_RANGE => c"a result is not representable in double precision",
         MECH_STATUS_PANIC => c"internal error: a panic was caught at the C boundary",
         _ => c"unknown status",
     };

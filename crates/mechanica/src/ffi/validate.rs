@@ -212,6 +212,18 @@ pub(crate) fn finite<T: Finite + ?Sized>(value: &T, what: &str) -> Result<(), Ff
     }
 }
 
+/// Fails with OUT_OF_RANGE, naming `quantity`, if a computed result holds NaN or ±∞ (it
+/// overflowed although every input was finite); checked before any output is written.
+pub(crate) fn finite_result<T: Finite + ?Sized>(value: &T, quantity: &str) -> Result<(), FfiError> {
+    match value.first_non_finite() {
+        Some(bad) => Err(FfiError::new(
+            MECH_STATUS_OUT_OF_RANGE,
+            format!("the {quantity} is not representable: it overflows the range of double ({bad})"),
+        )),
+        None => Ok(()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -54,7 +54,10 @@ pub struct mech_impact_result_t {
     pub angular_velocity_after_2: mech_vec3_t,
     /// Total kinetic-energy change ΔT = P·(u⁻ + ½ W P) (J).
     pub energy_change: f64,
-    /// Estimated error of the impulse from the swerving-slip integration (N·s); 0 if exact.
+    /// A bound on the error of the impulse (N·s) against the exact impact process: the
+    /// swerving-slip integration, the slip-halting cut-off and the rounding of every
+    /// closed-form segment through the conditioning of the contact mobility; a few ulps of
+    /// |impulse| when nothing was integrated.
     pub integration_error: f64,
     /// Integration steps plus closed-form segments used.
     pub steps: u64,
@@ -69,7 +72,11 @@ pub struct mech_impact_result_t {
 /// unknown law or constraint; MECH_STATUS_INVALID_ARGUMENT for a non-unit normal, restitution
 /// outside [0, 1], negative friction, a non-positive tolerance or an invalid body (see
 /// mech_impulse_apply); MECH_STATUS_SINGULAR when neither body can move along the normal;
-/// MECH_STATUS_NOT_CONVERGED for a frictional jam.
+/// MECH_STATUS_NOT_CONVERGED for a frictional jam, including a contact that self-locks (friction
+/// holds it at rest, so the normal velocity stays zero) under MECH_RESTITUTION_NEWTON or
+/// MECH_RESTITUTION_STRONGE with restitution > 0 (under MECH_RESTITUTION_POISSON the impact
+/// ends at (1 + e) times the compression impulse with the contact at rest);
+/// MECH_STATUS_OUT_OF_RANGE when the impulse or a velocity overflows.
 ///
 /// # Safety
 /// `body1`, `body2` and `contact` must be readable, `out` writable.

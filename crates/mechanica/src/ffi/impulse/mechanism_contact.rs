@@ -138,7 +138,8 @@ pub struct mech_mechanism_impact_t {
     pub energy_change: f64,
     /// Largest complementarity residual over contacts (m/s); 0 for the single-contact process.
     pub complementarity_residual: f64,
-    /// Impulse error of the single-contact process (N·s); 0 for several contacts.
+    /// Error bound of the single-contact process's impulse (N·s, see
+    /// mech_impact_result_t::integration_error); 0 for several contacts.
     pub integration_error: f64,
     /// Factor applied to the restitution impulses by the energy guard (1: untouched).
     pub restitution_scale: f64,
@@ -210,7 +211,9 @@ fn contacts_from_c(raw: &[mech_mechanism_contact_t]) -> Result<Vec<MechanismCont
 /// of range, or a tree that is not finalized or has no state; MECH_STATUS_SINGULAR when an
 /// approaching contact cannot move along its normal; MECH_STATUS_NOT_POSITIVE_DEFINITE for a
 /// singular mass matrix; MECH_STATUS_NOT_CONVERGED for a frictional jam of the single-contact
-/// process (an unconverged simultaneous solve is reported by `converged` = 0, not an error).
+/// process, a self-locking contact under Newton's or Stronge's law included (an unconverged
+/// simultaneous solve is reported by `converged` = 0, not an error); MECH_STATUS_OUT_OF_RANGE
+/// when an impulse, velocity or energy overflows.
 ///
 /// # Safety
 /// `tree` must be a live handle; `bodies` must point to `body_count` readable values,

@@ -39,6 +39,7 @@ impl From<ImpulseError> for FfiError {
             ImpulseError::BodyOutOfRange { .. } => MECH_STATUS_INVALID_ARGUMENT,
             ImpulseError::ContactImmovable { .. } => MECH_STATUS_SINGULAR,
             ImpulseError::NonFinite { .. } => MECH_STATUS_NON_FINITE,
+            ImpulseError::NonFiniteResult { .. } => MECH_STATUS_OUT_OF_RANGE,
             ImpulseError::NonPositiveMass { .. }
             | ImpulseError::NegativeInverseMass { .. }
             | ImpulseError::RestitutionOutOfRange(_)

@@ -1,5 +1,5 @@
 //! C entry points of the kinematics crate: rotations, Euler angles, rigid and relative motion,
-//! and the kinematic tree handle.
+//! and the kinematic tree handle. A result that overflows is MECH_STATUS_OUT_OF_RANGE.
 
 use super::boundary::FfiError;
 use super::status::*;
@@ -24,6 +24,7 @@ impl From<KinematicsError> for FfiError {
         let status = match error {
             KinematicsError::NonFinite { .. } | KinematicsError::NonFiniteEntry { .. } => MECH_STATUS_NON_FINITE,
             KinematicsError::EulerRateSingular { .. } => MECH_STATUS_SINGULAR,
+            KinematicsError::NonFiniteResult { .. } => MECH_STATUS_OUT_OF_RANGE,
             KinematicsError::WrongLength { .. } => MECH_STATUS_BAD_DIMENSION,
             KinematicsError::NotARotation { .. }
             | KinematicsError::NotAUnitQuaternion { .. }
@@ -35,7 +36,8 @@ impl From<KinematicsError> for FfiError {
             | KinematicsError::MultipleRoots { .. }
             | KinematicsError::Cycle { .. }
             | KinematicsError::BodyOutOfRange { .. }
-            | KinematicsError::WorkspaceNotReady { .. } => MECH_STATUS_INVALID_ARGUMENT,
+            | KinematicsError::WorkspaceNotReady { .. }
+            | KinematicsError::RotationAngleUnresolved { .. } => MECH_STATUS_INVALID_ARGUMENT,
             // A variant added after this layer was written: its message still says what was wrong.
             _ => MECH_STATUS_INVALID_ARGUMENT,
         };

@@ -63,7 +63,8 @@ unsafe fn read_motion(ptr: *const mech_rigid_motion_t, what: &str) -> Result<Rig
 /// `x` (m) in the rigid motion `motion`, written to `velocity_out` (world components).
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
-/// `motion->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+/// `motion->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12; MECH_STATUS_OUT_OF_RANGE
+/// when the result overflows.
 ///
 /// # Safety
 /// `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
@@ -78,8 +79,10 @@ pub unsafe extern "C" fn mech_velocity_field(
         // SAFETY: caller's contract.
         let (m, x) = unsafe { (read_motion(motion, "motion")?, read_vec3(x, "x")?) };
         let out = Out::new(velocity_out, "velocity_out")?;
+        let v = m.velocity_at(&x);
+        finite_result(v.as_slice(), "velocity")?;
         // SAFETY: caller's contract.
-        unsafe { out.write(m.velocity_at(&x).into()) };
+        unsafe { out.write(v.into()) };
         Ok(())
     })
 }
@@ -103,8 +106,10 @@ pub unsafe extern "C" fn mech_acceleration_field(
         // SAFETY: caller's contract.
         let (m, x) = unsafe { (read_motion(motion, "motion")?, read_vec3(x, "x")?) };
         let out = Out::new(acceleration_out, "acceleration_out")?;
+        let a = m.acceleration_at(&x);
+        finite_result(a.as_slice(), "acceleration")?;
         // SAFETY: caller's contract.
-        unsafe { out.write(m.acceleration_at(&x).into()) };
+        unsafe { out.write(a.into()) };
         Ok(())
     })
 }
@@ -133,7 +138,8 @@ pub struct mech_relative_decomposition_t {
 /// Coriolis and relative parts (syllabus 2.22–2.32), written to `decomposition_out`.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
-/// `frame->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+/// `frame->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12; MECH_STATUS_OUT_OF_RANGE
+/// when a part of the result overflows.
 ///
 /// # Safety
 /// `frame` must point to a readable mech_rigid_motion_t, `xi`, `xi_dot`, `xi_ddot` to readable

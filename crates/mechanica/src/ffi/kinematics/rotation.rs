@@ -42,7 +42,8 @@ pub unsafe extern "C" fn mech_quat_from_rotation_matrix(
 /// rounding leaves in Ṙ Rᵀ is discarded by averaging the two off-diagonal entries.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT
-/// when `rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+/// when `rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12; MECH_STATUS_OUT_OF_RANGE when
+/// ω overflows.
 ///
 /// # Safety
 /// `rotation` and `rotation_rate` must point to readable mech_mat3_t values and `omega_out` to a
@@ -109,9 +110,12 @@ pub unsafe extern "C" fn mech_rotation_matrix_from_quat(
 
 /// The rotation matrix exp([φ]×) (column-major) of the rotation vector φ = `rotation_vector`
 /// (rad; the rotation by |φ| about φ/|φ|), by Rodrigues' formula, written to `rotation_out`.
-/// Exact to rounding for every |φ|, including |φ| → 0 and |φ| ≥ π.
+/// |φ| is computed on φ scaled by a power of two (no overflow or underflow). Exact to rounding
+/// for every |φ| up to 2⁵³ rad, including |φ| → 0 and |φ| ≥ π.
 ///
-/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite component.
+/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite component; MECH_STATUS_INVALID_ARGUMENT
+/// for |φ| > 2⁵³ rad (9.0e15), where one rounding of |φ| exceeds a radian and the rotation is
+/// not determined by φ.
 ///
 /// # Safety
 /// `rotation_vector` must point to a readable mech_vec3_t and `rotation_out` to a writable mech_mat3_t.
@@ -156,7 +160,9 @@ pub unsafe extern "C" fn mech_rotation_log(
 }
 
 /// The rotation matrix (column-major) of the rotation by `angle` (rad, right-handed) about the
-/// unit vector `axis`, written to `rotation_out`.
+/// unit vector `axis`, written to `rotation_out`. Every finite angle is reduced modulo 2π
+/// exactly: the result is the rotation by the angle the double holds (beyond 2⁵³ rad adjacent
+/// doubles are more than a radian apart, so only an exactly known angle is meaningful there).
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT
 /// for a zero or non-unit axis (|‖a‖ − 1| > 1e-12).
@@ -186,7 +192,8 @@ pub unsafe extern "C" fn mech_rotation_from_axis_angle(
 /// `correction_out` receives the size of the repair ‖matrix − rotation‖_F.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT for
-/// det(matrix) ≤ 0 (a reflection or a singular matrix is not a drifted rotation).
+/// det(matrix) ≤ 0 (a reflection or a singular matrix is not a drifted rotation);
+/// MECH_STATUS_OUT_OF_RANGE when the correction exceeds the largest double.
 ///
 /// # Safety
 /// `matrix` must point to a readable mech_mat3_t, `rotation_out` to a writable mech_mat3_t and

@@ -13,7 +13,7 @@ use mechanica_mass::MassProperties;
 /// in which B has this pose. Written to `out`.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0 or a non-unit quaternion.
+/// a mass ≤ 0 or a non-unit quaternion; MECH_STATUS_OUT_OF_RANGE when the result overflows.
 ///
 /// # Safety
 /// All pointers must be readable (inputs) or writable (`out`).
@@ -31,6 +31,7 @@ pub unsafe extern "C" fn mech_mass_transform(
         let (q, t) = unsafe { (read(rotation, "rotation")?, read(translation, "translation")?) };
         let out = Out::new(out, "out")?;
         let moved = props.transformed(&pose(&q, &t)?);
+        finite_result(&mech_mass_properties_t::from(moved), "transformed mass properties")?;
         // SAFETY: caller's contract.
         unsafe { out.write(moved.into()) };
         Ok(())
@@ -45,7 +46,8 @@ pub unsafe extern "C" fn mech_mass_transform(
 ///
 /// Errors: MECH_STATUS_BAD_DIMENSION for count = 0; MECH_STATUS_NULL_POINTER when only one of
 /// `rotations` and `translations` is NULL; MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT
-/// for a part with mass ≤ 0 (the message names it) or a non-unit quaternion.
+/// for a part with mass ≤ 0 (the message names it) or a non-unit quaternion;
+/// MECH_STATUS_OUT_OF_RANGE when the total mass, centre or tensor overflows.
 ///
 /// # Safety
 /// `parts` (and, when non-NULL, `rotations` and `translations`) must point to `count` readable
@@ -99,7 +101,7 @@ pub unsafe extern "C" fn mech_mass_combine(
 /// Errors: MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0 or a hole at
 /// least as heavy as the body; MECH_STATUS_NOT_POSITIVE_DEFINITE or
 /// MECH_STATUS_INVALID_ARGUMENT when the remainder is not a valid body (a hole that does not fit
-/// inside).
+/// inside); MECH_STATUS_OUT_OF_RANGE when the remainder overflows.
 ///
 /// # Safety
 /// `body` and `hole` must be readable and `out` writable.

@@ -13,7 +13,7 @@ use crate::ffi::validate::*;
 /// 3.27–3.29), written to `inertia_out`.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0.
+/// a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when an entry of J_A overflows.
 ///
 /// # Safety
 /// `properties` and `point` must be readable and `inertia_out` writable.
@@ -28,6 +28,7 @@ pub unsafe extern "C" fn mech_mass_inertia_about(
         let (props, a) = unsafe { (read_properties(properties, "properties")?, read_vec3(point, "point")?) };
         let out = Out::new(inertia_out, "inertia_out")?;
         let j = props.inertia_about(&a);
+        finite_result(j.as_slice(), "inertia tensor about the point")?;
         // SAFETY: caller's contract.
         unsafe { out.write(j.into()) };
         Ok(())
@@ -68,11 +69,14 @@ pub unsafe extern "C" fn mech_mass_moment_about_line(
 /// `properties`, as the columns of a right-handed rotation matrix R (column-major) with
 /// J = R diag(I) Rᵀ into `axes_out`. Repeated moments (relative gap ≤ 1e-10) give a canonical
 /// frame: the identity for three equal moments; the exact symmetry axis and the coordinate axis
-/// least aligned with it for two. The symmetric part of the tensor is decomposed; its validity
-/// is not checked (see mech_mass_check).
+/// least aligned with it for two. The tensor must be symmetric within the validity tolerance,
+/// |J_ij − J_ji| ≤ 1e-9·(|J_00| + |J_11| + |J_22|); its symmetric part is decomposed, scaled
+/// by a power of two, so that any finite tensor whose moments are representable works. Its
+/// other validity conditions are not checked (see mech_mass_check).
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite entry; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0.
+/// a mass ≤ 0 or a tensor outside the symmetry tolerance; MECH_STATUS_OUT_OF_RANGE when a
+/// moment exceeds the largest double.
 ///
 /// # Safety
 /// `properties` must be readable and `moments_out`, `axes_out` writable.

@@ -43,6 +43,7 @@ impl From<MassError> for FfiError {
     fn from(error: MassError) -> Self {
         let status = match &error {
             MassError::NonFinite { .. } | MassError::NonFiniteVertex { .. } => MECH_STATUS_NON_FINITE,
+            MassError::NonFiniteResult { .. } | MassError::MassUnderflow { .. } => MECH_STATUS_OUT_OF_RANGE,
             MassError::TooManyVertices(_) | MassError::TooManyTriangles(_) | MassError::WrongLength { .. } => {
                 MECH_STATUS_BAD_DIMENSION
             }
@@ -88,6 +89,15 @@ impl From<MassProperties> for mech_mass_properties_t {
             center_of_mass: m.p_oc.into(),
             inertia_about_com: m.inertia_c.into(),
         }
+    }
+}
+
+impl Finite for mech_mass_properties_t {
+    fn first_non_finite(&self) -> Option<f64> {
+        self.mass
+            .first_non_finite()
+            .or_else(|| self.center_of_mass.first_non_finite())
+            .or_else(|| self.inertia_about_com.first_non_finite())
     }
 }
 

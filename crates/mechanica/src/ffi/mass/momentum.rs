@@ -1,7 +1,7 @@
 //! Momenta and kinetic energy of one moving body.
 
 use super::{mech_mass_properties_t, read_properties};
-use crate::ffi::boundary::{FfiError, boundary};
+use crate::ffi::boundary::boundary;
 use crate::ffi::spatial::read_vec3;
 use crate::ffi::status::*;
 use crate::ffi::types::*;
@@ -13,7 +13,7 @@ use crate::ffi::validate::*;
 /// angular velocity `omega` (rad/s), both in that frame. Written to `angular_momentum_out`.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0.
+/// a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when the angular momentum overflows.
 ///
 /// # Safety
 /// The inputs must be readable and `angular_momentum_out` writable.
@@ -38,6 +38,7 @@ pub unsafe extern "C" fn mech_mass_angular_momentum(
         };
         let out = Out::new(angular_momentum_out, "angular_momentum_out")?;
         let d = props.angular_momentum_about(&a, &v, &w);
+        finite_result(d.as_slice(), "angular momentum")?;
         // SAFETY: caller's contract.
         unsafe { out.write(d.into()) };
         Ok(())
@@ -49,8 +50,8 @@ pub unsafe extern "C" fn mech_mass_angular_momentum(
 /// centre velocity `com_velocity` (m/s) and angular velocity `omega` (rad/s), both in the frame
 /// of `properties`.
 ///
-/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input or an energy that overflows;
-/// MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0.
+/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+/// a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when the energy or the momentum overflows.
 ///
 /// # Safety
 /// The inputs must be readable, `energy_out` writable, `momentum_out` NULL or writable.
@@ -70,17 +71,16 @@ pub unsafe extern "C" fn mech_mass_kinetic_energy(
         let energy = Out::new(energy_out, "energy_out")?;
         let momentum = Out::optional(momentum_out, "momentum_out")?;
         let t = props.kinetic_energy(&v, &w);
-        if !t.is_finite() {
-            return Err(FfiError::new(
-                MECH_STATUS_NON_FINITE,
-                format!("kinetic energy overflows: {t}"),
-            ));
+        finite_result(&t, "kinetic energy")?;
+        let p = props.linear_momentum(&v);
+        if momentum.is_some() {
+            finite_result(p.as_slice(), "momentum")?;
         }
         // SAFETY: caller's contract.
         unsafe {
             energy.write(t);
-            if let Some(p) = momentum {
-                p.write(props.linear_momentum(&v).into());
+            if let Some(out) = momentum {
+                out.write(p.into());
             }
         }
         Ok(())

@@ -164,7 +164,11 @@ pub(super) fn amount_of(kind: mech_amount_t, value: f64) -> Result<Amount, FfiEr
 /// Errors: MECH_STATUS_BAD_ENUM for an unknown `kind` or `amount_kind`;
 /// MECH_STATUS_BAD_DIMENSION when `dimension_count` is not the count of `kind`;
 /// MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a non-positive dimension, mass or
-/// density, or a torus tube radius above its ring radius.
+/// density, or a torus tube radius above its ring radius; MECH_STATUS_OUT_OF_RANGE when the
+/// mass or a moment of inertia is not representable (it overflows, or a mass from a density
+/// underflows to zero; mech_last_error names the quantity). Masses and moments are formed as
+/// products with the exponents kept apart, so that only a result that is itself out of range
+/// fails.
 ///
 /// # Safety
 /// `dimensions` must point to `dimension_count` readable doubles (it may be NULL when the count

@@ -1,0 +1,179 @@
+//! Mass properties at the ends of the double range: exact scaling laws as the reference
+//! (sizes and masses scaled by powers of two scale moments exactly by m·λ²), typed errors
+//! where a result is not representable, and principal axes of any finite tensor.
+
+use mechanica_kinematics::nalgebra::{Matrix3, Rotation3, Vector3};
+use mechanica_mass::primitives::{self, Amount};
+use mechanica_mass::principal::principal_axes;
+use mechanica_mass::validity::{InertiaIssue, ValidityTolerance, check};
+use mechanica_mass::{MassError, MassProperties};
+use proptest::prelude::*;
+
+type Primitive = fn(&[f64], Amount) -> Result<MassProperties, MassError>;
+
+/// 2^e for any e the doubles can hold (subnormal results included), exactly.
+fn pow2(e: i32) -> f64 {
+    2f64.powi(e / 2) * 2f64.powi(e - e / 2)
+}
+
+/// Every primitive with dimensions of order one (the torus tube below its ring radius).
+fn primitives() -> Vec<(&'static str, Primitive, Vec<f64>, i32)> {
+    // (name, constructor, dimensions, dimension count of its measure: 1 line, 2 area, 3 volume)
+    vec![
+        ("rod", |d, a| primitives::rod(d[0], a), vec![1.3], 1),
+        (
+            "rectangle",
+            |d, a| primitives::rectangle_lamina(d[0], d[1], a),
+            vec![0.7, 1.9],
+            2,
+        ),
+        ("disc", |d, a| primitives::disc_lamina(d[0], a), vec![0.8], 2),
+        ("sphere", |d, a| primitives::sphere(d[0], a), vec![1.1], 3),
+        (
+            "ellipsoid",
+            |d, a| primitives::ellipsoid(d[0], d[1], d[2], a),
+            vec![0.5, 1.2, 2.0],
+            3,
+        ),
+        (
+            "box",
+            |d, a| primitives::solid_box(d[0], d[1], d[2], a),
+            vec![0.3, 1.7, 0.9],
+            3,
+        ),
+        (
+            "cylinder",
+            |d, a| primitives::cylinder(d[0], d[1], a),
+            vec![0.7, 2.5],
+            3,
+        ),
+        ("cone", |d, a| primitives::cone(d[0], d[1], a), vec![0.5, 1.0], 3),
+        ("capsule", |d, a| primitives::capsule(d[0], d[1], a), vec![0.7, 1.1], 3),
+        ("torus", |d, a| primitives::torus(d[0], d[1], a), vec![2.0, 0.6], 3),
+        ("hemisphere", |d, a| primitives::hemisphere(d[0], a), vec![1.3], 3),
+    ]
+}
+
+proptest! {
+    /// Dimensions scaled by λ = 2^k and the mass by 2^j: the moments are exactly 2^(j+2k) times
+    /// those of the unit body (up to the few roundings of the closed form), or a typed error
+    /// naming the moment when that is not representable.
+    #[test]
+    fn primitives_by_mass_scale_exactly_or_fail_typed(k in -560i32..560, j in -600i32..600, which in 0..11usize) {
+        let (name, build, dims, _) = primitives()[which].clone();
+        let unit = build(&dims, Amount::Mass(1.0)).expect("unit body");
+        let lambda = pow2(k);
+        let scaled: Vec<f64> = dims.iter().map(|d| d * lambda).collect();
+        // unit·2^(j+2k), rounded once.
+        let expected = unit.inertia_c.map(|x| x * pow2((j + 2 * k) / 2) * pow2(j + 2 * k - (j + 2 * k) / 2));
+        match build(&scaled, Amount::Mass(2f64.powi(j))) {
+            Ok(p) => {
+                prop_assert!(expected.iter().all(|x| x.is_finite()), "{name}: Ok for an overflowing moment");
+                for (got, want) in p.inertia_c.iter().zip(expected.iter()) {
+                    // Subnormal results keep an absolute accuracy of a few smallest doubles.
+                    prop_assert!((got - want).abs() <= 16.0 * f64::EPSILON * want.abs() + 1e-320, "{name}: {got} vs {want}");
+                }
+                prop_assert!((p.p_oc - unit.p_oc * lambda).norm() <= 4.0 * f64::EPSILON * (unit.p_oc * lambda).norm());
+            }
+            Err(MassError::NonFiniteResult { quantity }) => {
+                prop_assert!(quantity.ends_with("moment of inertia"), "{name}: {quantity}");
+                prop_assert!(expected.iter().any(|x| !x.is_finite()) || expected.amax() > 0.5 * f64::MAX, "{name}: {expected}");
+            }
+            Err(other) => prop_assert!(false, "{name}: {other}"),
+        }
+    }
+
+    /// By density: m = ρ λ^d V₁ exactly, or MassUnderflow / NonFiniteResult("mass").
+    #[test]
+    fn primitives_by_density_scale_exactly_or_fail_typed(k in -400i32..400, j in -600i32..600, which in 0..11usize) {
+        let (name, build, dims, dim) = primitives()[which].clone();
+        let unit = build(&dims, Amount::Density(1.0)).expect("unit body");
+        let lambda = pow2(k);
+        let scaled: Vec<f64> = dims.iter().map(|d| d * lambda).collect();
+        let e = j + dim * k;
+        let mass = unit.mass * pow2(e / 2) * pow2(e - e / 2);
+        match build(&scaled, Amount::Density(2f64.powi(j))) {
+            Ok(p) => prop_assert!((p.mass - mass).abs() <= 8.0 * f64::EPSILON * mass + 1e-320, "{name}: {} vs {mass}", p.mass),
+            Err(MassError::MassUnderflow { .. }) => prop_assert!(mass < 1e-300, "{name}: {mass}"),
+            Err(MassError::NonFiniteResult { quantity: "mass" }) => prop_assert!(mass > 1e300, "{name}: {mass}"),
+            Err(MassError::NonFiniteResult { quantity }) => prop_assert!(quantity.ends_with("moment of inertia")),
+            Err(other) => prop_assert!(false, "{name}: {other}"),
+        }
+    }
+
+    /// J = s R diag(I) Rᵀ for s over the whole range: the principal moments are s·I sorted,
+    /// the axes those of R, whatever the scale.
+    #[test]
+    fn principal_axes_of_any_finite_tensor(
+        a in -3.0..3.0f64, b in -3.0..3.0f64, c in -3.0..3.0f64,
+        i1 in 0.1..1.0f64, i2 in 0.1..1.0f64, k in -1000i32..1000,
+    ) {
+        let r = Rotation3::from_scaled_axis(Vector3::new(a, b, c));
+        let moments = Vector3::new(i1, i2, i1 + i2);
+        let s = 2f64.powi(k);
+        let j = r.matrix() * Matrix3::from_diagonal(&moments) * r.matrix().transpose() * s;
+        let j = j * 0.5 + j.transpose() * 0.5;
+        let p = principal_axes(&j).expect("representable moments");
+        let mut sorted = [i1, i2, i1 + i2];
+        sorted.sort_by(f64::total_cmp);
+        for (got, want) in p.moments.iter().zip(sorted) {
+            prop_assert!((got - want * s).abs() <= 1e-13 * (i1 + i2) * s, "{got} vs {}", want * s);
+        }
+        prop_assert!(p.relative_residual <= 1e-12);
+        let class = check(&MassProperties { mass: 1.0, p_oc: Vector3::zeros(), inertia_c: j }, &ValidityTolerance::default())
+            .map(|report| report.class);
+        let unit_class = check(&MassProperties { mass: 1.0, p_oc: Vector3::zeros(), inertia_c: j / s }, &ValidityTolerance::default())
+            .map(|report| report.class);
+        prop_assert_eq!(class, unit_class);
+    }
+}
+
+#[test]
+fn the_reported_cases() {
+    // A sphere of radius 1e308 (by mass): its moment 0.4·m·r² is not representable.
+    assert_eq!(
+        primitives::sphere(1e308, Amount::Mass(1.0)),
+        Err(MassError::NonFiniteResult {
+            quantity: "sphere moment of inertia"
+        })
+    );
+    // A tiny sphere by density: its mass underflows, and the message says so.
+    let tiny = primitives::sphere(1e-120, Amount::Density(1.0));
+    assert!(matches!(tiny, Err(MassError::MassUnderflow { .. })), "{tiny:?}");
+    let message = tiny.expect_err("underflow").to_string();
+    assert!(
+        message.contains("underflows to zero") && !message.contains("not finite"),
+        "{message}"
+    );
+    // The principal axes of a tensor with entries of 1e308 (its moments up to 3e308 would
+    // overflow; these are representable): no NaN.
+    let r = Rotation3::from_scaled_axis(Vector3::new(0.3, -1.2, 0.7));
+    let j = r.matrix() * Matrix3::from_diagonal(&Vector3::new(0.5e308, 0.6e308, 1.1e308)) * r.matrix().transpose();
+    let j = j * 0.5 + j.transpose() * 0.5;
+    let p = principal_axes(&j).expect("representable");
+    assert!((p.moments - Vector3::new(0.5e308, 0.6e308, 1.1e308)).amax() <= 1e-13 * 1.1e308);
+    // Moments beyond f64::MAX: a typed error, not NaN.
+    // All entries MAX/2 but the diagonal MAX: the largest moment is 2·MAX.
+    let mut huge = Matrix3::repeat(f64::MAX / 2.0);
+    huge.fill_diagonal(f64::MAX);
+    assert_eq!(
+        principal_axes(&huge),
+        Err(MassError::NonFiniteResult {
+            quantity: "principal moments"
+        })
+    );
+    // An asymmetric tensor is refused with the asymmetry named.
+    let mut asymmetric = Matrix3::from_diagonal(&Vector3::new(1.0, 2.0, 2.5));
+    asymmetric[(0, 1)] = 1e-3;
+    assert_eq!(
+        principal_axes(&asymmetric),
+        Err(MassError::InvalidInertia(vec![InertiaIssue::NotSymmetric {
+            row: 0,
+            col: 1,
+            difference: 1e-3
+        }]))
+    );
+    // Within the tolerance (1e-9 of the trace) the symmetric part is decomposed.
+    asymmetric[(0, 1)] = 1e-10;
+    assert!(principal_axes(&asymmetric).is_ok());
+}
