@@ -44,6 +44,7 @@ impl From<ModalError> for FfiError {
             ModalError::IndefiniteMass { .. } => MECH_STATUS_NOT_POSITIVE_DEFINITE,
             ModalError::SingularPencil { .. } => MECH_STATUS_SINGULAR,
             ModalError::NoConvergence { .. } => MECH_STATUS_NOT_CONVERGED,
+            ModalError::OutOfRange { .. } => MECH_STATUS_OUT_OF_RANGE,
             // A variant added after this layer was written: its message still says what was wrong.
             _ => MECH_STATUS_INVALID_ARGUMENT,
         };
