@@ -26,8 +26,11 @@ pub enum Selection {
 /// condensation is then exact), and otherwise keeps its first-order bounds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Refinement {
-    /// Refine every selected, simple, finite mode whose first-order error bound from the
-    /// reduction exceeds [`AUTO_REFINE_RELATIVE_BOUND`]·|ω²| (stiff and graded problems).
+    /// Refine the selected, simple, finite modes whose first-order error bound from the
+    /// reduction exceeds [`AUTO_REFINE_RELATIVE_BOUND`]·|ω²| (stiff and graded problems), from
+    /// the lowest up, at most max(256, n/4) of them ([`crate::Tuning::auto_refined_at_least`]);
+    /// on a graded pencil whose low modes the reduction cannot resolve, they are first taken
+    /// from the reversed pencil (`dense::reversed`, docs/theory.md).
     Auto,
     /// Never refine (the plain reduction; its bounds can then be large on stiff problems).
     Off,
