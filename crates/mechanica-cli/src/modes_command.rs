@@ -43,7 +43,14 @@ pub struct ModesArgs {
     /// Sketched accuracy report (probabilistic upper bounds at O(n²) cost; dense solver).
     #[arg(long)]
     pub sketched: bool,
+    /// Largest order solved densely: a dense solve keeps about seven n×n matrices (n = 10 000:
+    /// about 5.6 GB); above it the dense solver is refused with an error (use --lowest K).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_DENSE_ORDER)]
+    pub max_dense_order: usize,
 }
+
+/// The default of `--max-dense-order`.
+pub const DEFAULT_MAX_DENSE_ORDER: usize = 10_000;
 
 fn quantity(name: &str, values: Vec<f64>, unit: &str, accuracy: Option<String>) -> Quantity {
     Quantity {
@@ -169,6 +176,12 @@ pub fn run(args: &ModesArgs) -> Result<Report, String> {
         matches!(args.lowest, Some(k) if n > Tuning::DEFAULT.dense_limit && k < n) && !args.dense && !args.values_only;
     if sparse {
         steps.extend(sparse_steps(args, &a, &b)?);
+    } else if n > args.max_dense_order {
+        return Err(format!(
+            "order {n} is above the dense limit --max-dense-order {} (about seven n×n matrices of doubles, {:.1} GB): ask for --lowest K (sparse Lanczos), or raise the limit",
+            args.max_dense_order,
+            7.0 * 8.0 * (n as f64) * (n as f64) / 1e9
+        ));
     } else {
         steps.extend(dense_steps(args, refinement, &a, &b)?);
     }
@@ -202,6 +215,7 @@ fn read_pencil(
                 a.nrows, a.ncols, b.nrows, b.ncols
             ));
         }
+        mechanica::modal::check_every_coordinate_used(a.nrows, &a.entries, &b.entries).map_err(|e| e.to_string())?;
         let out = vec![
             quantity("order n", vec![a.nrows as f64], "", None),
             quantity(

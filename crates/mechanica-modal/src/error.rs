@@ -198,6 +198,16 @@ pub enum ModalError {
         /// What is wrong.
         detail: String,
     },
+    /// A coordinate has no entry in A or in B: its row of λA + B vanishes for every λ, so
+    /// det(λA + B) ≡ 0 (a singular pencil). Checked before anything of the pencil's order is
+    /// allocated, so a file declaring a huge order with few entries is refused at once.
+    #[error("coordinate {index} of the order-{order} pencil has no entry in A or B: det(λA + B) vanishes for every λ")]
+    EmptyCoordinate {
+        /// The first coordinate without an entry.
+        index: usize,
+        /// The declared order n.
+        order: usize,
+    },
     /// The pencil's entries span more binary orders than double precision holds once scaled
     /// to a common range, or a result (an ω², a bound) lies outside the range of doubles.
     #[error("{what} is outside the range of double precision: {detail}")]

@@ -81,7 +81,8 @@ pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use runtime::scratch::release as release_scratch;
 pub use sparse::{
     MatrixMarket, SparseAccuracyReport, SparseInertiaCount, SparseModalSolution, SparsePencil, SparseSolveOptions,
-    SparseSolveTimings, count_below_sparse, parse_matrix_market, read_matrix_market, solve_sparse,
+    SparseSolveTimings, check_every_coordinate_used, count_below_sparse, parse_matrix_market, read_matrix_market,
+    solve_sparse,
 };
 pub use spectrum::{Mode, ModeGroup, ModeKind, classify};
 pub use tuning::Tuning;

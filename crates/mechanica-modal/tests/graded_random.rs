@@ -301,3 +301,26 @@ fn sparse_lanczos_on_large_graded_systems() {
         }
     }
 }
+
+/// A declared order far beyond the entries (a file of one entry declaring 10⁹ or 2⁶³
+/// coordinates) is a singular pencil, refused before anything of that order is allocated; every
+/// coordinate with an entry in A or B passes.
+#[test]
+fn coordinates_without_entries_are_refused_before_allocation() {
+    use mechanica_modal::{ModalError, check_every_coordinate_used};
+    let one = [Triplet::new(0, 0, 1.0)];
+    for order in [2usize, 12_000, 1_000_000_000, 1 << 63] {
+        match check_every_coordinate_used(order, &one, &one) {
+            Err(ModalError::EmptyCoordinate { index: 1, order: o }) => assert_eq!(o, order),
+            other => panic!("order {order}: {other:?}"),
+        }
+    }
+    let a = [Triplet::new(0, 0, 1.0), Triplet::new(2, 2, 1.0)];
+    let b = [Triplet::new(1, 0, -1.0)];
+    assert!(check_every_coordinate_used(3, &a, &b).is_ok());
+    assert!(matches!(
+        check_every_coordinate_used(4, &a, &b),
+        Err(ModalError::EmptyCoordinate { index: 3, .. })
+    ));
+    assert!(SparsePencil::from_triplets(1 << 40, &one, &one).is_err());
+}

@@ -65,7 +65,7 @@ mod supernodal;
 pub use inertia::{SparseInertiaCount, count_below_sparse};
 pub use matrix_market::{MatrixMarket, parse_matrix_market, read_matrix_market};
 pub use options::SparseSolveOptions;
-pub use pencil::SparsePencil;
+pub use pencil::{SparsePencil, check_every_coordinate_used};
 pub use solution::{SparseAccuracyReport, SparseModalSolution, SparseSolveTimings};
 
 use crate::error::ModalError;

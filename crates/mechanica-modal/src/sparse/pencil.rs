@@ -217,6 +217,7 @@ impl SparsePencil {
         a: &[Triplet<usize, usize, f64>],
         b: &[Triplet<usize, usize, f64>],
     ) -> Result<Self, ModalError> {
+        check_every_coordinate_used(n, a, b)?;
         let entries = |t: &[Triplet<usize, usize, f64>]| t.iter().map(|e| (e.row, e.col, e.val)).collect::<Vec<_>>();
         let (ea, eb) = (entries(a), entries(b));
         check_entries("A", n, ea.iter().copied())?;
@@ -339,4 +340,30 @@ mod tests {
             })
         ));
     }
+}
+
+/// Every coordinate 0..n has an entry (of any value) in A or B: otherwise
+/// [`ModalError::EmptyCoordinate`]. Costs O(nnz log nnz) and allocates only the entries' row
+/// indices, never anything of size n, so a declared order far beyond the entries is refused
+/// before it is allocated. Out-of-range indices are left to the entry checks.
+pub fn check_every_coordinate_used(
+    n: usize,
+    a: &[Triplet<usize, usize, f64>],
+    b: &[Triplet<usize, usize, f64>],
+) -> Result<(), ModalError> {
+    let mut rows: Vec<usize> = a.iter().chain(b).map(|e| e.row).filter(|&r| r < n).collect();
+    rows.sort_unstable();
+    rows.dedup();
+    let first_missing = rows
+        .iter()
+        .enumerate()
+        .find(|(k, r)| *k != **r)
+        .map_or(rows.len(), |(k, _)| k);
+    if first_missing < n {
+        return Err(ModalError::EmptyCoordinate {
+            index: first_missing,
+            order: n,
+        });
+    }
+    Ok(())
 }
