@@ -307,6 +307,32 @@ pub(crate) fn abs_quadratic(m: SparseColMatRef<'_, usize, f64>, x: &[f64]) -> f6
     s
 }
 
+/// Every coordinate 0..n has an entry (of any value) in A or B: otherwise
+/// [`ModalError::EmptyCoordinate`]. Costs O(nnz log nnz) and allocates only the entries' row
+/// indices, never anything of size n, so a declared order far beyond the entries is refused
+/// before it is allocated. Out-of-range indices are left to the entry checks.
+pub fn check_every_coordinate_used(
+    n: usize,
+    a: &[Triplet<usize, usize, f64>],
+    b: &[Triplet<usize, usize, f64>],
+) -> Result<(), ModalError> {
+    let mut rows: Vec<usize> = a.iter().chain(b).map(|e| e.row).filter(|&r| r < n).collect();
+    rows.sort_unstable();
+    rows.dedup();
+    let first_missing = rows
+        .iter()
+        .enumerate()
+        .find(|(k, r)| *k != **r)
+        .map_or(rows.len(), |(k, _)| k);
+    if first_missing < n {
+        return Err(ModalError::EmptyCoordinate {
+            index: first_missing,
+            order: n,
+        });
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -340,30 +366,4 @@ mod tests {
             })
         ));
     }
-}
-
-/// Every coordinate 0..n has an entry (of any value) in A or B: otherwise
-/// [`ModalError::EmptyCoordinate`]. Costs O(nnz log nnz) and allocates only the entries' row
-/// indices, never anything of size n, so a declared order far beyond the entries is refused
-/// before it is allocated. Out-of-range indices are left to the entry checks.
-pub fn check_every_coordinate_used(
-    n: usize,
-    a: &[Triplet<usize, usize, f64>],
-    b: &[Triplet<usize, usize, f64>],
-) -> Result<(), ModalError> {
-    let mut rows: Vec<usize> = a.iter().chain(b).map(|e| e.row).filter(|&r| r < n).collect();
-    rows.sort_unstable();
-    rows.dedup();
-    let first_missing = rows
-        .iter()
-        .enumerate()
-        .find(|(k, r)| *k != **r)
-        .map_or(rows.len(), |(k, _)| k);
-    if first_missing < n {
-        return Err(ModalError::EmptyCoordinate {
-            index: first_missing,
-            order: n,
-        });
-    }
-    Ok(())
 }
