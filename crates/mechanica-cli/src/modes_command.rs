@@ -96,7 +96,7 @@ fn mode_quantities(modes: &[mechanica::modal::Mode], groups: &[mechanica::modal:
             _ => 0.0,
         })
         .collect();
-    vec![
+    let mut quantities = vec![
         quantity(
             "λ (8.89: det(λA + B) = 0)",
             modes.iter().map(|m| m.lambda).collect(),
@@ -152,7 +152,10 @@ fn mode_quantities(modes: &[mechanica::modal::Mode], groups: &[mechanica::modal:
             "",
             None,
         ),
-    ]
+    ];
+    // Values only: no backward error was measured; the row is left out rather than printed as NaN.
+    quantities.retain(|q| !(q.name == "backward error η" && q.values.iter().all(|v| v.is_nan())));
+    quantities
 }
 
 fn shapes(x: &Mat<f64>) -> Quantity {
@@ -348,19 +351,17 @@ fn dense_steps(
 
 /// The accuracy report, refinement and Sturm check steps of a dense solution.
 fn dense_accuracy_steps(acc: &mechanica::modal::AccuracyReport, t: &mechanica::modal::SolveTimings) -> [Step; 3] {
-    let accuracy = stage(
-        "accuracy report",
-        t.accuracy,
-        vec![quantity(
+    // Values only: no pair was formed, so there is no backward error to print (not a NaN).
+    let measured = match (acc.max_backward_error, acc.orthogonality_error) {
+        (Some(eta), Some(orthogonality)) => vec![quantity(
             "max backward error, A-orthogonality error",
-            vec![
-                acc.max_backward_error.unwrap_or(f64::NAN),
-                acc.orthogonality_error.unwrap_or(f64::NAN),
-            ],
+            vec![eta, orthogonality],
             "",
             Some(format!("{:?} residuals", acc.residuals)),
         )],
-    );
+        _ => Vec::new(),
+    };
+    let accuracy = stage("accuracy report", t.accuracy, measured);
     let refined = acc.refinement_steps.iter().filter(|&&s| s > 0).count();
     let refine = stage(
         "refine (Newton, double-double residuals)",

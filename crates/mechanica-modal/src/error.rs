@@ -58,9 +58,12 @@ pub enum ModalError {
         /// The tolerance n·u·‖A‖ below which a negative eigenvalue counts as rounding of zero.
         tolerance: f64,
     },
-    /// A is singular and B is singular on the null space of A: det(λA + B) vanishes for every λ.
+    /// A is singular and B is singular on the null space of A, so the massless directions cannot
+    /// be condensed out. Either det(λA + B) vanishes for every λ (a singular pencil), or the
+    /// pencil is regular with infinite eigenvalues of higher index (A = [[1, 0], [0, 0]],
+    /// B = [[0, 1], [1, 0]]: det(λA + B) = −1), which this solver does not reduce.
     #[error(
-        "the pencil is singular: B restricted to the {nullity}-dimensional null space of A has a zero pivot at {pivot}"
+        "the massless directions cannot be condensed: B restricted to the {nullity}-dimensional null space of A has a zero pivot at {pivot} (the pencil is singular, or has infinite eigenvalues of higher index)"
     )]
     SingularPencil {
         /// Dimension of the null space of A.
