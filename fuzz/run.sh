@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# Builds the fuzz targets (if needed) and runs one of them with libFuzzer.
+#
+#   fuzz/run.sh TARGET SECONDS [libFuzzer options...]
+#   fuzz/run.sh build            # only build every target
+#   fuzz/run.sh list             # the target names
+#
+# The corpus grows in fuzz/corpus/TARGET (the committed seeds plus what the run finds; commit
+# only small, interesting additions); crashes are written to fuzz/artifacts/TARGET/. Each run
+# uses one process (-jobs/-workers may be passed for more). Environment: FUZZ_TARGET_DIR
+# (default fuzz/target), FUZZ_RSS_LIMIT_MB (default 2048), FUZZ_MAX_LEN (default 65536 bytes).
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+targets=(stl obj matrix_market scene urdf abi_kinematics abi_mass abi_impulse abi_modal abi_mechanism)
+export CARGO_TARGET_DIR="${FUZZ_TARGET_DIR:-$here/target}"
+export CARGO_INCREMENTAL=0
+# Instrumentation is added by the wrapper, crate by crate; RUSTFLAGS would also reach build
+# scripts and proc macros, which cannot link libFuzzer's hooks.
+export RUSTC_WRAPPER="$here/sancov-rustc"
+unset RUSTFLAGS
+
+build() {
+    cargo build --manifest-path "$here/Cargo.toml" --release --locked --bins
+}
+
+case "${1:-}" in
+    list)
+        printf '%s\n' "${targets[@]}"
+        exit 0
+        ;;
+    build)
+        build
+        exit 0
+        ;;
+    "" | -h | --help)
+        sed -n '2,12p' "$0"
+        exit 2
+        ;;
+esac
+
+target="$1"
+seconds="${2:?usage: fuzz/run.sh TARGET SECONDS [libFuzzer options...]}"
+shift 2
+if [[ ! " ${targets[*]} " =~ " $target " ]]; then
+    echo "unknown target '$target'; targets: ${targets[*]}" >&2
+    exit 2
+fi
+build
+corpus="$here/corpus/$target"
+artifacts="$here/artifacts/$target"
+mkdir -p "$corpus" "$artifacts"
+# A scratch corpus directory first: new inputs land there, not in the committed seeds, unless
+# FUZZ_GROW_CORPUS=1 asks for the committed directory to grow.
+if [ "${FUZZ_GROW_CORPUS:-0}" = 1 ]; then
+    dirs=("$corpus")
+else
+    scratch="$CARGO_TARGET_DIR/corpus/$target"
+    mkdir -p "$scratch"
+    dirs=("$scratch" "$corpus")
+fi
+exec "$CARGO_TARGET_DIR/release/$target" \
+    -max_total_time="$seconds" \
+    -rss_limit_mb="${FUZZ_RSS_LIMIT_MB:-2048}" \
+    -max_len="${FUZZ_MAX_LEN:-65536}" \
+    -timeout=20 \
+    -print_final_stats=1 \
+    -artifact_prefix="$artifacts/" \
+    "$@" "${dirs[@]}"
