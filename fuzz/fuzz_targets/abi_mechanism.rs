@@ -19,6 +19,11 @@ struct Mechanism {
     n: usize,
     rotating: bool,
     limited: bool,
+    /// Size of the terms the potential sums (stiffness × length², force × length, …): the
+    /// rounding of U* and its derivatives is relative to it, not to the result.
+    load_scale: f64,
+    /// Total mass of the bodies (kg).
+    mass: f64,
 }
 
 impl Drop for Mechanism {
@@ -38,27 +43,46 @@ fn vec_or(input: &mut Input, scale: f64) -> mech_vec3_t {
 /// One load call chosen by the input.
 fn load(m: &mut Mechanism, bodies: usize, input: &mut Input) {
     let h = m.handle;
+    // Every length in these trees is below REACH (placements ≤ 1, coordinates ≤ 2 per body).
+    const REACH: f64 = 16.0;
+    let mut magnitude = 0.0;
+    let mass = m.mass;
+    let mut weigh = |x: &mech_vec3_t, power: i32| magnitude += (x.x.abs() + x.y.abs() + x.z.abs()) * (REACH + 1.0).powi(power);
     let (name, status) = match input.u8() % 6 {
-        0 => ("mech_mechanism_set_gravity", unsafe { mech_mechanism_set_gravity(h, vec_or(input, 10.0)) }),
+        0 => {
+            let g = vec_or(input, 10.0);
+            weigh(&v3([(g.x.abs() + g.y.abs() + g.z.abs()) * mass, 0.0, 0.0]), 1);
+            ("mech_mechanism_set_gravity", unsafe { mech_mechanism_set_gravity(h, g) })
+        }
         1 => {
             let axis = if input.u8() < 224 { v3(input.unit_vec3()) } else { vec_or(input, 1.0) };
-            let status = unsafe { mech_mechanism_set_rotating_frame(h, axis, any_or(input, 3.0)) };
+            let rate = any_or(input, 3.0);
+            weigh(&v3([rate * rate * mass, 0.0, 0.0]), 2);
+            let status = unsafe { mech_mechanism_set_rotating_frame(h, axis, rate) };
             m.rotating |= status == MECH_STATUS_OK;
             ("mech_mechanism_set_rotating_frame", status)
         }
         2 => {
             let coordinate = input.below(m.n + 1);
-            ("mech_mechanism_add_joint_spring", unsafe { mech_mechanism_add_joint_spring(h, coordinate, any_or(input, 50.0), any_or(input, 1.0)) })
+            let (k, rest) = (any_or(input, 50.0), any_or(input, 1.0));
+            weigh(&v3([k * (1.0 + rest.abs()).powi(2), 0.0, 0.0]), 2);
+            ("mech_mechanism_add_joint_spring", unsafe { mech_mechanism_add_joint_spring(h, coordinate, k, rest) })
         }
         3 => {
             let (a, b) = (input.below(bodies + 2) as i64 - 1, input.below(bodies + 2) as i64 - 1);
             let (pa, pb) = (vec_or(input, 1.0), vec_or(input, 1.0));
-            let status = unsafe { mech_mechanism_add_point_spring(h, a, pa, b, pb, any_or(input, 50.0), any_or(input, 1.0)) };
+            let (k, rest) = (any_or(input, 50.0), any_or(input, 1.0));
+            let reach = 1.0 + rest.abs() + pa.x.abs() + pa.y.abs() + pa.z.abs() + pb.x.abs() + pb.y.abs() + pb.z.abs();
+            weigh(&v3([k * reach * reach, 0.0, 0.0]), 2);
+            let status = unsafe { mech_mechanism_add_point_spring(h, a, pa, b, pb, k, rest) };
             ("mech_mechanism_add_point_spring", status)
         }
         4 => {
             let body = input.below(bodies + 1);
-            ("mech_mechanism_add_force", unsafe { mech_mechanism_add_force(h, body, vec_or(input, 1.0), vec_or(input, 10.0)) })
+            let (point, force) = (vec_or(input, 1.0), vec_or(input, 10.0));
+            weigh(&force, 1);
+            weigh(&v3([(force.x.abs() + force.y.abs() + force.z.abs()) * (point.x.abs() + point.y.abs() + point.z.abs()), 0.0, 0.0]), 0);
+            ("mech_mechanism_add_force", unsafe { mech_mechanism_add_force(h, body, point, force) })
         }
         _ => {
             let coordinate = input.below(m.n + 1);
@@ -69,6 +93,9 @@ fn load(m: &mut Mechanism, bodies: usize, input: &mut Input) {
         }
     };
     check_status(name, status);
+    if status == MECH_STATUS_OK {
+        m.load_scale += magnitude;
+    }
 }
 
 /// U*, its gradient and Hessian at q; the Hessian must be symmetric.
@@ -85,10 +112,11 @@ fn potential(m: &Mechanism, q: &[f64]) -> Option<(f64, Vec<f64>, Vec<f64>)> {
         return None;
     }
     let largest = hessian.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let tolerance = 1e-9 * largest + 1e-12 * m.load_scale;
     for i in 0..n {
         for j in 0..i {
             let (x, y) = (hessian[i + n * j], hessian[j + n * i]);
-            assert!((x - y).abs() <= 1e-9 * largest, "Hessian not symmetric: H[{i},{j}] = {x}, H[{j},{i}] = {y}");
+            assert!((x - y).abs() <= tolerance, "Hessian not symmetric: H[{i},{j}] = {x}, H[{j},{i}] = {y}");
         }
     }
     Some((value.value, gradient, hessian))
@@ -197,7 +225,8 @@ fuzz_target!(|data: &[u8]| {
     let mut dof = Sentinel::<usize>::new();
     assert_eq!(unsafe { mech_mechanism_dof(handle, dof.ptr()) }, MECH_STATUS_OK);
     assert_eq!(dof.value, tree.dof, "the mechanism's dof differs from its tree's");
-    let mut m = Mechanism { handle, n: tree.dof, rotating: false, limited: false };
+    let mass: f64 = bodies.iter().map(|b| b.mass.abs()).sum();
+    let mut m = Mechanism { handle, n: tree.dof, rotating: false, limited: false, load_scale: 0.0, mass };
     for _ in 0..input.below(6) {
         load(&mut m, tree.bodies, &mut input);
     }

@@ -14,22 +14,21 @@ use libfuzzer_sys::fuzz_target;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-/// The file the inputs are written to, in a directory of this process's own.
-fn robot_file() -> &'static PathBuf {
-    static FILE: OnceLock<PathBuf> = OnceLock::new();
-    FILE.get_or_init(|| {
-        let dir = std::env::temp_dir().join(format!("mechanica-fuzz-urdf-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("temporary directory");
-        dir.join("robot.urdf")
-    })
+/// A directory of this process's own, removed after every input (so nothing is left behind).
+fn scratch_dir() -> &'static PathBuf {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| std::env::temp_dir().join(format!("mechanica-fuzz-urdf-{}", std::process::id())))
 }
 
 fuzz_target!(|data: &[u8]| {
-    let path = robot_file();
-    std::fs::write(path, data).expect("write the robot file");
+    let dir = scratch_dir();
+    std::fs::create_dir_all(dir).expect("temporary directory");
+    let path = dir.join("robot.urdf");
+    std::fs::write(&path, data).expect("write the robot file");
     for repair in [false, true] {
-        if let Ok((scene, _notes)) = urdf::load(path, repair) {
-            scene.check(path).expect("a loaded robot is a valid scene");
+        if let Ok((scene, _notes)) = urdf::load(&path, repair) {
+            scene.check(&path).expect("a loaded robot is a valid scene");
         }
     }
+    let _ = std::fs::remove_dir_all(dir);
 });

@@ -144,6 +144,13 @@ pub(crate) fn rodrigues_coefficients(theta: f64) -> (f64, f64) {
 
 /// [`exp_map`] for an input already known to be finite.
 pub(crate) fn exp_unchecked(phi: &Vector3<f64>) -> Rotation3<f64> {
+    let largest = phi.amax();
+    if largest > 1e150 {
+        // |φ|² and [φ]×² would overflow: Rodrigues on the unit axis u, R = I + sin θ [u]× + (1 − cos θ) [u]×².
+        let (u, theta) = (phi / largest, largest * (phi / largest).norm());
+        let k = skew(&(u / u.norm()));
+        return Rotation3::from_matrix_unchecked(Matrix3::identity() + k * theta.sin() + k * k * (1.0 - theta.cos()));
+    }
     let theta = phi.norm();
     let (a, b) = rodrigues_coefficients(theta);
     let k = skew(phi);
@@ -481,6 +488,21 @@ mod tests {
             orthonormalize_quaternion(&Quaternion::new(0.0, 0.0, 0.0, 0.0)),
             Err(KinematicsError::NotAUnitQuaternion { norm: 0.0 })
         ));
+    }
+
+    #[test]
+    fn exp_of_huge_vectors_is_a_rotation_about_their_axis() {
+        // |φ|² overflows from |φ| ≈ 1.3e154 on; the map must still give the rotation by |φ|.
+        for &s in &[1e154, 1e200, 1e300, f64::MAX] {
+            let r = exp_map(&Vector3::new(s, 0.0, 0.0)).expect("finite");
+            let expected = Rotation3::from_axis_angle(&Vector3::x_axis(), s);
+            assert!((r.matrix() - expected.matrix()).norm() <= 4.0 * EPS, "s = {s}: {r}");
+            let diagonal = Vector3::new(s, -s, s) / 2.0;
+            let r = exp_map(&diagonal).expect("finite");
+            assert!((r.matrix().transpose() * r.matrix() - Matrix3::identity()).norm() <= 8.0 * EPS, "s = {s}");
+            let axis = diagonal.normalize();
+            assert!((r * axis - axis).norm() <= 8.0 * EPS, "s = {s}: the axis moved");
+        }
     }
 
     #[test]

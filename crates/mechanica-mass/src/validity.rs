@@ -239,8 +239,10 @@ pub fn repair(props: &MassProperties, tol: &ValidityTolerance) -> Result<(MassPr
     if props.mass == 0.0 {
         j = Matrix3::zeros();
     }
-    let change_norm = (j - props.inertia_c).norm();
-    let given = props.inertia_c.norm();
+    // Norms of the tensors divided by their largest entry, so that entries near f64::MAX do not
+    // overflow the sum of squares (‖J‖_F/s is within [1, 3]).
+    let s = props.inertia_c.amax().max(j.amax()).max(f64::MIN_POSITIVE);
+    let (change_norm, given) = ((j / s - props.inertia_c / s).norm() * s, (props.inertia_c / s).norm() * s);
     Ok((
         MassProperties { inertia_c: j, ..*props },
         RepairReport {
@@ -363,5 +365,20 @@ mod tests {
         let (fixed, _) = repair(&props(1.0, j), &tol).expect("repairable");
         assert!(check(&fixed, &tol).is_ok());
         assert!(repair(&props(-1.0, diag(1.0, 1.0, 1.0)), &tol).is_err());
+    }
+
+    #[test]
+    fn the_relative_change_of_a_repair_does_not_overflow_for_huge_entries() {
+        // The repair is homogeneous (repair(cJ) = c·repair(J)), so the relative change of a
+        // tensor scaled towards f64::MAX is that of the unscaled one.
+        let tol = ValidityTolerance::default();
+        let mut j = diag(-0.2, 5.0, 2.5);
+        j[(1, 2)] = -2.5;
+        j[(2, 1)] = -2.5;
+        let (_, small) = repair(&props(1.0, j), &tol).expect("repairable");
+        let (fixed, huge) = repair(&props(1.0, j * 1e307), &tol).expect("repairable");
+        assert!(fixed.inertia_c.iter().all(|x| x.is_finite()));
+        assert!(huge.relative_change.is_finite() && small.relative_change > 0.0, "{huge:?}");
+        assert!((huge.relative_change - small.relative_change).abs() <= 1e-14 * small.relative_change);
     }
 }
