@@ -2428,8 +2428,9 @@ mech_status_t mech_tree_jacobian(struct mech_tree_t *tree,
  * The velocity v = ω × (x − c) + ċ (m/s, syllabus 2.13) of the body point at world position
  * `x` (m) in the rigid motion `motion`, written to `velocity_out` (world components).
  *
- * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
- * `motion->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input or a velocity that overflows;
+ * MECH_STATUS_INVALID_ARGUMENT when `motion->rotation` is not a rotation within
+ * ‖RᵀR − I‖_F ≤ 1e-12.
  *
  * # Safety
  * `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
@@ -2446,7 +2447,7 @@ mech_status_t mech_velocity_field(const struct mech_rigid_motion_t *motion,
  * point at world position `x` (m) in the rigid motion `motion`, written to `acceleration_out`
  * (world components).
  *
- * Errors: as mech_velocity_field.
+ * Errors: as mech_velocity_field (for an acceleration that overflows).
  *
  * # Safety
  * `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
@@ -2981,8 +2982,8 @@ mech_status_t mech_mass_mesh_same_connectivity(const double *vertices,
  * in the inertial frame at this instant, moving with centre velocity `com_velocity` (m/s) and
  * angular velocity `omega` (rad/s), both in that frame. Written to `angular_momentum_out`.
  *
- * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0.
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input or a momentum that overflows;
+ * MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0.
  *
  * # Safety
  * The inputs must be readable and `angular_momentum_out` writable.
@@ -3271,7 +3272,8 @@ mech_status_t mech_mechanism_potential(struct mech_mechanism_t *mechanism,
  * do not move).
  *
  * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_BAD_ENUM for an unknown
- * `seek`; MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_NOT_CONVERGED when
+ * `seek`; MECH_STATUS_NON_FINITE for a NaN or infinite input or a potential or gradient that
+ * overflows at the point found; MECH_STATUS_NOT_CONVERGED when
  * the search fails, in which case `q_out` still receives the best point found and
  * `report_out` its gradient norm (potential and last step NaN), so the caller can inspect it.
  *

@@ -62,8 +62,9 @@ unsafe fn read_motion(ptr: *const mech_rigid_motion_t, what: &str) -> Result<Rig
 /// The velocity v = ω × (x − c) + ċ (m/s, syllabus 2.13) of the body point at world position
 /// `x` (m) in the rigid motion `motion`, written to `velocity_out` (world components).
 ///
-/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT when
-/// `motion->rotation` is not a rotation within ‖RᵀR − I‖_F ≤ 1e-12.
+/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input or a velocity that overflows;
+/// MECH_STATUS_INVALID_ARGUMENT when `motion->rotation` is not a rotation within
+/// ‖RᵀR − I‖_F ≤ 1e-12.
 ///
 /// # Safety
 /// `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
@@ -78,8 +79,10 @@ pub unsafe extern "C" fn mech_velocity_field(
         // SAFETY: caller's contract.
         let (m, x) = unsafe { (read_motion(motion, "motion")?, read_vec3(x, "x")?) };
         let out = Out::new(velocity_out, "velocity_out")?;
+        let v = m.velocity_at(&x);
+        finite(&[v.x, v.y, v.z][..], "velocity (overflow)")?;
         // SAFETY: caller's contract.
-        unsafe { out.write(m.velocity_at(&x).into()) };
+        unsafe { out.write(v.into()) };
         Ok(())
     })
 }
@@ -88,7 +91,7 @@ pub unsafe extern "C" fn mech_velocity_field(
 /// point at world position `x` (m) in the rigid motion `motion`, written to `acceleration_out`
 /// (world components).
 ///
-/// Errors: as mech_velocity_field.
+/// Errors: as mech_velocity_field (for an acceleration that overflows).
 ///
 /// # Safety
 /// `motion` must point to a readable mech_rigid_motion_t, `x` to a readable mech_vec3_t and
@@ -103,8 +106,10 @@ pub unsafe extern "C" fn mech_acceleration_field(
         // SAFETY: caller's contract.
         let (m, x) = unsafe { (read_motion(motion, "motion")?, read_vec3(x, "x")?) };
         let out = Out::new(acceleration_out, "acceleration_out")?;
+        let a = m.acceleration_at(&x);
+        finite(&[a.x, a.y, a.z][..], "acceleration (overflow)")?;
         // SAFETY: caller's contract.
-        unsafe { out.write(m.acceleration_at(&x).into()) };
+        unsafe { out.write(a.into()) };
         Ok(())
     })
 }

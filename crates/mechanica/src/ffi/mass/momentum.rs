@@ -12,8 +12,8 @@ use crate::ffi::validate::*;
 /// in the inertial frame at this instant, moving with centre velocity `com_velocity` (m/s) and
 /// angular velocity `omega` (rad/s), both in that frame. Written to `angular_momentum_out`.
 ///
-/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0.
+/// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input or a momentum that overflows;
+/// MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0.
 ///
 /// # Safety
 /// The inputs must be readable and `angular_momentum_out` writable.
@@ -38,6 +38,7 @@ pub unsafe extern "C" fn mech_mass_angular_momentum(
         };
         let out = Out::new(angular_momentum_out, "angular_momentum_out")?;
         let d = props.angular_momentum_about(&a, &v, &w);
+        finite(&[d.x, d.y, d.z][..], "angular momentum (overflow)")?;
         // SAFETY: caller's contract.
         unsafe { out.write(d.into()) };
         Ok(())
