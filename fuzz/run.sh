@@ -4,6 +4,8 @@
 #   fuzz/run.sh TARGET SECONDS [libFuzzer options...]
 #   fuzz/run.sh build            # only build every target
 #   fuzz/run.sh list             # the target names
+#   fuzz/run.sh ci SECONDS       # CI: replay every committed corpus, then SECONDS per target
+#                                # from seed 1 (deterministic: a slower machine runs a prefix)
 #
 # The corpus grows in fuzz/corpus/TARGET (the committed seeds plus what the run finds; commit
 # only small, interesting additions); crashes are written to fuzz/artifacts/TARGET/. Each run
@@ -32,8 +34,41 @@ case "${1:-}" in
         build
         exit 0
         ;;
+    ci)
+        seconds="${2:?usage: fuzz/run.sh ci SECONDS}"
+        build
+        failed=()
+        for target in "${targets[@]}"; do
+            binary="$CARGO_TARGET_DIR/release/$target"
+            artifacts="$here/artifacts/$target"
+            scratch="$CARGO_TARGET_DIR/ci-corpus/$target"
+            log="$CARGO_TARGET_DIR/ci-$target.log"
+            rm -rf "$scratch"
+            mkdir -p "$artifacts" "$scratch"
+            # -runs=0 runs every input of the committed corpus once and stops; then the
+            # exploration starts from that corpus with a fixed seed.
+            if "$binary" -runs=0 -rss_limit_mb=2048 -timeout=20 -artifact_prefix="$artifacts/" \
+                "$here/corpus/$target" > "$log" 2>&1 &&
+                "$binary" -seed=1 -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=20 \
+                    -max_len="${FUZZ_MAX_LEN:-65536}" -print_final_stats=1 -artifact_prefix="$artifacts/" \
+                    "$scratch" "$here/corpus/$target" >> "$log" 2>&1; then
+                runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+                found=$(sed -n 's/^stat::new_units_added: *//p' "$log" | tail -n 1)
+                echo "$target: corpus replayed, then $runs inputs in ${seconds} s ($found new), no crash"
+            else
+                tail -n 40 "$log"
+                failed+=("$target")
+            fi
+        done
+        if [ ${#failed[@]} -gt 0 ]; then
+            echo "fuzzing found crashes in: ${failed[*]} (inputs in fuzz/artifacts/)"
+            exit 1
+        fi
+        echo "fuzzing: ${#targets[@]} targets, corpus replayed and ${seconds} s each, no crash"
+        exit 0
+        ;;
     "" | -h | --help)
-        sed -n '2,12p' "$0"
+        sed -n '2,14p' "$0"
         exit 2
         ;;
 esac

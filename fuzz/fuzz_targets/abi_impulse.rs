@@ -86,6 +86,11 @@ struct Body {
     raw: mech_impulse_body_t,
     mass: f64,
     inertia: [f64; 9],
+    /// Whether every principal moment is well above the 1e-12·max below which the C ABI's
+    /// pseudo-inverse locks the axis (documented: exact only for impulses through that axis,
+    /// the work on a locked rotation being the work done on its driver): only then is
+    /// ½ m v² + ½ ωᵀJω the energy the library accounts for.
+    energy_known: bool,
 }
 
 impl Body {
@@ -111,7 +116,12 @@ fn body(input: &mut Input) -> Option<Body> {
         assert!(out.untouched());
         return None;
     }
-    Some(Body { raw: out.value, mass: p.mass, inertia: p.inertia_about_com.m })
+    let j = p.inertia_about_com.m;
+    let trace = j[0] + j[4] + j[8];
+    let det = j[0] * (j[4] * j[8] - j[7] * j[5]) - j[3] * (j[1] * j[8] - j[7] * j[2]) + j[6] * (j[1] * j[5] - j[4] * j[2]);
+    // det ≥ λ_min·(trace/3)²·… : det > 1e-6·(trace/3)³ keeps λ_min above 1e-6·trace/3.
+    let energy_known = trace > 0.0 && det > 1e-6 * (trace / 3.0).powi(3);
+    Some(Body { raw: out.value, mass: p.mass, inertia: j, energy_known })
 }
 
 /// An impulse on a free body: m ΔV = S and the energy change of (7.107).
@@ -133,10 +143,17 @@ fn apply(input: &mut Input) {
     }
     let direct = b.energy(v, w) - b.energy_before();
     let scale = b.energy(v, w) + b.energy_before();
-    if !scale.is_finite() {
+    if !scale.is_finite() || !b.energy_known {
         return; // the energies overflow here, not in the library
     }
-    assert!((direct - out.value.energy_change).abs() <= 1e-9 * scale + 1e-300, "ΔT {} vs {direct}", out.value.energy_change);
+    assert!(
+        (direct - out.value.energy_change).abs() <= 1e-9 * scale + 1e-300,
+        "ΔT {} vs {direct}: mass {}, J {:?}, S {s:?} at {point:?}, moment {moment:?}, v {v0:?}, ω {:?} → v {v:?}, ω {w:?}",
+        out.value.energy_change,
+        b.mass,
+        b.inertia,
+        arr(&b.raw.angular_velocity)
+    );
 }
 
 /// Fixing a point stops it and never gains energy.
@@ -152,7 +169,7 @@ fn fix(input: &mut Input) {
     let (v, w) = (arr(&out.value.velocity_after), arr(&out.value.angular_velocity_after));
     let before = b.energy_before();
     let after = b.energy(v, w);
-    if !(before + after).is_finite() {
+    if !(before + after).is_finite() || !b.energy_known {
         return;
     }
     assert!(after - before <= 1e-9 * before, "fixing a point gained {} of {before}", after - before);
@@ -194,7 +211,7 @@ fn contact(input: &mut Input) {
     }
     let before = b1.energy_before() + b2.energy_before();
     let after = b1.energy(v1, w1) + b2.energy(v2, w2);
-    if !(before + after).is_finite() {
+    if !(before + after).is_finite() || !b1.energy_known || !b2.energy_known {
         return;
     }
     let direct = after - before;
@@ -276,9 +293,12 @@ fn mechanism(input: &mut Input) {
 /// ΔT of an impulse equals ½(q̇+Δq̇)ᵀA(q̇+Δq̇) − ½q̇ᵀAq̇ with A from mech_tree_mass_matrix.
 fn check_impulse_energy(tree: &mechanica_fuzz::tree::OwnedTree, bodies: &[mech_mass_properties_t], dq: &[f64], r: &mech_mechanism_response_t) {
     let n = tree.dof;
+    if n == 0 {
+        return; // mech_tree_mass_matrix refuses n = 0 (BAD_DIMENSION)
+    }
     let mut a = vec![0.0; n * n];
     let status = unsafe { mech_tree_mass_matrix(tree.handle, bodies.as_ptr(), bodies.len(), a.as_mut_ptr(), n) };
-    assert_eq!(status, MECH_STATUS_OK, "an impulse was solved without a mass matrix");
+    assert_eq!(status, MECH_STATUS_OK, "an impulse was solved without a mass matrix: {}", mechanica_fuzz::oracle::last_error());
     let mut energy = 0.0;
     let mut momenta = vec![0.0; n];
     let status = unsafe { mech_tree_kinetic_energy(tree.handle, bodies.as_ptr(), bodies.len(), &mut energy, momenta.as_mut_ptr(), n) };

@@ -10,7 +10,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use mechanica::ffi::*;
-use mechanica_fuzz::Input;
+use mechanica_fuzz::{Input, trace};
 use mechanica_fuzz::oracle::{Sentinel, check_outputs, check_status, doubles_untouched, sentinel_doubles};
 use mechanica_fuzz::tree::{OwnedTree, body_properties, build_tree, v3};
 
@@ -52,12 +52,14 @@ fn load(m: &mut Mechanism, bodies: usize, input: &mut Input) {
         0 => {
             let g = vec_or(input, 10.0);
             weigh(&v3([(g.x.abs() + g.y.abs() + g.z.abs()) * mass, 0.0, 0.0]), 1);
+            trace!("set_gravity({g:?})");
             ("mech_mechanism_set_gravity", unsafe { mech_mechanism_set_gravity(h, g) })
         }
         1 => {
             let axis = if input.u8() < 224 { v3(input.unit_vec3()) } else { vec_or(input, 1.0) };
             let rate = any_or(input, 3.0);
             weigh(&v3([rate * rate * mass, 0.0, 0.0]), 2);
+            trace!("set_rotating_frame({axis:?}, {rate:e})");
             let status = unsafe { mech_mechanism_set_rotating_frame(h, axis, rate) };
             m.rotating |= status == MECH_STATUS_OK;
             ("mech_mechanism_set_rotating_frame", status)
@@ -66,6 +68,7 @@ fn load(m: &mut Mechanism, bodies: usize, input: &mut Input) {
             let coordinate = input.below(m.n + 1);
             let (k, rest) = (any_or(input, 50.0), any_or(input, 1.0));
             weigh(&v3([k * (1.0 + rest.abs()).powi(2), 0.0, 0.0]), 2);
+            trace!("add_joint_spring({coordinate}, {k:e}, {rest:e})");
             ("mech_mechanism_add_joint_spring", unsafe { mech_mechanism_add_joint_spring(h, coordinate, k, rest) })
         }
         3 => {
@@ -74,6 +77,7 @@ fn load(m: &mut Mechanism, bodies: usize, input: &mut Input) {
             let (k, rest) = (any_or(input, 50.0), any_or(input, 1.0));
             let reach = 1.0 + rest.abs() + pa.x.abs() + pa.y.abs() + pa.z.abs() + pb.x.abs() + pb.y.abs() + pb.z.abs();
             weigh(&v3([k * reach * reach, 0.0, 0.0]), 2);
+            trace!("add_point_spring({a}, {pa:?}, {b}, {pb:?}, {k:e}, {rest:e})");
             let status = unsafe { mech_mechanism_add_point_spring(h, a, pa, b, pb, k, rest) };
             ("mech_mechanism_add_point_spring", status)
         }
@@ -82,11 +86,13 @@ fn load(m: &mut Mechanism, bodies: usize, input: &mut Input) {
             let (point, force) = (vec_or(input, 1.0), vec_or(input, 10.0));
             weigh(&force, 1);
             weigh(&v3([(force.x.abs() + force.y.abs() + force.z.abs()) * (point.x.abs() + point.y.abs() + point.z.abs()), 0.0, 0.0]), 0);
+            trace!("add_force({body}, {point:?}, {force:?})");
             ("mech_mechanism_add_force", unsafe { mech_mechanism_add_force(h, body, point, force) })
         }
         _ => {
             let coordinate = input.below(m.n + 1);
             let (lo, hi) = (any_or(input, 3.0), any_or(input, 3.0));
+            trace!("set_limits({coordinate}, {lo:e}, {hi:e})");
             let status = unsafe { mech_mechanism_set_limits(h, coordinate, lo, hi) };
             m.limited |= status == MECH_STATUS_OK;
             ("mech_mechanism_set_limits", status)
@@ -196,7 +202,11 @@ fn equilibrium(m: &Mechanism, q0: &[f64], input: &mut Input) {
         return;
     }
     let r = report.value;
-    assert!(q.iter().all(|v| v.is_finite()) && r.potential.is_finite() && r.gradient_norm.is_finite(), "non-finite equilibrium");
+    assert!(
+        q.iter().all(|v| v.is_finite()) && r.potential.is_finite() && r.gradient_norm.is_finite(),
+        "non-finite equilibrium from q0 = {q0:?}: q = {q:?}, U* = {}, ‖∇U*‖ = {}, tolerance {}",
+        r.potential, r.gradient_norm, r.tolerance
+    );
     assert!(r.gradient_norm <= r.tolerance, "converged with ‖∇U*‖ = {} above its tolerance {}", r.gradient_norm, r.tolerance);
     let Some((value, gradient, _)) = potential(m, &q) else { return };
     let scale = value.abs() + 1e-300;
@@ -214,6 +224,7 @@ fuzz_target!(|data: &[u8]| {
     let mut input = Input::new(data);
     let Some(tree) = build_tree(&mut input) else { return };
     let bodies: Vec<mech_mass_properties_t> = (0..tree.bodies).map(|_| body_properties(&mut input)).collect();
+    trace!("tree: {} bodies, {} coordinates; bodies {bodies:?}", tree.bodies, tree.dof);
     let claimed = if input.u8() < 240 { bodies.len() } else { input.below(6) };
     let mut handle = std::ptr::null_mut();
     let status = unsafe { mech_mechanism_create(tree.handle, bodies.as_ptr(), claimed.min(bodies.len()), &mut handle) };

@@ -25,6 +25,20 @@ pub const AWKWARD: [f64; 20] = [
     std::f64::consts::PI,
 ];
 
+/// The largest finite magnitude [`Input::any_f64`] produces: `FUZZ_MAX_MAGNITUDE` from the
+/// environment (e.g. `1e100`, so that products of a few inputs cannot overflow), or
+/// `f64::MAX` when it is not set.
+pub fn magnitude_cap() -> f64 {
+    static CAP: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+    *CAP.get_or_init(|| {
+        std::env::var("FUZZ_MAX_MAGNITUDE")
+            .ok()
+            .and_then(|v| v.parse::<f64>().ok())
+            .filter(|c| *c > 0.0)
+            .unwrap_or(f64::MAX)
+    })
+}
+
 /// A cursor over the fuzzer's bytes.
 pub struct Input<'a> {
     bytes: &'a [u8],
@@ -72,14 +86,17 @@ impl<'a> Input<'a> {
     }
 
     /// Any double: one of [`AWKWARD`], a raw bit pattern, or a small decimal m·10^e with
-    /// |m| < 2^15 and |e| ≤ 40, chosen by the first byte.
+    /// |m| < 2^15 and |e| ≤ 40, chosen by the first byte. Finite values above
+    /// [`magnitude_cap`] are clamped to it (NaN, ±∞ and subnormals pass).
     pub fn any_f64(&mut self) -> f64 {
         let selector = self.u8();
-        match selector % 8 {
+        let x = match selector % 8 {
             0 => AWKWARD[usize::from(selector / 8) % AWKWARD.len()],
             1 => f64::from_bits(self.u64()),
             _ => self.decimal(40),
-        }
+        };
+        let cap = magnitude_cap();
+        if x.is_finite() && x.abs() > cap { cap.copysign(x) } else { x }
     }
 
     /// A finite double of moderate size: m·10^e with |m| < 2^15 and |e| ≤ `max_exponent`.

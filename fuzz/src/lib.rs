@@ -15,4 +15,21 @@ pub mod oracle;
 pub mod tree;
 
 pub use input::Input;
+
+/// Whether `MECH_FUZZ_TRACE` is set: targets then print the calls they make (to reproduce a
+/// crash as a plain test).
+pub fn tracing() -> bool {
+    static TRACING: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *TRACING.get_or_init(|| std::env::var_os("MECH_FUZZ_TRACE").is_some())
+}
+
+/// `eprintln!` when [`tracing`].
+#[macro_export]
+macro_rules! trace {
+    ($($arg:tt)*) => {
+        if $crate::tracing() {
+            eprintln!($($arg)*);
+        }
+    };
+}
 pub use oracle::{Sentinel, check_status, finite, rel_close};

@@ -38,6 +38,7 @@ pub fn build_tree(input: &mut Input) -> Option<OwnedTree> {
         let axis = v3(input.unit_vec3());
         let rotation = mech_mat3_t { m: rotation_of(input.unit_quaternion()) };
         let translation = v3(input.vec3_moderate(1.0));
+        crate::trace!("add_body(parent {parent}, joint {joint}, axis {axis:?}, R {:?}, t {translation:?})", rotation.m);
         let mut body = 0usize;
         // SAFETY: all pointers are to live locals; the handle is live.
         let status = unsafe { mech_tree_add_body(handle, parent, joint, &axis, &rotation, &translation, &mut body) };

@@ -178,3 +178,43 @@ pub unsafe extern "C" fn mech_relative_motion_decompose(
         Ok(())
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: f64, y: f64, z: f64) -> mech_vec3_t {
+        mech_vec3_t { x, y, z }
+    }
+
+    #[test]
+    fn a_velocity_or_acceleration_that_overflows_is_an_error_and_writes_nothing() {
+        // ω × (x − c) with |ω| = |x − c| = 1e200 is 1e400: finite inputs, no finite result.
+        let motion = mech_rigid_motion_t {
+            rotation: mech_mat3_t { m: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] },
+            c: v(0.0, 0.0, 0.0),
+            c_dot: v(0.0, 0.0, 0.0),
+            c_ddot: v(0.0, 0.0, 0.0),
+            omega: v(0.0, 0.0, 1e200),
+            omega_dot: v(0.0, 0.0, 0.0),
+        };
+        let x = v(1e200, 0.0, 0.0);
+        let sentinel = v(7.0, 7.0, 7.0);
+        let (mut velocity, mut acceleration) = (sentinel, sentinel);
+        // SAFETY: all pointers are to live locals.
+        let (s1, s2) = unsafe {
+            (
+                mech_velocity_field(&motion, &x, &mut velocity),
+                mech_acceleration_field(&motion, &x, &mut acceleration),
+            )
+        };
+        assert_eq!((s1, s2), (MECH_STATUS_NON_FINITE, MECH_STATUS_NON_FINITE));
+        assert_eq!((velocity, acceleration), (sentinel, sentinel));
+        // With |ω| = 1e100 the velocity ω × x = (0, 1e300, 0) is finite and is written.
+        let slow = mech_rigid_motion_t { omega: v(0.0, 0.0, 1e100), ..motion };
+        // SAFETY: as above.
+        let s = unsafe { mech_velocity_field(&slow, &x, &mut velocity) };
+        assert_eq!(s, MECH_STATUS_OK);
+        assert_eq!(velocity.y, 1e300);
+    }
+}

@@ -87,3 +87,31 @@ pub unsafe extern "C" fn mech_mass_kinetic_energy(
         Ok(())
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_angular_momentum_that_overflows_is_an_error_and_writes_nothing() {
+        let body = mech_mass_properties_t {
+            mass: 1e300,
+            center_of_mass: mech_vec3_t { x: 1.0, y: 0.0, z: 0.0 },
+            inertia_about_com: mech_mat3_t { m: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] },
+        };
+        let origin = mech_vec3_t { x: 0.0, y: 0.0, z: 0.0 };
+        let fast = mech_vec3_t { x: 0.0, y: 1e100, z: 0.0 };
+        let sentinel = mech_vec3_t { x: 7.0, y: 7.0, z: 7.0 };
+        let mut d = sentinel;
+        // (c − a) × m v = x̂ × 1e400 ŷ overflows.
+        // SAFETY: all pointers are to live locals.
+        let status = unsafe { mech_mass_angular_momentum(&body, &origin, &fast, &origin, &mut d) };
+        assert_eq!(status, MECH_STATUS_NON_FINITE);
+        assert_eq!(d, sentinel);
+        let slow = mech_vec3_t { x: 0.0, y: 1.0, z: 0.0 };
+        // SAFETY: as above.
+        let status = unsafe { mech_mass_angular_momentum(&body, &origin, &slow, &origin, &mut d) };
+        assert_eq!(status, MECH_STATUS_OK);
+        assert_eq!(d.z, 1e300);
+    }
+}
