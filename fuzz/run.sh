@@ -21,6 +21,17 @@ export CARGO_INCREMENTAL=0
 export RUSTC_WRAPPER="$here/sancov-rustc"
 unset RUSTFLAGS
 
+# Whether a panic message matches a line of known-findings.txt.
+known_finding() {
+    local message="$1" pattern
+    [ -n "$message" ] || return 1
+    while IFS= read -r pattern; do
+        [[ -z "$pattern" || "$pattern" == \#* ]] && continue
+        [[ "$message" =~ $pattern ]] && return 0
+    done < "$here/known-findings.txt"
+    return 1
+}
+
 build() {
     cargo build --manifest-path "$here/Cargo.toml" --release --locked --bins
 }
@@ -42,22 +53,42 @@ case "${1:-}" in
             binary="$CARGO_TARGET_DIR/release/$target"
             artifacts="$here/artifacts/$target"
             scratch="$CARGO_TARGET_DIR/ci-corpus/$target"
+            found="$CARGO_TARGET_DIR/ci-crashes/$target"
             log="$CARGO_TARGET_DIR/ci-$target.log"
-            rm -rf "$scratch"
-            mkdir -p "$artifacts" "$scratch"
-            # -runs=0 runs every input of the committed corpus once and stops; then the
-            # exploration starts from that corpus with a fixed seed.
-            if "$binary" -runs=0 -rss_limit_mb=2048 -timeout=20 -artifact_prefix="$artifacts/" \
-                "$here/corpus/$target" > "$log" 2>&1 &&
-                "$binary" -seed=1 -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=20 \
-                    -max_len="${FUZZ_MAX_LEN:-65536}" -print_final_stats=1 -artifact_prefix="$artifacts/" \
-                    "$scratch" "$here/corpus/$target" >> "$log" 2>&1; then
-                runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
-                found=$(sed -n 's/^stat::new_units_added: *//p' "$log" | tail -n 1)
-                echo "$target: corpus replayed, then $runs inputs in ${seconds} s ($found new), no crash"
-            else
+            rm -rf "$scratch" "$found"
+            mkdir -p "$artifacts" "$scratch" "$found"
+            # 1. Every committed input once (-runs=0 stops after reading the corpus): the seeds
+            #    and the regressions must pass, known findings or not.
+            if ! "$binary" -runs=0 -rss_limit_mb=2048 -timeout=20 -artifact_prefix="$artifacts/" \
+                "$here/corpus/$target" > "$log" 2>&1; then
                 tail -n 40 "$log"
+                failed+=("$target (committed corpus)")
+                continue
+            fi
+            # 2. Exploration from seed 1, collecting crashes instead of stopping at the first.
+            explored=0
+            "$binary" -fork=1 -ignore_crashes=1 -ignore_ooms=0 -ignore_timeouts=0 -seed=1 \
+                -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=20 -max_len="${FUZZ_MAX_LEN:-65536}" \
+                -artifact_prefix="$found/" "$scratch" "$here/corpus/$target" >> "$log" 2>&1 || explored=$?
+            new=0
+            known=0
+            for crash in "$found"/*; do
+                [ -e "$crash" ] || continue
+                message=$("$binary" "$crash" 2>&1 | grep -A1 'panicked at' | sed -n 2p || true)
+                if known_finding "$message"; then
+                    known=$((known + 1))
+                    echo "$target: known finding: ${message:0:160}"
+                else
+                    new=$((new + 1))
+                    cp "$crash" "$artifacts/"
+                    echo "$target: NEW crash $(basename "$crash"): ${message:-$(basename "$crash")}"
+                fi
+            done
+            if [ "$new" -gt 0 ] || { [ "$explored" -ne 0 ] && [ "$known" -eq 0 ]; }; then
+                tail -n 20 "$log"
                 failed+=("$target")
+            else
+                echo "$target: corpus replayed, then ${seconds} s from seed 1: $known known finding(s), no new crash"
             fi
         done
         if [ ${#failed[@]} -gt 0 ]; then

@@ -11,7 +11,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use mechanica::ffi::*;
-use mechanica_fuzz::Input;
+use mechanica_fuzz::{Input, trace};
 use mechanica_fuzz::oracle::{Sentinel, check_status, doubles_untouched, sentinel_doubles};
 
 const MAX_ORDER: usize = 8;
@@ -168,6 +168,7 @@ fn finite_omega(s: &Solved) -> Vec<(f64, f64)> {
 fn spectra_agree(what: &str, x: &[(f64, f64)], y: &[(f64, f64)]) {
     for ((w1, e1), (w2, e2)) in x.iter().zip(y) {
         let allowed = 2.0 * (e1 + e2) + 1e-13 * (w1.abs() + w2.abs());
+        trace!("{what}: {x:?} vs {y:?}");
         assert!((w1 - w2).abs() <= allowed, "{what}: ω² {w1} vs {w2} (bounds {e1:e}, {e2:e})");
     }
 }
@@ -181,6 +182,7 @@ fn dense(input: &mut Input) {
         order.swap(i, input.below(i + 1));
     }
     let q = p.permuted(&order);
+    trace!("pencil n = {}: A = {:?}, B = {:?}, permutation {order:?}", p.n, p.a, p.b);
     if let Some(second) = solve(&q, input) {
         let (x, y) = (finite_omega(&first), finite_omega(&second));
         if x.len() == y.len() {
