@@ -8,14 +8,18 @@
 
 use libfuzzer_sys::fuzz_target;
 use mechanica::ffi::*;
-use mechanica_fuzz::{Input, trace};
 use mechanica_fuzz::input::{mat_vec, rotation_of};
 use mechanica_fuzz::oracle::{Sentinel, check_outputs, check_status, doubles_of, doubles_untouched, sentinel_doubles};
+use mechanica_fuzz::{Input, trace};
 
 const MAX_BODIES: usize = 8;
 
 fn v3(a: [f64; 3]) -> mech_vec3_t {
-    mech_vec3_t { x: a[0], y: a[1], z: a[2] }
+    mech_vec3_t {
+        x: a[0],
+        y: a[1],
+        z: a[2],
+    }
 }
 
 fn arr(v: &mech_vec3_t) -> [f64; 3] {
@@ -40,13 +44,17 @@ fn orthonormality(r: &[f64; 9]) -> (f64, f64) {
             worst = worst.max((dot - if i == j { 1.0 } else { 0.0 }).abs());
         }
     }
-    let det = r[0] * (r[4] * r[8] - r[7] * r[5]) - r[3] * (r[1] * r[8] - r[7] * r[2]) + r[6] * (r[1] * r[5] - r[4] * r[2]);
+    let det =
+        r[0] * (r[4] * r[8] - r[7] * r[5]) - r[3] * (r[1] * r[8] - r[7] * r[2]) + r[6] * (r[1] * r[5] - r[4] * r[2]);
     (worst, det)
 }
 
 fn assert_rotation(call: &str, r: &[f64; 9]) {
     let (error, det) = orthonormality(r);
-    assert!(error <= 1e-12 && (det - 1.0).abs() <= 1e-12, "{call}: not a rotation (‖RᵀR − I‖ = {error:e}, det = {det})");
+    assert!(
+        error <= 1e-12 && (det - 1.0).abs() <= 1e-12,
+        "{call}: not a rotation (‖RᵀR − I‖ = {error:e}, det = {det})"
+    );
 }
 
 /// Rotation from Euler angles, then back to angles and forward again: the same rotation.
@@ -71,7 +79,10 @@ fn euler_round_trip(input: &mut Input) {
     let status = unsafe { mech_rotation_from_euler(sequence, back.as_ptr(), again.ptr()) };
     check_status("mech_rotation_from_euler", status);
     let gap = distance(&r.value.m, &again.value.m);
-    assert!(gap <= 1e-9, "Euler round trip of {angles:?} (sequence {sequence}) is off by {gap:e}");
+    assert!(
+        gap <= 1e-9,
+        "Euler round trip of {angles:?} (sequence {sequence}) is off by {gap:e}"
+    );
 }
 
 /// Rotation → quaternion → rotation, and rotation vector → rotation → rotation vector.
@@ -79,7 +90,12 @@ fn quaternion_and_log_round_trips(input: &mut Input) {
     let matrix = m3(input.mat3());
     let mut q = Sentinel::<mech_quat_t>::new();
     let status = unsafe { mech_quat_from_rotation_matrix(&matrix, q.ptr()) };
-    check_outputs("mech_quat_from_rotation_matrix", status, q.untouched(), doubles_of(&q.value));
+    check_outputs(
+        "mech_quat_from_rotation_matrix",
+        status,
+        q.untouched(),
+        doubles_of(&q.value),
+    );
     if status == MECH_STATUS_OK {
         assert!(q.value.w >= 0.0, "quaternion with w < 0");
         let mut r = Sentinel::<mech_mat3_t>::new();
@@ -106,13 +122,24 @@ fn quaternion_and_log_round_trips(input: &mut Input) {
     let status = unsafe { mech_rotation_exp(&log.value, again.ptr()) };
     check_status("mech_rotation_exp", status);
     let gap = distance(&r.value.m, &again.value.m);
-    assert!(gap <= 1e-11, "exp(log(exp(φ))) differs from exp(φ) by {gap:e} for φ = {phi:?}");
+    assert!(
+        gap <= 1e-11,
+        "exp(log(exp(φ))) differs from exp(φ) by {gap:e} for φ = {phi:?}"
+    );
 }
 
 /// Axis-angle equals exp(angle·axis); the polar factor is a rotation at the stated distance.
 fn axis_angle_and_orthonormalize(input: &mut Input) {
-    let axis = if input.bool() { input.unit_vec3() } else { input.vec3_any() };
-    let angle = if input.bool() { input.moderate(10.0) } else { input.any_f64() };
+    let axis = if input.bool() {
+        input.unit_vec3()
+    } else {
+        input.vec3_any()
+    };
+    let angle = if input.bool() {
+        input.moderate(10.0)
+    } else {
+        input.any_f64()
+    };
     let mut r = Sentinel::<mech_mat3_t>::new();
     let status = unsafe { mech_rotation_from_axis_angle(&v3(axis), angle, r.ptr()) };
     check_outputs("mech_rotation_from_axis_angle", status, r.untouched(), &r.value.m);
@@ -121,7 +148,10 @@ fn axis_angle_and_orthonormalize(input: &mut Input) {
         let status = unsafe { mech_rotation_exp(&v3(axis.map(|c| c * angle)), e.ptr()) };
         assert_eq!(status, MECH_STATUS_OK);
         let gap = distance(&r.value.m, &e.value.m);
-        assert!(gap <= 1e-12 * (1.0 + angle.abs()), "axis-angle and exp differ by {gap:e}");
+        assert!(
+            gap <= 1e-12 * (1.0 + angle.abs()),
+            "axis-angle and exp differ by {gap:e}"
+        );
     }
     let matrix = input.mat3();
     let mut polar = Sentinel::<mech_mat3_t>::new();
@@ -134,7 +164,12 @@ fn axis_angle_and_orthonormalize(input: &mut Input) {
     if status == MECH_STATUS_OK {
         trace!("orthonormalize({matrix:?}) = {:?}", polar.value.m);
         assert_rotation("mech_rotation_orthonormalize", &polar.value.m);
-        let frobenius = matrix.iter().zip(&polar.value.m).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
+        let frobenius = matrix
+            .iter()
+            .zip(&polar.value.m)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt();
         let scale = matrix.iter().map(|a| a * a).sum::<f64>().sqrt();
         assert!(
             (frobenius - correction.value).abs() <= 1e-10 * (scale + 1.0),
@@ -151,24 +186,42 @@ fn euler_rates(input: &mut Input) {
     let angles = input.vec3_any();
     let rates = input.vec3_any();
     let mut omega = Sentinel::<mech_vec3_t>::new();
-    let status = unsafe { mech_angular_velocity_from_euler_rates(sequence, angles.as_ptr(), rates.as_ptr(), frame, omega.ptr()) };
-    check_outputs("mech_angular_velocity_from_euler_rates", status, omega.untouched(), doubles_of(&omega.value));
+    let status = unsafe {
+        mech_angular_velocity_from_euler_rates(sequence, angles.as_ptr(), rates.as_ptr(), frame, omega.ptr())
+    };
+    check_outputs(
+        "mech_angular_velocity_from_euler_rates",
+        status,
+        omega.untouched(),
+        doubles_of(&omega.value),
+    );
     if status != MECH_STATUS_OK {
         return;
     }
     let mut back = sentinel_doubles(3);
-    let status = unsafe { mech_euler_rates_from_angular_velocity(sequence, angles.as_ptr(), &omega.value, frame, back.as_mut_ptr()) };
-    check_outputs("mech_euler_rates_from_angular_velocity", status, doubles_untouched(&back), &back);
+    let status = unsafe {
+        mech_euler_rates_from_angular_velocity(sequence, angles.as_ptr(), &omega.value, frame, back.as_mut_ptr())
+    };
+    check_outputs(
+        "mech_euler_rates_from_angular_velocity",
+        status,
+        doubles_untouched(&back),
+        &back,
+    );
     if status != MECH_STATUS_OK {
         return;
     }
     let mut again = Sentinel::<mech_vec3_t>::new();
-    let status = unsafe { mech_angular_velocity_from_euler_rates(sequence, angles.as_ptr(), back.as_ptr(), frame, again.ptr()) };
+    let status =
+        unsafe { mech_angular_velocity_from_euler_rates(sequence, angles.as_ptr(), back.as_ptr(), frame, again.ptr()) };
     check_status("mech_angular_velocity_from_euler_rates", status);
     if status == MECH_STATUS_OK {
         let scale = back.iter().map(|c| c.abs()).sum::<f64>() + arr(&omega.value).iter().map(|c| c.abs()).sum::<f64>();
         let gap = distance(doubles_of(&omega.value), doubles_of(&again.value));
-        assert!(gap <= 1e-12 * scale + 1e-300, "ω → rates → ω is off by {gap:e} (scale {scale:e})");
+        assert!(
+            gap <= 1e-12 * scale + 1e-300,
+            "ω → rates → ω is off by {gap:e} (scale {scale:e})"
+        );
     }
 }
 
@@ -192,7 +245,12 @@ fn fields(input: &mut Input) {
     let (xi, xi_dot, xi_ddot) = (v3(input.vec3_any()), v3(input.vec3_any()), v3(input.vec3_any()));
     let mut d = Sentinel::<mech_relative_decomposition_t>::new();
     let status = unsafe { mech_relative_motion_decompose(&motion, &xi, &xi_dot, &xi_ddot, d.ptr()) };
-    check_outputs("mech_relative_motion_decompose", status, d.untouched(), doubles_of(&d.value));
+    check_outputs(
+        "mech_relative_motion_decompose",
+        status,
+        d.untouched(),
+        doubles_of(&d.value),
+    );
 
     let r = rotation_of(input.unit_quaternion());
     let w = input.vec3_moderate(100.0);
@@ -204,10 +262,18 @@ fn fields(input: &mut Input) {
     }
     let mut omega = Sentinel::<mech_vec3_t>::new();
     let status = unsafe { mech_angular_velocity_from_rate(&m3(r), &m3(rate), omega.ptr()) };
-    check_outputs("mech_angular_velocity_from_rate", status, omega.untouched(), doubles_of(&omega.value));
+    check_outputs(
+        "mech_angular_velocity_from_rate",
+        status,
+        omega.untouched(),
+        doubles_of(&omega.value),
+    );
     assert_eq!(status, MECH_STATUS_OK, "a rotation from a unit quaternion was refused");
     let gap = distance(&arr(&omega.value), &w);
-    assert!(gap <= 1e-12 * (1.0 + w.iter().map(|c| c.abs()).sum::<f64>()), "ω from Ṙ = [ω]×R is off by {gap:e}");
+    assert!(
+        gap <= 1e-12 * (1.0 + w.iter().map(|c| c.abs()).sum::<f64>()),
+        "ω from Ṙ = [ω]×R is off by {gap:e}"
+    );
 }
 
 /// One tree handle driven by the input; dropped (destroyed) at the end.
@@ -233,7 +299,15 @@ impl Tree {
         let mut handle = std::ptr::null_mut();
         let status = unsafe { mech_tree_create(&mut handle) };
         assert_eq!(status, MECH_STATUS_OK);
-        Tree { handle, bodies: 0, finalized: false, dof: 0, q_dot: None, base_moving: false, reach: 0.0 }
+        Tree {
+            handle,
+            bodies: 0,
+            finalized: false,
+            dof: 0,
+            q_dot: None,
+            base_moving: false,
+            reach: 0.0,
+        }
     }
 
     fn add_body(&mut self, input: &mut Input) {
@@ -242,11 +316,29 @@ impl Tree {
         }
         let parent = input.below(self.bodies + 2) as i64 - 1;
         let joint = input.enum_i32(6);
-        let axis = if input.bool() { input.unit_vec3() } else { input.vec3_any() };
+        let axis = if input.bool() {
+            input.unit_vec3()
+        } else {
+            input.vec3_any()
+        };
         let rotation = m3(input.mat3());
-        let translation = v3(if input.bool() { input.vec3_moderate(2.0) } else { input.vec3_any() });
+        let translation = v3(if input.bool() {
+            input.vec3_moderate(2.0)
+        } else {
+            input.vec3_any()
+        });
         let mut body = Sentinel::<usize>::new();
-        let status = unsafe { mech_tree_add_body(self.handle, parent, joint, &v3(axis), &rotation, &translation, body.ptr()) };
+        let status = unsafe {
+            mech_tree_add_body(
+                self.handle,
+                parent,
+                joint,
+                &v3(axis),
+                &rotation,
+                &translation,
+                body.ptr(),
+            )
+        };
         check_status("mech_tree_add_body", status);
         if status == MECH_STATUS_OK {
             assert_eq!(body.value, self.bodies, "bodies are numbered in the order of the calls");
@@ -277,7 +369,15 @@ impl Tree {
     fn set_state(&mut self, input: &mut Input) {
         let n = if input.u8() < 230 { self.dof } else { input.below(64) };
         let q: Vec<f64> = (0..n).map(|_| input.any_f64()).collect();
-        let q_dot: Vec<f64> = (0..n).map(|_| if input.bool() { input.moderate(10.0) } else { input.any_f64() }).collect();
+        let q_dot: Vec<f64> = (0..n)
+            .map(|_| {
+                if input.bool() {
+                    input.moderate(10.0)
+                } else {
+                    input.any_f64()
+                }
+            })
+            .collect();
         let status = unsafe { mech_tree_set_state(self.handle, q.as_ptr(), q_dot.as_ptr(), n) };
         check_status("mech_tree_set_state", status);
         self.q_dot = (status == MECH_STATUS_OK).then_some(q_dot);
@@ -309,34 +409,66 @@ impl Tree {
 
     fn query(&mut self, input: &mut Input) {
         let body = input.below(self.bodies + 1);
-        let point = v3(if input.bool() { input.vec3_moderate(2.0) } else { input.vec3_any() });
+        let point = v3(if input.bool() {
+            input.vec3_moderate(2.0)
+        } else {
+            input.vec3_any()
+        });
         let (mut rotation, mut position) = (Sentinel::<mech_mat3_t>::new(), Sentinel::<mech_vec3_t>::new());
         let status = unsafe { mech_tree_body_pose(self.handle, body, rotation.ptr(), position.ptr()) };
         let mut written = rotation.value.m.to_vec();
         written.extend_from_slice(doubles_of(&position.value));
-        check_outputs("mech_tree_body_pose", status, rotation.untouched() && position.untouched(), &written);
+        check_outputs(
+            "mech_tree_body_pose",
+            status,
+            rotation.untouched() && position.untouched(),
+            &written,
+        );
         if status == MECH_STATUS_OK {
             let (error, det) = orthonormality(&rotation.value.m);
-            assert!(error <= 1e-9 && (det - 1.0).abs() <= 1e-9, "body pose is not a rotation: {error:e}, det {det}");
+            assert!(
+                error <= 1e-9 && (det - 1.0).abs() <= 1e-9,
+                "body pose is not a rotation: {error:e}, det {det}"
+            );
         }
         let (mut omega, mut velocity) = (Sentinel::<mech_vec3_t>::new(), Sentinel::<mech_vec3_t>::new());
         let status = unsafe { mech_tree_body_velocity(self.handle, body, &point, omega.ptr(), velocity.ptr()) };
         let mut written = doubles_of(&omega.value).to_vec();
         written.extend_from_slice(doubles_of(&velocity.value));
-        check_outputs("mech_tree_body_velocity", status, omega.untouched() && velocity.untouched(), &written);
+        check_outputs(
+            "mech_tree_body_velocity",
+            status,
+            omega.untouched() && velocity.untouched(),
+            &written,
+        );
         if status == MECH_STATUS_OK {
             self.check_jacobian(body, &point, arr(&omega.value), arr(&velocity.value));
         }
         let (mut omega_dot, mut acceleration) = (Sentinel::<mech_vec3_t>::new(), Sentinel::<mech_vec3_t>::new());
-        let status = unsafe { mech_tree_body_acceleration(self.handle, body, &point, omega_dot.ptr(), acceleration.ptr()) };
+        let status =
+            unsafe { mech_tree_body_acceleration(self.handle, body, &point, omega_dot.ptr(), acceleration.ptr()) };
         let mut written = doubles_of(&omega_dot.value).to_vec();
         written.extend_from_slice(doubles_of(&acceleration.value));
-        check_outputs("mech_tree_body_acceleration", status, omega_dot.untouched() && acceleration.untouched(), &written);
+        check_outputs(
+            "mech_tree_body_acceleration",
+            status,
+            omega_dot.untouched() && acceleration.untouched(),
+            &written,
+        );
         let kind = input.enum_i32(4);
-        let capacity = if input.u8() < 230 { 3 * self.dof } else { input.below(3 * self.dof + 2) };
+        let capacity = if input.u8() < 230 {
+            3 * self.dof
+        } else {
+            input.below(3 * self.dof + 2)
+        };
         let mut jacobian = sentinel_doubles(capacity);
         let status = unsafe { mech_tree_jacobian(self.handle, body, kind, &point, jacobian.as_mut_ptr(), capacity) };
-        check_outputs("mech_tree_jacobian", status, doubles_untouched(&jacobian), &jacobian[..capacity.min(3 * self.dof)]);
+        check_outputs(
+            "mech_tree_jacobian",
+            status,
+            doubles_untouched(&jacobian),
+            &jacobian[..capacity.min(3 * self.dof)],
+        );
     }
 
     /// With the base at rest, ω = J_ω q̇ and v = J_p(point) q̇.
@@ -352,7 +484,8 @@ impl Tree {
         let noise = 1e-12 * rate * lever;
         for (kind, actual) in [(MECH_JACOBIAN_ANGULAR, omega), (MECH_JACOBIAN_POINT, velocity)] {
             let mut jacobian = vec![0.0; 3 * self.dof];
-            let status = unsafe { mech_tree_jacobian(self.handle, body, kind, point, jacobian.as_mut_ptr(), jacobian.len()) };
+            let status =
+                unsafe { mech_tree_jacobian(self.handle, body, kind, point, jacobian.as_mut_ptr(), jacobian.len()) };
             assert_eq!(status, MECH_STATUS_OK, "velocity known but no Jacobian");
             for row in 0..3 {
                 let terms = (0..self.dof).map(|k| jacobian[row + 3 * k] * q_dot[k]);
@@ -386,7 +519,11 @@ fuzz_target!(|data: &[u8]| {
             7 => tree.finalize(),
             8 => tree.set_state(&mut input),
             9 => {
-                if input.bool() { tree.set_base(&mut input) } else { tree.set_accelerations(&mut input) }
+                if input.bool() {
+                    tree.set_base(&mut input)
+                } else {
+                    tree.set_accelerations(&mut input)
+                }
             }
             _ => tree.query(&mut input),
         }

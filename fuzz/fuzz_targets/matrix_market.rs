@@ -39,7 +39,10 @@ fn check_file(text: &str) -> Option<MatrixMarket> {
         }
         Err(ModalError::MatrixMarket { line, .. }) => {
             let lines = text.lines().count().max(1);
-            assert!((1..=lines + 1).contains(&line), "error on line {line} of a {lines}-line text");
+            assert!(
+                (1..=lines + 1).contains(&line),
+                "error on line {line} of a {lines}-line text"
+            );
             None
         }
         Err(other) => panic!("a parse failure that is not a located Matrix Market error: {other}"),
@@ -48,7 +51,14 @@ fn check_file(text: &str) -> Option<MatrixMarket> {
 
 fn check_consistent(m: &MatrixMarket) {
     for e in &m.entries {
-        assert!(e.row < m.nrows && e.col < m.ncols, "entry ({}, {}) outside {}×{}", e.row, e.col, m.nrows, m.ncols);
+        assert!(
+            e.row < m.nrows && e.col < m.ncols,
+            "entry ({}, {}) outside {}×{}",
+            e.row,
+            e.col,
+            m.nrows,
+            m.ncols
+        );
         assert!(e.val.is_finite(), "non-finite value {}", e.val);
     }
     if m.symmetric {
@@ -61,7 +71,8 @@ fn check_consistent(m: &MatrixMarket) {
 
 fn check_round_trip(m: &MatrixMarket) {
     let written = symmetric_to_string(m.nrows, &m.entries);
-    let again = parse_matrix_market(&written).unwrap_or_else(|e| panic!("the written file does not parse: {e}\n{written}"));
+    let again =
+        parse_matrix_market(&written).unwrap_or_else(|e| panic!("the written file does not parse: {e}\n{written}"));
     assert_eq!((again.nrows, again.ncols, again.symmetric), (m.nrows, m.ncols, true));
     let key = |t: &mechanica::modal::faer::sparse::Triplet<usize, usize, f64>| (t.row, t.col, t.val.to_bits());
     let mut before: Vec<_> = m.entries.iter().map(key).collect();

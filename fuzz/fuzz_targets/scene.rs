@@ -17,8 +17,15 @@ fuzz_target!(|data: &[u8]| {
         && let Some((line, column)) = error.position
     {
         let lines: Vec<&str> = text.split('\n').collect();
-        assert!((1..=lines.len()).contains(&line), "error at line {line} of {}: {error}", lines.len());
+        assert!(
+            (1..=lines.len()).contains(&line),
+            "error at line {line} of {}: {error}",
+            lines.len()
+        );
         let length = lines[line - 1].len();
-        assert!((1..=length + 1).contains(&column), "error at column {column} of a {length}-byte line: {error}");
+        assert!(
+            (1..=length + 1).contains(&column),
+            "error at column {column} of a {length}-byte line: {error}"
+        );
     }
 });

@@ -96,7 +96,11 @@ impl<'a> Input<'a> {
             _ => self.decimal(40),
         };
         let cap = magnitude_cap();
-        if x.is_finite() && x.abs() > cap { cap.copysign(x) } else { x }
+        if x.is_finite() && x.abs() > cap {
+            cap.copysign(x)
+        } else {
+            x
+        }
     }
 
     /// A finite double of moderate size: m·10^e with |m| < 2^15 and |e| ≤ `max_exponent`.
@@ -129,7 +133,12 @@ impl<'a> Input<'a> {
     /// A unit quaternion (w, x, y, z), normalised from moderate components (the identity if
     /// they are all zero).
     pub fn unit_quaternion(&mut self) -> [f64; 4] {
-        let q = [self.moderate(1.0), self.moderate(1.0), self.moderate(1.0), self.moderate(1.0)];
+        let q = [
+            self.moderate(1.0),
+            self.moderate(1.0),
+            self.moderate(1.0),
+            self.moderate(1.0),
+        ];
         let norm = q.iter().map(|c| c * c).sum::<f64>().sqrt();
         if norm < 1e-3 {
             [1.0, 0.0, 0.0, 0.0]
@@ -167,7 +176,11 @@ impl<'a> Input<'a> {
     pub fn unit_vec3(&mut self) -> [f64; 3] {
         let v = self.vec3_moderate(1.0);
         let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        if norm < 1e-3 { [1.0, 0.0, 0.0] } else { v.map(|c| c / norm) }
+        if norm < 1e-3 {
+            [1.0, 0.0, 0.0]
+        } else {
+            v.map(|c| c / norm)
+        }
     }
 }
 

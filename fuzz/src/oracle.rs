@@ -5,7 +5,11 @@ use mechanica::ffi::{MECH_STATUS_OK, MECH_STATUS_PANIC, mech_status_t};
 /// The statuses a call may return (`MECH_STATUS_OK` … `MECH_STATUS_PARSE_ERROR`); anything
 /// else, including `MECH_STATUS_PANIC`, is a library bug and aborts the run.
 pub fn check_status(call: &str, status: mech_status_t) {
-    assert!(status != MECH_STATUS_PANIC, "{call}: the library panicked: {}", last_error());
+    assert!(
+        status != MECH_STATUS_PANIC,
+        "{call}: the library panicked: {}",
+        last_error()
+    );
     assert!((0..=12).contains(&status), "{call}: undocumented status {status}");
 }
 
@@ -43,9 +47,8 @@ impl<T: Copy> Sentinel<T> {
     /// Whether no byte changed since [`Sentinel::new`].
     pub fn untouched(&self) -> bool {
         // SAFETY: the value's bytes were all initialised by `new` and are read, not written.
-        let bytes = unsafe {
-            std::slice::from_raw_parts((&self.value as *const T).cast::<u8>(), std::mem::size_of::<T>())
-        };
+        let bytes =
+            unsafe { std::slice::from_raw_parts((&self.value as *const T).cast::<u8>(), std::mem::size_of::<T>()) };
         bytes.iter().all(|&b| b == PATTERN)
     }
 }

@@ -20,7 +20,11 @@ impl Drop for OwnedTree {
 }
 
 pub fn v3(a: [f64; 3]) -> mech_vec3_t {
-    mech_vec3_t { x: a[0], y: a[1], z: a[2] }
+    mech_vec3_t {
+        x: a[0],
+        y: a[1],
+        z: a[2],
+    }
 }
 
 /// A chain or branching tree of 1–4 bodies on valid joints with placements from the input;
@@ -30,15 +34,24 @@ pub fn build_tree(input: &mut Input) -> Option<OwnedTree> {
     // SAFETY: `handle` is a writable pointer.
     let status = unsafe { mech_tree_create(&mut handle) };
     assert_eq!(status, MECH_STATUS_OK);
-    let mut tree = OwnedTree { handle, bodies: 0, dof: 0 };
+    let mut tree = OwnedTree {
+        handle,
+        bodies: 0,
+        dof: 0,
+    };
     let count = 1 + input.below(4);
     for i in 0..count {
         let parent = if i == 0 { -1 } else { input.below(i) as i64 };
         let joint = input.enum_i32(6);
         let axis = v3(input.unit_vec3());
-        let rotation = mech_mat3_t { m: rotation_of(input.unit_quaternion()) };
+        let rotation = mech_mat3_t {
+            m: rotation_of(input.unit_quaternion()),
+        };
         let translation = v3(input.vec3_moderate(1.0));
-        crate::trace!("add_body(parent {parent}, joint {joint}, axis {axis:?}, R {:?}, t {translation:?})", rotation.m);
+        crate::trace!(
+            "add_body(parent {parent}, joint {joint}, axis {axis:?}, R {:?}, t {translation:?})",
+            rotation.m
+        );
         let mut body = 0usize;
         // SAFETY: all pointers are to live locals; the handle is live.
         let status = unsafe { mech_tree_add_body(handle, parent, joint, &axis, &rotation, &translation, &mut body) };
@@ -77,7 +90,9 @@ pub fn body_properties(input: &mut Input) -> mech_mass_properties_t {
         return mech_mass_properties_t {
             mass: input.any_f64(),
             center_of_mass: v3(input.vec3_any()),
-            inertia_about_com: mech_mat3_t { m: std::array::from_fn(|_| input.any_f64()) },
+            inertia_about_com: mech_mat3_t {
+                m: std::array::from_fn(|_| input.any_f64()),
+            },
         };
     }
     let mass = 0.01 + input.fraction() * 10.0;
