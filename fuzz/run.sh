@@ -74,7 +74,7 @@ case "${1:-}" in
             known=0
             for crash in "$found"/*; do
                 [ -e "$crash" ] || continue
-                message=$("$binary" "$crash" 2>&1 | grep -A1 'panicked at' | sed -n 2p || true)
+                message=$(timeout 60 "$binary" "$crash" 2>&1 | grep -A1 'panicked at' | sed -n 2p || true)
                 if known_finding "$message"; then
                     known=$((known + 1))
                     echo "$target: known finding: ${message:0:160}"
