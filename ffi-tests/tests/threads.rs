@@ -26,14 +26,20 @@ fn the_concurrency_test_passes_under_thread_sanitizer() {
         .env_remove("LD_LIBRARY_PATH")
         .env(
             "TSAN_OPTIONS",
-            format!("halt_on_error=1 second_deadlock_stack=1 suppressions={}", suppressions.display()),
+            format!(
+                "halt_on_error=1 second_deadlock_stack=1 suppressions={}",
+                suppressions.display()
+            ),
         )
         .env("RUST_BACKTRACE", "0")
         .output()
         .unwrap_or_else(|e| panic!("could not start {}: {e}", exe.display()));
     check_success(&exe.display().to_string(), &output).unwrap_or_else(|e| panic!("{e}"));
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!stderr.contains("ThreadSanitizer"), "ThreadSanitizer reported:\n{stderr}");
+    assert!(
+        !stderr.contains("ThreadSanitizer"),
+        "ThreadSanitizer reported:\n{stderr}"
+    );
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(stdout.contains("agree bit for bit"), "unexpected output:\n{stdout}");
     let _ = std::fs::remove_file(&exe);

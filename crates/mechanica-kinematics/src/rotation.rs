@@ -499,7 +499,10 @@ mod tests {
             assert!((r.matrix() - expected.matrix()).norm() <= 4.0 * EPS, "s = {s}: {r}");
             let diagonal = Vector3::new(s, -s, s) / 2.0;
             let r = exp_map(&diagonal).expect("finite");
-            assert!((r.matrix().transpose() * r.matrix() - Matrix3::identity()).norm() <= 8.0 * EPS, "s = {s}");
+            assert!(
+                (r.matrix().transpose() * r.matrix() - Matrix3::identity()).norm() <= 8.0 * EPS,
+                "s = {s}"
+            );
             let axis = diagonal.normalize();
             assert!((r * axis - axis).norm() <= 8.0 * EPS, "s = {s}: the axis moved");
         }

@@ -242,7 +242,10 @@ pub fn repair(props: &MassProperties, tol: &ValidityTolerance) -> Result<(MassPr
     // Norms of the tensors divided by their largest entry, so that entries near f64::MAX do not
     // overflow the sum of squares (‖J‖_F/s is within [1, 3]).
     let s = props.inertia_c.amax().max(j.amax()).max(f64::MIN_POSITIVE);
-    let (change_norm, given) = ((j / s - props.inertia_c / s).norm() * s, (props.inertia_c / s).norm() * s);
+    let (change_norm, given) = (
+        (j / s - props.inertia_c / s).norm() * s,
+        (props.inertia_c / s).norm() * s,
+    );
     Ok((
         MassProperties { inertia_c: j, ..*props },
         RepairReport {
@@ -378,7 +381,10 @@ mod tests {
         let (_, small) = repair(&props(1.0, j), &tol).expect("repairable");
         let (fixed, huge) = repair(&props(1.0, j * 1e307), &tol).expect("repairable");
         assert!(fixed.inertia_c.iter().all(|x| x.is_finite()));
-        assert!(huge.relative_change.is_finite() && small.relative_change > 0.0, "{huge:?}");
+        assert!(
+            huge.relative_change.is_finite() && small.relative_change > 0.0,
+            "{huge:?}"
+        );
         assert!((huge.relative_change - small.relative_change).abs() <= 1e-14 * small.relative_change);
     }
 }

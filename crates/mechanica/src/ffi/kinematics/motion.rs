@@ -191,7 +191,9 @@ mod tests {
     fn a_velocity_or_acceleration_that_overflows_is_an_error_and_writes_nothing() {
         // ω × (x − c) with |ω| = |x − c| = 1e200 is 1e400: finite inputs, no finite result.
         let motion = mech_rigid_motion_t {
-            rotation: mech_mat3_t { m: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] },
+            rotation: mech_mat3_t {
+                m: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            },
             c: v(0.0, 0.0, 0.0),
             c_dot: v(0.0, 0.0, 0.0),
             c_ddot: v(0.0, 0.0, 0.0),
@@ -211,7 +213,10 @@ mod tests {
         assert_eq!((s1, s2), (MECH_STATUS_NON_FINITE, MECH_STATUS_NON_FINITE));
         assert_eq!((velocity, acceleration), (sentinel, sentinel));
         // With |ω| = 1e100 the velocity ω × x = (0, 1e300, 0) is finite and is written.
-        let slow = mech_rigid_motion_t { omega: v(0.0, 0.0, 1e100), ..motion };
+        let slow = mech_rigid_motion_t {
+            omega: v(0.0, 0.0, 1e100),
+            ..motion
+        };
         // SAFETY: as above.
         let s = unsafe { mech_velocity_field(&slow, &x, &mut velocity) };
         assert_eq!(s, MECH_STATUS_OK);

@@ -97,10 +97,16 @@ mod tests {
         let body = mech_mass_properties_t {
             mass: 1e300,
             center_of_mass: mech_vec3_t { x: 1.0, y: 0.0, z: 0.0 },
-            inertia_about_com: mech_mat3_t { m: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0] },
+            inertia_about_com: mech_mat3_t {
+                m: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            },
         };
         let origin = mech_vec3_t { x: 0.0, y: 0.0, z: 0.0 };
-        let fast = mech_vec3_t { x: 0.0, y: 1e100, z: 0.0 };
+        let fast = mech_vec3_t {
+            x: 0.0,
+            y: 1e100,
+            z: 0.0,
+        };
         let sentinel = mech_vec3_t { x: 7.0, y: 7.0, z: 7.0 };
         let mut d = sentinel;
         // (c − a) × m v = x̂ × 1e400 ŷ overflows.
