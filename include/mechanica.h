@@ -3313,7 +3313,8 @@ mech_status_t mech_mechanism_potential(struct mech_mechanism_t *mechanism,
  * do not move).
  *
  * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_BAD_ENUM for an unknown
- * `seek`; MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_NOT_CONVERGED when
+ * `seek`; MECH_STATUS_NON_FINITE for a NaN or infinite input or a potential or gradient that
+ * overflows at the point found; MECH_STATUS_NOT_CONVERGED when
  * the search fails, in which case `q_out` still receives the best point found and
  * `report_out` its gradient norm (potential and last step NaN), so the caller can inspect it.
  *

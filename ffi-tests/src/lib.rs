@@ -155,6 +155,19 @@ pub const STRICT_FLAGS: &[&str] = &[
     "-fno-omit-frame-pointer",
 ];
 
+/// The flags of the ThreadSanitizer build of the concurrency test: the warnings of
+/// [`STRICT_FLAGS`] with `-fsanitize=thread` (which excludes ASan) and `-pthread`.
+pub const TSAN_FLAGS: &[&str] = &[
+    "-Wall",
+    "-Wextra",
+    "-Werror",
+    "-pedantic",
+    "-g",
+    "-fsanitize=thread",
+    "-fno-omit-frame-pointer",
+    "-pthread",
+];
+
 /// Libraries a Rust static library needs on Linux (`rustc --print native-static-libs`).
 pub const STATIC_LINK_LIBS: &[&str] = &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"];
 
@@ -167,12 +180,24 @@ pub fn compile(
     link: LinkKind,
     defines: &[&str],
 ) -> Result<(), String> {
+    compile_with_flags(source, exe, library, link, STRICT_FLAGS, defines)
+}
+
+/// As [`compile`], with `flags` in place of [`STRICT_FLAGS`] (e.g. [`TSAN_FLAGS`]).
+pub fn compile_with_flags(
+    source: &Path,
+    exe: &Path,
+    library: &BuiltLibrary,
+    link: LinkKind,
+    flags: &[&str],
+    defines: &[&str],
+) -> Result<(), String> {
     let language = Language::of(source).ok_or_else(|| format!("{}: not a .c or .cpp file", source.display()))?;
     let (compiler, standard) = language.compiler_and_standard();
     let root = workspace_root();
     let mut cmd = Command::new(compiler);
     cmd.arg(standard)
-        .args(STRICT_FLAGS)
+        .args(flags)
         .args(defines)
         .arg("-I")
         .arg(root.join("include"))

@@ -94,7 +94,8 @@ pub struct mech_equilibrium_report_t {
 /// do not move).
 ///
 /// Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_BAD_ENUM for an unknown
-/// `seek`; MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_NOT_CONVERGED when
+/// `seek`; MECH_STATUS_NON_FINITE for a NaN or infinite input or a potential or gradient that
+/// overflows at the point found; MECH_STATUS_NOT_CONVERGED when
 /// the search fails, in which case `q_out` still receives the best point found and
 /// `report_out` its gradient norm (potential and last step NaN), so the caller can inspect it.
 ///
@@ -129,6 +130,9 @@ pub unsafe extern "C" fn mech_mechanism_equilibrium(
         };
         match find_equilibrium(m, &q0, &options) {
             Ok(eq) => {
+                let scalars = [eq.potential, eq.gradient_norm, eq.tolerance, eq.last_step];
+                finite(&scalars[..], "equilibrium report (overflow)")?;
+                finite(&eq.q[..], "equilibrium coordinates")?;
                 let report = mech_equilibrium_report_t {
                     potential: eq.potential,
                     gradient_norm: eq.gradient_norm,

@@ -1,0 +1,14 @@
+//! Wavefront OBJ: parsing never panics, and a mesh that parses has mass properties invariant
+//! under a rigid motion (see `mesh_oracle`).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use mechanica::mass::io::read_obj;
+use mechanica_fuzz::{Input, mesh_oracle};
+
+fuzz_target!(|data: &[u8]| {
+    if let Ok(mesh) = read_obj(&mut std::io::BufReader::new(data)) {
+        let tail = &data[data.len().saturating_sub(16)..];
+        mesh_oracle::check_rigid_motion_invariance(&mesh, &mut Input::new(tail));
+    }
+});
