@@ -25,8 +25,12 @@ fuzz_target!(|data: &[u8]| {
     std::fs::create_dir_all(dir).expect("temporary directory");
     let path = dir.join("robot.urdf");
     std::fs::write(&path, data).expect("write the robot file");
-    for repair in [false, true] {
-        if let Ok((scene, _notes)) = urdf::load(&path, repair) {
+    for (repair_inertia, allow_missing_mesh) in [(false, false), (true, true)] {
+        let options = urdf::UrdfOptions {
+            repair_inertia,
+            allow_missing_mesh,
+        };
+        if let Ok((scene, _notes)) = urdf::load(&path, options) {
             scene.check(&path).expect("a loaded robot is a valid scene");
         }
     }
