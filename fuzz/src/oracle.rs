@@ -10,7 +10,8 @@ pub fn check_status(call: &str, status: mech_status_t) {
         "{call}: the library panicked: {}",
         last_error()
     );
-    assert!((0..=12).contains(&status), "{call}: undocumented status {status}");
+    // 0 OK through 13 MECH_STATUS_OUT_OF_RANGE (include/mechanica.h).
+    assert!((0..=13).contains(&status), "{call}: undocumented status {status}");
 }
 
 /// This thread's last error message.
