@@ -77,7 +77,7 @@ pub(crate) fn invert_spd_block(d: &Matrix6<f64>, dim: usize) -> Result<Matrix6<f
         for k in 0..j {
             pivot -= l[(j, k)] * l[(j, k)];
         }
-        if !(pivot > 8.0 * f64::EPSILON * scale) || !pivot.is_finite() {
+        if !pivot.is_finite() || pivot <= 8.0 * f64::EPSILON * scale {
             return Err((pivot, scale));
         }
         let root = pivot.sqrt();
