@@ -5,7 +5,7 @@ use crate::dissipation::Damper;
 use crate::error::{DynamicsError, check_vector};
 use crate::spatial::{WorldInertia, Wrench};
 use crate::velocity_potential::VelocityPotential;
-use mechanica_kinematics::tree::{BaseState, KinematicTree, Workspace};
+use mechanica_kinematics::tree::{BaseMotion, BaseState, KinematicTree, Workspace};
 use mechanica_mechanism::Mechanism;
 use nalgebra::{Matrix6, Rotation3, Vector3, Vector6};
 use std::sync::Arc;
@@ -56,11 +56,13 @@ pub(crate) struct ArticulatedBuffers {
 /// A mechanism (tree, bodies, gravity, rotating frame, potentials) with its dampers and
 /// velocity-dependent potentials, and the preallocated buffers of the recursions.
 ///
-/// All vectors are world components: the base frame at the instant of evaluation. With a
-/// steadily rotating frame ([`mechanica_mechanism::RotatingFrame`]) the coordinates describe
-/// the motion relative to that frame; the recursions run in an inertial frame that coincides
-/// with the base frame at this instant and turns at Ω relative to it, so the Coriolis and
-/// centrifugal terms of the relative motion (§8e) appear in the velocity-product terms.
+/// All vectors are components in the base frame at the instant of evaluation, called "world"
+/// throughout (with a fixed base the two are the same). With a steadily rotating frame
+/// ([`mechanica_mechanism::RotatingFrame`]) or a prescribed base motion
+/// ([`Dynamics::set_base_motion`]) the coordinates describe the motion relative to the base;
+/// the recursions run in an inertial frame that coincides with the base frame at this instant,
+/// so the Coriolis, centrifugal and drag terms of the relative motion (§8e, (7.51)–(7.52))
+/// appear in the velocity-product terms.
 #[derive(Debug, Clone)]
 pub struct Dynamics {
     pub(crate) mechanism: Mechanism,
@@ -72,6 +74,8 @@ pub struct Dynamics {
     pub(crate) loads: Vec<Wrench>,
     pub(crate) joint_loads: Vec<f64>,
     pub(crate) articulated: ArticulatedBuffers,
+    base_motion: Option<PrescribedBase>,
+    gravity: Vector3<f64>,
 }
 
 impl Dynamics {
@@ -108,6 +112,8 @@ impl Dynamics {
                 acceleration: vec![zero6; bodies],
             },
             ws,
+            base_motion: None,
+            gravity: mechanism.gravity(),
             mechanism,
         })
     }
@@ -159,9 +165,44 @@ impl Dynamics {
         &self.ws
     }
 
-    /// Gravity in world components.
+    /// Gravity in base-frame components at the last evaluated instant.
     pub(crate) fn gravity(&self) -> Vector3<f64> {
-        self.mechanism.gravity()
+        self.gravity
+    }
+
+    /// Prescribes the motion of the base (rheonomic, (7.51)) as a function of time, or fixes
+    /// the base again with `None`. The mechanism's gravity is then read in world components and
+    /// turned into the base frame at each instant; everything else (points on the ground,
+    /// reported vectors) is in base-frame components at the instant of evaluation. Refused for a
+    /// mechanism with a steadily rotating frame, which already prescribes the base.
+    pub fn set_base_motion(&mut self, motion: Option<Arc<dyn BaseMotion + Send + Sync>>) -> Result<(), DynamicsError> {
+        if motion.is_some() && self.mechanism.rotating_frame().is_some() {
+            return Err(DynamicsError::OutOfRange {
+                what: "base motion of a mechanism in a rotating frame",
+                requirement: "absent (the rotating frame already prescribes the base)",
+                value: 1.0,
+            });
+        }
+        self.base_motion = motion.map(PrescribedBase);
+        Ok(())
+    }
+
+    /// The base's state at time t in its own frame (pose at the origin, rates in base
+    /// components), and gravity in the same frame.
+    fn refresh_base(&mut self, t: f64) -> Result<(), DynamicsError> {
+        let Some(motion) = &self.base_motion else { return Ok(()) };
+        let world = motion.0.state_at(t);
+        let r_t = world.rotation.inverse();
+        let base = BaseState {
+            omega: r_t * world.omega,
+            velocity: r_t * world.velocity,
+            omega_dot: r_t * world.omega_dot,
+            acceleration: r_t * world.acceleration,
+            ..BaseState::default()
+        };
+        self.ws.set_base(base)?;
+        self.gravity = r_t * self.mechanism.gravity();
+        crate::error::check_result(self.gravity.iter(), "gravity in the base frame")
     }
 
     /// Checks the state and runs forward kinematics to velocities, and refreshes the bodies'
@@ -177,6 +218,7 @@ impl Dynamics {
                 value: state.t,
             });
         }
+        self.refresh_base(state.t)?;
         let tree = self.mechanism.tree();
         tree.update_positions(&mut self.ws, state.q)?;
         tree.update_velocities(&mut self.ws, state.q_dot)?;
@@ -184,6 +226,16 @@ impl Dynamics {
             self.world[i] = WorldInertia::new(body, self.ws.rotation(i)?.matrix());
         }
         Ok(())
+    }
+}
+
+/// A prescribed base motion (a wrapper so that [`Dynamics`] can be `Debug`).
+#[derive(Clone)]
+struct PrescribedBase(Arc<dyn BaseMotion + Send + Sync>);
+
+impl std::fmt::Debug for PrescribedBase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("PrescribedBase")
     }
 }
 

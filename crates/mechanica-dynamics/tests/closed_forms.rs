@@ -232,3 +232,38 @@ fn constant_force_at_rest_is_balanced_by_the_joints() {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// A base accelerating upwards at a adds to gravity: θ̈ = −((g + a)/l) sin θ; and a base
+    /// turning steadily (prescribed through the tree's `SteadyRotation`, at any t) gives the
+    /// rotating frame's θ̈ = sin θ (Ω² cos θ − g/l).
+    #[test]
+    fn pendulum_on_a_prescribed_base(seed in any::<u64>()) {
+        use mechanica_kinematics::tree::{BaseMotion, BaseState, SteadyRotation};
+        #[derive(Debug)]
+        struct Lift(f64);
+        impl BaseMotion for Lift {
+            fn state_at(&self, _t: f64) -> BaseState {
+                BaseState { acceleration: Vector3::new(0.0, 0.0, self.0), ..BaseState::default() }
+            }
+        }
+        let mut rng = Rng::new(seed);
+        let (m, l, g) = (10f64.powf(rng.uniform(-3.0, 3.0)), 10f64.powf(rng.uniform(-2.0, 2.0)), rng.uniform(0.0, 20.0));
+        let (a, omega, t) = (rng.uniform(-5.0, 30.0), rng.uniform(-10.0, 10.0), rng.uniform(-100.0, 100.0));
+        let (q, q_dot) = ([rng.uniform(-3.1, 3.1)], [rng.uniform(-5.0, 5.0)]);
+        let mut mechanism = pendulum(m, l);
+        mechanism.set_gravity(Vector3::new(0.0, 0.0, -g)).expect("gravity");
+        let mut dynamics = Dynamics::new(mechanism).expect("dynamics");
+        dynamics.set_base_motion(Some(Arc::new(Lift(a)))).expect("lift");
+        let lifted = dynamics.forward_dynamics(&State::new(&q, &q_dot), &[0.0]).expect("forward").q_ddot[0];
+        let expected = -((g + a) / l) * q[0].sin();
+        prop_assert!(close(lifted, expected, 1e-13, (g + a.abs()) / l), "θ̈ = {lifted} against {expected}");
+        let spin = SteadyRotation { axis: Unit::new_normalize(Vector3::z()), rate: omega };
+        dynamics.set_base_motion(Some(Arc::new(spin))).expect("spin");
+        let spun = dynamics.forward_dynamics(&State::new(&q, &q_dot).at_time(t), &[0.0]).expect("forward").q_ddot[0];
+        let expected = q[0].sin() * (omega * omega * q[0].cos() - g / l);
+        prop_assert!(close(spun, expected, 1e-12, omega * omega + g / l), "θ̈ = {spun} against {expected}");
+    }
+}
