@@ -185,3 +185,88 @@ fn check_anchor(tree: &KinematicTree, anchor: &Anchor) -> Result<(), DynamicsErr
         _ => Ok(()),
     }
 }
+
+/// The relative point Jacobian ∂(x_a − x_b)/∂q (3×dof, column-major) at the positions in `ws`;
+/// a ground point contributes nothing (it does not move with q).
+fn relative_jacobian(tree: &KinematicTree, ws: &Workspace, a: &Anchor, b: &Anchor) -> Result<Vec<f64>, DynamicsError> {
+    let n = tree.dof();
+    let mut out = vec![0.0; 3 * n];
+    let mut part = vec![0.0; 3 * n];
+    for (anchor, sign) in [(a, 1.0), (b, -1.0)] {
+        if let Some(body) = anchor.body {
+            tree.point_jacobian(ws, body, &anchor.point, &mut part)?;
+            for (o, p) in out.iter_mut().zip(&part) {
+                *o += sign * p;
+            }
+        }
+    }
+    Ok(out)
+}
+
+impl Damper {
+    /// Adds this damper's part of the damping matrix C(q) (D = ½ q̇ᵀ C q̇, FM 4.64) at the
+    /// positions in `ws` into `c` (dof × dof): c on the diagonal for a joint damper,
+    /// c Jᵀ J for linear friction between points and c (eᵀJ)ᵀ(eᵀJ) for a dashpot, with J the
+    /// relative point Jacobian.
+    pub(crate) fn add_to_damping_matrix(
+        &self,
+        tree: &KinematicTree,
+        ws: &Workspace,
+        c: &mut faer::Mat<f64>,
+    ) -> Result<(), DynamicsError> {
+        let n = tree.dof();
+        match self {
+            Damper::Joint {
+                coordinate,
+                coefficient,
+            } => c[(*coordinate, *coordinate)] += coefficient,
+            Damper::Points { a, b, coefficient } => {
+                let j = relative_jacobian(tree, ws, a, b)?;
+                for k in 0..n {
+                    for l in 0..n {
+                        let dot: f64 = (0..3).map(|r| j[3 * k + r] * j[3 * l + r]).sum();
+                        c[(k, l)] += coefficient * dot;
+                    }
+                }
+            }
+            Damper::Dashpot { a, b, coefficient } => {
+                let ((xa, _), (xb, _)) = (point_motion(ws, a)?, point_motion(ws, b)?);
+                let d = xa - xb;
+                let length = d.norm();
+                if length == 0.0 || !length.is_finite() {
+                    return Err(DynamicsError::Dissipation {
+                        name: self.name(),
+                        reason: "its points coincide, so the dashpot's direction is undefined",
+                    });
+                }
+                let e = d / length;
+                let j = relative_jacobian(tree, ws, a, b)?;
+                let row: Vec<f64> = (0..n).map(|k| (0..3).map(|r| e[r] * j[3 * k + r]).sum()).collect();
+                for k in 0..n {
+                    for l in 0..n {
+                        c[(k, l)] += coefficient * row[k] * row[l];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl crate::Dynamics {
+    /// The damping matrix C(q) of the dampers (FM 4.64): symmetric, positive semidefinite, with
+    /// D = ½ q̇ᵀ C q̇ and the dampers' generalized force −C q̇ (FM 4.65).
+    pub fn damping_matrix(&mut self, q: &[f64]) -> Result<faer::Mat<f64>, DynamicsError> {
+        let n = self.dof();
+        self.update_state(&crate::State::new(q, &vec![0.0; n]))?;
+        let tree = self.mechanism.tree();
+        let mut c = faer::Mat::zeros(n, n);
+        for damper in &self.dampers {
+            damper.add_to_damping_matrix(tree, &self.ws, &mut c)?;
+        }
+        for j in 0..n {
+            crate::error::check_result(c.col(j).iter(), "damping matrix")?;
+        }
+        Ok(c)
+    }
+}

@@ -134,3 +134,35 @@ proptest! {
         prop_assert!(split.dissipation >= 0.0);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// C(q) is symmetric, and the dampers' generalized force is −C q̇ with D = ½ q̇ᵀ C q̇.
+    #[test]
+    fn damping_matrix_matches_the_damper_forces(seed in any::<u64>(), bodies in 1usize..8) {
+        let mut rng = Rng::new(seed);
+        let mechanism = random_mechanism(&mut rng, bodies, 4.0, false);
+        let mut dynamics = loaded(&mut rng, mechanism);
+        let (q, q_dot, _) = random_state(&mut rng, dynamics.mechanism());
+        let n = q.len();
+        let c = dynamics.damping_matrix(&q).expect("damping matrix");
+        let split = dynamics.inverse_dynamics(&State::new(&q, &q_dot), &vec![0.0; n]).expect("inverse");
+        let mut damper_force = vec![0.0; n];
+        for load in split.loads.iter().filter(|l| l.kind == LoadKind::Damper) {
+            for k in 0..n {
+                damper_force[k] += load.force[k];
+            }
+        }
+        let size: f64 = (0..n).map(|k| (0..n).map(|l| (c[(k, l)] * q_dot[l]).abs()).sum::<f64>()).fold(0.0, f64::max);
+        for k in 0..n {
+            let c_qd: f64 = (0..n).map(|l| c[(k, l)] * q_dot[l]).sum();
+            prop_assert!((damper_force[k] + c_qd).abs() <= 1e-12 * (size + 1e-300), "k = {k}: Q = {} but −C q̇ = {}", damper_force[k], -c_qd);
+            for l in 0..n {
+                prop_assert!((c[(k, l)] - c[(l, k)]).abs() <= 1e-14 * (c[(k, k)].abs() + c[(l, l)].abs()));
+            }
+        }
+        let quadratic: f64 = (0..n).map(|k| (0..n).map(|l| 0.5 * q_dot[k] * c[(k, l)] * q_dot[l]).sum::<f64>()).sum();
+        prop_assert!((quadratic - split.dissipation).abs() <= 1e-12 * (split.dissipation + size * 1e-3));
+    }
+}
