@@ -51,6 +51,9 @@ c_enum!(JointKind,
 pub struct mech_tree_t {
     pub(crate) builder: TreeBuilder,
     pub(crate) built: Option<(KinematicTree, Workspace)>,
+    /// The validated body mass properties of the last mass call, with their recursion's state.
+    #[cfg(feature = "mass")]
+    pub(crate) mass_cache: Option<crate::ffi::mass::TreeMassCache>,
 }
 
 impl Handle for mech_tree_t {}
@@ -94,6 +97,8 @@ pub unsafe extern "C" fn mech_tree_create(tree_out: *mut *mut mech_tree_t) -> me
         let tree = mech_tree_t {
             builder: TreeBuilder::new(),
             built: None,
+            #[cfg(feature = "mass")]
+            mass_cache: None,
         };
         // SAFETY: caller's contract.
         unsafe { out.write(tree.into_raw()) };
@@ -216,6 +221,10 @@ pub unsafe extern "C" fn mech_tree_finalize(tree: *mut mech_tree_t) -> mech_stat
         let kt = t.builder.clone().build()?;
         let ws = kt.workspace();
         t.built = Some((kt, ws));
+        #[cfg(feature = "mass")]
+        {
+            t.mass_cache = None;
+        }
         Ok(())
     })
 }

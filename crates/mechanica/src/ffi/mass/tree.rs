@@ -37,8 +37,20 @@ impl From<EnergySplit> for mech_energy_split_t {
     }
 }
 
-/// The per-body mass properties of a finalized tree with positions set (`bodies`: one entry per
-/// body, `body_count` of them), as the recursion's state, with the tree and its workspace.
+/// The body mass properties of the last mass call on a tree handle, as given and validated,
+/// with the recursion's state and an output buffer: repeated calls with the same bodies skip
+/// the validation and allocate nothing.
+#[derive(Debug)]
+pub(crate) struct TreeMassCache {
+    bodies: Vec<mech_mass_properties_t>,
+    mass: TreeMass,
+    matrix: Vec<f64>,
+}
+
+/// The recursion's state for the per-body mass properties `bodies` (one entry per body,
+/// `body_count` of them) of a finalized tree with positions set, taken from the handle's cache
+/// when the bodies are the same as last time, with the tree, its workspace and a scratch
+/// buffer for the mass matrix.
 ///
 /// # Safety
 /// `tree` must be a live handle; `bodies` must point to `body_count` readable entries.
@@ -46,15 +58,40 @@ unsafe fn tree_mass<'a>(
     tree: *mut mech_tree_t,
     bodies: *const mech_mass_properties_t,
     body_count: usize,
-) -> Result<(TreeMass, &'a KinematicTree, &'a Workspace), FfiError> {
+) -> Result<(&'a mut TreeMass, &'a KinematicTree, &'a Workspace, &'a mut Vec<f64>), FfiError> {
     // SAFETY: caller's contract.
     let t = unsafe { mech_tree_t::borrow_mut(tree, "tree") }?;
     // SAFETY: caller's contract.
     let raw = unsafe { read_slice(bodies, body_count, "bodies") }?;
-    let (kt, ws) = t.built()?;
-    let props = raw.iter().map(raw_properties).collect();
-    let mass = TreeMass::new(kt, props)?;
-    Ok((mass, kt, ws))
+    if t.built.is_none() {
+        t.built()?; // the "not finalized" error
+    }
+    let Some((kt, ws)) = &t.built else {
+        return unreachable_state();
+    };
+    let fresh = !matches!(&t.mass_cache, Some(cache) if cache.bodies.as_slice() == raw);
+    if fresh {
+        t.mass_cache = None;
+        let props = raw.iter().map(raw_properties).collect();
+        let mass = TreeMass::new(kt, props)?;
+        t.mass_cache = Some(TreeMassCache {
+            bodies: raw.to_vec(),
+            mass,
+            matrix: Vec::new(),
+        });
+    }
+    match &mut t.mass_cache {
+        Some(cache) => Ok((&mut cache.mass, kt, ws, &mut cache.matrix)),
+        None => unreachable_state(),
+    }
+}
+
+/// The error for a state the code above rules out (a cache just filled, a tree just checked).
+fn unreachable_state<T>() -> Result<T, FfiError> {
+    Err(FfiError::new(
+        MECH_STATUS_PANIC,
+        "internal: tree mass cache missing".to_string(),
+    ))
 }
 
 /// The mass matrix A(q) = [α_kl] (syllabus 8.28) of a finalized tree at the coordinates of the
@@ -83,12 +120,13 @@ pub unsafe extern "C" fn mech_tree_mass_matrix(
         let len = square_len(n, "n")?;
         let dest = OutSlice::new(a_out, len, "a_out")?;
         // SAFETY: caller's contract.
-        let (mut mass, kt, ws) = unsafe { tree_mass(tree, bodies, body_count) }?;
+        let (mass, kt, ws, a) = unsafe { tree_mass(tree, bodies, body_count) }?;
         check_dof(kt, n, "a_out")?;
-        let mut a = vec![0.0; len];
-        mass.mass_matrix(kt, ws, &mut a)?;
+        a.clear();
+        a.resize(len, 0.0);
+        mass.mass_matrix(kt, ws, a)?;
         // SAFETY: caller's contract.
-        unsafe { dest.write(&a) };
+        unsafe { dest.write(a) };
         Ok(())
     })
 }
@@ -117,7 +155,7 @@ pub unsafe extern "C" fn mech_tree_kinetic_energy(
         let e_out = Out::new(energy_out, "energy_out")?;
         let p_out = OutSlice::new(momenta_out, n, "momenta_out")?;
         // SAFETY: caller's contract.
-        let (mut mass, kt, ws) = unsafe { tree_mass(tree, bodies, body_count) }?;
+        let (mass, kt, ws, _) = unsafe { tree_mass(tree, bodies, body_count) }?;
         check_dof(kt, n, "momenta_out")?;
         ws.angular_velocity(0)?; // the velocities of mech_tree_set_state must be in place
         let mut a = vec![0.0; n * n];
@@ -156,7 +194,7 @@ pub unsafe extern "C" fn mech_tree_center_of_mass(
         let len = product(3, n, "n")?;
         let j_out = OutSlice::new(jacobian_out, len, "jacobian_out")?;
         // SAFETY: caller's contract.
-        let (mut mass, kt, ws) = unsafe { tree_mass(tree, bodies, body_count) }?;
+        let (mass, kt, ws, _) = unsafe { tree_mass(tree, bodies, body_count) }?;
         check_dof(kt, n, "jacobian_out")?;
         let mut j = vec![0.0; len];
         let system = mass.centre_of_mass(kt, ws, &mut j)?;
@@ -208,7 +246,7 @@ pub unsafe extern "C" fn mech_tree_energy_split(
         let b_dest = OutSlice::new(b_out, n, "b_out")?;
         let p_dest = OutSlice::new(momenta_out, n, "momenta_out")?;
         // SAFETY: caller's contract.
-        let (mut mass, kt, ws) = unsafe { tree_mass(tree, bodies, body_count) }?;
+        let (mass, kt, ws, _) = unsafe { tree_mass(tree, bodies, body_count) }?;
         check_dof(kt, n, "b_out and momenta_out")?;
         ws.angular_velocity(0)?; // the velocities of mech_tree_set_state must be in place
         let drag = DragField {
