@@ -529,6 +529,20 @@ static void tree_mechanism(void) {
     CHECK_NEAR(a[2], a12, tol);
     CHECK_NEAR(a[3], a22, tol);
 
+    /* The handle keeps the last bodies: changed bodies must be seen. Doubling every mass and
+     * tensor doubles A exactly; the original bodies give the original A again. */
+    mech_mass_properties_t doubled[2] = {bodies[0], bodies[1]};
+    for (int b = 0; b < 2; ++b) {
+        doubled[b].mass *= 2.0;
+        for (int e = 0; e < 9; ++e) doubled[b].inertia_about_com.m[e] *= 2.0;
+    }
+    double a_doubled[4];
+    CHECK_STATUS(mech_tree_mass_matrix(tree, doubled, 2, a_doubled, 2), MECH_STATUS_OK);
+    for (int e = 0; e < 4; ++e) CHECK(a_doubled[e] == 2.0 * a[e]);
+    double a_again[4];
+    CHECK_STATUS(mech_tree_mass_matrix(tree, bodies, 2, a_again, 2), MECH_STATUS_OK);
+    for (int e = 0; e < 4; ++e) CHECK(a_again[e] == a[e]);
+
     /* Positions, point Jacobians and velocities of the rod centre c1 and the bob p2. */
     const double s1 = sin(q[0]), k1 = cos(q[0]), s12 = sin(q[0] + q[1]), k12 = cos(q[0] + q[1]);
     const double c1x = 0.5 * l1 * k1, c1y = 0.5 * l1 * s1;
