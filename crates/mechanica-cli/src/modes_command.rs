@@ -18,10 +18,10 @@ use std::time::Duration;
 /// Arguments of `mechanica modes`.
 #[derive(Debug, clap::Args)]
 pub struct ModesArgs {
-    /// Mass matrix A (symmetric positive semidefinite), Matrix Market coordinate format.
+    /// Mass matrix A (symmetric positive semidefinite), Matrix Market file, coordinate or array (as `scipy.io.mmwrite` writes dense arrays).
     #[arg(long, value_name = "A.mtx")]
     pub mass: PathBuf,
-    /// Stiffness matrix B (symmetric), Matrix Market coordinate format.
+    /// Stiffness matrix B (symmetric), Matrix Market file, coordinate or array (as `scipy.io.mmwrite` writes dense arrays).
     #[arg(long, value_name = "B.mtx")]
     pub stiffness: PathBuf,
     /// Only the k lowest modes (sparse Lanczos above the dense limit).

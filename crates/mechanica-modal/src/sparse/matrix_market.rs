@@ -1,6 +1,13 @@
-//! Matrix Market coordinate files (the exchange format of SciPy, PETSc and the SuiteSparse
-//! collection): `%%MatrixMarket matrix coordinate real|integer general|symmetric`, 1-based
-//! indices. Symmetric files store one triangle; the reader mirrors it so the result holds both
+//! Matrix Market files (the exchange format of SciPy, PETSc and the SuiteSparse collection):
+//! `%%MatrixMarket matrix coordinate|array real|integer general|symmetric`.
+//!
+//! - **coordinate**: a size line `rows cols entries`, then one `row col value` per entry,
+//!   1-based indices.
+//! - **array** (what `scipy.io.mmwrite` writes for a dense array): a size line `rows cols`, then
+//!   the values column by column, one per line; a symmetric array stores the lower triangle
+//!   (diagonal included) column by column. Exact zeros are not kept as entries.
+//!
+//! Symmetric files store one triangle; the reader mirrors it so the result holds both
 //! triangles, as [`crate::SparsePencil::from_triplets`] expects. Every malformed line gives
 //! [`ModalError::MatrixMarket`] with its 1-based line number.
 
@@ -37,11 +44,107 @@ pub fn read_matrix_market(path: &Path) -> Result<MatrixMarket, ModalError> {
     parse_matrix_market(&text)
 }
 
-/// Parses the text of a Matrix Market coordinate file.
+/// The storage format named by the header.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Format {
+    Coordinate,
+    Array,
+}
+
+/// The non-comment, non-blank lines of a file after its header, with 1-based line numbers.
+fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines()
+        .enumerate()
+        .skip(1)
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('%'))
+}
+
+/// Parses the text of a Matrix Market coordinate or array file.
 pub fn parse_matrix_market(text: &str) -> Result<MatrixMarket, ModalError> {
-    let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l));
-    let (_, header) = lines.next().ok_or_else(|| bad(1, "empty file"))?;
-    let symmetric = parse_header(header)?;
+    let header = text.lines().next().ok_or_else(|| bad(1, "empty file"))?;
+    let (format, symmetric) = parse_header(header)?;
+    match format {
+        Format::Coordinate => parse_coordinate(text, symmetric),
+        Format::Array => parse_array(text, symmetric),
+    }
+}
+
+/// The body of an `array` file: size line `rows cols`, then the values column-major (the
+/// lower triangle only when symmetric).
+fn parse_array(text: &str, symmetric: bool) -> Result<MatrixMarket, ModalError> {
+    let mut lines = data_lines(text);
+    let (size_line, size) = lines
+        .next()
+        .ok_or_else(|| bad(2, "missing the size line 'rows cols'"))?;
+    let tokens: Vec<&str> = size.split_whitespace().collect();
+    if tokens.len() != 2 {
+        return Err(bad(
+            size_line,
+            "an array's size line needs exactly 2 integers: rows cols",
+        ));
+    }
+    let nrows = parse_usize(size_line, tokens[0], "rows")?;
+    let ncols = parse_usize(size_line, tokens[1], "cols")?;
+    if symmetric && nrows != ncols {
+        return Err(bad(
+            size_line,
+            format!("a symmetric matrix must be square, got {nrows}×{ncols}"),
+        ));
+    }
+    // Positions (row, col) in storage order; the count is checked against the text, not
+    // allocated from the header.
+    let mut positions = (0..ncols).flat_map(|c| ((if symmetric { c } else { 0 })..nrows).map(move |r| (r, c)));
+    let mut entries = Vec::new();
+    let mut last_line = size_line;
+    for (number, line) in lines {
+        last_line = number;
+        let Some((r, c)) = positions.next() else {
+            return Err(bad(number, format!("more values than a {nrows}×{ncols} array holds")));
+        };
+        let value = parse_value(number, line)?;
+        if value != 0.0 {
+            entries.push(Triplet::new(r, c, value));
+            if symmetric && r != c {
+                entries.push(Triplet::new(c, r, value));
+            }
+        }
+    }
+    if let Some((r, c)) = positions.next() {
+        return Err(bad(
+            last_line,
+            format!("values end before entry ({}, {}) of the array", r + 1, c + 1),
+        ));
+    }
+    Ok(MatrixMarket {
+        nrows,
+        ncols,
+        entries,
+        symmetric,
+    })
+}
+
+/// One finite value alone on line `number`.
+fn parse_value(number: usize, line: &str) -> Result<f64, ModalError> {
+    let tokens: Vec<&str> = line.split_whitespace().collect();
+    if tokens.len() != 1 {
+        return Err(bad(
+            number,
+            format!("an array line holds one value, got {} tokens", tokens.len()),
+        ));
+    }
+    let value: f64 = tokens[0]
+        .parse()
+        .map_err(|_| bad(number, format!("value '{}' is not a number", tokens[0])))?;
+    if !value.is_finite() {
+        return Err(bad(number, format!("value {value} is not finite")));
+    }
+    Ok(value)
+}
+
+/// The body of a `coordinate` file.
+fn parse_coordinate(text: &str, symmetric: bool) -> Result<MatrixMarket, ModalError> {
+    let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l)).skip(1);
     // Size line: the first line that is neither a comment nor blank.
     let (size_line, size) = lines
         .by_ref()
@@ -81,9 +184,10 @@ pub fn parse_matrix_market(text: &str) -> Result<MatrixMarket, ModalError> {
     })
 }
 
-/// The header `%%MatrixMarket matrix coordinate <real|integer|double> <general|symmetric>`
-/// (case-insensitive): whether the matrix is stored symmetric.
-fn parse_header(header: &str) -> Result<bool, ModalError> {
+/// The header `%%MatrixMarket matrix <coordinate|array> <real|integer|double>
+/// <general|symmetric>` (case-insensitive): the format, and whether the matrix is stored
+/// symmetric.
+fn parse_header(header: &str) -> Result<(Format, bool), ModalError> {
     let words: Vec<String> = header.split_whitespace().map(str::to_ascii_lowercase).collect();
     if words.first().map(String::as_str) != Some("%%matrixmarket") {
         return Err(bad(1, "missing the %%MatrixMarket header"));
@@ -91,18 +195,19 @@ fn parse_header(header: &str) -> Result<bool, ModalError> {
     if words.len() != 5 {
         return Err(bad(
             1,
-            "header needs: %%MatrixMarket matrix coordinate <field> <symmetry>",
+            "header needs: %%MatrixMarket matrix <coordinate|array> <field> <symmetry>",
         ));
     }
-    if words[1] != "matrix" || words[2] != "coordinate" {
-        return Err(bad(
-            1,
-            format!(
-                "unsupported object/format '{} {}' (need 'matrix coordinate')",
-                words[1], words[2]
-            ),
-        ));
-    }
+    let format = match (words[1].as_str(), words[2].as_str()) {
+        ("matrix", "coordinate") => Format::Coordinate,
+        ("matrix", "array") => Format::Array,
+        (object, format) => {
+            return Err(bad(
+                1,
+                format!("unsupported object/format '{object} {format}' (need 'matrix coordinate' or 'matrix array')"),
+            ));
+        }
+    };
     if words[3] != "real" && words[3] != "integer" && words[3] != "double" {
         return Err(bad(
             1,
@@ -110,8 +215,8 @@ fn parse_header(header: &str) -> Result<bool, ModalError> {
         ));
     }
     match words[4].as_str() {
-        "general" => Ok(false),
-        "symmetric" => Ok(true),
+        "general" => Ok((format, false)),
+        "symmetric" => Ok((format, true)),
         other => Err(bad(
             1,
             format!("unsupported symmetry '{other}' (need general or symmetric)"),
@@ -245,11 +350,82 @@ mod tests {
         assert_eq!(m.entries.len(), 3);
     }
 
+    /// A dense matrix written as a general array, as a symmetric array and as coordinates reads
+    /// back as the same entries, for random sizes with random zero entries.
+    #[test]
+    fn array_files_read_as_their_coordinate_twins() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..40 {
+            let n = 1 + (next() % 7) as usize;
+            let mut dense = vec![0.0; n * n];
+            for j in 0..n {
+                for i in j..n {
+                    let v = if next() % 3 == 0 {
+                        0.0
+                    } else {
+                        (next() % 2001) as f64 / 7.0 - 140.0
+                    };
+                    dense[i + n * j] = v;
+                    dense[j + n * i] = v;
+                }
+            }
+            let mut general =
+                format!("%%MatrixMarket matrix array real general\n% written column by column\n{n} {n}\n");
+            let mut symmetric = format!("%%MatrixMarket matrix array real symmetric\n{n} {n}\n");
+            for j in 0..n {
+                for i in 0..n {
+                    general.push_str(&format!("{:e}\n", dense[i + n * j]));
+                    if i >= j {
+                        symmetric.push_str(&format!("{:.17e}\n", dense[i + n * j]));
+                    }
+                }
+            }
+            let sorted = |m: MatrixMarket| {
+                let mut e: Vec<(usize, usize, f64)> = m.entries.iter().map(|t| (t.row, t.col, t.val)).collect();
+                e.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+                e
+            };
+            let expected: Vec<(usize, usize, f64)> = (0..n)
+                .flat_map(|i| (0..n).map(move |j| (i, j)))
+                .filter(|&(i, j)| dense[i + n * j] != 0.0)
+                .map(|(i, j)| (i, j, dense[i + n * j]))
+                .collect();
+            assert_eq!(sorted(parse_matrix_market(&general).expect("general array")), expected);
+            assert_eq!(
+                sorted(parse_matrix_market(&symmetric).expect("symmetric array")),
+                expected
+            );
+        }
+    }
+
+    #[test]
+    fn an_array_declaring_a_huge_size_is_a_located_error() {
+        let text = "%%MatrixMarket matrix array real general\n1000000000 1000000000\n1\n";
+        assert!(matches!(
+            parse_matrix_market(text),
+            Err(ModalError::MatrixMarket { line: 3, .. })
+        ));
+        let text = "%%MatrixMarket matrix array real symmetric\n2 3\n1\n";
+        assert!(matches!(
+            parse_matrix_market(text),
+            Err(ModalError::MatrixMarket { line: 2, .. })
+        ));
+    }
+
     #[test]
     fn malformed_files_name_their_line() {
         assert_eq!(line_of(""), 1);
         assert_eq!(line_of("hello\n"), 1);
-        assert_eq!(line_of("%%MatrixMarket matrix array real general\n2 2\n"), 1);
+        assert_eq!(line_of("%%MatrixMarket vector array real general\n2 2\n"), 1);
+        assert_eq!(line_of("%%MatrixMarket matrix array real general\n2 2\n1\n2\n"), 4);
+        assert_eq!(line_of("%%MatrixMarket matrix array real general\n1 1\n1\n2\n"), 4);
+        assert_eq!(line_of("%%MatrixMarket matrix array real general\n1 1\n1 2\n"), 3);
         assert_eq!(line_of("%%MatrixMarket matrix coordinate complex general\n"), 1);
         assert_eq!(line_of("%%MatrixMarket matrix coordinate real skew-symmetric\n"), 1);
         let h = "%%MatrixMarket matrix coordinate real general\n";
