@@ -17,7 +17,9 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), St
     let mut dynamics = build_dynamics(scene, model)?;
     let n = model.q0.len();
     let vector = |values: &Option<toml::Spanned<Vec<f64>>>, default: &[f64]| {
-        values.as_ref().map_or_else(|| default.to_vec(), |v| v.get_ref().clone())
+        values
+            .as_ref()
+            .map_or_else(|| default.to_vec(), |v| v.get_ref().clone())
     };
     let q_dot = vector(&spec.q_dot, &model.qd0);
     let zeros = vec![0.0; n];
@@ -37,14 +39,17 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), St
     )?);
     let forward = forward.ok_or("internal: forward dynamics missing")?;
     let q_ddot = vector(&spec.q_ddot, &forward.q_ddot);
-    let step = timed_step("dynamics: inverse τ = A q̈ + c + g − Σ Q and joint reactions (RNEA)", || {
-        let result = dynamics
-            .inverse_dynamics(&state, &q_ddot)
-            .map_err(|e| format!("analyses.dynamics: inverse dynamics: {e}"))?;
-        let mut quantities = inverse_quantities(&result, &q_ddot);
-        quantities.extend(reaction_quantities(&dynamics, &result, model, spec)?);
-        Ok::<_, String>(quantities)
-    })?;
+    let step = timed_step(
+        "dynamics: inverse τ = A q̈ + c + g − Σ Q and joint reactions (RNEA)",
+        || {
+            let result = dynamics
+                .inverse_dynamics(&state, &q_ddot)
+                .map_err(|e| format!("analyses.dynamics: inverse dynamics: {e}"))?;
+            let mut quantities = inverse_quantities(&result, &q_ddot);
+            quantities.extend(reaction_quantities(&dynamics, &result, model, spec)?);
+            Ok::<_, String>(quantities)
+        },
+    )?;
     steps.push(step);
     Ok(())
 }
@@ -96,18 +101,16 @@ fn forward_quantities(result: &ForwardDynamics) -> Vec<Quantity> {
     };
     let mut accuracy = format!("{method}; backward error {:.1e}", result.backward_error);
     if let (Some(condition), Some(estimate)) = (result.condition, result.error_estimate) {
-        accuracy.push_str(&format!(
-            "; κ∞(A) = {condition:.2e}, error estimate {estimate:.1e}"
-        ));
+        accuracy.push_str(&format!("; κ∞(A) = {condition:.2e}, error estimate {estimate:.1e}"));
     }
     vec![
-        quantity("q̈ (forward dynamics)", result.q_ddot.clone(), "rad/s² | m/s²", Some(accuracy)),
         quantity(
-            "residual τ − RNEA(q, q̇, q̈)",
-            result.residual.clone(),
-            "N·m | N",
-            None,
+            "q̈ (forward dynamics)",
+            result.q_ddot.clone(),
+            "rad/s² | m/s²",
+            Some(accuracy),
         ),
+        quantity("residual τ − RNEA(q, q̇, q̈)", result.residual.clone(), "N·m | N", None),
         quantity(
             "dissipation function D of the dampers",
             vec![result.dissipation],

@@ -888,7 +888,11 @@ impl<'a> Validator<'a> {
     /// Ok when every joint spring's coordinate index lies within its joint.
     fn check_joint_springs(&self) -> Result<(), SceneError> {
         for (i, spring) in self.scene.joint_springs.iter().enumerate() {
-            self.check_coordinate(&spring.joint, &spring.coordinate, format!("joint_spring[{i}].coordinate"))?;
+            self.check_coordinate(
+                &spring.joint,
+                &spring.coordinate,
+                format!("joint_spring[{i}].coordinate"),
+            )?;
         }
         Ok(())
     }
@@ -929,7 +933,11 @@ impl<'a> Validator<'a> {
             }
         }
         for (i, damper) in self.scene.joint_dampers.iter().enumerate() {
-            self.check_coordinate(&damper.joint, &damper.coordinate, format!("joint_damper[{i}].coordinate"))?;
+            self.check_coordinate(
+                &damper.joint,
+                &damper.coordinate,
+                format!("joint_damper[{i}].coordinate"),
+            )?;
         }
         Ok(())
     }

@@ -22,7 +22,10 @@ fn run_json(name: &str, text: &str) -> serde_json::Value {
 }
 
 fn close(got: f64, exact: f64, tolerance: f64) {
-    assert!((got - exact).abs() <= tolerance, "{got} vs {exact} (tolerance {tolerance:e})");
+    assert!(
+        (got - exact).abs() <= tolerance,
+        "{got} vs {exact} (tolerance {tolerance:e})"
+    );
 }
 
 const G: f64 = 9.81;
@@ -69,10 +72,22 @@ fn a_damped_pendulum_matches_its_closed_forms_in_every_frame() {
         let scale = G / l + accel.abs();
         let world = run_json("pendulum_world", &pendulum(m, l, theta, rate, tau, c, "world"));
         close(values(&world, "q̈ (forward dynamics)")[0], accel, 1e-13 * scale);
-        close(values(&world, "τ (inverse dynamics)")[0], tau, 1e-13 * m * G * l + 1e-15);
-        close(values(&world, "g(q): gravity terms")[0], m * G * l * s, 1e-13 * m * G * l);
+        close(
+            values(&world, "τ (inverse dynamics)")[0],
+            tau,
+            1e-13 * m * G * l + 1e-15,
+        );
+        close(
+            values(&world, "g(q): gravity terms")[0],
+            m * G * l * s,
+            1e-13 * m * G * l,
+        );
         close(values(&world, "Q of joint damper")[0], -c * rate, 1e-15 * (1.0 + c));
-        close(values(&world, "dissipation function D")[0], 0.5 * c * rate * rate, 1e-15);
+        close(
+            values(&world, "dissipation function D")[0],
+            0.5 * c * rate * rate,
+            1e-15,
+        );
         // ẍ_C of x_C = (−l sin θ, 0, −l cos θ).
         let ax = -l * co * accel + l * s * rate * rate;
         let az = l * s * accel + l * co * rate * rate;
@@ -191,7 +206,11 @@ fn bad_dynamics_input_gives_located_errors() {
         let path = scene_file(&format!("bad{i}"), text);
         let (ok, out, err) = mechanica(&["run", path.to_str().expect("path")]);
         assert!(!ok, "{field}: accepted:\n{out}");
-        let line = text.lines().position(|l| l.contains(line_of)).map(|i| i + 1).expect("line");
+        let line = text
+            .lines()
+            .position(|l| l.contains(line_of))
+            .map(|i| i + 1)
+            .expect("line");
         let located = format!("{}:{line}:", path.display());
         assert!(err.contains(&located), "{field}: {err} (expected {located})");
         assert!(err.contains(&format!("field {field}")), "{field}: {err}");
