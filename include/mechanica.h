@@ -50,6 +50,8 @@
 #define MECH_FEATURE_MODAL 1
 /** Declared by default: the mechanism functions (potentials, equilibrium, stability, modes). */
 #define MECH_FEATURE_MECHANISM 1
+/** Declared by default: the dynamics functions (inverse and forward dynamics, joint reactions). */
+#define MECH_FEATURE_DYNAMICS 1
 #endif
 
 /**
@@ -98,11 +100,26 @@
  */
 #define MECH_FEATURE_BIT_MECHANISM (1 << 4)
 
+/**
+ * Bit of mech_features() set when the dynamics functions (inverse and forward dynamics, joint
+ * reactions) are compiled in.
+ */
+#define MECH_FEATURE_BIT_DYNAMICS (1 << 5)
+
 #if defined(MECH_FEATURE_MECHANISM)
 /**
  * The ground, as a body index for mech_mechanism_add_point_spring.
  */
 #define MECH_GROUND -1
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The dynamics of a mechanism (opaque): a copy of the mechanism (tree, bodies, gravity,
+ * rotating frame, potentials) with its dampers and charged points, and the working storage of
+ * its recursions. Created by mech_dynamics_create, freed by mech_dynamics_destroy.
+ */
+typedef struct mech_dynamics_t mech_dynamics_t;
 #endif
 
 #if defined(MECH_FEATURE_MECHANISM)
@@ -133,6 +150,53 @@ typedef struct mech_tree_t mech_tree_t;
  * Values are stable across versions and never reused.
  */
 typedef int32_t mech_status_t;
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The route that produced q̈ (int32_t).
+ */
+typedef int32_t mech_forward_method_t;
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The accuracy report of a forward-dynamics solve. Quantities that the route did not compute
+ * read −1 (never NaN).
+ */
+typedef struct mech_forward_report_t {
+    /**
+     * The route that produced q̈ (a mech_forward_method_t).
+     */
+    mech_forward_method_t method;
+    /**
+     * ‖r‖∞ / max_k scale_k with r = τ − RNEA(q, q̇, q̈) the residual of the equations of motion
+     * at the computed q̈ and scale_k the magnitude of the terms summed into τ_k: the relative
+     * change of the forces that makes q̈ exact, up to the rounding of the check.
+     */
+    double backward_error;
+    /**
+     * κ∞(A) = ‖A‖∞ ‖A⁻¹‖∞ when the mass matrix was formed (MECH_FORWARD_MASS_MATRIX), else −1.
+     */
+    double condition;
+    /**
+     * A first-order estimate of the ∞-norm error of q̈, ‖A⁻¹‖∞ (‖r‖∞ + ρ) with ρ the rounding
+     * estimate of the check, when the mass matrix was formed; else −1. An estimate, not a bound.
+     */
+    double error_estimate;
+    /**
+     * The dampers' dissipation function D = ½ q̇ᵀ C q̇ at the state (W; 2D is the power they
+     * take out of the mechanism).
+     */
+    double dissipation;
+} mech_forward_report_t;
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The frame in which a joint reaction is expressed (int32_t).
+ */
+typedef int32_t mech_reaction_frame_t;
+#endif
 
 /**
  * A 3-vector of doubles (x, y, z). Its frame is stated by each function that uses it.
@@ -1436,6 +1500,44 @@ typedef struct mech_modal_sparse_details_t {
  */
 #define MECH_STATUS_PANIC 100
 
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The articulated-body recursion, O(n), accepted when the inverse dynamics confirms it to the
+ * rounding level.
+ */
+#define MECH_FORWARD_ARTICULATED_BODY 0
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The composite-rigid-body mass matrix and Cholesky, O(n³), backward stable at every grading
+ * of the inertias; reports the condition of A.
+ */
+#define MECH_FORWARD_MASS_MATRIX 1
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * World (base-frame) components.
+ */
+#define MECH_REACTION_FRAME_WORLD 0
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The child body's frame (the frame its joint moves).
+ */
+#define MECH_REACTION_FRAME_BODY 1
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The joint frame, fixed in the parent body (in the base for a root body's joint), in which
+ * the joint's axis is given.
+ */
+#define MECH_REACTION_FRAME_JOINT 2
+#endif
+
 #if defined(MECH_FEATURE_IMPULSE)
 /**
  * Newton's kinematic law u_n⁺ = −e u_n⁻ (7.94); may gain energy with friction (Kane's paradox).
@@ -2084,6 +2186,292 @@ uint32_t mech_abi_version(void);
  * The MECH_FEATURE_BIT_* bits of the capabilities compiled into the linked library.
  */
 uint32_t mech_features(void);
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Creates the dynamics of a mechanism and writes its handle to `*dynamics_out`. The mechanism
+ * is copied with its gravity, rotating frame and potentials: later changes to it, or its
+ * destruction, do not affect the dynamics. The dynamics starts without dampers or charged
+ * points. The caller owns the handle and frees it with mech_dynamics_destroy.
+ *
+ * Errors: none beyond the pointer checks (MECH_STATUS_INVALID_ARGUMENT only if the mechanism's
+ * rotating frame cannot be set up as the tree's base motion).
+ *
+ * # Safety
+ * `mechanism` must be a live mechanism handle and `dynamics_out` a writable pointer.
+ */
+mech_status_t mech_dynamics_create(const struct mech_mechanism_t *mechanism,
+                                   struct mech_dynamics_t **dynamics_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Frees a dynamics handle. NULL is accepted and ignored.
+ *
+ * # Safety
+ * `dynamics` must be NULL or a live handle from mech_dynamics_create, not used afterwards.
+ */
+void mech_dynamics_destroy(struct mech_dynamics_t *dynamics);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes the number of coordinates n (the tree's dof) to `*dof_out`: the length of every q,
+ * q̇, q̈ and τ argument of the mech_dynamics_* functions.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `dynamics` must be a live handle and `dof_out` writable.
+ */
+mech_status_t mech_dynamics_dof(const struct mech_dynamics_t *dynamics,
+                                size_t *dof_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes the number of bodies of the mechanism to `*bodies_out`: the number of joint
+ * reactions of mech_dynamics_reactions.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `dynamics` must be a live handle and `bodies_out` writable.
+ */
+mech_status_t mech_dynamics_body_count(const struct mech_dynamics_t *dynamics,
+                                       size_t *bodies_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes q̈ (n values) for the applied forces `tau` at (`q`, `q_dot`) to `q_ddot_out` by the
+ * articulated-body algorithm in O(n), with every load of the dynamics at time 0; when an
+ * articulated inertia is singular to working precision it solves by the mass matrix instead.
+ * The fast path: no accuracy report, and its backward error grows with the grading of the
+ * inertias (about u times the mass ratio); mech_dynamics_forward checks it.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_SINGULAR when A(q) is
+ * singular (a coordinate moves no mass) or a dashpot's points coincide;
+ * MECH_STATUS_OUT_OF_RANGE when q̈ overflows.
+ *
+ * # Safety
+ * `dynamics` must be a live handle not used by another thread during the call; `q`, `q_dot`,
+ * `tau` must point to n readable doubles and `q_ddot_out` to n writable doubles.
+ */
+mech_status_t mech_dynamics_aba(struct mech_dynamics_t *dynamics,
+                                const double *q,
+                                const double *q_dot,
+                                const double *tau,
+                                size_t n,
+                                double *q_ddot_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes q̈ (n values) for the applied forces `tau` at (`q`, `q_dot`) and time `t` (s) to
+ * `q_ddot_out`, and its accuracy report to `*report_out` (may be NULL). The articulated-body
+ * recursion's q̈ is checked by the inverse dynamics and accepted when its backward error is
+ * at the rounding level of the check, 16·(d + 4)·u (d the depth of the tree); otherwise the
+ * equations are solved by the mass matrix and Cholesky (as mech_dynamics_forward_crba).
+ * `report_out->method` says which.
+ *
+ * Errors: as mech_dynamics_aba, and MECH_STATUS_NON_FINITE for a NaN or infinite `t`.
+ *
+ * # Safety
+ * As mech_dynamics_aba; `report_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_forward(struct mech_dynamics_t *dynamics,
+                                    const double *q,
+                                    const double *q_dot,
+                                    const double *tau,
+                                    double t,
+                                    size_t n,
+                                    double *q_ddot_out,
+                                    struct mech_forward_report_t *report_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * As mech_dynamics_forward, always by the composite-rigid-body mass matrix A(q) and its
+ * Cholesky factor, O(n³): backward stable at every grading of the inertias, and the report
+ * gives κ∞(A) and the error estimate of q̈.
+ *
+ * Errors: as mech_dynamics_forward.
+ *
+ * # Safety
+ * As mech_dynamics_forward.
+ */
+mech_status_t mech_dynamics_forward_crba(struct mech_dynamics_t *dynamics,
+                                         const double *q,
+                                         const double *q_dot,
+                                         const double *tau,
+                                         double t,
+                                         size_t n,
+                                         double *q_ddot_out,
+                                         struct mech_forward_report_t *report_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes the mass matrix A(q) (8.28) at `q` (n values) to `a_out`, n·n doubles in column-major
+ * order (symmetric), by the composite-rigid-body recursion: T = ½ q̇ᵀ A q̇ relative to the base
+ * frame.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_OUT_OF_RANGE when an
+ * entry overflows.
+ *
+ * # Safety
+ * `dynamics` must be a live handle not used by another thread during the call; `q` must point
+ * to n readable doubles and `a_out` to n·n writable doubles.
+ */
+mech_status_t mech_dynamics_mass_matrix(struct mech_dynamics_t *dynamics,
+                                        const double *q,
+                                        size_t n,
+                                        double *a_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes τ (n values) for the accelerations `q_ddot` at (`q`, `q_dot`) to `tau_out`: the
+ * generalized forces the actuators must apply, τ = A(q) q̈ + c(q, q̇) + g(q) − Σ Q_loads with
+ * every load of the dynamics (potentials, dampers, charges) at time 0, in N or N·m per
+ * coordinate, by the recursive Newton–Euler algorithm in O(n). The fast path: no split and no
+ * accuracy report (see mech_dynamics_inverse).
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_SINGULAR when a dashpot's
+ * points coincide; MECH_STATUS_OUT_OF_RANGE when τ overflows.
+ *
+ * # Safety
+ * `dynamics` must be a live handle not used by another thread during the call; `q`, `q_dot`,
+ * `q_ddot` must point to n readable doubles and `tau_out` to n writable doubles.
+ */
+mech_status_t mech_dynamics_rnea(struct mech_dynamics_t *dynamics,
+                                 const double *q,
+                                 const double *q_dot,
+                                 const double *q_ddot,
+                                 size_t n,
+                                 double *tau_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes τ (n values) for the accelerations `q_ddot` at (`q`, `q_dot`) and time `t` (s) to
+ * `tau_out`, as mech_dynamics_rnea, and its parts, each n values, to the optional outputs (may
+ * be NULL): `velocity_product_out` c(q, q̇), the Coriolis and centrifugal terms (with those of
+ * a rotating frame), `gravity_out` g(q) = ∂U_g/∂q, the force that balances the weights, and
+ * `error_estimate_out` a first-order estimate of the rounding error of each τ_k
+ * (16·(d + 4)·u times the magnitudes τ_k is summed from, d the depth of the tree; an
+ * estimate, not a bound). The loads' generalized force is Σ Q = A q̈ + c + g − τ.
+ *
+ * Errors: as mech_dynamics_rnea, and MECH_STATUS_NON_FINITE for a NaN or infinite `t`.
+ *
+ * # Safety
+ * As mech_dynamics_rnea; each non-NULL optional output must point to n writable doubles.
+ */
+mech_status_t mech_dynamics_inverse(struct mech_dynamics_t *dynamics,
+                                    const double *q,
+                                    const double *q_dot,
+                                    const double *q_ddot,
+                                    double t,
+                                    size_t n,
+                                    double *tau_out,
+                                    double *velocity_product_out,
+                                    double *gravity_out,
+                                    double *error_estimate_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes the wrench that each body's joint transmits, at (`q`, `q_dot`) with the accelerations
+ * `q_ddot` (the inverse dynamics' motion, loads at time 0), to `wrenches_out`: 6 doubles per
+ * body in body order, the force (N) then the moment (N·m) about the joint origin (the body
+ * frame's origin), that the parent (or the ground) exerts on the body through the joint,
+ * constraint reaction and actuator force together (7.33–7.36, FM 4.61). Components in `frame`
+ * (a mech_reaction_frame_t). `bodies` must be the body count (mech_dynamics_body_count).
+ *
+ * Errors: as mech_dynamics_rnea, and MECH_STATUS_BAD_ENUM for an unknown frame,
+ * MECH_STATUS_BAD_DIMENSION when `bodies` is not the body count.
+ *
+ * # Safety
+ * As mech_dynamics_rnea; `wrenches_out` must point to 6·bodies writable doubles.
+ */
+mech_status_t mech_dynamics_reactions(struct mech_dynamics_t *dynamics,
+                                      const double *q,
+                                      const double *q_dot,
+                                      const double *q_ddot,
+                                      size_t n,
+                                      mech_reaction_frame_t frame,
+                                      size_t bodies,
+                                      double *wrenches_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Adds a damper on coordinate `coordinate`: the dissipation function D = ½ c q̇_k² and the
+ * generalized force Q_k = −c q̇_k (c in N·m·s/rad for an angle, N·s/m for a length). Writes the
+ * damper's index (0, 1, … in the order dampers are added) to `*index_out` (may be NULL).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite c; MECH_STATUS_INVALID_ARGUMENT for
+ * c < 0 or a coordinate ≥ n.
+ *
+ * # Safety
+ * `dynamics` must be a live handle; `index_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_add_joint_damper(struct mech_dynamics_t *dynamics,
+                                             size_t coordinate,
+                                             double c,
+                                             size_t *index_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Adds a linear damper between the point `point_a` of body `body_a` and `point_b` of `body_b`
+ * (body coordinates, m; MECH_GROUND and base-frame coordinates for the ground). With
+ * v = ẋ_a − ẋ_b the relative velocity of the points: `axial` = 0 resists all of it,
+ * D = ½ c |v|², force −c v on a and +c v on b (FM 4.62); `axial` = 1 only its component along
+ * the line between the points, D = ½ c (e·v)² with e = (x_a − x_b)/|x_a − x_b| (a dashpot; an
+ * evaluation where the points meet fails with MECH_STATUS_SINGULAR). c in N·s/m. Writes the
+ * damper's index to `*index_out` (may be NULL).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * c < 0, `axial` other than 0 or 1, a body index below MECH_GROUND or out of range.
+ *
+ * # Safety
+ * `dynamics` must be a live handle; `index_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_add_point_damper(struct mech_dynamics_t *dynamics,
+                                             int64_t body_a,
+                                             struct mech_vec3_t point_a,
+                                             int64_t body_b,
+                                             struct mech_vec3_t point_b,
+                                             double c,
+                                             int32_t axial,
+                                             size_t *index_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Adds a charge `charge` (C) at the point `point` (body coordinates, m) of body `body`, in the
+ * uniform static fields E = `electric` (V/m) and B = `magnetic` (T), base-frame components.
+ * Its velocity-dependent potential U = e (φ − ẋ·𝐀) (FM 4.105, gauge φ = −E·x, 𝐀 = ½ B × x)
+ * gives the Lorentz force e (E + ẋ × B) at the point, ẋ its velocity (with a rotating frame,
+ * in the inertial frame that coincides with the base frame at the instant). Writes the potential's index (0, 1, … in the order charges are added) to
+ * `*index_out` (may be NULL).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a body out of range.
+ *
+ * # Safety
+ * `dynamics` must be a live handle; `index_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_add_charged_point(struct mech_dynamics_t *dynamics,
+                                              size_t body,
+                                              struct mech_vec3_t point,
+                                              double charge,
+                                              struct mech_vec3_t electric,
+                                              struct mech_vec3_t magnetic,
+                                              size_t *index_out);
+#endif
 
 #if defined(MECH_FEATURE_IMPULSE)
 /**

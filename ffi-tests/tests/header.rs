@@ -148,3 +148,46 @@ fn every_declaration_in_the_header_has_a_doxygen_comment() {
         undocumented.join("\n")
     );
 }
+
+/// A program for a library built with `mechanism` but without `dynamics` sees no dynamics
+/// declaration: a call to one does not compile, and compiles once MECH_FEATURE_DYNAMICS is
+/// defined too (so the failure is the guard's).
+#[test]
+fn the_dynamics_declarations_are_guarded_by_their_feature() {
+    let dir = target_dir().join("ffi-tests/header");
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{e}"));
+    let source = dir.join("uses_dynamics.c");
+    let body = "#include \"mechanica.h\"\nint main(void) {\n    mech_dynamics_t *d = NULL;\n    \
+                return (int)mech_dynamics_create(NULL, &d);\n}\n";
+    std::fs::write(&source, body).unwrap_or_else(|e| panic!("{e}"));
+    let mechanism_only = [
+        "-DMECH_FEATURES_EXPLICIT",
+        "-DMECH_FEATURE_KINEMATICS",
+        "-DMECH_FEATURE_MASS",
+        "-DMECH_FEATURE_MODAL",
+        "-DMECH_FEATURE_MECHANISM",
+    ];
+    let compile = |extra: &[&str]| {
+        std::process::Command::new("gcc")
+            .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic", "-fsyntax-only"])
+            .args(mechanism_only)
+            .args(extra)
+            .arg("-I")
+            .arg(workspace_root().join("include"))
+            .arg(&source)
+            .output()
+            .unwrap_or_else(|e| panic!("could not run gcc: {e}"))
+    };
+    let without = compile(&[]);
+    assert!(
+        !without.status.success(),
+        "a dynamics call compiled without MECH_FEATURE_DYNAMICS"
+    );
+    assert!(
+        String::from_utf8_lossy(&without.stderr).contains("mech_dynamics"),
+        "failed for another reason:\n{}",
+        String::from_utf8_lossy(&without.stderr)
+    );
+    check_success("gcc with MECH_FEATURE_DYNAMICS", &compile(&["-DMECH_FEATURE_DYNAMICS"]))
+        .unwrap_or_else(|e| panic!("{e}"));
+}

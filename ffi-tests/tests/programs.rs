@@ -71,6 +71,7 @@ fn a_modal_only_build_links_and_leaves_out_the_other_declarations() {
         "mech_quat_from_rotation_matrix",
         "mech_mass_point",
         "mech_collide_collinear",
+        "mech_dynamics_create",
     ] {
         assert!(!symbols.contains(absent), "{absent} is exported by a modal-only build");
     }

@@ -3,6 +3,7 @@
 //! files, and prints a readable report, or JSON with `--json`.
 
 mod default_scene;
+mod dynamics_run;
 mod mass_command;
 mod mechanism_run;
 mod modes_command;

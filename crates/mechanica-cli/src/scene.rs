@@ -47,6 +47,19 @@
 //! point = [0.0, 0.0, -1.0]
 //! force = [1.0, 0.0, 0.0]
 //!
+//! [[joint_damper]]                     # Rayleigh damper D = ½ c q̇², on one coordinate of a joint
+//! joint = "elbow"
+//! damping = 0.2                        # c ≥ 0: N·m·s/rad or N·s/m
+//! coordinate = 0                       # optional: index within the joint (default 0)
+//!
+//! [[damper]]                           # linear damper between two points, c ≥ 0 in N·s/m
+//! a = "lower"                          # body name or "ground"
+//! a_point = [0.0, 0.0, -1.0]
+//! b = "ground"
+//! b_point = [0.5, 0.0, -2.0]
+//! damping = 1.5
+//! axial = false                        # optional: true resists only the rate along the line a–b
+//!
 //! [analyses]                           # only what is listed is computed
 //! mass_properties = true
 //! equilibrium = { seek = "minimum" }   # or "stationary"; optional starts = [[...], ...]
@@ -57,11 +70,18 @@
 //! impact = { body = "lower", point = [0.0, 0.0, -1.0], normal = [0.0, 0.0, 1.0],
 //!            friction = 0.3, restitution = 0.5, law = "stronge",
 //!            compare_laws = true }           # at q0 with qd0; compare_laws adds the other two laws
+//! dynamics = { q_dot = [0.5, 0.0], tau = [1.0, 0.0], q_ddot = [0.0, 0.0], frame = "body" }
+//!                                      # at q0: forward dynamics q̈ for τ (default 0), then the
+//!                                      # inverse dynamics τ = A q̈ + c + g − Σ Q with its split and
+//!                                      # the joint reactions at q_ddot (default: that q̈); q_dot
+//!                                      # defaults to the joints' qd0; frame of the reactions:
+//!                                      # "world" (default), "body" or "joint"
 //! ```
 //!
 //! `inertia` lists the six independent entries (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) about the centre
 //! of mass, in the body frame. Unknown fields are errors, and so are coordinate counts that do
-//! not match the joints (q0, qd0, limits, joint springs, starts, dq0, v0). Every error names
+//! not match the joints (q0, qd0, limits, joint springs and dampers, starts, dq0, v0, the
+//! dynamics' q_dot, tau, q_ddot), and negative or non-finite damping. Every error names
 //! the file, the line and column, and the field.
 
 use serde::Deserialize;
@@ -95,6 +115,12 @@ pub struct Scene {
     /// Constant forces at body points.
     #[serde(default, rename = "force")]
     pub forces: Vec<ForceSpec>,
+    /// Rayleigh dampers on joint coordinates (used by the dynamics).
+    #[serde(default, rename = "joint_damper")]
+    pub joint_dampers: Vec<JointDamperSpec>,
+    /// Linear dampers between body points or a body point and the ground (used by the dynamics).
+    #[serde(default, rename = "damper")]
+    pub dampers: Vec<DamperSpec>,
     /// The analyses requested; nothing else is computed.
     #[serde(default)]
     pub analyses: Analyses,
@@ -145,6 +171,40 @@ pub struct SpringSpec {
     /// Rest length, m.
     #[serde(default)]
     pub rest_length: f64,
+}
+
+/// A Rayleigh damper on one coordinate of a joint: D = ½ c q̇².
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointDamperSpec {
+    /// The joint's name.
+    pub joint: Spanned<String>,
+    /// c ≥ 0, N·m·s/rad or N·s/m.
+    pub damping: Spanned<f64>,
+    /// Index of the coordinate within the joint.
+    #[serde(default = "unlocated_zero")]
+    pub coordinate: Spanned<usize>,
+}
+
+/// A linear damper between two points: D = ½ c |v|², or ½ c (e·v)² along the line when axial.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DamperSpec {
+    /// First end: a body name or "ground".
+    pub a: Spanned<String>,
+    /// First end's point, body coordinates (world for the ground), m.
+    #[serde(default)]
+    pub a_point: [f64; 3],
+    /// Second end: a body name or "ground".
+    pub b: Spanned<String>,
+    /// Second end's point, m.
+    #[serde(default)]
+    pub b_point: [f64; 3],
+    /// c ≥ 0, N·s/m.
+    pub damping: Spanned<f64>,
+    /// Resist only the relative velocity along the line between the points (a dashpot).
+    #[serde(default)]
+    pub axial: bool,
 }
 
 /// A constant world force at a body point.
@@ -294,6 +354,25 @@ pub struct Analyses {
     pub response: Option<Spanned<ResponseSpec>>,
     /// One impact of a body point against the ground, at (q0, qd0).
     pub impact: Option<ImpactSpec>,
+    /// Forward and inverse dynamics, with the joint reactions, at q0.
+    pub dynamics: Option<DynamicsSpec>,
+}
+
+/// The frames in which the dynamics step can report joint reactions.
+pub const DYNAMICS_FRAMES: [&str; 3] = ["world", "body", "joint"];
+
+/// The state and frame of the dynamics step.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsSpec {
+    /// q̇ (default: the joints' qd0).
+    pub q_dot: Option<Spanned<Vec<f64>>>,
+    /// The applied generalized forces τ of the forward dynamics (default 0).
+    pub tau: Option<Spanned<Vec<f64>>>,
+    /// The accelerations of the inverse dynamics and reactions (default: the forward q̈).
+    pub q_ddot: Option<Spanned<Vec<f64>>>,
+    /// "world" (default), "body" or "joint": the frame of the joint reactions.
+    pub frame: Option<Spanned<String>>,
 }
 
 /// Equilibrium search options.
@@ -477,6 +556,7 @@ impl Scene {
         validator.check_option_names()?;
         validator.check_joint_values()?;
         validator.check_joint_springs()?;
+        validator.check_dampers()?;
         validator.check_analyses()
     }
 }
@@ -675,20 +755,29 @@ impl<'a> Validator<'a> {
         for (i, force) in self.scene.forces.iter().enumerate() {
             self.check_body(&force.body, format!("force[{i}].body"), index_of)?;
         }
+        for (i, damper) in self.scene.dampers.iter().enumerate() {
+            self.check_body_or_ground(&damper.a, format!("damper[{i}].a"), index_of)?;
+            self.check_body_or_ground(&damper.b, format!("damper[{i}].b"), index_of)?;
+        }
+        for (i, damper) in self.scene.joint_dampers.iter().enumerate() {
+            self.check_joint_name(&damper.joint, format!("joint_damper[{i}].joint"))?;
+        }
         if let Some(impact) = &self.scene.analyses.impact {
             self.check_body(&impact.body, "analyses.impact.body".into(), index_of)?;
         }
         for (i, spring) in self.scene.joint_springs.iter().enumerate() {
-            let name = spring.joint.get_ref();
-            if !self.scene.joints.iter().any(|j| &j.name == name) {
-                return Err(self.error(
-                    Some(spring.joint.span()),
-                    format!("joint_spring[{i}].joint"),
-                    format!("no joint named \"{name}\""),
-                ));
-            }
+            self.check_joint_name(&spring.joint, format!("joint_spring[{i}].joint"))?;
         }
         Ok(())
+    }
+
+    /// Ok when `name` is a joint's name; else an error on `field`.
+    fn check_joint_name(&self, name: &Spanned<String>, field: String) -> Result<(), SceneError> {
+        if self.scene.joints.iter().any(|j| &j.name == name.get_ref()) {
+            return Ok(());
+        }
+        let message = format!("no joint named \"{}\"", name.get_ref());
+        Err(self.error(Some(name.span()), field, message))
     }
 
     /// Ok when `name` is "ground" or a body's name; else an error on `field`.
@@ -799,19 +888,56 @@ impl<'a> Validator<'a> {
     /// Ok when every joint spring's coordinate index lies within its joint.
     fn check_joint_springs(&self) -> Result<(), SceneError> {
         for (i, spring) in self.scene.joint_springs.iter().enumerate() {
-            let Some(joint) = self.scene.joints.iter().find(|j| &j.name == spring.joint.get_ref()) else {
-                continue;
-            };
-            let dof = joint.kind.get_ref().dof();
-            let index = *spring.coordinate.get_ref();
-            if index >= dof {
-                let span = Some(spring.coordinate.span()).filter(|s| s.end > s.start);
-                return Err(self.error(
-                    span.or(Some(spring.joint.span())),
-                    format!("joint_spring[{i}].coordinate"),
-                    format!("coordinate {index} of joint \"{}\", which has {dof}", joint.name),
-                ));
+            self.check_coordinate(
+                &spring.joint,
+                &spring.coordinate,
+                format!("joint_spring[{i}].coordinate"),
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Ok when `coordinate` indexes a coordinate of the joint named `joint` (an unknown joint is
+    /// reported by [`Validator::check_references`]); else an error on `field`.
+    fn check_coordinate(
+        &self,
+        joint: &Spanned<String>,
+        coordinate: &Spanned<usize>,
+        field: String,
+    ) -> Result<(), SceneError> {
+        let Some(spec) = self.scene.joints.iter().find(|j| &j.name == joint.get_ref()) else {
+            return Ok(());
+        };
+        let dof = spec.kind.get_ref().dof();
+        let index = *coordinate.get_ref();
+        if index < dof {
+            return Ok(());
+        }
+        let span = Some(coordinate.span()).filter(|s| s.end > s.start);
+        let message = format!("coordinate {index} of joint \"{}\", which has {dof}", spec.name);
+        Err(self.error(span.or(Some(joint.span())), field, message))
+    }
+
+    /// Ok when every damper's coefficient is finite and ≥ 0 and every joint damper's coordinate
+    /// lies within its joint.
+    fn check_dampers(&self) -> Result<(), SceneError> {
+        let joint = self.scene.joint_dampers.iter().enumerate();
+        let joint = joint.map(|(i, d)| (&d.damping, format!("joint_damper[{i}].damping")));
+        let point = self.scene.dampers.iter().enumerate();
+        let point = point.map(|(i, d)| (&d.damping, format!("damper[{i}].damping")));
+        for (damping, field) in joint.chain(point) {
+            let c = *damping.get_ref();
+            if !(c.is_finite() && c >= 0.0) {
+                let message = format!("the damping coefficient must be finite and ≥ 0, got {c}");
+                return Err(self.error(Some(damping.span()), field, message));
             }
+        }
+        for (i, damper) in self.scene.joint_dampers.iter().enumerate() {
+            self.check_coordinate(
+                &damper.joint,
+                &damper.coordinate,
+                format!("joint_damper[{i}].coordinate"),
+            )?;
         }
         Ok(())
     }
@@ -837,10 +963,33 @@ impl<'a> Validator<'a> {
                 format!("{} modes asked for; the scene has {dof} coordinates", lowest.get_ref()),
             ));
         }
+        if let Some(dynamics) = &analyses.dynamics {
+            self.check_dynamics(dynamics, dof)?;
+        }
         match &analyses.response {
             Some(response) => self.check_response(response, dof),
             None => Ok(()),
         }
+    }
+
+    /// Ok when the dynamics' state vectors have one finite value per coordinate and its frame
+    /// is a known name.
+    fn check_dynamics(&self, spec: &DynamicsSpec, dof: usize) -> Result<(), SceneError> {
+        for (values, what) in [(&spec.q_dot, "q_dot"), (&spec.tau, "tau"), (&spec.q_ddot, "q_ddot")] {
+            let Some(values) = values else { continue };
+            let field = format!("analyses.dynamics.{what}");
+            self.check_length(values, dof, field.clone(), "the scene has")?;
+            if let Some(bad) = values.get_ref().iter().find(|v| !v.is_finite()) {
+                return Err(self.error(Some(values.span()), field, format!("{bad} is not a finite number")));
+            }
+        }
+        if let Some(frame) = &spec.frame
+            && !DYNAMICS_FRAMES.contains(&frame.get_ref().as_str())
+        {
+            let message = format!("\"{}\" is not one of {DYNAMICS_FRAMES:?}", frame.get_ref());
+            return Err(self.error(Some(frame.span()), "analyses.dynamics.frame".into(), message));
+        }
+        Ok(())
     }
 
     /// Ok when the free response is well defined (see [`Validator::check_analyses`]).

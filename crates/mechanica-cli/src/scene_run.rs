@@ -43,6 +43,7 @@ pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report
     }
     let mut plots = crate::plots::PlotData::default();
     crate::mechanism_run::run(scene, &model, &mut steps, &mut plots)?;
+    crate::dynamics_run::run(scene, &model, &mut steps)?;
     for step in &steps {
         crate::report::check_finite(step, |name| {
             crate::mechanism_run::INFINITE_FOR_MASSLESS_MODES.contains(&name)

@@ -93,6 +93,8 @@ pub fn load(path: &Path, options: UrdfOptions) -> Result<(Scene, Vec<String>), S
         joint_springs: Vec::new(),
         springs: Vec::new(),
         forces: Vec::new(),
+        joint_dampers: Vec::new(),
+        dampers: Vec::new(),
         analyses: Analyses {
             mass_properties: true,
             equilibrium: Some(EquilibriumSpec {
@@ -103,6 +105,7 @@ pub fn load(path: &Path, options: UrdfOptions) -> Result<(Scene, Vec<String>), S
             modes: Some(ModesSpec { lowest: None }),
             response: None,
             impact: None,
+            dynamics: None,
         },
     };
     scene.check(path)?;

@@ -9,10 +9,13 @@
 //! | `impulse`    | [`impulse`]              | `mechanica-impulse`     |
 //! | `modal`      | [`modal`]                | `mechanica-modal`       |
 //! | `mechanism`  | [`mechanism`]            | `mechanica-mechanism`   |
+//! | `dynamics`   | [`dynamics`]             | `mechanica-dynamics`    |
 //!
 //! C and C++ programs use the same capabilities through [`ffi`], declared in the generated
 //! header `include/mechanica.h`.
 
+#[cfg(feature = "dynamics")]
+pub use mechanica_dynamics as dynamics;
 #[cfg(feature = "impulse")]
 pub use mechanica_impulse as impulse;
 #[cfg(feature = "kinematics")]

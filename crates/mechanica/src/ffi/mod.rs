@@ -16,7 +16,8 @@
         feature = "mass",
         feature = "impulse",
         feature = "modal",
-        feature = "mechanism"
+        feature = "mechanism",
+        feature = "dynamics"
     )),
     allow(dead_code, unused_imports, unused_macros)
 )]
@@ -31,6 +32,8 @@ mod types;
 mod validate;
 mod version;
 
+#[cfg(feature = "dynamics")]
+mod dynamics;
 #[cfg(feature = "impulse")]
 mod impulse;
 #[cfg(feature = "kinematics")]
@@ -47,6 +50,8 @@ pub use status::*;
 pub use types::*;
 pub use version::*;
 
+#[cfg(feature = "dynamics")]
+pub use dynamics::*;
 #[cfg(feature = "impulse")]
 pub use impulse::*;
 #[cfg(feature = "kinematics")]

@@ -22,6 +22,9 @@ pub const MECH_FEATURE_BIT_IMPULSE: u32 = 1 << 2;
 pub const MECH_FEATURE_BIT_MODAL: u32 = 1 << 3;
 /// Bit of mech_features() set when the mechanism functions (potentials, equilibrium, modes) are compiled in.
 pub const MECH_FEATURE_BIT_MECHANISM: u32 = 1 << 4;
+/// Bit of mech_features() set when the dynamics functions (inverse and forward dynamics, joint
+/// reactions) are compiled in.
+pub const MECH_FEATURE_BIT_DYNAMICS: u32 = 1 << 5;
 
 /// The library version as a static NUL-terminated string "MAJOR.MINOR.PATCH".
 #[unsafe(no_mangle)]
@@ -53,6 +56,9 @@ pub extern "C" fn mech_features() -> u32 {
     }
     if cfg!(feature = "mechanism") {
         bits |= MECH_FEATURE_BIT_MECHANISM;
+    }
+    if cfg!(feature = "dynamics") {
+        bits |= MECH_FEATURE_BIT_DYNAMICS;
     }
     bits
 }

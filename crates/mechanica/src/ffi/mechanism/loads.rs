@@ -98,8 +98,9 @@ pub unsafe extern "C" fn mech_mechanism_add_joint_spring(
 /// The ground, as a body index for mech_mechanism_add_point_spring.
 pub const MECH_GROUND: i64 = -1;
 
-/// The anchor of a spring end: MECH_GROUND or a body index (INVALID_ARGUMENT below −1).
-fn anchor(body: i64, point: mech_vec3_t) -> Result<Anchor, FfiError> {
+/// The anchor of a spring or damper end: MECH_GROUND or a body index (INVALID_ARGUMENT below
+/// −1).
+pub(crate) fn anchor(body: i64, point: mech_vec3_t) -> Result<Anchor, FfiError> {
     let body = match body {
         MECH_GROUND => None,
         b if b >= 0 => Some(b as usize),

@@ -52,6 +52,13 @@ pub struct mech_mechanism_t {
 
 impl Handle for mech_mechanism_t {}
 
+impl mech_mechanism_t {
+    /// The mechanism behind the handle.
+    pub(crate) fn mechanism(&self) -> &Mechanism {
+        &self.mechanism
+    }
+}
+
 /// Borrows the mechanism behind a handle for changing it (NULL_POINTER, MISALIGNED_POINTER).
 ///
 /// # Safety

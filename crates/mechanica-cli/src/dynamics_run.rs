@@ -1,0 +1,184 @@
+//! The dynamics step of a scene: at q0, the forward dynamics q̈ for the applied forces τ and the
+//! inverse dynamics τ = A q̈ + c + g − Σ Q (Lagrange's equations (7.60)) with its split and the
+//! joint reactions, with the scene's dampers.
+
+use crate::report::{Quantity, Step, timed_step};
+use crate::scene::{DynamicsSpec, Scene};
+use crate::scene_run::{Model, quantity};
+use mechanica::dynamics::{Damper, Dynamics, ForwardDynamics, ForwardMethod, Frame, InverseDynamics, State};
+use mechanica::kinematics::nalgebra::Vector3;
+use mechanica::mechanism::Anchor;
+
+/// Runs the dynamics step when the scene asks for it.
+pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), String> {
+    let Some(spec) = &scene.analyses.dynamics else {
+        return Ok(());
+    };
+    let mut dynamics = build_dynamics(scene, model)?;
+    let n = model.q0.len();
+    let vector = |values: &Option<toml::Spanned<Vec<f64>>>, default: &[f64]| {
+        values
+            .as_ref()
+            .map_or_else(|| default.to_vec(), |v| v.get_ref().clone())
+    };
+    let q_dot = vector(&spec.q_dot, &model.qd0);
+    let zeros = vec![0.0; n];
+    let tau = vector(&spec.tau, &zeros);
+    let state = State::new(&model.q0, &q_dot);
+    let mut forward = None;
+    steps.push(timed_step(
+        "dynamics: forward q̈ = A⁻¹ (τ + Σ Q − c − g) at q0 (7.60)",
+        || {
+            let result = dynamics
+                .forward_dynamics(&state, &tau)
+                .map_err(|e| format!("analyses.dynamics: forward dynamics: {e}"))?;
+            let quantities = forward_quantities(&result);
+            forward = Some(result);
+            Ok::<_, String>(quantities)
+        },
+    )?);
+    let forward = forward.ok_or("internal: forward dynamics missing")?;
+    let q_ddot = vector(&spec.q_ddot, &forward.q_ddot);
+    let step = timed_step(
+        "dynamics: inverse τ = A q̈ + c + g − Σ Q and joint reactions (RNEA)",
+        || {
+            let result = dynamics
+                .inverse_dynamics(&state, &q_ddot)
+                .map_err(|e| format!("analyses.dynamics: inverse dynamics: {e}"))?;
+            let mut quantities = inverse_quantities(&result, &q_ddot);
+            quantities.extend(reaction_quantities(&dynamics, &result, model, spec)?);
+            Ok::<_, String>(quantities)
+        },
+    )?;
+    steps.push(step);
+    Ok(())
+}
+
+/// The scene's mechanism (potentials, frame) with its joint and point dampers.
+fn build_dynamics(scene: &Scene, model: &Model) -> Result<Dynamics, String> {
+    let mechanism = crate::mechanism_run::build_mechanism(scene, model)?;
+    let mut dynamics = Dynamics::new(mechanism).map_err(|e| format!("analyses.dynamics: {e}"))?;
+    for (i, damper) in scene.joint_dampers.iter().enumerate() {
+        let body = model
+            .joint_body
+            .iter()
+            .find(|(name, _)| name == damper.joint.get_ref())
+            .map(|(_, b)| *b)
+            .ok_or_else(|| format!("joint_damper[{i}]: no joint \"{}\"", damper.joint.get_ref()))?;
+        let coordinate = model.tree.dof_range(body).start + *damper.coordinate.get_ref();
+        dynamics
+            .add_damper(Damper::Joint {
+                coordinate,
+                coefficient: *damper.damping.get_ref(),
+            })
+            .map_err(|e| format!("joint_damper[{i}]: {e}"))?;
+    }
+    let body_index = |name: &str| scene.bodies.iter().position(|b| b.name.get_ref() == name);
+    let anchor = |name: &str, point: [f64; 3]| Anchor {
+        body: if name == "ground" { None } else { body_index(name) },
+        point: Vector3::from(point),
+    };
+    for (i, damper) in scene.dampers.iter().enumerate() {
+        let (a, b) = (
+            anchor(damper.a.get_ref(), damper.a_point),
+            anchor(damper.b.get_ref(), damper.b_point),
+        );
+        let coefficient = *damper.damping.get_ref();
+        let element = if damper.axial {
+            Damper::Dashpot { a, b, coefficient }
+        } else {
+            Damper::Points { a, b, coefficient }
+        };
+        dynamics.add_damper(element).map_err(|e| format!("damper[{i}]: {e}"))?;
+    }
+    Ok(dynamics)
+}
+
+fn forward_quantities(result: &ForwardDynamics) -> Vec<Quantity> {
+    let method = match result.method {
+        ForwardMethod::ArticulatedBody => "articulated-body recursion, confirmed by the inverse dynamics",
+        ForwardMethod::MassMatrix => "mass matrix and Cholesky",
+    };
+    let mut accuracy = format!("{method}; backward error {:.1e}", result.backward_error);
+    if let (Some(condition), Some(estimate)) = (result.condition, result.error_estimate) {
+        accuracy.push_str(&format!("; κ∞(A) = {condition:.2e}, error estimate {estimate:.1e}"));
+    }
+    vec![
+        quantity(
+            "q̈ (forward dynamics)",
+            result.q_ddot.clone(),
+            "rad/s² | m/s²",
+            Some(accuracy),
+        ),
+        quantity("residual τ − RNEA(q, q̇, q̈)", result.residual.clone(), "N·m | N", None),
+        quantity(
+            "dissipation function D of the dampers",
+            vec![result.dissipation],
+            "W",
+            None,
+        ),
+    ]
+}
+
+fn inverse_quantities(result: &InverseDynamics, q_ddot: &[f64]) -> Vec<Quantity> {
+    let rounding = result.error_estimate.iter().copied().fold(0.0, f64::max);
+    let mut out = vec![
+        quantity("q̈ of the inverse dynamics", q_ddot.to_vec(), "rad/s² | m/s²", None),
+        quantity(
+            "τ (inverse dynamics)",
+            result.tau.clone(),
+            "N·m | N",
+            Some(format!("rounding estimate {rounding:.1e}")),
+        ),
+        quantity(
+            "c(q, q̇): velocity-product terms",
+            result.velocity_product.clone(),
+            "N·m | N",
+            None,
+        ),
+        quantity("g(q): gravity terms", result.gravity.clone(), "N·m | N", None),
+    ];
+    for load in &result.loads {
+        out.push(quantity(
+            &format!("Q of {}", load.name),
+            load.force.clone(),
+            "N·m | N",
+            None,
+        ));
+    }
+    out
+}
+
+/// One quantity per joint: the force and the moment about the joint origin that the parent
+/// exerts on the body through the joint, in the requested frame.
+fn reaction_quantities(
+    dynamics: &Dynamics,
+    result: &InverseDynamics,
+    model: &Model,
+    spec: &DynamicsSpec,
+) -> Result<Vec<Quantity>, String> {
+    let name = spec.frame.as_ref().map_or("world", |f| f.get_ref().as_str());
+    let frame = match name {
+        "body" => Frame::Body,
+        "joint" => Frame::Joint,
+        _ => Frame::World,
+    };
+    let mut out = Vec::with_capacity(result.reactions.len());
+    for reaction in &result.reactions {
+        let wrench = reaction
+            .expressed_in(dynamics, frame)
+            .map_err(|e| format!("analyses.dynamics: {e}"))?;
+        let joint = model
+            .joint_body
+            .iter()
+            .find(|(_, b)| *b == reaction.body)
+            .map_or("?", |(n, _)| n.as_str());
+        out.push(quantity(
+            &format!("reaction at joint \"{joint}\": force, moment about its origin ({name} frame)"),
+            wrench.force.iter().chain(wrench.moment.iter()).copied().collect(),
+            "N | N·m",
+            None,
+        ));
+    }
+    Ok(out)
+}

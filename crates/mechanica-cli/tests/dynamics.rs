@@ -1,0 +1,219 @@
+//! The `dynamics` analysis of `mechanica run`: forward and inverse dynamics, joint reactions and
+//! dampers against closed forms, and located errors for bad dynamics input.
+
+use std::path::PathBuf;
+mod common;
+use common::{mechanica, values};
+
+fn scene_file(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mechanica-dynamics-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).expect("write scene");
+    path
+}
+
+/// Runs a scene and returns its JSON report.
+fn run_json(name: &str, text: &str) -> serde_json::Value {
+    let path = scene_file(name, text);
+    let (ok, out, err) = mechanica(&["run", path.to_str().expect("path"), "--json"]);
+    assert!(ok, "{err}");
+    serde_json::from_str(&out).expect("JSON report")
+}
+
+fn close(got: f64, exact: f64, tolerance: f64) {
+    assert!(
+        (got - exact).abs() <= tolerance,
+        "{got} vs {exact} (tolerance {tolerance:e})"
+    );
+}
+
+const G: f64 = 9.81;
+
+/// A point mass m on a rod of length l, hinged about y at the origin, with a joint damper.
+fn pendulum(m: f64, l: f64, theta: f64, rate: f64, tau: f64, c: f64, frame: &str) -> String {
+    format!(
+        r#"title = "damped pendulum"
+gravity = [0.0, 0.0, -{G:?}]
+[[body]]
+name = "bob"
+primitive = {{ shape = "point", mass = {m:?} }}
+offset = [0.0, 0.0, -{l:?}]
+[[joint]]
+name = "hinge"
+type = "revolute"
+parent = "ground"
+child = "bob"
+axis = [0.0, 1.0, 0.0]
+q0 = [{theta:?}]
+qd0 = [{rate:?}]
+[[joint_damper]]
+joint = "hinge"
+damping = {c:?}
+[analyses]
+dynamics = {{ tau = [{tau:?}], frame = "{frame}" }}
+"#
+    )
+}
+
+/// θ̈ = (τ − m g l sin θ − c θ̇) / (m l²); the inverse dynamics at that θ̈ gives back τ with
+/// g = m g l sin θ and the damper's Q = −c θ̇; the pivot's reaction is m (ẍ_C − g) in the world
+/// and, in the body frame, (−m (l θ̈ + g sin θ), 0, m (l θ̇² + g cos θ)).
+#[test]
+fn a_damped_pendulum_matches_its_closed_forms_in_every_frame() {
+    let cases = [
+        (1.3, 0.7, 0.4, -1.2, 0.8, 0.3),
+        (0.2, 2.5, -2.9, 3.0, -0.05, 1.5),
+        (5.0, 0.1, 1.6, 0.0, 2.0, 0.0),
+    ];
+    for (m, l, theta, rate, tau, c) in cases {
+        let (s, co) = (f64::sin(theta), f64::cos(theta));
+        let accel = (tau - m * G * l * s - c * rate) / (m * l * l);
+        let scale = G / l + accel.abs();
+        let world = run_json("pendulum_world", &pendulum(m, l, theta, rate, tau, c, "world"));
+        close(values(&world, "q̈ (forward dynamics)")[0], accel, 1e-13 * scale);
+        close(
+            values(&world, "τ (inverse dynamics)")[0],
+            tau,
+            1e-13 * m * G * l + 1e-15,
+        );
+        close(
+            values(&world, "g(q): gravity terms")[0],
+            m * G * l * s,
+            1e-13 * m * G * l,
+        );
+        close(values(&world, "Q of joint damper")[0], -c * rate, 1e-15 * (1.0 + c));
+        close(
+            values(&world, "dissipation function D")[0],
+            0.5 * c * rate * rate,
+            1e-15,
+        );
+        // ẍ_C of x_C = (−l sin θ, 0, −l cos θ).
+        let ax = -l * co * accel + l * s * rate * rate;
+        let az = l * s * accel + l * co * rate * rate;
+        let force_scale = m * (G + l * (accel.abs() + rate * rate));
+        let reaction = values(&world, "reaction at joint \"hinge\"");
+        close(reaction[0], m * ax, 1e-13 * force_scale);
+        close(reaction[1], 0.0, 1e-13 * force_scale);
+        close(reaction[2], m * (az + G), 1e-13 * force_scale);
+        // The moment about the hinge along its axis is what the hinge applies: τ and the damper.
+        close(reaction[4], tau - c * rate, 1e-12 * force_scale * l);
+        let body = run_json("pendulum_body", &pendulum(m, l, theta, rate, tau, c, "body"));
+        let reaction = values(&body, "reaction at joint \"hinge\"");
+        close(reaction[0], -m * (l * accel + G * s), 1e-13 * force_scale);
+        close(reaction[2], m * (l * rate * rate + G * co), 1e-13 * force_scale);
+    }
+}
+
+/// A slider of mass m along x, at x = q, with a damper to a ground point (x0, 0, h): on the
+/// full relative velocity q̈ = (τ − c v)/m; as a dashpot along the line only the rate along it
+/// resists, q̈ = (τ − c v (q − x0)²/((q − x0)² + h²))/m.
+#[test]
+fn point_dampers_and_dashpots_resist_the_relative_velocity() {
+    let (m, q, v, tau, c, x0, h) = (2.0, 0.3, -1.7, 0.4, 0.9, -0.5, 0.6);
+    for axial in [false, true] {
+        let text = format!(
+            r#"title = "damped slider"
+[[body]]
+name = "slider"
+primitive = {{ shape = "box", size = [0.1, 0.1, 0.1], mass = {m:?} }}
+[[joint]]
+name = "rail"
+type = "prismatic"
+parent = "ground"
+child = "slider"
+axis = [1.0, 0.0, 0.0]
+q0 = [{q:?}]
+[[damper]]
+a = "slider"
+b = "ground"
+b_point = [{x0:?}, 0.0, {h:?}]
+damping = {c:?}
+axial = {axial}
+[analyses]
+dynamics = {{ q_dot = [{v:?}], tau = [{tau:?}], q_ddot = [0.0] }}
+"#
+        );
+        let json = run_json("slider", &text);
+        let d = q - x0;
+        let along = if axial { d * d / (d * d + h * h) } else { 1.0 };
+        let expected = (tau - c * v * along) / m;
+        close(values(&json, "q̈ (forward dynamics)")[0], expected, 1e-14);
+        // At the given q̈ = 0 the inverse dynamics needs τ = −Q = c v (fraction along the line).
+        close(values(&json, "τ (inverse dynamics)")[0], c * v * along, 1e-14);
+        let dissipation = 0.5 * c * v * v * along;
+        close(values(&json, "dissipation function D")[0], dissipation, 1e-15);
+    }
+}
+
+#[test]
+fn bad_dynamics_input_gives_located_errors() {
+    let base = pendulum(1.0, 1.0, 0.3, 0.0, 0.0, 0.5, "world");
+    let cases = [
+        (
+            base.replace("damping = 0.5", "damping = -0.5"),
+            "joint_damper[0].damping",
+            "damping = -0.5",
+            "≥ 0",
+        ),
+        (
+            base.replace("damping = 0.5", "damping = nan"),
+            "joint_damper[0].damping",
+            "damping = nan",
+            "finite",
+        ),
+        (
+            base.replace(
+                "[analyses]",
+                "[[damper]]\na = \"bob\"\nb = \"ground\"\ndamping = -2.0\n\n[analyses]",
+            ),
+            "damper[0].damping",
+            "damping = -2.0",
+            "≥ 0",
+        ),
+        (
+            base.replace("joint = \"hinge\"", "joint = \"hing\""),
+            "joint_damper[0].joint",
+            "joint = \"hing\"",
+            "no joint",
+        ),
+        (
+            base.replace("damping = 0.5", "damping = 0.5\ncoordinate = 1"),
+            "joint_damper[0].coordinate",
+            "coordinate = 1",
+            "which has 1",
+        ),
+        (
+            base.replace("tau = [0.0]", "tau = [0.0, 1.0]"),
+            "analyses.dynamics.tau",
+            "dynamics =",
+            "2 values",
+        ),
+        (
+            base.replace("frame = \"world\"", "frame = \"sideways\""),
+            "analyses.dynamics.frame",
+            "dynamics =",
+            "sideways",
+        ),
+        (
+            base.replace("tau = [0.0]", "tau = [0.0], q_dot = [inf]"),
+            "analyses.dynamics.q_dot",
+            "dynamics =",
+            "finite",
+        ),
+    ];
+    for (i, (text, field, line_of, says)) in cases.iter().enumerate() {
+        let path = scene_file(&format!("bad{i}"), text);
+        let (ok, out, err) = mechanica(&["run", path.to_str().expect("path")]);
+        assert!(!ok, "{field}: accepted:\n{out}");
+        let line = text
+            .lines()
+            .position(|l| l.contains(line_of))
+            .map(|i| i + 1)
+            .expect("line");
+        let located = format!("{}:{line}:", path.display());
+        assert!(err.contains(&located), "{field}: {err} (expected {located})");
+        assert!(err.contains(&format!("field {field}")), "{field}: {err}");
+        assert!(err.contains(says), "{field}: {err}");
+    }
+}
