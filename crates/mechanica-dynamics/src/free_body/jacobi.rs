@@ -1,0 +1,132 @@
+//! Jacobi's elliptic functions sn, cn, dn and the amplitude am for real argument u and modulus
+//! 0 ≤ k ≤ 1.
+//!
+//! - The argument is reduced by the real quarter period: u = qK + r, |r| ≤ K/2, with K in
+//!   double-double, and the quarter-period shifts sn(r + K) = cn r / dn r,
+//!   cn(r + K) = −k′ sn r / dn r, dn(r + K) = k′ / dn r (DLMF 22.4.3) bring the value back.
+//! - On |r| ≤ K/2 the descending Landen transformation (DLMF 22.7.1–22.7.3) with
+//!   kₙ₊₁ = (1 − kₙ′)/(1 + kₙ′) and wₙ₊₁ = wₙ / (1 + kₙ₊₁) lowers the modulus quadratically,
+//!   and at kₙ² < 1e-12 the first-order expansions in m = k² (DLMF 22.10.4–22.10.6) give the
+//!   bottom values. Going back up, every step is a product or quotient of positive terms
+//!   (dn of DLMF 22.7.3 rewritten as (cn² + (1 − k₁) sn²) / (1 + k₁ sn²)), so sn, cn and dn
+//!   keep their relative accuracy even where cn or dn is small.
+//! - k = 0 gives sin, cos, 1 and k = 1 gives tanh, sech, sech exactly (DLMF 22.5.3, 22.5.4).
+//! - am(u) = mπ + atan2(sn u′, cn u′) for u = 2mK + u′, |u′| ≤ K (DLMF 22.16.1, 22.16.2).
+
+use super::double_double::PI;
+use super::elliptic::EllipticModulus;
+use crate::error::{DynamicsError, check_input};
+
+/// sn u, cn u and dn u at one argument.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JacobiValues {
+    /// sn(u, k).
+    pub sn: f64,
+    /// cn(u, k).
+    pub cn: f64,
+    /// dn(u, k).
+    pub dn: f64,
+}
+
+impl EllipticModulus {
+    /// sn, cn, dn at u; an error for a non-finite u.
+    pub fn jacobi(&self, u: f64) -> Result<JacobiValues, DynamicsError> {
+        check_input(&[u], "argument u")?;
+        Ok(self.jacobi_unchecked(u))
+    }
+
+    /// am(u) (DLMF 22.16.1); an error for a non-finite u.
+    pub fn amplitude(&self, u: f64) -> Result<f64, DynamicsError> {
+        check_input(&[u], "argument u")?;
+        Ok(self.amplitude_unchecked(u))
+    }
+
+    pub(crate) fn jacobi_unchecked(&self, u: f64) -> JacobiValues {
+        let Some(quarter) = self.quarter_period_dd() else {
+            let sech = 1.0 / u.cosh();
+            return JacobiValues {
+                sn: u.tanh(),
+                cn: sech,
+                dn: sech,
+            };
+        };
+        let q = (u / quarter.hi).round();
+        let r = q.mul_add(-quarter.hi, u) - q * quarter.lo;
+        let v = self.landen_descent(r);
+        let kc = self.complementary();
+        match q.rem_euclid(4.0) as u8 {
+            0 => v,
+            1 => JacobiValues {
+                sn: v.cn / v.dn,
+                cn: -kc * v.sn / v.dn,
+                dn: kc / v.dn,
+            },
+            2 => JacobiValues {
+                sn: -v.sn,
+                cn: -v.cn,
+                dn: v.dn,
+            },
+            _ => JacobiValues {
+                sn: -v.cn / v.dn,
+                cn: kc * v.sn / v.dn,
+                dn: kc / v.dn,
+            },
+        }
+    }
+
+    pub(crate) fn amplitude_unchecked(&self, u: f64) -> f64 {
+        let Some(quarter) = self.quarter_period_dd() else {
+            return u.sinh().atan();
+        };
+        let half = quarter.scale(2.0);
+        let m = (u / half.hi).round();
+        let rest = m.mul_add(-half.hi, u) - m * half.lo;
+        let v = self.jacobi_unchecked(rest);
+        m.mul_add(PI.hi, m.mul_add(PI.lo, v.sn.atan2(v.cn)))
+    }
+
+    /// sn, cn, dn for |r| ≤ K/2 by the descending Landen transformation.
+    fn landen_descent(&self, r: f64) -> JacobiValues {
+        let moduli = self.landen_moduli();
+        let mut w = r;
+        for step in moduli {
+            w /= 1.0 + step.k;
+        }
+        let bottom = moduli.last().map_or(self.parameter(), |step| step.k * step.k);
+        let mut v = small_parameter(w, bottom);
+        for step in moduli.iter().rev() {
+            let s2 = v.sn * v.sn;
+            let denominator = 1.0 + step.k * s2;
+            v = JacobiValues {
+                sn: (1.0 + step.k) * v.sn / denominator,
+                cn: v.cn * v.dn / denominator,
+                dn: (v.cn * v.cn + step.one_minus_k * s2) / denominator,
+            };
+        }
+        v
+    }
+}
+
+/// sn, cn, dn to first order in a small parameter m (DLMF 22.10.4–22.10.6).
+fn small_parameter(w: f64, m: f64) -> JacobiValues {
+    let (s, c) = w.sin_cos();
+    if m == 0.0 {
+        return JacobiValues { sn: s, cn: c, dn: 1.0 };
+    }
+    let shift = m / 4.0 * (w - s * c);
+    JacobiValues {
+        sn: s - shift * c,
+        cn: c + shift * s,
+        dn: 1.0 - m / 2.0 * s * s,
+    }
+}
+
+/// sn(u, k), cn(u, k), dn(u, k) for 0 ≤ k ≤ 1.
+pub fn jacobi_elliptic(u: f64, k: f64) -> Result<JacobiValues, DynamicsError> {
+    EllipticModulus::new(k)?.jacobi(u)
+}
+
+/// am(u, k) for 0 ≤ k ≤ 1.
+pub fn jacobi_amplitude(u: f64, k: f64) -> Result<f64, DynamicsError> {
+    EllipticModulus::new(k)?.amplitude(u)
+}
