@@ -6,7 +6,9 @@ crates/mechanica-dynamics/src/free_body/.
 
 Usage: pip install mpmath; python3 tools/elliptic_reference.py > tools/elliptic_reference.json
 
-Arguments are f64 values (written with repr, so Rust reads them back exactly); the modulus k
+Arguments are f64 values; every number is written as a JSON string holding Python's repr
+(the shortest decimal that reads back to the same f64), so that the test parses it with a
+correctly rounded parser; the modulus k
 enters mpmath as the exact parameter m = k² (50 digits hold the 106-bit square). Every result is the f64
 nearest to the 50-digit value. Conventions: F(phi, k), Pi(n; phi, k) = int_0^phi dt / ((1 - n sin^2 t) sqrt(1 - k^2
 sin^2 t)), sn/cn/dn(u, k), am(u, k) with am(u + 2K) = am(u) + pi.
@@ -146,7 +148,9 @@ def main():
     reference.update(carlson_points(rng))
     reference.update(legendre_points(rng))
     reference.update(jacobi_points(rng))
-    print(json.dumps(reference, indent=0))
+    as_text = {key: [[repr(float(v)) for v in row] for row in rows] if isinstance(rows, list) else rows
+               for key, rows in reference.items()}
+    print(json.dumps(as_text, indent=0))
 
 
 if __name__ == "__main__":

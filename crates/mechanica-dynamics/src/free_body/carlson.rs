@@ -137,10 +137,10 @@ pub fn carlson_rj(x: f64, y: f64, z: f64, p: f64) -> Result<f64, DynamicsError> 
 }
 
 /// R_J without the domain check (Carlson 1995, algorithm for R_J, with the sum of
-/// R_C(1, 1 + eₘ)/dₘ).
+/// R_C(1, 1 + eₘ)/dₘ; 1 + eₘ is formed without cancellation, which keeps the accuracy when
+/// p ≪ x, y, z).
 pub(crate) fn rj(x0: f64, y0: f64, z0: f64, p0: f64) -> f64 {
     let a0 = (x0 + y0 + z0 + 2.0 * p0) / 5.0;
-    let delta = (p0 - x0) * (p0 - y0) * (p0 - z0);
     let spread = [x0, y0, z0, p0].iter().fold(0.0_f64, |m, v| m.max((a0 - v).abs()));
     let q = (TOLERANCE / 4.0).powf(-1.0 / 6.0) * spread;
     let (mut x, mut y, mut z, mut p, mut a) = (x0, y0, z0, p0, a0);
@@ -152,8 +152,10 @@ pub(crate) fn rj(x0: f64, y0: f64, z0: f64, p0: f64) -> f64 {
         let (sx, sy, sz, sp) = (x.sqrt(), y.sqrt(), z.sqrt(), p.sqrt());
         let lambda = sx * sy + sy * sz + sz * sx;
         let d = (sp + sx) * (sp + sy) * (sp + sz);
-        let e = scale * scale * scale * delta / (d * d);
-        sum += scale * rc(1.0, 1.0 + e) / d;
+        // 1 + eₘ with eₘ = 4⁻³ᵐδ/dₘ² = Π(√p − √x)/Π(√p + √x), written without cancellation:
+        // Π(√p + √x) + Π(√p − √x) = 2√p (p + λ).
+        let one_plus_e = 2.0 * sp * (p + lambda) / d;
+        sum += scale * rc(1.0, one_plus_e) / d;
         x = (x + lambda) / 4.0;
         y = (y + lambda) / 4.0;
         z = (z + lambda) / 4.0;

@@ -13,7 +13,7 @@
 //! - k = 0 gives sin, cos, 1 and k = 1 gives tanh, sech, sech exactly (DLMF 22.5.3, 22.5.4).
 //! - am(u) = mπ + atan2(sn u′, cn u′) for u = 2mK + u′, |u′| ≤ K (DLMF 22.16.1, 22.16.2).
 
-use super::double_double::PI;
+use super::double_double::{DoubleDouble, PI};
 use super::elliptic::EllipticModulus;
 use crate::error::{DynamicsError, check_input};
 
@@ -51,7 +51,7 @@ impl EllipticModulus {
             };
         };
         let q = (u / quarter.hi).round();
-        let r = q.mul_add(-quarter.hi, u) - q * quarter.lo;
+        let r = DoubleDouble::from_f64(u).sub(quarter.scale(q));
         let v = self.landen_descent(r);
         let kc = self.complementary();
         match q.rem_euclid(4.0) as u8 {
@@ -85,12 +85,13 @@ impl EllipticModulus {
         m.mul_add(PI.hi, m.mul_add(PI.lo, v.sn.atan2(v.cn)))
     }
 
-    /// sn, cn, dn for |r| ≤ K/2 by the descending Landen transformation.
-    fn landen_descent(&self, r: f64) -> JacobiValues {
+    /// sn, cn, dn for |r| ≤ K/2 by the descending Landen transformation; the argument is carried
+/// in double-double down to the bottom, so that its rounding is not amplified by the ascent.
+    fn landen_descent(&self, r: DoubleDouble) -> JacobiValues {
         let moduli = self.landen_moduli();
         let mut w = r;
         for step in moduli {
-            w /= 1.0 + step.k;
+            w = w.div(DoubleDouble::sum(1.0, step.k));
         }
         let bottom = moduli.last().map_or(self.parameter(), |step| step.k * step.k);
         let mut v = small_parameter(w, bottom);
@@ -107,9 +108,12 @@ impl EllipticModulus {
     }
 }
 
-/// sn, cn, dn to first order in a small parameter m (DLMF 22.10.4–22.10.6).
-fn small_parameter(w: f64, m: f64) -> JacobiValues {
-    let (s, c) = w.sin_cos();
+/// sn, cn, dn to first order in a small parameter m (DLMF 22.10.4–22.10.6), with sin and cos
+/// of the double-double argument w corrected by its low part.
+fn small_parameter(w: DoubleDouble, m: f64) -> JacobiValues {
+    let (s, c) = w.hi.sin_cos();
+    let (s, c) = (s + c * w.lo, c - s * w.lo);
+    let w = w.hi;
     if m == 0.0 {
         return JacobiValues { sn: s, cn: c, dn: 1.0 };
     }
