@@ -55,8 +55,8 @@ fn body(case: &Case) -> TorqueFreeBody {
 /// RK4 on (ω, R) with `steps` equal steps up to t.
 fn rk4(case: &Case, t: f64, steps: usize) -> (Matrix3<f64>, Vector3<f64>) {
     let rhs = |w: &Vector3<f64>, r: &Matrix3<f64>| {
-        let dw = euler_rates(&case.moments, w, &Vector3::zeros()).unwrap();
-        (dw, attitude_rate(r, w).unwrap())
+        let dw = euler_rates(&case.moments, w, &Vector3::zeros()).expect("a valid input");
+        (dw, attitude_rate(r, w).expect("a valid input"))
     };
     let h = t / steps as f64;
     let (mut w, mut r) = (case.omega0, *case.r0.matrix());
@@ -77,7 +77,7 @@ fn rk4_error(case: &Case, t: f64) -> (f64, f64) {
     let rate = case.omega0.norm() * (case.moments.max() / case.moments.min());
     let steps = ((t * rate * 4000.0).ceil() as usize).max(100);
     let (r_ref, w_ref) = rk4(case, t, steps);
-    let (r, w) = body(case).state_at(t).unwrap();
+    let (r, w) = body(case).state_at(t).expect("a valid input");
     ((w - w_ref).norm() / w_ref.norm(), (r.matrix() - r_ref).abs().max())
 }
 
@@ -112,7 +112,10 @@ fn random_bodies_follow_euler_equations_in_both_regimes() {
         let (dw, dr) = rk4_error(&case, t);
         worst = (worst.0.max(dw), worst.1.max(dr));
     }
-    println!("random bodies ({major} major-axis, {minor} minor-axis): ω {:.2e}, R {:.2e}", worst.0, worst.1);
+    println!(
+        "random bodies ({major} major-axis, {minor} minor-axis): ω {:.2e}, R {:.2e}",
+        worst.0, worst.1
+    );
     assert!(major >= 5 && minor >= 5);
     assert!(worst.0 < 1e-9 && worst.1 < 1e-9, "{worst:?}");
 }
@@ -128,7 +131,11 @@ fn bodies_near_and_on_the_separatrix_follow_euler_equations() {
             if delta == 0.0 {
                 assert_eq!(solver.regime(), Regime::Separatrix);
             } else {
-                let expected = if delta > 0.0 { Regime::MajorAxis } else { Regime::MinorAxis };
+                let expected = if delta > 0.0 {
+                    Regime::MajorAxis
+                } else {
+                    Regime::MinorAxis
+                };
                 assert_eq!(solver.regime(), expected, "delta {delta}");
             }
             let t = 12.0 / case.omega0.norm();
@@ -152,7 +159,11 @@ fn axisymmetric_spherical_and_steady_bodies_follow_euler_equations() {
             2 => Vector3::new(a, a, a),
             _ => Vector3::new(a.min(b), 0.5 * (a + b), a.max(b)),
         };
-        let omega = if i % 4 == 3 { Vector3::new(0.0, rng.uniform(0.5, 2.0), 0.0) } else { rng.vector(1.0) };
+        let omega = if i % 4 == 3 {
+            Vector3::new(0.0, rng.uniform(0.5, 2.0), 0.0)
+        } else {
+            rng.vector(1.0)
+        };
         let case = permuted(&mut rng, sorted, omega);
         let solver = body(&case);
         if i % 4 >= 2 {
@@ -177,15 +188,16 @@ fn energy_momentum_and_orthonormality_hold_over_100_periods() {
     cases.push(near_separatrix(&mut rng, -1e-10));
     for case in &cases {
         let solver = body(case);
-        let period = solver.period().unwrap();
+        let period = solver.period().expect("a valid input");
         let (t0, l0) = (solver.energy(), solver.angular_momentum());
         for j in 0..=200 {
             let t = 100.0 * period * j as f64 / 200.0 + if j % 2 == 1 { 0.123 * period } else { 0.0 };
-            let (r, w) = solver.state_at(t).unwrap();
+            let (r, w) = solver.state_at(t).expect("a valid input");
             let iw = case.moments.component_mul(&w);
             energy = energy.max((0.5 * w.dot(&iw) - t0).abs() / t0);
             momentum = momentum.max((r * iw - l0).norm() / l0.norm());
-            orthonormality = orthonormality.max((r.matrix().transpose() * r.matrix() - Matrix3::identity()).abs().max());
+            orthonormality =
+                orthonormality.max((r.matrix().transpose() * r.matrix() - Matrix3::identity()).abs().max());
         }
     }
     println!("over 100 periods: T {energy:.2e}, L {momentum:.2e}, RᵀR − 1 {orthonormality:.2e}");
@@ -197,7 +209,7 @@ fn state_at_zero_is_the_initial_state() {
     let mut rng = Rng::new(15);
     for _ in 0..20 {
         let case = random_case(&mut rng);
-        let (r, w) = body(&case).state_at(0.0).unwrap();
+        let (r, w) = body(&case).state_at(0.0).expect("a valid input");
         assert!((w - case.omega0).norm() <= 1e-14 * case.omega0.norm());
         assert!((r.matrix() - case.r0.matrix()).abs().max() <= 1e-14);
     }
@@ -205,7 +217,9 @@ fn state_at_zero_is_the_initial_state() {
 
 fn numbers(value: &serde_json::Value) -> Vec<f64> {
     let list = value.as_array().expect("a list");
-    list.iter().map(|v| v.as_str().expect("text").parse().expect("a number")).collect()
+    list.iter()
+        .map(|v| v.as_str().expect("text").parse().expect("a number"))
+        .collect()
 }
 
 /// The attitude and ω against mpmath's 30-digit Taylor integration at up to 100 periods.
@@ -219,10 +233,10 @@ fn attitude_matches_the_extended_precision_integration() {
         let moments = Vector3::from_vec(numbers(&case["moments"]));
         let omega0 = Vector3::from_vec(numbers(&case["omega0"]));
         let r0 = Rotation3::from_matrix_unchecked(Matrix3::from_row_slice(&numbers(&case["r0"])));
-        let solver = TorqueFreeBody::new(moments, omega0, r0).unwrap();
+        let solver = TorqueFreeBody::new(moments, omega0, r0).expect("a valid input");
         for state in case["states"].as_array().expect("states") {
             let s = numbers(state);
-            let (r, w) = solver.state_at(s[0]).unwrap();
+            let (r, w) = solver.state_at(s[0]).expect("a valid input");
             let dw = (w - Vector3::new(s[1], s[2], s[3])).norm() / omega0.norm();
             let dr = (r.matrix() - Matrix3::from_row_slice(&s[4..13])).abs().max();
             println!("{} at t = {:.6}: ω {dw:.2e}, R {dr:.2e}", case["name"], s[0]);
@@ -245,9 +259,15 @@ fn bad_inputs_are_typed_errors() {
         TorqueFreeBody::new(good, Vector3::new(f64::NAN, 0.0, 0.0), r0),
         Err(DynamicsError::NonFiniteInput { .. })
     ));
-    let solver = TorqueFreeBody::new(good, Vector3::new(0.1, 0.2, 0.3), r0).unwrap();
-    assert!(matches!(solver.state_at(f64::INFINITY), Err(DynamicsError::NonFiniteInput { .. })));
-    assert!(matches!(solver.state_at(1e308), Err(DynamicsError::NonFiniteResult { .. })));
+    let solver = TorqueFreeBody::new(good, Vector3::new(0.1, 0.2, 0.3), r0).expect("a valid input");
+    assert!(matches!(
+        solver.state_at(f64::INFINITY),
+        Err(DynamicsError::NonFiniteInput { .. })
+    ));
+    assert!(matches!(
+        solver.state_at(1e308),
+        Err(DynamicsError::NonFiniteResult { .. })
+    ));
     let huge = TorqueFreeBody::new(good, Vector3::new(1e200, 1e200, 1e200), r0);
     assert!(matches!(huge, Err(DynamicsError::NonFiniteResult { .. })));
 }

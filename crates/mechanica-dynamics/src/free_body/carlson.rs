@@ -68,8 +68,7 @@ pub(crate) fn rf(x0: f64, y0: f64, z0: f64) -> f64 {
 
 /// The fifth-order series shared by R_D and R_J (Carlson 1995, eqs. for R_J and R_D).
 fn rd_rj_series(e2: f64, e3: f64, e4: f64, e5: f64) -> f64 {
-    1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0 - 9.0 * e2 * e3 / 52.0
-        + 3.0 * e5 / 26.0
+    1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0 - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0
 }
 
 /// R_D(x, y, z) = R_J(x, y, z, z) = (3/2)∫₀^∞ dt/((t+z)√((t+x)(t+y)(t+z))) (DLMF 19.16.5) for
@@ -182,7 +181,11 @@ pub fn carlson_rc(x: f64, y: f64) -> Result<f64, DynamicsError> {
         return Err(domain_error("carlson_rc x", "≥ 0", x));
     }
     if y <= 0.0 {
-        return Err(domain_error("carlson_rc y", "> 0 (the principal value is not provided)", y));
+        return Err(domain_error(
+            "carlson_rc y",
+            "> 0 (the principal value is not provided)",
+            y,
+        ));
     }
     Ok(rc(x, y))
 }
@@ -205,6 +208,7 @@ pub(crate) fn rc(x0: f64, y0: f64) -> f64 {
     }
     let s = (y0 - a0) * scale / a;
     let series = 1.0
-        + s * s * (3.0 / 10.0 + s * (1.0 / 7.0 + s * (3.0 / 8.0 + s * (9.0 / 22.0 + s * (159.0 / 208.0 + s * 9.0 / 8.0)))));
+        + s * s
+            * (3.0 / 10.0 + s * (1.0 / 7.0 + s * (3.0 / 8.0 + s * (9.0 / 22.0 + s * (159.0 / 208.0 + s * 9.0 / 8.0)))));
     series / a.sqrt()
 }

@@ -194,7 +194,11 @@ impl EllipticModulus {
         reduced: impl Fn(f64, f64) -> f64,
         complete: impl Fn(DoubleDouble) -> f64,
     ) -> f64 {
-        let m = if phi.abs() <= 0.5 * PI.hi { 0.0 } else { (phi / PI.hi).round() };
+        let m = if phi.abs() <= 0.5 * PI.hi {
+            0.0
+        } else {
+            (phi / PI.hi).round()
+        };
         if m == 0.0 {
             let (s, c) = phi.sin_cos();
             return reduced(s, c);

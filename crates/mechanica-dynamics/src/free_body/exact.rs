@@ -223,7 +223,11 @@ fn classify(moments: &Vector3<f64>, w: &Vector3<f64>) -> Result<(Regime, Motion)
     let major_side = i3 * d32 * sq.z;
     let minor_side = i1 * d21 * sq.x;
     let e2 = major_side - minor_side;
-    let excess = [i2 * d21 * sq.y + i3 * d31 * sq.z, e2.abs(), i1 * d31 * sq.x + i2 * d32 * sq.y];
+    let excess = [
+        i2 * d21 * sq.y + i3 * d31 * sq.z,
+        e2.abs(),
+        i1 * d31 * sq.x + i2 * d32 * sq.y,
+    ];
     check_result(excess.iter(), "Γ² − 2TIᵢ")?;
     let regime = if e2.abs() <= 8.0 * f64::EPSILON * (major_side + minor_side) {
         Regime::Separatrix

@@ -86,7 +86,7 @@ impl EllipticModulus {
     }
 
     /// sn, cn, dn for |r| ≤ K/2 by the descending Landen transformation; the argument is carried
-/// in double-double down to the bottom, so that its rounding is not amplified by the ascent.
+    /// in double-double down to the bottom, so that its rounding is not amplified by the ascent.
     fn landen_descent(&self, r: DoubleDouble) -> JacobiValues {
         let moduli = self.landen_moduli();
         let mut w = r;
