@@ -45,16 +45,26 @@ impl DoubleDouble {
         Self { hi, lo }
     }
 
+    /// a·b for two f64, exactly.
+    pub(crate) fn product(a: f64, b: f64) -> Self {
+        let (hi, lo) = two_prod(a, b);
+        Self { hi, lo }
+    }
+
+    pub(crate) fn neg(self) -> Self {
+        Self {
+            hi: -self.hi,
+            lo: -self.lo,
+        }
+    }
+
     pub(crate) fn add(self, other: Self) -> Self {
         let (s, e) = two_sum(self.hi, other.hi);
         Self::normalized(s, e + self.lo + other.lo)
     }
 
     pub(crate) fn sub(self, other: Self) -> Self {
-        self.add(Self {
-            hi: -other.hi,
-            lo: -other.lo,
-        })
+        self.add(other.neg())
     }
 
     pub(crate) fn mul(self, other: Self) -> Self {
@@ -83,4 +93,19 @@ impl DoubleDouble {
         let residual = (self.hi - p) - e + self.lo;
         Self::normalized(s, residual / (2.0 * s))
     }
+}
+
+/// sin w and cos w in double-double for |w| ≤ 1, by their Taylor series (terms below 1e-34).
+pub(crate) fn sin_cos(w: DoubleDouble) -> (DoubleDouble, DoubleDouble) {
+    let w2 = w.mul(w).neg();
+    let series = |first: DoubleDouble, start: f64| {
+        let (mut term, mut sum, mut n) = (first, first, start);
+        while term.hi.abs() > 1e-34 * sum.hi.abs().max(f64::MIN_POSITIVE) {
+            term = term.mul(w2).div(DoubleDouble::from_f64((n + 1.0) * (n + 2.0)));
+            sum = sum.add(term);
+            n += 2.0;
+        }
+        sum
+    };
+    (series(w, 1.0), series(DoubleDouble::from_f64(1.0), 0.0))
 }

@@ -34,6 +34,7 @@ pub struct EllipticModulus {
     parameter: f64,
     complementary_parameter: f64,
     complementary: f64,
+    complementary_dd: DoubleDouble,
     quarter_period: Option<DoubleDouble>,
     landen: [LandenStep; MAX_LANDEN_LEVELS],
     levels: usize,
@@ -51,7 +52,7 @@ impl EllipticModulus {
             });
         }
         let complementary = DoubleDouble::sum(1.0, -k).mul(DoubleDouble::sum(1.0, k));
-        Ok(Self::build(k, k * k, complementary))
+        Ok(Self::build(k, DoubleDouble::product(k, k), complementary))
     }
 
     /// The modulus with complementary parameter k′² = 1 − k² given, 0 ≤ k′² ≤ 1.
@@ -64,24 +65,25 @@ impl EllipticModulus {
                 value: complementary_parameter,
             });
         }
-        let parameter = 1.0 - complementary_parameter;
+        let parameter = DoubleDouble::sum(1.0, -complementary_parameter);
         Ok(Self::build(
-            parameter.sqrt(),
+            parameter.hi.sqrt(),
             parameter,
             DoubleDouble::from_f64(complementary_parameter),
         ))
     }
 
-    fn build(k: f64, parameter: f64, complementary_parameter: DoubleDouble) -> Self {
+    fn build(k: f64, parameter: DoubleDouble, complementary_parameter: DoubleDouble) -> Self {
         let complementary_dd = complementary_parameter.sqrt();
         let complementary = complementary_dd.hi;
         let quarter_period = (complementary > 0.0).then(|| quarter_period(complementary_dd));
-        let (landen, levels) = landen_moduli(parameter, complementary);
+        let (landen, levels) = landen_moduli(parameter, complementary_dd);
         Self {
             k,
-            parameter,
+            parameter: parameter.hi,
             complementary_parameter: complementary_parameter.hi,
             complementary,
+            complementary_dd,
             quarter_period,
             landen,
             levels,
@@ -117,11 +119,8 @@ impl EllipticModulus {
         self.quarter_period
     }
 
-    /// The number L of descending Landen steps that Jacobi's functions take for this modulus
-    /// (0 for k² < 1e-12, 4 at k = 0.99, 8 at k = 1 − 1e-12). Each step of the ascent can double
-    /// the relative rounding error of cn and dn, so their error bound is 2^L ulps.
-    pub fn landen_steps(&self) -> usize {
-        self.levels
+    pub(crate) fn complementary_dd(&self) -> DoubleDouble {
+        self.complementary_dd
     }
 
     pub(crate) fn landen_moduli(&self) -> &[LandenStep] {
@@ -249,29 +248,36 @@ fn quarter_period(complementary: DoubleDouble) -> DoubleDouble {
     PI.div(a.add(b)) // π / (2 · (a + b)/2)
 }
 
-/// One step of the descending Landen transformation: the next modulus kₙ₊₁ and 1 − kₙ₊₁.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+/// One step of the descending Landen transformation: the next modulus kₙ₊₁ and 1 − kₙ₊₁, in
+/// double-double.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct LandenStep {
-    pub k: f64,
-    pub one_minus_k: f64,
+    pub k: DoubleDouble,
+    pub one_minus_k: DoubleDouble,
 }
 
 /// The moduli k₁, k₂, … of the descending Landen transformation kₙ₊₁ = kₙ² / (1 + kₙ′)²
 /// (DLMF 22.7.1, kₙ₊₁ = (1 − kₙ′)/(1 + kₙ′) without the cancellation), with
-/// 1 − kₙ₊₁ = 2kₙ′ / (1 + kₙ′) and kₙ₊₁′ = 2√kₙ′ / (1 + kₙ′), until kₙ² < [`LANDEN_STOP`].
-fn landen_moduli(parameter: f64, complementary: f64) -> ([LandenStep; MAX_LANDEN_LEVELS], usize) {
-    let mut steps = [LandenStep::default(); MAX_LANDEN_LEVELS];
+/// 1 − kₙ₊₁ = 2kₙ′ / (1 + kₙ′) and kₙ₊₁′ = 2√kₙ′ / (1 + kₙ′), in double-double, until
+/// kₙ² < [`LANDEN_STOP`].
+fn landen_moduli(parameter: DoubleDouble, complementary: DoubleDouble) -> ([LandenStep; MAX_LANDEN_LEVELS], usize) {
+    let zero = DoubleDouble::from_f64(0.0);
+    let mut steps = [LandenStep {
+        k: zero,
+        one_minus_k: zero,
+    }; MAX_LANDEN_LEVELS];
     let (mut m, mut kc) = (parameter, complementary);
     let mut levels = 0;
-    while m >= LANDEN_STOP && kc > 0.0 && levels < MAX_LANDEN_LEVELS {
-        let next = m / ((1.0 + kc) * (1.0 + kc));
+    while m.hi >= LANDEN_STOP && kc.hi > 0.0 && levels < MAX_LANDEN_LEVELS {
+        let one_plus_kc = kc.add(DoubleDouble::from_f64(1.0));
+        let next = m.div(one_plus_kc.mul(one_plus_kc));
         steps[levels] = LandenStep {
             k: next,
-            one_minus_k: 2.0 * kc / (1.0 + kc),
+            one_minus_k: kc.scale(2.0).div(one_plus_kc),
         };
         levels += 1;
-        kc = 2.0 * kc.sqrt() / (1.0 + kc);
-        m = next * next;
+        kc = kc.sqrt().scale(2.0).div(one_plus_kc);
+        m = next.mul(next);
     }
     (steps, levels)
 }

@@ -13,7 +13,7 @@
 //! - k = 0 gives sin, cos, 1 and k = 1 gives tanh, sech, sech exactly (DLMF 22.5.3, 22.5.4).
 //! - am(u) = mπ + atan2(sn u′, cn u′) for u = 2mK + u′, |u′| ≤ K (DLMF 22.16.1, 22.16.2).
 
-use super::double_double::{DoubleDouble, PI};
+use super::double_double::{DoubleDouble, PI, sin_cos};
 use super::elliptic::EllipticModulus;
 use crate::error::{DynamicsError, check_input};
 
@@ -52,25 +52,18 @@ impl EllipticModulus {
         };
         let q = (u / quarter.hi).round();
         let r = DoubleDouble::from_f64(u).sub(quarter.scale(q));
-        let v = self.landen_descent(r);
-        let kc = self.complementary();
-        match q.rem_euclid(4.0) as u8 {
-            0 => v,
-            1 => JacobiValues {
-                sn: v.cn / v.dn,
-                cn: -kc * v.sn / v.dn,
-                dn: kc / v.dn,
-            },
-            2 => JacobiValues {
-                sn: -v.sn,
-                cn: -v.cn,
-                dn: v.dn,
-            },
-            _ => JacobiValues {
-                sn: -v.cn / v.dn,
-                cn: kc * v.sn / v.dn,
-                dn: kc / v.dn,
-            },
+        let (sn, cn, dn) = self.landen_descent(r);
+        let kc = self.complementary_dd();
+        let (sn, cn, dn) = match q.rem_euclid(4.0) as u8 {
+            0 => (sn, cn, dn),
+            1 => (cn.div(dn), kc.mul(sn).div(dn).neg(), kc.div(dn)),
+            2 => (sn.neg(), cn.neg(), dn),
+            _ => (cn.div(dn).neg(), kc.mul(sn).div(dn), kc.div(dn)),
+        };
+        JacobiValues {
+            sn: sn.hi,
+            cn: cn.hi,
+            dn: dn.hi,
         }
     }
 
@@ -85,44 +78,43 @@ impl EllipticModulus {
         m.mul_add(PI.hi, m.mul_add(PI.lo, v.sn.atan2(v.cn)))
     }
 
-    /// sn, cn, dn for |r| ≤ K/2 by the descending Landen transformation; the argument is carried
-    /// in double-double down to the bottom, so that its rounding is not amplified by the ascent.
-    fn landen_descent(&self, r: DoubleDouble) -> JacobiValues {
+    /// sn, cn, dn for |r| ≤ K/2 by the descending Landen transformation, in double-double
+    /// throughout: each step of the ascent can double the relative error of cn and dn, which
+    /// the ~106-bit arithmetic absorbs, so the f64 results are rounded once at the end.
+    fn landen_descent(&self, r: DoubleDouble) -> (DoubleDouble, DoubleDouble, DoubleDouble) {
+        let one = DoubleDouble::from_f64(1.0);
         let moduli = self.landen_moduli();
         let mut w = r;
         for step in moduli {
-            w = w.div(DoubleDouble::sum(1.0, step.k));
+            w = w.div(step.k.add(one));
         }
-        let bottom = moduli.last().map_or(self.parameter(), |step| step.k * step.k);
-        let mut v = small_parameter(w, bottom);
+        let bottom = moduli.last().map_or(self.parameter(), |step| step.k.hi * step.k.hi);
+        let (mut sn, mut cn, mut dn) = small_parameter(w, bottom);
         for step in moduli.iter().rev() {
-            let s2 = v.sn * v.sn;
-            let denominator = 1.0 + step.k * s2;
-            v = JacobiValues {
-                sn: (1.0 + step.k) * v.sn / denominator,
-                cn: v.cn * v.dn / denominator,
-                dn: (v.cn * v.cn + step.one_minus_k * s2) / denominator,
-            };
+            let s2 = sn.mul(sn);
+            let denominator = step.k.mul(s2).add(one);
+            let next_dn = cn.mul(cn).add(step.one_minus_k.mul(s2)).div(denominator);
+            sn = step.k.add(one).mul(sn).div(denominator);
+            cn = cn.mul(dn).div(denominator);
+            dn = next_dn;
         }
-        v
+        (sn, cn, dn)
     }
 }
 
-/// sn, cn, dn to first order in a small parameter m (DLMF 22.10.4–22.10.6), with sin and cos
-/// of the double-double argument w corrected by its low part.
-fn small_parameter(w: DoubleDouble, m: f64) -> JacobiValues {
-    let (s, c) = w.hi.sin_cos();
-    let (s, c) = (s + c * w.lo, c - s * w.lo);
-    let w = w.hi;
+/// sn, cn, dn to first order in a small parameter m < 1e-12 (DLMF 22.10.4–22.10.6; the
+/// neglected O(m²) is below 1e-24), with sin and cos of the double-double argument.
+fn small_parameter(w: DoubleDouble, m: f64) -> (DoubleDouble, DoubleDouble, DoubleDouble) {
+    let (s, c) = sin_cos(w);
     if m == 0.0 {
-        return JacobiValues { sn: s, cn: c, dn: 1.0 };
+        return (s, c, DoubleDouble::from_f64(1.0));
     }
-    let shift = m / 4.0 * (w - s * c);
-    JacobiValues {
-        sn: s - shift * c,
-        cn: c + shift * s,
-        dn: 1.0 - m / 2.0 * s * s,
-    }
+    let shift = m / 4.0 * (w.hi - s.hi * c.hi);
+    (
+        s.add(DoubleDouble::from_f64(-shift * c.hi)),
+        c.add(DoubleDouble::from_f64(shift * s.hi)),
+        DoubleDouble::from_f64(1.0).add(DoubleDouble::from_f64(-m / 2.0 * s.hi * s.hi)),
+    )
 }
 
 /// sn(u, k), cn(u, k), dn(u, k) for 0 ≤ k ≤ 1.
