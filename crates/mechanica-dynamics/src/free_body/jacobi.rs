@@ -9,7 +9,11 @@
 //!   and at kₙ² < 1e-12 the first-order expansions in m = k² (DLMF 22.10.4–22.10.6) give the
 //!   bottom values. Going back up, every step is a product or quotient of positive terms
 //!   (dn of DLMF 22.7.3 rewritten as (cn² + (1 − k₁) sn²) / (1 + k₁ sn²)), so sn, cn and dn
-//!   keep their relative accuracy even where cn or dn is small.
+//!   keep their relative accuracy even where cn or dn is small. Each step can still double the
+//!   relative error of cn and dn (up to 8 steps at k = 1 − 1e-12), so the reduction, the
+//!   descent and the ascent run in double-double (with sin and cos of the bottom argument by
+//!   their Taylor series) and the results are rounded to f64 once: measured against mpmath,
+//!   sn, cn and dn are within 1 ulp and am within 1 ulp (k from 0 to 1, |u| up to 1e4).
 //! - k = 0 gives sin, cos, 1 and k = 1 gives tanh, sech, sech exactly (DLMF 22.5.3, 22.5.4).
 //! - am(u) = mπ + atan2(sn u′, cn u′) for u = 2mK + u′, |u′| ≤ K (DLMF 22.16.1, 22.16.2).
 
