@@ -271,3 +271,55 @@ fn bad_inputs_are_typed_errors() {
     let huge = TorqueFreeBody::new(good, Vector3::new(1e200, 1e200, 1e200), r0);
     assert!(matches!(huge, Err(DynamicsError::NonFiniteResult { .. })));
 }
+
+/// Euler's equations with a torque M: the gyroscopic terms do no work and exert no moment on
+/// |L|, so dT/dt = ω·M (7.48) and d|L|²/dt = 2 L·M, for random moments, ω and M.
+#[test]
+fn euler_rates_balance_power_and_momentum() {
+    let mut rng = Rng::new(16);
+    for _ in 0..200 {
+        let scale = 10f64.powf(rng.uniform(-3.0, 3.0));
+        let moments = Vector3::new(rng.uniform(0.1, 10.0), rng.uniform(0.1, 10.0), rng.uniform(0.1, 10.0)) * scale;
+        let (omega, torque) = (rng.vector(3.0), rng.vector(scale));
+        let rates = euler_rates(&moments, &omega, &torque).expect("a valid input");
+        let i_rates = moments.component_mul(&rates);
+        let momentum = moments.component_mul(&omega);
+        let size = moments.max() * omega.norm() * omega.norm() * omega.norm() + torque.norm() * omega.norm();
+        assert!((omega.dot(&i_rates) - omega.dot(&torque)).abs() <= 1e-14 * size);
+        assert!((momentum.dot(&i_rates) - momentum.dot(&torque)).abs() <= 1e-14 * size * moments.max());
+    }
+}
+
+#[test]
+fn special_functions_and_rates_reject_bad_inputs() {
+    use mechanica_dynamics::free_body::{carlson_rf, carlson_rj, elliptic_f, elliptic_k, elliptic_pi, jacobi_elliptic};
+    let out_of_range = |r: Result<f64, DynamicsError>| matches!(r, Err(DynamicsError::OutOfRange { .. }));
+    assert!(out_of_range(elliptic_k(1.0)));
+    assert!(out_of_range(elliptic_k(1.5)));
+    assert!(out_of_range(elliptic_pi(1.5, 0.3, 0.5)));
+    assert!(out_of_range(carlson_rf(-1.0, 1.0, 1.0)));
+    assert!(out_of_range(carlson_rf(0.0, 0.0, 1.0)));
+    assert!(out_of_range(carlson_rj(1.0, 1.0, 1.0, -1.0)));
+    assert!(matches!(
+        elliptic_f(4.0, 1.0),
+        Err(DynamicsError::NonFiniteResult { .. })
+    ));
+    assert!(matches!(
+        jacobi_elliptic(f64::NAN, 0.5),
+        Err(DynamicsError::NonFiniteInput { .. })
+    ));
+    let moments = Vector3::new(1.0, 0.0, 2.0);
+    assert!(matches!(
+        euler_rates(&moments, &Vector3::zeros(), &Vector3::zeros()),
+        Err(DynamicsError::OutOfRange { .. })
+    ));
+    let torque = Vector3::new(f64::NAN, 0.0, 0.0);
+    assert!(matches!(
+        euler_rates(&Vector3::new(1.0, 2.0, 3.0), &Vector3::zeros(), &torque),
+        Err(DynamicsError::NonFiniteInput { .. })
+    ));
+    assert!(matches!(
+        attitude_rate(&Matrix3::identity(), &Vector3::new(f64::INFINITY, 0.0, 0.0)),
+        Err(DynamicsError::NonFiniteInput { .. })
+    ));
+}
