@@ -15,7 +15,8 @@
 //!
 //! with sign a₂ = sign(a_c a_d). At Γ² = 2TI₂ (k = 1, [`Regime::Separatrix`]) cn and dn become
 //! sech and sn becomes tanh; at k = 0 (I₁ = I₂ or I₂ = I₃) they become cos, sin and 1. Each
-//! Eᵢ is formed as a sum of terms Iⱼ(Iⱼ − Iᵢ)ωⱼ², so only E₂ can cancel; the regime is the
+//! Eᵢ is formed as a sum of terms Iⱼ(Iⱼ − Iᵢ)ωⱼ², so only E₂ can cancel (its two terms are
+//! formed in double-double, so k′² stays accurate next to the separatrix); the regime is the
 //! separatrix when |E₂| ≤ 8ε (I₃(I₃ − I₂)ω₃² + I₁(I₂ − I₁)ω₁²), ε = 2⁻⁵², i.e. when 2TI₂ − Γ² is
 //! zero to the rounding of its two terms. A body turning about a principal axis (Euler's
 //! right-hand side exactly zero, which includes the sphere) is [`Regime::Steady`].
@@ -31,6 +32,7 @@
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
+use super::double_double::DoubleDouble;
 use super::elliptic::EllipticModulus;
 use crate::error::{DynamicsError, check_input, check_result};
 
@@ -220,9 +222,12 @@ fn classify(moments: &Vector3<f64>, w: &Vector3<f64>) -> Result<(Regime, Motion)
     }
     let sq = w.component_mul(w);
     let (d21, d32, d31) = (i2 - i1, i3 - i2, i3 - i1);
-    let major_side = i3 * d32 * sq.z;
-    let minor_side = i1 * d21 * sq.x;
-    let e2 = major_side - minor_side;
+    // E₂ = Γ² − 2TI₂ cancels near the separatrix: its two terms are formed in double-double, so
+    // that k′² keeps its relative accuracy down to |E₂| ~ 1e-30 of the terms.
+    let term = |i: f64, j: f64, k: f64, w: f64| DoubleDouble::sum(j, -k).scale(i).scale(w).scale(w);
+    let (major_dd, minor_dd) = (term(i3, i3, i2, w.z), term(i1, i2, i1, w.x));
+    let (major_side, minor_side) = (major_dd.hi, minor_dd.hi);
+    let e2 = major_dd.sub(minor_dd).hi;
     let excess = [
         i2 * d21 * sq.y + i3 * d31 * sq.z,
         e2.abs(),
