@@ -260,14 +260,20 @@ impl Polhode {
         d: usize,
     ) -> Option<Self> {
         let (ic, i2, id) = (moments[c], moments[1], moments[d]);
-        let (gap_dc, gap_d2) = ((id - ic).abs(), (id - i2).abs());
+        let (gap_dc, gap_d2, gap_2c) = ((id - ic).abs(), (id - i2).abs(), (i2 - ic).abs());
         let (ec, ed) = (excess[c], excess[d]);
         let sigma = (gap_d2 * ec / (moments.x * moments.y * moments.z)).sqrt();
         let separatrix = regime == Regime::Separatrix;
-        let complementary = if separatrix {
-            0.0
+        // k² and k′² each from its own formula; the smaller one defines the modulus, so that
+        // k = 0 (two equal moments) and k = 1 (the separatrix) come out exactly.
+        let parameter = (gap_2c * ed / (gap_d2 * ec)).clamp(0.0, 1.0);
+        let complementary = (gap_dc * excess[1] / (gap_d2 * ec)).clamp(0.0, 1.0);
+        let modulus = if separatrix {
+            EllipticModulus::from_complementary_parameter(0.0)
+        } else if parameter <= complementary {
+            EllipticModulus::new(parameter.sqrt())
         } else {
-            (gap_dc * excess[1] / (gap_d2 * ec)).clamp(0.0, 1.0)
+            EllipticModulus::from_complementary_parameter(complementary)
         };
         let a_c = (ed / (ic * gap_dc)).sqrt();
         let a_c = if separatrix { a_c.copysign(w[c]) } else { a_c };
@@ -276,7 +282,7 @@ impl Polhode {
         if !(sigma > 0.0 && a_c != 0.0 && a_2 != 0.0 && a_d != 0.0 && sigma.is_finite()) {
             return None;
         }
-        let modulus = EllipticModulus::from_complementary_parameter(complementary).ok()?;
+        let modulus = modulus.ok()?;
         let phi0 = (w.y / a_2).atan2(w[c] / a_c);
         let gamma = moments.component_mul(w).norm();
         let n = -(ic * ed) / (id * ec);
