@@ -23,6 +23,7 @@ pub mod crba;
 pub mod dissipation;
 pub mod error;
 pub mod forward;
+pub mod free_body;
 pub mod inverse;
 pub mod loads;
 pub mod model;
