@@ -11,7 +11,10 @@
 //! the Lagrangian U + λᵀf. H comes from the mechanism crate's exact point Hessians: λᵀf is
 //! evaluated as one more potential of a copy of the mechanism, a linear function of the
 //! points for coincidence and plane constraints and |x_a − x_b| for a rod (stiffness
-//! λ(1 − uuᵀ)/|d|). The starting multipliers are the least-squares λ of ∇U + Jᵀλ = 0 at q₀.
+//! λ(1 − uuᵀ)/|d|). H is shifted by √u·max|H_kl| on its diagonal, so that neutral directions
+//! (a body free to spin about a rod's axis) give a bounded step instead of a singular system;
+//! the shift slows the final convergence from quadratic to linear with a ratio near √u, and the
+//! convergence test is on the residuals, not on the step. The starting multipliers are the least-squares λ of ∇U + Jᵀλ = 0 at q₀.
 //! Steps are shortened to ‖δq‖ ≤ `max_step` and backtracked (at most 40 halvings) until the
 //! merit ‖∇U + Jᵀλ‖/τ_g + ‖f‖/τ_f decreases. Spherical and free joints are re-centred before
 //! every Hessian ([`mechanica_mechanism::Mechanism::rebase`]), so the returned q is in the
@@ -295,8 +298,12 @@ impl ConstrainedDynamics {
         let identity = Metric::new(Mat::identity(n, n))?;
         Schur::new(&identity, &current.evaluated, self.pivot_tolerance).map_err(|r| self.redundant(r))?;
         let j = &current.evaluated.jacobian;
+        let size = (0..n)
+            .flat_map(|r| (0..n).map(move |c| (r, c)))
+            .fold(0.0f64, |a, rc| a.max(hessian[rc].abs()));
+        let shift = f64::EPSILON.sqrt() * size;
         let kkt = Mat::from_fn(n + m, n + m, |r, c| match (r < n, c < n) {
-            (true, true) => hessian[(r, c)],
+            (true, true) => hessian[(r, c)] + if r == c { shift } else { 0.0 },
             (true, false) => j[(c - n, r)],
             (false, true) => j[(r - n, c)],
             (false, false) => 0.0,

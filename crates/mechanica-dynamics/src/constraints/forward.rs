@@ -7,11 +7,14 @@
 //! residuals with A and J as formed), which brings the backward error to the rounding level
 //! unless A or S is extremely ill-conditioned.
 //!
-//! **Accuracy report.** The residual r = [τ + Q − h − A q̈ − Jᵀλ; γ − J q̈], its componentwise
-//! (Oettli–Prager) backward error
-//! η = max_i |r_i| / (|K| |x| + |b|)_i with K the KKT matrix, x = [q̈; λ], b the right-hand
-//! side, and κ∞(A), κ∞(S). The forward error of q̈ and λ is roughly η times the conditioning
-//! of K, which grows with κ(A)·κ(S).
+//! **Accuracy report.** The residual r = [τ + Q − h − A q̈ − Jᵀλ; γ − J q̈] and its row-wise
+//! backward error η: each |r_i| against the size of the terms of its row, with q̈ measured by
+//! s = max(‖q̈‖∞, ‖A⁻¹(τ + Q − h)‖∞) (a q̈_k that should vanish, or a linkage held at rest by
+//! its constraints, is judged against the accelerations the forces would cause) and each λ_r
+//! by itself (the multipliers of different constraints carry different units):
+//! η = max over rows of |r_k| / (Σ_l |A_kl| s + Σ_r |J_rk λ_r| + |b_k|) and
+//! |r_r| / (Σ_k |J_rk| s + |γ_r|), with κ∞(A) and κ∞(S). The forward error of q̈ and λ is
+//! roughly η times the conditioning of the KKT matrix, which grows with κ(A)·κ(S).
 //!
 //! **Drift.** f(q) and J q̇ are not zero along a numerically integrated motion; the report
 //! gives ‖f‖₂ and ‖J q̇‖₂ (mixed units when rows mix lengths and angles).
@@ -70,8 +73,10 @@ pub struct ConstrainedForward {
     pub velocity_drift: f64,
     /// The KKT residual r (n entries of forces, then m of constraint accelerations).
     pub residual: Vec<f64>,
-    /// The componentwise backward error η of the KKT solve (module docs).
+    /// The row-wise backward error η of the KKT solve (module docs).
     pub backward_error: f64,
+    /// s = max(‖q̈‖∞, ‖A⁻¹(τ + Q − h)‖∞): the size of q̈ in η.
+    pub acceleration_scale: f64,
     /// κ∞(A).
     pub mass_condition: f64,
     /// κ∞(J A⁻¹ Jᵀ).
@@ -97,12 +102,15 @@ struct Kkt<'a> {
     j: &'a Mat<f64>,
     b: &'a [f64],
     gamma: &'a [f64],
+    /// ‖A⁻¹ b‖∞, the unconstrained acceleration.
+    acceleration_scale: f64,
 }
 
 impl Kkt<'_> {
-    /// The residual [b − A x − Jᵀλ; γ − J x] and its componentwise backward error.
+    /// The residual [b − A x − Jᵀλ; γ − J x] and its row-wise backward error (module docs).
     fn residual(&self, x: &[f64], lambda: &[f64]) -> (Vec<f64>, f64) {
         let (n, m) = (x.len(), lambda.len());
+        let x_norm = x.iter().fold(self.acceleration_scale, |a, v| a.max(v.abs()));
         let mut r = Vec::with_capacity(n + m);
         let mut eta = 0.0f64;
         let mut ratio = |residual: f64, size: f64| {
@@ -113,7 +121,7 @@ impl Kkt<'_> {
             let (mut value, mut size) = (self.b[k], self.b[k].abs());
             for l in 0..n {
                 value -= self.a[(k, l)] * x[l];
-                size += (self.a[(k, l)] * x[l]).abs();
+                size += self.a[(k, l)].abs() * x_norm;
             }
             for (row, l) in lambda.iter().enumerate() {
                 value -= self.j[(row, k)] * l;
@@ -126,7 +134,7 @@ impl Kkt<'_> {
             let (mut value, mut size) = (self.gamma[row], self.gamma[row].abs());
             for (k, xk) in x.iter().enumerate() {
                 value -= self.j[(row, k)] * xk;
-                size += (self.j[(row, k)] * xk).abs();
+                size += self.j[(row, k)].abs() * x_norm;
             }
             ratio(value, size);
             r.push(value);
@@ -159,11 +167,13 @@ impl ConstrainedDynamics {
         let metric = Metric::new(self.dynamics.mass_matrix(state.q)?)?;
         let schur = Schur::new(&metric, &evaluated, self.pivot_tolerance).map_err(|r| self.redundant(r))?;
         let gamma = self.stabilised_bias(&evaluated);
+        let unconstrained = metric.solve(&Mat::from_fn(n, 1, |k, _| b[k]));
         let kkt = Kkt {
             a: metric.matrix(),
             j: &evaluated.jacobian,
             b: &b,
             gamma: &gamma,
+            acceleration_scale: (0..n).fold(0.0f64, |m, k| m.max(unconstrained[(k, 0)].abs())),
         };
         let (mut q_ddot, mut lambda) = kkt_solve(&metric, &schur, kkt.j, &b, &gamma);
         let (r, _) = kkt.residual(&q_ddot, &lambda);
@@ -178,6 +188,7 @@ impl ConstrainedDynamics {
             velocity_drift: norm2(&evaluated.velocity),
             residual,
             backward_error,
+            acceleration_scale: q_ddot.iter().fold(kkt.acceleration_scale, |m, x| m.max(x.abs())),
             mass_condition: metric.condition(),
             schur_condition: schur.condition(),
             q_ddot,

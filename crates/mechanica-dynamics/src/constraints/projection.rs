@@ -7,7 +7,8 @@
 //! 64·m·u·max_r(the magnitude of the terms of f_r), the rounding level of f.
 //!
 //! **Velocities.** q̇ ← q̇ − A⁻¹Jᵀ (J A⁻¹ Jᵀ)⁻¹ J q̇: the A-orthogonal projection onto
-//! J q̇ = 0, which removes the least kinetic energy (one linear solve, exact up to rounding).
+//! J q̇ = 0, which removes the least kinetic energy (one factorization, two passes: the second
+//! removes what the rounding of the first left of J q̇).
 
 use super::ConstrainedDynamics;
 use super::evaluate::Evaluated;
@@ -142,22 +143,26 @@ impl ConstrainedDynamics {
         }
     }
 
-    /// q̇ projected A-orthogonally onto J(q) q̇ = 0 (module docs).
+    /// q̇ projected A-orthogonally onto J(q) q̇ = 0 (module docs), with one more pass on the
+    /// projected q̇ (iterative refinement) against the rounding of an ill-conditioned J A⁻¹ Jᵀ.
     pub fn project_velocities(&mut self, q: &[f64], q_dot: &[f64]) -> Result<VelocityProjection, DynamicsError> {
         let evaluated = self.evaluate(q, q_dot)?;
+        let removed = norm2(&evaluated.velocity);
         let (_, schur) = self.factors(q, ProjectionMetric::MassMatrix, &evaluated)?;
-        let mu = schur.solve(&evaluated.velocity);
-        let projected: Vec<f64> = q_dot
-            .iter()
-            .enumerate()
-            .map(|(k, v)| v - (0..mu.len()).map(|r| schur.y[(k, r)] * mu[r]).sum::<f64>())
-            .collect();
-        crate::error::check_result(projected.iter(), "projected velocity")?;
-        let after = self.evaluate(q, &projected)?;
+        let mut projected = q_dot.to_vec();
+        let mut velocity = evaluated.velocity;
+        for _ in 0..2 {
+            let mu = schur.solve(&velocity);
+            for (k, v) in projected.iter_mut().enumerate() {
+                *v -= (0..mu.len()).map(|r| schur.y[(k, r)] * mu[r]).sum::<f64>();
+            }
+            crate::error::check_result(projected.iter(), "projected velocity")?;
+            velocity = self.evaluate(q, &projected)?.velocity;
+        }
         Ok(VelocityProjection {
             q_dot: projected,
-            removed: norm2(&evaluated.velocity),
-            residual: norm2(&after.velocity),
+            removed,
+            residual: norm2(&velocity),
         })
     }
 }
