@@ -226,6 +226,77 @@ proptest! {
     }
 }
 
+/// J q̇ along the motion's direction at q + s q̇, from the public Jacobian.
+fn constraint_velocity(constrained: &mut ConstrainedDynamics, q: &[f64], q_dot: &[f64], s: f64) -> Vec<f64> {
+    let n = q.len();
+    let shifted: Vec<f64> = q.iter().zip(q_dot).map(|(x, v)| x + s * v).collect();
+    let j = constrained.constraint_jacobian(&shifted).expect("J");
+    (0..j.len() / n.max(1))
+        .map(|r| (0..n).map(|k| j[r * n + k] * q_dot[k]).sum())
+        .collect()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Random trees with a rod to the ground, a coincidence of two body points along one or two
+    /// random directions and, with Baumgarte gains, off the constraint manifold: J from central
+    /// differences of f, and the constraint accelerations J q̈ = −J̇ q̇ − 2α J q̇ − β² f with J̇ q̇
+    /// from central differences of J q̇ along q̇.
+    #[test]
+    fn jacobian_and_bias_match_central_differences(seed in any::<u64>(), bodies in 2usize..8, stabilised in any::<bool>()) {
+        let mut rng = Rng::new(seed);
+        let mut mechanism = random_mechanism(&mut rng, bodies, 3.0, false);
+        mechanism.set_gravity(Vector3::new(0.0, -9.81, 0.0)).expect("gravity");
+        let (q, q_dot, _) = random_state(&mut rng, &mechanism);
+        let n = q.len();
+        prop_assume!(n > 0);
+        let mut constrained = ConstrainedDynamics::new(Dynamics::new(mechanism).expect("dynamics"));
+        let anchor = |rng: &mut Rng| Anchor { body: Some(rng.below(bodies)), point: rng.vector(1.0) };
+        let rod = Constraint::Distance { a: anchor(&mut rng), b: Anchor { body: None, point: rng.vector(2.0) }, length: rng.uniform(0.5, 2.0) };
+        constrained.add_constraint("rod", rod).expect("rod");
+        let directions = (0..1 + rng.below(2)).map(|_| rng.unit()).collect();
+        let pair = Constraint::PointsCoincide { a: anchor(&mut rng), b: anchor(&mut rng), directions };
+        constrained.add_constraint("pair", pair).expect("pair");
+        let gains = Baumgarte { alpha: rng.uniform(0.0, 5.0), beta: rng.uniform(0.0, 5.0) };
+        if stabilised {
+            constrained.set_baumgarte(Some(gains)).expect("gains");
+        }
+        let m = constrained.equation_count();
+        let j = constrained.constraint_jacobian(&q).expect("J");
+        let h = 1e-6;
+        for k in 0..n {
+            let (mut plus, mut minus) = (q.clone(), q.clone());
+            plus[k] += h;
+            minus[k] -= h;
+            let (fp, fm) = (constrained.constraint_values(&plus).expect("f+"), constrained.constraint_values(&minus).expect("f−"));
+            for r in 0..m {
+                let difference = (fp[r] - fm[r]) / (2.0 * h);
+                prop_assert!((difference - j[r * n + k]).abs() <= 1e-6 * (1.0 + j[r * n + k].abs()), "∂f_{r}/∂q_{k}: {difference} against {}", j[r * n + k]);
+            }
+        }
+        let tau = vec![0.0; n];
+        let result = match constrained.forward_dynamics(&State::new(&q, &q_dot), &tau) {
+            Ok(result) => result,
+            Err(DynamicsError::RedundantConstraint { .. }) => return Err(TestCaseError::reject("dependent constraints drawn")),
+            Err(other) => return Err(TestCaseError::fail(format!("{other}"))),
+        };
+        let velocity = constraint_velocity(&mut constrained, &q, &q_dot, 0.0);
+        let (vp, vm) = (constraint_velocity(&mut constrained, &q, &q_dot, h), constraint_velocity(&mut constrained, &q, &q_dot, -h));
+        let f = constrained.constraint_values(&q).expect("f");
+        for r in 0..m {
+            let j_dot_q_dot = (vp[r] - vm[r]) / (2.0 * h);
+            let j_q_ddot: f64 = (0..n).map(|k| j[r * n + k] * result.q_ddot[k]).sum();
+            let mut expected = -j_dot_q_dot;
+            if stabilised {
+                expected -= 2.0 * gains.alpha * velocity[r] + gains.beta * gains.beta * f[r];
+            }
+            let scale: f64 = 1.0 + (0..n).map(|k| (j[r * n + k] * result.q_ddot[k]).abs()).sum::<f64>() + j_dot_q_dot.abs();
+            prop_assert!((j_q_ddot - expected).abs() <= 1e-6 * scale, "row {r}: J q̈ = {j_q_ddot} against {expected}");
+        }
+    }
+}
+
 /// A body hanging on a rod from a ground point settles with its centre straight below the
 /// pivot, the rod's tension m g; a pendulum locked at θ₀ needs the torque m g l sin θ₀.
 #[test]

@@ -108,69 +108,7 @@ pub(crate) fn evaluate(
         geometry: Vec::with_capacity(constraints.len()),
     };
     for constraint in constraints {
-        let geometry = match constraint {
-            Constraint::PointsCoincide { a, b, directions } => {
-                let (pa, pb) = (PointMotion::of(tree, ws, a)?, PointMotion::of(tree, ws, b)?);
-                for d in directions {
-                    let row = Row {
-                        value: d.dot(&(pa.x - pb.x)),
-                        value_scale: pa.x.norm() + pb.x.norm(),
-                        bias: -d.dot(&(pa.bias - pb.bias)),
-                    };
-                    out.push_pair_row(&row, d, &pa, &pb);
-                }
-                pair_geometry(&pa, &pb, directions.clone())
-            }
-            Constraint::PointOnPlane { point, normal, offset } => {
-                let p = PointMotion::of(tree, ws, point)?;
-                let row = Row {
-                    value: normal.dot(&p.x) - offset,
-                    value_scale: p.x.norm() + offset.abs(),
-                    bias: -normal.dot(&p.bias),
-                };
-                out.push_pair_row(&row, normal, &p, &PointMotion::of(tree, ws, &ground())?);
-                ReactionGeometry {
-                    point: Some(p.x),
-                    opposite_point: None,
-                    gradients: vec![*normal],
-                }
-            }
-            Constraint::Distance { a, b, length } => {
-                let (pa, pb) = (PointMotion::of(tree, ws, a)?, PointMotion::of(tree, ws, b)?);
-                let d = pa.x - pb.x;
-                let distance = d.norm();
-                if !(distance > 0.0 && distance.is_finite()) {
-                    return Err(DynamicsError::OutOfRange {
-                        what: "distance between the points of a rod constraint",
-                        requirement: "> 0 and finite",
-                        value: distance,
-                    });
-                }
-                let u = d / distance;
-                let d_dot = pa.v - pb.v;
-                let along = u.dot(&d_dot);
-                let row = Row {
-                    value: distance - length,
-                    value_scale: pa.x.norm() + pb.x.norm() + length,
-                    bias: -u.dot(&(pa.bias - pb.bias)) - (d_dot.norm_squared() - along * along) / distance,
-                };
-                out.push_pair_row(&row, &u, &pa, &pb);
-                pair_geometry(&pa, &pb, vec![u])
-            }
-            Constraint::Coordinate { index, value } => {
-                let r = out.value.len();
-                out.value.push(ws.q()[*index] - value);
-                out.value_scale.push(ws.q()[*index].abs() + value.abs());
-                out.jacobian[(r, *index)] = 1.0;
-                out.row_scale.push(1.0);
-                out.bias.push(0.0);
-                ReactionGeometry {
-                    point: None,
-                    opposite_point: None,
-                    gradients: Vec::new(),
-                }
-            }
-        };
+        let geometry = out.push(tree, ws, constraint)?;
         out.geometry.push(geometry);
     }
     for r in 0..m {
@@ -200,6 +138,78 @@ fn pair_geometry(pa: &PointMotion, pb: &PointMotion, gradients: Vec<Vector3<f64>
 }
 
 impl Evaluated {
+    /// Appends the equations of `constraint` and returns the geometry of its reaction.
+    fn push(
+        &mut self,
+        tree: &KinematicTree,
+        ws: &Workspace,
+        constraint: &Constraint,
+    ) -> Result<ReactionGeometry, DynamicsError> {
+        Ok(match constraint {
+            Constraint::PointsCoincide { a, b, directions } => {
+                let (pa, pb) = (PointMotion::of(tree, ws, a)?, PointMotion::of(tree, ws, b)?);
+                for d in directions {
+                    let row = Row {
+                        value: d.dot(&(pa.x - pb.x)),
+                        value_scale: pa.x.norm() + pb.x.norm(),
+                        bias: -d.dot(&(pa.bias - pb.bias)),
+                    };
+                    self.push_pair_row(&row, d, &pa, &pb);
+                }
+                pair_geometry(&pa, &pb, directions.clone())
+            }
+            Constraint::PointOnPlane { point, normal, offset } => {
+                let p = PointMotion::of(tree, ws, point)?;
+                let row = Row {
+                    value: normal.dot(&p.x) - offset,
+                    value_scale: p.x.norm() + offset.abs(),
+                    bias: -normal.dot(&p.bias),
+                };
+                self.push_pair_row(&row, normal, &p, &PointMotion::of(tree, ws, &ground())?);
+                ReactionGeometry {
+                    point: Some(p.x),
+                    opposite_point: None,
+                    gradients: vec![*normal],
+                }
+            }
+            Constraint::Distance { a, b, length } => {
+                let (pa, pb) = (PointMotion::of(tree, ws, a)?, PointMotion::of(tree, ws, b)?);
+                let d = pa.x - pb.x;
+                let distance = d.norm();
+                if !(distance > 0.0 && distance.is_finite()) {
+                    return Err(DynamicsError::OutOfRange {
+                        what: "distance between the points of a rod constraint",
+                        requirement: "> 0 and finite",
+                        value: distance,
+                    });
+                }
+                let u = d / distance;
+                let d_dot = pa.v - pb.v;
+                let along = u.dot(&d_dot);
+                let row = Row {
+                    value: distance - length,
+                    value_scale: pa.x.norm() + pb.x.norm() + length,
+                    bias: -u.dot(&(pa.bias - pb.bias)) - (d_dot.norm_squared() - along * along) / distance,
+                };
+                self.push_pair_row(&row, &u, &pa, &pb);
+                pair_geometry(&pa, &pb, vec![u])
+            }
+            Constraint::Coordinate { index, value } => {
+                let r = self.value.len();
+                self.value.push(ws.q()[*index] - value);
+                self.value_scale.push(ws.q()[*index].abs() + value.abs());
+                self.jacobian[(r, *index)] = 1.0;
+                self.row_scale.push(1.0);
+                self.bias.push(0.0);
+                ReactionGeometry {
+                    point: None,
+                    opposite_point: None,
+                    gradients: Vec::new(),
+                }
+            }
+        })
+    }
+
     /// Appends the equation `row` whose Jacobian row is dᵀ (J_a − J_b).
     fn push_pair_row(&mut self, row: &Row, d: &Vector3<f64>, pa: &PointMotion, pb: &PointMotion) {
         let r = self.value.len();
