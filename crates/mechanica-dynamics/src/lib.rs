@@ -17,8 +17,11 @@
 //!   the conditioning of A.
 //! - [`Dynamics::rnea_into`] and [`Dynamics::aba_into`]: the same without reports, allocating
 //!   nothing, for simulators' inner loops.
+//! - [`ConstrainedDynamics`] ([`constraints`]): loop closures and prescribed coordinates by
+//!   Lagrange multipliers, with reactions, projections and constrained equilibria.
 
 mod articulated;
+pub mod constraints;
 pub mod crba;
 pub mod dissipation;
 pub mod error;
@@ -30,6 +33,10 @@ pub mod model;
 pub mod spatial;
 pub mod velocity_potential;
 
+pub use constraints::{
+    Baumgarte, ConstrainedDynamics, ConstrainedEquilibrium, ConstrainedEquilibriumOptions, ConstrainedForward,
+    Constraint, ConstraintReaction, PositionProjection, ProjectionMetric, ProjectionOptions, VelocityProjection,
+};
 pub use dissipation::Damper;
 pub use error::DynamicsError;
 pub use forward::{ForwardDynamics, ForwardMethod};
