@@ -28,7 +28,7 @@ impl Dynamics {
         let n = self.dof();
         check_vector(tau, n, "tau")?;
         let mut h = vec![0.0; n];
-        self.rnea_into(state.q, state.q_dot, &vec![0.0; n], &mut h)?;
+        self.rnea_at(state, &vec![0.0; n], &mut h)?;
         let dissipation = self.evaluate_loads(state, false)?.0;
         let a = self.mass_matrix(state.q)?;
         let llt = a.llt(Side::Lower).map_err(|e| {

@@ -195,11 +195,12 @@ impl Dynamics {
         Ok(())
     }
 
-    /// q̈ for the applied forces `tau` at (q, q̇), into `q_ddot_out`, by the articulated-body
-    /// algorithm (module docs); allocates nothing when the mechanism has no loads besides
+    /// q̈ for the applied forces `tau` at (q, q̇) and t = 0, into `q_ddot_out`, by the
+    /// articulated-body algorithm (module docs); allocates nothing when the mechanism has no loads besides
     /// gravity. When an articulated inertia is singular to working precision (strongly graded
     /// trees), it solves by the mass matrix instead, which allocates. No accuracy report, and
-    /// the backward error grows with the grading: see [`Dynamics::forward_dynamics`].
+    /// the backward error grows with the grading: see [`Dynamics::forward_dynamics`]. On an
+    /// error the contents of `q_ddot_out` are unspecified.
     pub fn aba_into(
         &mut self,
         q: &[f64],

@@ -128,8 +128,17 @@ impl Dynamics {
                 got: tau_out.len(),
             });
         }
-        let state = State::new(q, q_dot);
-        self.rnea_state(&state, q_ddot, false)?;
+        self.rnea_at(&State::new(q, q_dot), q_ddot, tau_out)
+    }
+
+    /// τ at `state` (its time included) into `tau_out`, lengths already checked.
+    pub(crate) fn rnea_at(
+        &mut self,
+        state: &State<'_>,
+        q_ddot: &[f64],
+        tau_out: &mut [f64],
+    ) -> Result<(), DynamicsError> {
+        self.rnea_state(state, q_ddot, false)?;
         let mut wrenches = std::mem::take(&mut self.wrenches);
         let result = self.accumulate_to_joints(&mut wrenches, tau_out);
         self.wrenches = wrenches;
