@@ -63,6 +63,7 @@ pub mod error;
 #[doc(hidden)]
 pub mod linalg;
 pub mod problem;
+pub mod quadratic;
 mod refine;
 pub mod response;
 mod runtime;
@@ -77,6 +78,10 @@ pub use dense::{Method, ModalSolution, Refinement, Selection, SolveOptions, Solv
 pub use error::ModalError;
 pub use faer;
 pub use problem::PencilProblem;
+pub use quadratic::{
+    QuadraticBoundKind, QuadraticEigenvalue, QuadraticMode, QuadraticModeKind, QuadraticModes, QuadraticOptions,
+    quadratic_modes,
+};
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use runtime::scratch::release as release_scratch;
 pub use sparse::{
