@@ -71,7 +71,21 @@ fn norm(v: &[c64]) -> f64 {
     v.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt()
 }
 
-/// η, κ and the first-order bound of eigenpair k (see the module docs).
+/// y*(M x) for column k of a product M X.
+fn left_product(y: &[c64], product: &(Mat<f64>, Mat<f64>), k: usize) -> c64 {
+    column(product, k).zip(y).map(|(mx, y)| y.conj() * mx).sum()
+}
+
+/// The radius of the local model of a perturbed eigenvalue, min(2ρ/σ, √(ρ/κ)) for a residual ρ,
+/// slope σ = |y*P′x| and curvature κ = |y*Ax| (x/0 = ∞): the distance from a computed root of
+/// a scalar quadratic to the nearest exact root when ρ bounds its residual.
+fn local_radius(residual: f64, slope: f64, curvature: f64) -> f64 {
+    let first = if slope > 0.0 { 2.0 * residual / slope } else { f64::INFINITY };
+    let second = if curvature > 0.0 { (residual / curvature).sqrt() } else { f64::INFINITY };
+    first.min(second)
+}
+
+/// η, κ and the bound of eigenpair k (see the module docs).
 fn first_order(p: &ScaledProblem, products: &Products, k: usize, pair: &Eigenpair) -> Result<QuadraticEigenvalue, ModalError> {
     let (a, b) = (pair.a, pair.b);
     let residual: Vec<c64> = column(&products.ax, k)
@@ -79,12 +93,13 @@ fn first_order(p: &ScaledProblem, products: &Products, k: usize, pair: &Eigenpai
         .zip(column(&products.bx, k))
         .map(|((ax, cx), bx)| a * a * ax + a * b * cx + bx * (b * b))
         .collect();
-    let derivative: c64 = column(&products.ax, k)
-        .zip(column(&products.cx, k))
-        .zip(&pair.y)
-        .map(|((ax, cx), y)| y.conj() * (a * 2.0 * ax + cx * b))
-        .sum();
-    let (x_norm, y_norm) = (norm(&pair.x), norm(&pair.y));
+    let y = &pair.y;
+    let (yax, ycx, ybx) = (
+        left_product(y, &products.ax, k),
+        left_product(y, &products.cx, k),
+        left_product(y, &products.bx, k),
+    );
+    let (x_norm, y_norm) = (norm(&pair.x), norm(y));
     let h = a.norm_sqr() * p.norm_a + a.norm() * b * p.norm_c + b * b * p.norm_b;
     let unit_roundoff = f64::EPSILON / 2.0;
     let rounding = 2.0 * (p.order() as f64 + 4.0) * unit_roundoff;
@@ -94,30 +109,37 @@ fn first_order(p: &ScaledProblem, products: &Products, k: usize, pair: &Eigenpai
         1.0
     };
     let numerator = eta * h * x_norm * y_norm;
-    let d = derivative.norm();
-    let infinite = b == 0.0 || d <= numerator;
-    let condition = (!infinite && a.norm() * d > 0.0).then(|| h * x_norm * y_norm / (a.norm() * d));
-    let (s, error_bound) = if infinite {
-        let chordal = if d > 0.0 { (numerator * b / d).min(1.0) } else { 1.0 };
-        (None, chordal)
-    } else {
-        let s = c64::new(
-            times_power_of_two(a.re / b, p.gamma_exponent),
-            times_power_of_two(a.im / b, p.gamma_exponent),
-        );
-        if !(s.re.is_finite() && s.im.is_finite()) {
-            return Err(ModalError::OutOfRange {
-                what: "an eigenvalue s".to_string(),
-                detail: format!("|s| exceeds the range of doubles once scaled back by 2^{}", p.gamma_exponent),
+    let forward = (yax * a * 2.0 + ycx * b).norm();
+    if a.norm() > b {
+        // μ̃ = b/a of the reversed polynomial μ²B̃ + μC̃ + Ã.
+        let reverse = (ycx * a + ybx * (2.0 * b)).norm();
+        let radius = local_radius(numerator / a.norm_sqr(), reverse / a.norm(), ybx.norm());
+        if b / a.norm() <= radius {
+            return Ok(QuadraticEigenvalue {
+                s: None,
+                backward_error: eta,
+                condition: None,
+                error_bound: times_power_of_two(2.0 * radius, -p.gamma_exponent),
+                bound_kind: QuadraticBoundKind::FirstOrder,
             });
         }
-        (Some(s), times_power_of_two(numerator / (b * d), p.gamma_exponent))
-    };
+    }
+    let s = c64::new(
+        times_power_of_two(a.re / b, p.gamma_exponent),
+        times_power_of_two(a.im / b, p.gamma_exponent),
+    );
+    if !(s.re.is_finite() && s.im.is_finite()) {
+        return Err(ModalError::OutOfRange {
+            what: "an eigenvalue s".to_string(),
+            detail: format!("|s| exceeds the range of doubles once scaled back by 2^{}", p.gamma_exponent),
+        });
+    }
+    let radius = local_radius(numerator / (b * b), forward / b, yax.norm());
     Ok(QuadraticEigenvalue {
-        s,
+        s: Some(s),
         backward_error: eta,
-        condition,
-        error_bound,
+        condition: (a.norm() * forward > 0.0).then(|| h * x_norm * y_norm / (a.norm() * forward)),
+        error_bound: times_power_of_two(radius, p.gamma_exponent),
         bound_kind: QuadraticBoundKind::FirstOrder,
     })
 }

@@ -11,6 +11,7 @@ use crate::error::ModalError;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::ComputeEigenvectors;
 use faer::linalg::gevd::{gevd_real, gevd_scratch};
+use faer::linalg::temp_mat_scratch;
 use faer::diag::Diag;
 use faer::{Mat, c64};
 
@@ -52,8 +53,10 @@ pub(super) fn solve_companion(p: &ScaledProblem) -> Result<Vec<Eigenpair>, Modal
     let (mut left, mut right) = (Mat::<f64>::zeros(m, m), Mat::<f64>::zeros(m, m));
     let par = faer::get_global_parallelism();
     let yes = ComputeEigenvectors::Yes;
-    let mut memory =
-        MemBuffer::try_new(gevd_scratch::<f64>(m, yes, yes, par, Default::default())).map_err(|_| {
+    // faer's estimate leaves out the temporaries of the eigenvector back-substitution (two
+    // norm columns and a few right-hand sides of two columns each): added here.
+    let scratch = gevd_scratch::<f64>(m, yes, yes, par, Default::default()).and(temp_mat_scratch::<f64>(m, 16));
+    let mut memory = MemBuffer::try_new(scratch).map_err(|_| {
             ModalError::Factorization {
                 what: "the companion linearization",
                 detail: format!("no memory for the QZ workspace of order {m}"),
