@@ -4,7 +4,8 @@
 //! P̃(λ)x = 0, and a left eigenvector [w₁; w₂] of L has w₁ = y with y*P̃(λ) = 0 (w₁ = 0 would
 //! force w₂ = 0). A is never inverted: a singular Ã makes X singular and gives eigenvalues with
 //! β = 0. faer's real QZ returns each eigenvalue as (α, β), λ = α/β, a complex conjugate pair
-//! as two columns (real and imaginary parts) of the eigenvector matrices.
+//! as two columns (real and imaginary parts) of the eigenvector matrices; its left vector u of a
+//! complex eigenvalue satisfies uᵀ(−Y) = λ uᵀX, so y = ū (checked by the tests).
 
 use super::scaling::ScaledProblem;
 use crate::error::ModalError;
@@ -80,7 +81,28 @@ pub(super) fn solve_companion(p: &ScaledProblem) -> Result<Vec<Eigenpair>, Modal
         im: alpha_im.column_vector().iter().copied().collect(),
         beta: beta.column_vector().iter().copied().collect(),
     };
-    collect_eigenpairs(n, &values, &left, &right, scale)
+    let mut pairs = collect_eigenpairs(n, &values, &left, &right, scale)?;
+    for pair in &mut pairs {
+        let usable = |v: &[c64]| v.iter().all(|z| z.re.is_finite() && z.im.is_finite()) && v.iter().any(|z| *z != c64::new(0.0, 0.0));
+        if !(usable(&pair.x) && usable(&pair.y)) {
+            singular_vectors(p, pair)?;
+        }
+    }
+    Ok(pairs)
+}
+
+/// x and y from the smallest singular triple of P̃(a, b), where faer's back-substitution gave
+/// no usable vectors (it returns NaN for some infinite eigenvalues of higher index).
+fn singular_vectors(p: &ScaledProblem, pair: &mut Eigenpair) -> Result<(), ModalError> {
+    let n = p.order();
+    let (a, b) = (pair.a, pair.b);
+    let poly = Mat::from_fn(n, n, |i, j| a * a * p.a[(i, j)] + a * b * p.c[(i, j)] + p.b[(i, j)] * (b * b));
+    let svd = poly.svd().map_err(|_| ModalError::NoConvergenceQz { n: 2 * n })?;
+    let sigma = svd.S().column_vector();
+    let smallest = (0..n).min_by(|&i, &j| sigma[i].re.total_cmp(&sigma[j].re)).unwrap_or(0);
+    pair.x = (0..n).map(|r| svd.V()[(r, smallest)]).collect();
+    pair.y = (0..n).map(|r| svd.U()[(r, smallest)]).collect();
+    Ok(())
 }
 
 /// The (α, β) of the QZ decomposition.
@@ -133,7 +155,7 @@ fn collect_eigenpairs(
             b,
             conjugate_pair: pair,
             x: (0..n).map(|r| conj(column(right, r + offset))).collect(),
-            y: (0..n).map(|r| conj(column(left, r))).collect(),
+            y: (0..n).map(|r| conj(column(left, r).conj())).collect(),
         });
         j += if pair { 2 } else { 1 };
     }
