@@ -21,9 +21,7 @@
 use crate::{Mechanism, MechanismError};
 use faer::Mat;
 use faer::c64;
-use mechanica_modal::{
-    ModalSolution, ModeKind, PencilProblem, QuadraticOptions, SolveOptions, quadratic_modes, solve,
-};
+use mechanica_modal::{ModalSolution, ModeKind, PencilProblem, QuadraticOptions, SolveOptions, quadratic_modes, solve};
 use nalgebra::Vector3;
 
 /// The stability of an equilibrium from the inertia of B relative to A (Lyapunov, 8.79–8.83;

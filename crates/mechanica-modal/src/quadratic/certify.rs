@@ -80,13 +80,26 @@ fn left_product(y: &[c64], product: &(Mat<f64>, Mat<f64>), k: usize) -> c64 {
 /// slope σ = |y*P′x| and curvature κ = |y*Ax| (x/0 = ∞): the distance from a computed root of
 /// a scalar quadratic to the nearest exact root when ρ bounds its residual.
 fn local_radius(residual: f64, slope: f64, curvature: f64) -> f64 {
-    let first = if slope > 0.0 { 2.0 * residual / slope } else { f64::INFINITY };
-    let second = if curvature > 0.0 { (residual / curvature).sqrt() } else { f64::INFINITY };
+    let first = if slope > 0.0 {
+        2.0 * residual / slope
+    } else {
+        f64::INFINITY
+    };
+    let second = if curvature > 0.0 {
+        (residual / curvature).sqrt()
+    } else {
+        f64::INFINITY
+    };
     first.min(second)
 }
 
 /// η, κ and the bound of eigenpair k (see the module docs).
-fn first_order(p: &ScaledProblem, products: &Products, k: usize, pair: &Eigenpair) -> Result<QuadraticEigenvalue, ModalError> {
+fn first_order(
+    p: &ScaledProblem,
+    products: &Products,
+    k: usize,
+    pair: &Eigenpair,
+) -> Result<QuadraticEigenvalue, ModalError> {
     let (a, b) = (pair.a, pair.b);
     let residual: Vec<c64> = column(&products.ax, k)
         .zip(column(&products.cx, k))
@@ -131,7 +144,10 @@ fn first_order(p: &ScaledProblem, products: &Products, k: usize, pair: &Eigenpai
     if !(s.re.is_finite() && s.im.is_finite()) {
         return Err(ModalError::OutOfRange {
             what: "an eigenvalue s".to_string(),
-            detail: format!("|s| exceeds the range of doubles once scaled back by 2^{}", p.gamma_exponent),
+            detail: format!(
+                "|s| exceeds the range of doubles once scaled back by 2^{}",
+                p.gamma_exponent
+            ),
         });
     }
     let radius = local_radius(numerator / (b * b), forward / b, yax.norm());
@@ -165,7 +181,10 @@ fn widen_clusters(certified: &mut [Certified]) {
         for members in groups(&label).iter().filter(|g| g.len() > 1) {
             let largest = members.iter().map(|&j| radius[j]).fold(0.0, f64::max);
             for &i in members {
-                let farthest = members.iter().map(|&j| (points[i].1 - points[j].1).norm()).fold(0.0, f64::max);
+                let farthest = members
+                    .iter()
+                    .map(|&j| (points[i].1 - points[j].1).norm())
+                    .fold(0.0, f64::max);
                 clustered[i] = true;
                 if farthest + largest > radius[i] {
                     radius[i] = farthest + largest;

@@ -50,7 +50,10 @@ pub(super) fn assemble(
                 value: c.value,
                 x: c.pair.x,
             });
-            entries.push(Entry { value: conjugate, x: x_conj });
+            entries.push(Entry {
+                value: conjugate,
+                x: x_conj,
+            });
             if c.value.s.is_some() {
                 groups.push(vec![first, first + 1]);
             } else {
@@ -83,7 +86,8 @@ fn pair_real_roots(entries: &[Entry], roots: &[usize]) -> Vec<Vec<usize>> {
     let cosine = |i: usize, j: usize| {
         let (x, y) = (&entries[i].x, &entries[j].x);
         let dot: c64 = x.iter().zip(y).map(|(a, b)| a.conj() * b).sum();
-        let norms = x.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt() * y.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
+        let norms =
+            x.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt() * y.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
         if norms > 0.0 { dot.norm() / norms } else { 0.0 }
     };
     let mut candidates = Vec::new();
@@ -188,7 +192,12 @@ fn real_pair_kind((s1, r1): (f64, f64), (s2, r2): (f64, f64)) -> QuadraticModeKi
 }
 
 /// The result with the eigenvalues (and vectors) renumbered in mode order.
-fn ordered(p: &ScaledProblem, entries: Vec<Entry>, mut modes: Vec<QuadraticMode>, options: &QuadraticOptions) -> QuadraticModes {
+fn ordered(
+    p: &ScaledProblem,
+    entries: Vec<Entry>,
+    mut modes: Vec<QuadraticMode>,
+    options: &QuadraticOptions,
+) -> QuadraticModes {
     let n = p.order();
     let mut order = Vec::with_capacity(entries.len());
     for mode in &mut modes {

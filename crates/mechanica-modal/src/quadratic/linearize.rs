@@ -9,11 +9,11 @@
 
 use super::scaling::ScaledProblem;
 use crate::error::ModalError;
+use faer::diag::Diag;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::evd::ComputeEigenvectors;
 use faer::linalg::gevd::{gevd_real, gevd_scratch};
 use faer::linalg::temp_mat_scratch;
-use faer::diag::Diag;
 use faer::{Mat, c64};
 
 /// One eigenvalue of the scaled problem (the one with Im > 0 of a conjugate pair) with its
@@ -57,12 +57,10 @@ pub(super) fn solve_companion(p: &ScaledProblem) -> Result<Vec<Eigenpair>, Modal
     // faer's estimate leaves out the temporaries of the eigenvector back-substitution (two
     // norm columns and a few right-hand sides of two columns each): added here.
     let scratch = gevd_scratch::<f64>(m, yes, yes, par, Default::default()).and(temp_mat_scratch::<f64>(m, 16));
-    let mut memory = MemBuffer::try_new(scratch).map_err(|_| {
-            ModalError::Factorization {
-                what: "the companion linearization",
-                detail: format!("no memory for the QZ workspace of order {m}"),
-            }
-        })?;
+    let mut memory = MemBuffer::try_new(scratch).map_err(|_| ModalError::Factorization {
+        what: "the companion linearization",
+        detail: format!("no memory for the QZ workspace of order {m}"),
+    })?;
     gevd_real(
         lhs.as_mut(),
         rhs.as_mut(),
@@ -83,7 +81,9 @@ pub(super) fn solve_companion(p: &ScaledProblem) -> Result<Vec<Eigenpair>, Modal
     };
     let mut pairs = collect_eigenpairs(n, &values, &left, &right, scale)?;
     for pair in &mut pairs {
-        let usable = |v: &[c64]| v.iter().all(|z| z.re.is_finite() && z.im.is_finite()) && v.iter().any(|z| *z != c64::new(0.0, 0.0));
+        let usable = |v: &[c64]| {
+            v.iter().all(|z| z.re.is_finite() && z.im.is_finite()) && v.iter().any(|z| *z != c64::new(0.0, 0.0))
+        };
         if !(usable(&pair.x) && usable(&pair.y)) {
             singular_vectors(p, pair)?;
         }
@@ -96,7 +96,9 @@ pub(super) fn solve_companion(p: &ScaledProblem) -> Result<Vec<Eigenpair>, Modal
 fn singular_vectors(p: &ScaledProblem, pair: &mut Eigenpair) -> Result<(), ModalError> {
     let n = p.order();
     let (a, b) = (pair.a, pair.b);
-    let poly = Mat::from_fn(n, n, |i, j| a * a * p.a[(i, j)] + a * b * p.c[(i, j)] + p.b[(i, j)] * (b * b));
+    let poly = Mat::from_fn(n, n, |i, j| {
+        a * a * p.a[(i, j)] + a * b * p.c[(i, j)] + p.b[(i, j)] * (b * b)
+    });
     let svd = poly.svd().map_err(|_| ModalError::NoConvergenceQz { n: 2 * n })?;
     let sigma = svd.S().column_vector();
     let smallest = (0..n).min_by(|&i, &j| sigma[i].re.total_cmp(&sigma[j].re)).unwrap_or(0);

@@ -42,7 +42,11 @@ impl ScaledProblem {
             .into_iter()
             .flatten()
             .fold(f64::NEG_INFINITY, f64::max);
-        let d = if largest.is_finite() { -(largest.round() as i32) } else { 0 };
+        let d = if largest.is_finite() {
+            -(largest.round() as i32)
+        } else {
+            0
+        };
         let a = scaled_copy("A", a, 2 * g + d)?;
         let c = scaled_copy("C", c, g + d)?;
         let b = scaled_copy("B", b, d)?;

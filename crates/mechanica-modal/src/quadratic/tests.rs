@@ -38,9 +38,18 @@ fn quadratic_roots(p: Dd, q: Dd, r: Dd) -> [c64; 2] {
 
 /// Every finite reported eigenvalue lies within its bound (plus `slack`, the reference's own
 /// uncertainty) of a reference root, and every reference root within a reported bound.
-fn assert_contained(modes: &QuadraticModes, reference: &[c64], slack: impl Fn(&QuadraticEigenvalue, c64) -> f64, context: &str) {
+fn assert_contained(
+    modes: &QuadraticModes,
+    reference: &[c64],
+    slack: impl Fn(&QuadraticEigenvalue, c64) -> f64,
+    context: &str,
+) {
     let finite: Vec<&QuadraticEigenvalue> = modes.eigenvalues.iter().filter(|e| e.s.is_some()).collect();
-    assert_eq!(finite.len(), reference.len(), "{context}: {modes:#?}\nreference {reference:?}");
+    assert_eq!(
+        finite.len(),
+        reference.len(),
+        "{context}: {modes:#?}\nreference {reference:?}"
+    );
     let near = |e: &QuadraticEigenvalue, z: c64| e.s.is_some_and(|s| (s - z).norm() <= e.error_bound + slack(e, z));
     for e in &finite {
         assert!(
@@ -49,7 +58,10 @@ fn assert_contained(modes: &QuadraticModes, reference: &[c64], slack: impl Fn(&Q
         );
     }
     for &z in reference {
-        assert!(finite.iter().any(|e| near(e, z)), "{context}: {z} is in no bound of {finite:#?}");
+        assert!(
+            finite.iter().any(|e| near(e, z)),
+            "{context}: {z} is in no bound of {finite:#?}"
+        );
     }
 }
 
@@ -121,7 +133,11 @@ fn check_frequency_and_ratio(result: &QuadraticModes, omega: f64, zeta: f64, con
     );
     let ratio = mode.damping_ratio.expect("ω_n > 0");
     // Δ(s₁ + s₂) ≤ r₁ + r₂ and Δω_n/ω_n ≤ relative/2; the stored c carries ζ to within 8u.
-    let sum_bound: f64 = mode.eigenvalues.iter().map(|&i| result.eigenvalues[i].error_bound).sum();
+    let sum_bound: f64 = mode
+        .eigenvalues
+        .iter()
+        .map(|&i| result.eigenvalues[i].error_bound)
+        .sum();
     let allowance = sum_bound / (2.0 * omega_n) + zeta * (relative / 2.0 + 8.0 * UNIT_ROUNDOFF);
     assert!(
         (ratio - zeta).abs() <= allowance,
@@ -147,8 +163,16 @@ fn proportional_damping_on_graded_trees_matches_the_closed_form() {
         let middle = (spectrum[0] * spectrum[n - 1]).sqrt().sqrt();
         let power = |x: f64| 2f64.powi(x.log2().round() as i32);
         let variant = seed % 3;
-        let alpha = if variant == 1 { 0.0 } else { power(middle * 10f64.powf(rng.uniform(-3.0, 1.0))) };
-        let beta = if variant == 0 { 0.0 } else { power(10f64.powf(rng.uniform(-3.0, 1.0)) / middle) };
+        let alpha = if variant == 1 {
+            0.0
+        } else {
+            power(middle * 10f64.powf(rng.uniform(-3.0, 1.0)))
+        };
+        let beta = if variant == 0 {
+            0.0
+        } else {
+            power(10f64.powf(rng.uniform(-3.0, 1.0)) / middle)
+        };
         let c = Mat::from_fn(n, n, |i, j| alpha * system.a[(i, j)] + beta * system.b[(i, j)]);
         let result = solve_dense(&system.a, &c, &system.b, false);
         let mut reference = Vec::new();
@@ -174,9 +198,15 @@ fn proportional_damping_on_graded_trees_matches_the_closed_form() {
                 _ => {}
             }
         }
-        assert!(result.max_backward_error <= 64.0 * n as f64 * UNIT_ROUNDOFF, "{context}: {result:#?}");
+        assert!(
+            result.max_backward_error <= 64.0 * n as f64 * UNIT_ROUNDOFF,
+            "{context}: {result:#?}"
+        );
     }
-    assert!(underdamped > 50 && overdamped > 50, "{underdamped} underdamped, {overdamped} overdamped modes");
+    assert!(
+        underdamped > 50 && overdamped > 50,
+        "{underdamped} underdamped, {overdamped} overdamped modes"
+    );
 }
 
 /// A spinning rotor (Jeffcott/gyroscope): m s² I + s G + k I with G = [[0, −g], [g, 0]] has
@@ -191,7 +221,10 @@ fn gyroscopes_have_their_closed_form_eigenvalues_on_the_imaginary_axis() {
         let omega0 = 10f64.powf(rng.uniform(-60.0, 60.0));
         let stabilized = case % 2 == 1;
         let (k, g) = if stabilized {
-            (-m * omega0 * omega0, 2.0 * m * omega0 * (1.0 + 10f64.powf(rng.uniform(-2.0, 3.0))))
+            (
+                -m * omega0 * omega0,
+                2.0 * m * omega0 * (1.0 + 10f64.powf(rng.uniform(-2.0, 3.0))),
+            )
         } else {
             (m * omega0 * omega0, m * omega0 * 10f64.powf(rng.uniform(-4.0, 4.0)))
         };
@@ -236,7 +269,11 @@ fn a_massless_coordinate_gives_infinite_eigenvalues_and_the_condensed_modes() {
         let modal = crate::solve(&problem, &crate::SolveOptions::default()).expect("modal solve");
         let result = solve_dense(&system.a, &Mat::zeros(n, n), &system.b, false);
         let context = format!("seed {seed}, n {n}, massless {massless}");
-        let infinite = result.modes.iter().filter(|m| m.kind == QuadraticModeKind::Infinite).count();
+        let infinite = result
+            .modes
+            .iter()
+            .filter(|m| m.kind == QuadraticModeKind::Infinite)
+            .count();
         assert_eq!(infinite, 2, "{context}: {result:#?}");
         let mut reference = Vec::new();
         let mut omega_bound = Vec::new();
@@ -276,7 +313,9 @@ fn left_and_right_vectors_of_the_linearization_annihilate_the_polynomial() {
         let p = scaling::ScaledProblem::new(a.as_ref(), c.as_ref(), b.as_ref()).expect("scaled");
         for pair in linearize::solve_companion(&p).expect("QZ") {
             let (s, t) = (pair.a, pair.b);
-            let poly = Mat::from_fn(n, n, |i, j| s * s * p.a[(i, j)] + s * t * p.c[(i, j)] + p.b[(i, j)] * (t * t));
+            let poly = Mat::from_fn(n, n, |i, j| {
+                s * s * p.a[(i, j)] + s * t * p.c[(i, j)] + p.b[(i, j)] * (t * t)
+            });
             let h = s.norm_sqr() * p.norm_a + s.norm() * t * p.norm_c + t * t * p.norm_b;
             let right: f64 = (0..n)
                 .map(|i| (0..n).map(|j| poly[(i, j)] * pair.x[j]).sum::<c64>().norm_sqr())
@@ -291,12 +330,19 @@ fn left_and_right_vectors_of_the_linearization_annihilate_the_polynomial() {
                 pair.y.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt(),
             );
             let tolerance = 64.0 * n as f64 * UNIT_ROUNDOFF;
-            assert!(right <= tolerance * h * xn, "case {case}: right residual {:e}", right / (h * xn));
-            assert!(left <= tolerance * h * yn, "case {case}: left residual {:e}", left / (h * yn));
+            assert!(
+                right <= tolerance * h * xn,
+                "case {case}: right residual {:e}",
+                right / (h * xn)
+            );
+            assert!(
+                left <= tolerance * h * yn,
+                "case {case}: left residual {:e}",
+                left / (h * yn)
+            );
         }
     }
 }
-
 
 /// ‖(s²A + sC + B)x‖ of a reported pair in double-double from the stored matrices.
 fn residual_dd(a: &Mat<f64>, c: &Mat<f64>, b: &Mat<f64>, s: c64, x: &[c64]) -> f64 {
@@ -307,8 +353,18 @@ fn residual_dd(a: &Mat<f64>, c: &Mat<f64>, b: &Mat<f64>, s: c64, x: &[c64]) -> f
     let (qr, qi) = (sr.times(sr).minus(si.times(si)), Dd::of(2.0).times(sr).times(si));
     (0..x.len())
         .map(|i| {
-            let real = qr.times(ar[i]).minus(qi.times(ai[i])).plus(sr.times(cr[i])).minus(si.times(ci[i])).plus(br[i]);
-            let imag = qr.times(ai[i]).plus(qi.times(ar[i])).plus(sr.times(ci[i])).plus(si.times(cr[i])).plus(bi[i]);
+            let real = qr
+                .times(ar[i])
+                .minus(qi.times(ai[i]))
+                .plus(sr.times(cr[i]))
+                .minus(si.times(ci[i]))
+                .plus(br[i]);
+            let imag = qr
+                .times(ai[i])
+                .plus(qi.times(ar[i]))
+                .plus(sr.times(ci[i]))
+                .plus(si.times(cr[i]))
+                .plus(bi[i]);
             real.to_f64().powi(2) + imag.to_f64().powi(2)
         })
         .sum::<f64>()
@@ -327,10 +383,19 @@ fn backward_errors_bound_the_true_residuals_on_random_nonsymmetric_damping() {
     let (mut worst_balanced, mut worst_heavy): (f64, f64) = (0.0, 0.0);
     for case in 0..80 {
         let n = 1 + rng.below(16);
-        let (scale_a, scale_b) = (10f64.powf(rng.uniform(-40.0, 40.0)), 10f64.powf(rng.uniform(-40.0, 40.0)));
-        let tau = 10f64.powf(if case % 2 == 0 { rng.uniform(-3.0, 1.0) } else { rng.uniform(1.0, 8.0) });
+        let (scale_a, scale_b) = (
+            10f64.powf(rng.uniform(-40.0, 40.0)),
+            10f64.powf(rng.uniform(-40.0, 40.0)),
+        );
+        let tau = 10f64.powf(if case % 2 == 0 {
+            rng.uniform(-3.0, 1.0)
+        } else {
+            rng.uniform(1.0, 8.0)
+        });
         let root = random_matrix(&mut rng, n, 1.0);
-        let a = Mat::from_fn(n, n, |i, j| scale_a * (0..n).map(|k| root[(k, i)] * root[(k, j)]).sum::<f64>());
+        let a = Mat::from_fn(n, n, |i, j| {
+            scale_a * (0..n).map(|k| root[(k, i)] * root[(k, j)]).sum::<f64>()
+        });
         let b = random_matrix(&mut rng, n, scale_b);
         let b = Mat::from_fn(n, n, |i, j| b[(i, j)] + b[(j, i)]);
         let c = random_matrix(&mut rng, n, 1.0);
@@ -345,7 +410,11 @@ fn backward_errors_bound_the_true_residuals_on_random_nonsymmetric_damping() {
             let column: Vec<c64> = (0..n).map(|r| x[(r, k)]).collect();
             let denominator = s.norm_sqr() * norms[0] + s.norm() * norms[1] + norms[2];
             let eta = residual_dd(&a, &c, &b, s, &column) / denominator;
-            assert!(eta <= e.backward_error, "case {case}: true η {eta:e} > reported {:e}", e.backward_error);
+            assert!(
+                eta <= e.backward_error,
+                "case {case}: true η {eta:e} > reported {:e}",
+                e.backward_error
+            );
             let relative = e.backward_error / (n as f64 * UNIT_ROUNDOFF);
             if tau <= 10.0 {
                 worst_balanced = worst_balanced.max(relative);
@@ -360,13 +429,22 @@ fn backward_errors_bound_the_true_residuals_on_random_nonsymmetric_damping() {
 
 #[test]
 fn bad_inputs_are_typed_errors() {
-    let (a, c, b) = (Mat::<f64>::identity(2, 2), Mat::<f64>::zeros(2, 2), Mat::<f64>::identity(2, 2));
+    let (a, c, b) = (
+        Mat::<f64>::identity(2, 2),
+        Mat::<f64>::zeros(2, 2),
+        Mat::<f64>::identity(2, 2),
+    );
     let options = QuadraticOptions::default();
     let mut nan = b.clone();
     nan[(1, 0)] = f64::NAN;
     assert!(matches!(
         quadratic_modes(a.as_ref(), c.as_ref(), nan.as_ref(), &options),
-        Err(ModalError::NonFinite { what: "B", row: 1, col: 0, .. })
+        Err(ModalError::NonFinite {
+            what: "B",
+            row: 1,
+            col: 0,
+            ..
+        })
     ));
     let wide = Mat::<f64>::zeros(2, 3);
     assert!(matches!(
