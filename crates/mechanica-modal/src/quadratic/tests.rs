@@ -102,6 +102,10 @@ fn single_oscillators_match_the_closed_form_from_zeta_1e_minus_6_to_1e6() {
                 Some(QuadraticModeKind::Underdamped)
             } else if zeta >= 2.0 {
                 Some(QuadraticModeKind::Overdamped)
+            } else if j == 0 {
+                // c = 2√(mk) rounded: the roots are within about √u·ω of a double root, which
+                // no bound from a backward error near u can separate.
+                Some(QuadraticModeKind::Critical)
             } else {
                 None
             };
@@ -470,4 +474,58 @@ fn bad_inputs_are_typed_errors() {
     let empty = Mat::<f64>::zeros(0, 0);
     let none = quadratic_modes(empty.as_ref(), empty.as_ref(), empty.as_ref(), &options).expect("order 0");
     assert!(none.eigenvalues.is_empty() && none.modes.is_empty());
+}
+
+/// A mass m on a spring k₁ to the ground, joined by a spring k₂ to a massless node that a
+/// damper c ties to the ground: det = (ms² + k₁ + k₂)(cs + k₂) − k₂², a cubic, so one
+/// eigenvalue is infinite (simple: the damper gives the massless node a first-order law). The
+/// real root lies in (−k₂/c, 0) and is found by bisection in double-double; the other two are
+/// the roots of the quotient quadratic.
+#[test]
+fn a_damped_massless_node_gives_one_infinite_eigenvalue_and_the_cubic_roots() {
+    let mut rng = SplitMix::new(0xc0b1c);
+    for case in 0..100 {
+        let [m, c, k1, k2] = [0; 4].map(|_| 10f64.powf(rng.uniform(-3.0, 3.0)));
+        let a = Mat::from_fn(2, 2, |i, j| if (i, j) == (0, 0) { m } else { 0.0 });
+        let damping = Mat::from_fn(2, 2, |i, j| if (i, j) == (1, 1) { c } else { 0.0 });
+        let b = Mat::from_fn(2, 2, |i, j| if i == j { [k1 + k2, k2][i] } else { -k2 });
+        let result = solve_dense(&a, &damping, &b, false);
+        let (m_, c_, k11, k2_) = (Dd::of(m), Dd::of(c), Dd::of(b[(0, 0)]), Dd::of(k2));
+        // (m s² + k11)(c s + k2) − k2² = mc s³ + m k2 s² + c k11 s + (k11 k2 − k2²).
+        let coefficients = [
+            m_.times(c_),
+            m_.times(k2_),
+            c_.times(k11),
+            k11.times(k2_).minus(k2_.times(k2_)),
+        ];
+        let cubic = |s: Dd| {
+            coefficients[1..]
+                .iter()
+                .fold(coefficients[0], |acc, &next| acc.times(s).plus(next))
+        };
+        let (mut low, mut high) = (Dd::of(-k2 / c * 1.0000001), Dd::of(0.0));
+        for _ in 0..200 {
+            let middle = low.plus(high).times(Dd::of(0.5));
+            if cubic(middle).hi < 0.0 {
+                low = middle
+            } else {
+                high = middle
+            }
+        }
+        let real = low;
+        // Synthetic division by (s − real).
+        let p = coefficients[0];
+        let q = coefficients[1].plus(p.times(real));
+        let t = coefficients[2].plus(q.times(real));
+        let mut reference = vec![c64::new(real.to_f64(), 0.0)];
+        reference.extend(quadratic_roots(p, q, t));
+        let context = format!("case {case}: m {m:e}, c {c:e}, k₁ {k1:e}, k₂ {k2:e}");
+        assert_contained(&result, &reference, |_, z| 8.0 * UNIT_ROUNDOFF * z.norm(), &context);
+        let infinite = result
+            .modes
+            .iter()
+            .filter(|m| m.kind == QuadraticModeKind::Infinite)
+            .count();
+        assert_eq!(infinite, 1, "{context}: {result:#?}");
+    }
 }
