@@ -12,15 +12,16 @@
 //!   inertia of a unit base translation d; Σ_k m_eff,k(d) = M when all modes are kept and the
 //!   mechanism can translate freely along d.
 //! - **Gyroscopic coupling** (rotating frame): the quadratic problem det(s²A + sG + B) = 0 is
-//!   solved by its first companion linearisation [0 1; −A⁻¹B −A⁻¹G] (faer's real
-//!   non-symmetric eigensolver), reported as s = σ ± iω with the backward error of each
-//!   eigenvalue, ‖(s²A + sG + B)x‖ / ((|s|²‖A‖ + |s|‖G‖ + ‖B‖)‖x‖). Gyroscopic stabilisation
-//!   (B indefinite, all Re s = 0) is reported as such.
+//!   solved by the modal crate's [`quadratic_modes`] (scaled companion linearization, QZ, no
+//!   inversion of A, so massless coordinates give infinite eigenvalues, which are omitted),
+//!   reported as s = σ ± iω with the backward error of each eigenvalue,
+//!   ‖(s²A + sG + B)x‖ / ((|s|²‖A‖ + |s|‖G‖ + ‖B‖)‖x‖), and its error bound. Gyroscopic
+//!   stabilisation (B indefinite, all Re s = 0 within their bounds) is reported as such.
 
 use crate::{Mechanism, MechanismError};
 use faer::Mat;
 use faer::c64;
-use mechanica_modal::{ModalSolution, ModeKind, PencilProblem, SolveOptions, solve};
+use mechanica_modal::{ModalSolution, ModeKind, PencilProblem, QuadraticOptions, SolveOptions, quadratic_modes, solve};
 use nalgebra::Vector3;
 
 /// The stability of an equilibrium from the inertia of B relative to A (Lyapunov, 8.79–8.83;
@@ -62,9 +63,10 @@ pub struct GyroscopicModes {
     pub backward_errors: Vec<f64>,
     /// Largest real part: > its error bound means unstable.
     pub max_real_part: f64,
-    /// Bound on |Re s| that is indistinguishable from zero (from the backward errors).
+    /// Bound on |Re s| that is indistinguishable from zero: the largest error bound of the
+    /// eigenvalues (backward error times condition, [`mechanica_modal::QuadraticEigenvalue`]).
     pub real_part_bound: f64,
-    /// True when every Re s is within `real_part_bound` of zero.
+    /// True when no Re s exceeds its own error bound (so every Re s ≤ `real_part_bound`).
     pub stable: bool,
 }
 
@@ -292,61 +294,25 @@ fn shapes_in_space(mechanism: &Mechanism, q: &[f64], solution: &ModalSolution) -
     Ok((displacements, effective, total_mass))
 }
 
-/// Solves det(s²A + sG + B) = 0 by the companion linearisation (see the module docs).
+/// Solves det(s²A + sG + B) = 0 with the modal crate's quadratic solver (see the module docs).
 fn gyroscopic_modes(a: &Mat<f64>, g: &Mat<f64>, b: &Mat<f64>) -> Result<GyroscopicModes, MechanismError> {
-    let n = a.nrows();
-    let llt = a
-        .llt(faer::Side::Lower)
-        .map_err(|_| MechanismError::Numerical("gyroscopic modes need a positive definite mass matrix"))?;
-    use faer::linalg::solvers::Solve;
-    let a_inv_b = llt.solve(b);
-    let a_inv_g = llt.solve(g);
-    let companion = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
-        (true, true) => 0.0,
-        (true, false) => f64::from(u8::from(i + n == j)),
-        (false, true) => -a_inv_b[(i - n, j)],
-        (false, false) => -a_inv_g[(i - n, j - n)],
-    });
-    let eig = companion
-        .eigen()
-        .map_err(|_| MechanismError::Numerical("the companion eigenproblem did not converge"))?;
-    let (s, u) = (eig.S(), eig.U());
-    let (na, ng, nb) = (a.norm_l2(), g.norm_l2(), b.norm_l2());
-    let mut pairs = Vec::with_capacity(2 * n);
-    for m in 0..2 * n {
-        let lambda: c64 = s[m];
-        // x = top half of the eigenvector.
-        let x: Vec<c64> = (0..n).map(|r| u[(r, m)]).collect();
-        let x_norm = x.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
-        let mut residual: f64 = 0.0;
-        for r in 0..n {
-            let mut acc = c64::new(0.0, 0.0);
-            for c in 0..n {
-                acc += (lambda * lambda * a[(r, c)] + lambda * g[(r, c)] + c64::new(b[(r, c)], 0.0)) * x[c];
-            }
-            residual += acc.norm_sqr();
-        }
-        let modulus = lambda.norm();
-        let scale = (modulus * modulus * na + modulus * ng + nb) * x_norm;
-        let eta = if scale > 0.0 { residual.sqrt() / scale } else { 0.0 };
-        pairs.push(((lambda.re, lambda.im), eta));
-    }
-    pairs.sort_by(|p, q| {
-        (p.0.1.abs(), p.0.0)
-            .partial_cmp(&(q.0.1.abs(), q.0.0))
+    let solution = quadratic_modes(a.as_ref(), g.as_ref(), b.as_ref(), &QuadraticOptions::default())?;
+    let mut finite: Vec<(c64, f64, f64)> = solution
+        .eigenvalues
+        .iter()
+        .filter_map(|e| e.s.map(|s| (s, e.backward_error, e.error_bound)))
+        .collect();
+    finite.sort_by(|p, q| {
+        (p.0.im.abs(), p.0.re)
+            .partial_cmp(&(q.0.im.abs(), q.0.re))
             .unwrap_or(std::cmp::Ordering::Equal)
     });
-    let max_real_part = pairs.iter().map(|p| p.0.0).fold(f64::NEG_INFINITY, f64::max);
-    let max_modulus = pairs.iter().map(|p| p.0.0.hypot(p.0.1)).fold(0.0, f64::max);
-    let max_eta = pairs.iter().map(|p| p.1).fold(0.0, f64::max);
-    // A backward error η perturbs s by about η·cond; take the companion scale as the yardstick.
-    let real_part_bound =
-        (max_eta.max(f64::EPSILON) * 2.0 * n as f64 * max_modulus.max(1.0)).sqrt() * max_modulus.max(1.0);
+    let max_real_part = finite.iter().map(|p| p.0.re).fold(f64::NEG_INFINITY, f64::max);
     Ok(GyroscopicModes {
-        eigenvalues: pairs.iter().map(|p| p.0).collect(),
-        backward_errors: pairs.iter().map(|p| p.1).collect(),
+        eigenvalues: finite.iter().map(|p| (p.0.re, p.0.im)).collect(),
+        backward_errors: finite.iter().map(|p| p.1).collect(),
         max_real_part,
-        real_part_bound,
-        stable: max_real_part <= real_part_bound,
+        real_part_bound: finite.iter().map(|p| p.2).fold(0.0, f64::max),
+        stable: finite.iter().all(|p| p.0.re <= p.2),
     })
 }

@@ -220,6 +220,19 @@ pub enum ModalError {
         /// Its value and the range it would need.
         detail: String,
     },
+    /// det(s²A + sC + B) vanishes for every s (a singular quadratic polynomial: A, C and B share
+    /// a null vector, or all three vanish), so its eigenvalues are not defined.
+    #[error("det(s²A + sC + B) vanishes for every s: the order-{order} quadratic polynomial is singular")]
+    SingularQuadratic {
+        /// The order n.
+        order: usize,
+    },
+    /// faer's QZ iteration did not converge on the linearization of a quadratic eigenproblem.
+    #[error("the QZ iteration did not converge on the {n}×{n} linearization")]
+    NoConvergenceQz {
+        /// Order 2n of the linearization.
+        n: usize,
+    },
     /// faer's eigensolver did not converge.
     #[error("the symmetric eigensolver did not converge on the reduced {n}×{n} matrix")]
     NoConvergence {

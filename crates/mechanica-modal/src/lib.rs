@@ -5,7 +5,8 @@
 //! validated [`PencilProblem`] (dense), [`solve_sparse`] on a [`SparsePencil`] (the k lowest
 //! modes of a large sparse pencil), [`count_below`] / [`count_below_sparse`] (how many modes lie
 //! below a shift, certified by Sylvester's inertia), [`FreeResponse`] (the motion from initial
-//! conditions).
+//! conditions), [`quadratic_modes`] (damped and gyroscopic modes, det(s²A + sC + B) = 0, each
+//! eigenvalue with its backward error, condition and bound; module [`quadratic`]).
 //!
 //! # Contract
 //!
@@ -52,7 +53,9 @@
 //! above them; [`spectrum`] (modes, classification, clusters); [`certify`] (the accuracy
 //! report, sketches, inertia counts, the bottom certificate); `refine` (Newton steps, bordered
 //! systems, projected corrections); then the solvers [`dense`] and [`sparse`] (which uses the
-//! dense solver for small pencils and Rayleigh–Ritz) and [`response`]. The test problems with
+//! dense solver for small pencils and Rayleigh–Ritz) and [`response`]; [`quadratic`] (the
+//! quadratic eigenproblem, on faer's QZ) uses only the error type, the norms and the
+//! power-of-two scaling of [`dense`]. The test problems with
 //! known spectra are in `testing` (cargo feature `testing`); the tuning choices are
 //! [`Tuning::DEFAULT`].
 
@@ -63,6 +66,7 @@ pub mod error;
 #[doc(hidden)]
 pub mod linalg;
 pub mod problem;
+pub mod quadratic;
 mod refine;
 pub mod response;
 mod runtime;
@@ -77,6 +81,10 @@ pub use dense::{Method, ModalSolution, Refinement, Selection, SolveOptions, Solv
 pub use error::ModalError;
 pub use faer;
 pub use problem::PencilProblem;
+pub use quadratic::{
+    QuadraticBoundKind, QuadraticEigenvalue, QuadraticMode, QuadraticModeKind, QuadraticModes, QuadraticOptions,
+    quadratic_modes,
+};
 pub use response::{CoordinateLaw, FreeResponse, InitialFit, ModalCoordinate};
 pub use runtime::scratch::release as release_scratch;
 pub use sparse::{

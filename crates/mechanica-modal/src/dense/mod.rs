@@ -19,7 +19,7 @@ mod idle_inputs;
 mod options;
 mod refinement;
 mod reversed;
-mod scaling;
+pub(crate) mod scaling;
 mod solution;
 mod values_only;
 

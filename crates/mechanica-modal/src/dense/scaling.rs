@@ -179,7 +179,7 @@ fn exponent_for(what: &str, m: MatRef<'_, f64>) -> Result<(i32, bool), ModalErro
 }
 
 /// The binary exponent e of x ≠ 0, 2^(e−1) ≤ |x| < 2^e (frexp's).
-fn exponent(x: f64) -> i32 {
+pub(crate) fn exponent(x: f64) -> i32 {
     let x = x.abs();
     let mut e = x.log2().floor() as i32 + 1;
     // log2 can be off by one next to powers of two.
