@@ -23,6 +23,7 @@
 mod articulated;
 pub mod constraints;
 pub mod crba;
+pub mod damped_modes;
 pub mod dissipation;
 pub mod error;
 pub mod forward;
@@ -37,6 +38,7 @@ pub use constraints::{
     Baumgarte, ConstrainedDynamics, ConstrainedEquilibrium, ConstrainedEquilibriumOptions, ConstrainedForward,
     Constraint, ConstraintReaction, PositionProjection, ProjectionMetric, ProjectionOptions, VelocityProjection,
 };
+pub use damped_modes::DampedModes;
 pub use dissipation::Damper;
 pub use error::DynamicsError;
 pub use forward::{ForwardDynamics, ForwardMethod};

@@ -187,6 +187,11 @@ impl Dynamics {
         Ok(())
     }
 
+    /// True when a base motion is prescribed.
+    pub(crate) fn has_base_motion(&self) -> bool {
+        self.base_motion.is_some()
+    }
+
     /// The base's state at time t in its own frame (pose at the origin, rates in base
     /// components), and gravity in the same frame.
     fn refresh_base(&mut self, t: f64) -> Result<(), DynamicsError> {

@@ -1,0 +1,145 @@
+//! Damped modes of mechanisms against the proportional-damping closed form: a chain of point
+//! masses on prismatic joints with joint springs, dampers from each mass to the ground
+//! (c_i = α m_i, so C_ground = α A) and joint dampers (c_k = β k_k, so C_joint = β B) has
+//! s = −ζω ± iω√(1 − ζ²), ζ = (α/ω + βω)/2, with ω² the eigenvalues of (A, B) from the modal
+//! crate's symmetric solver; overdamped modes (ζ > 1) have s = −ζω ± ω√(ζ² − 1).
+
+mod common;
+
+use common::Rng;
+use mechanica_dynamics::{Damper, Dynamics};
+use mechanica_kinematics::tree::{Joint, TreeBuilder};
+use mechanica_mass::MassProperties;
+use mechanica_mechanism::potentials::JointSpring;
+use mechanica_mechanism::{Anchor, Mechanism};
+use mechanica_modal::{PencilProblem, QuadraticModeKind, QuadraticOptions, SolveOptions, solve};
+use nalgebra::{Isometry3, Vector3};
+use proptest::prelude::*;
+
+fn chain(rng: &mut Rng, n: usize, alpha: f64, beta: f64) -> Dynamics {
+    let mut builder = TreeBuilder::new();
+    let mut masses = Vec::new();
+    for i in 0..n {
+        let parent = i.checked_sub(1);
+        builder.add_body(
+            parent,
+            Joint::Prismatic { axis: Vector3::x() },
+            Isometry3::translation(1.0, 0.0, 0.0),
+        );
+        masses.push(10f64.powf(rng.uniform(-2.0, 2.0)));
+    }
+    let tree = builder.build().expect("tree");
+    let bodies = masses
+        .iter()
+        .map(|&m| MassProperties::point(m, Vector3::zeros()).expect("mass"))
+        .collect();
+    let mut mechanism = Mechanism::new(tree, bodies).expect("mechanism");
+    let stiffness: Vec<f64> = (0..n).map(|_| 10f64.powf(rng.uniform(-1.0, 3.0))).collect();
+    for (k, &s) in stiffness.iter().enumerate() {
+        mechanism
+            .add_potential(JointSpring {
+                coordinate: k,
+                stiffness: s,
+                rest: 0.0,
+            })
+            .expect("spring");
+    }
+    let mut dynamics = Dynamics::new(mechanism).expect("dynamics");
+    for (i, &m) in masses.iter().enumerate() {
+        let a = Anchor {
+            body: Some(i),
+            point: Vector3::zeros(),
+        };
+        let b = Anchor {
+            body: None,
+            point: Vector3::new(-10.0, 3.0, 0.0),
+        };
+        dynamics
+            .add_damper(Damper::Points {
+                a,
+                b,
+                coefficient: alpha * m,
+            })
+            .expect("ground damper");
+        dynamics
+            .add_damper(Damper::Joint {
+                coordinate: i,
+                coefficient: beta * stiffness[i],
+            })
+            .expect("joint damper");
+    }
+    dynamics
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn proportional_damping_matches_its_closed_form(seed in any::<u64>(), n in 1usize..9) {
+        let mut rng = Rng::new(seed);
+        let alpha = 10f64.powf(rng.uniform(-3.0, 1.5));
+        let beta = 10f64.powf(rng.uniform(-4.0, -0.5));
+        let mut dynamics = chain(&mut rng, n, alpha, beta);
+        let q0 = vec![0.0; n];
+        let modes = dynamics.damped_modes(&q0, &QuadraticOptions::default()).expect("damped modes");
+        let undamped = solve(
+            &PencilProblem::new(modes.mass_matrix.as_ref(), modes.stiffness_matrix.as_ref()).expect("pencil"),
+            &SolveOptions::default(),
+        )
+        .expect("undamped modes");
+        let mut expected = Vec::new();
+        for mode in &undamped.modes {
+            let omega = mode.omega_sq.sqrt();
+            let zeta = 0.5 * (alpha / omega + beta * omega);
+            let root = (zeta * zeta - 1.0).abs().sqrt() * omega;
+            if zeta < 1.0 {
+                expected.push((-zeta * omega, root));
+                expected.push((-zeta * omega, -root));
+            } else {
+                expected.push((-zeta * omega + root, 0.0));
+                expected.push((-zeta * omega - root, 0.0));
+            }
+        }
+        prop_assert_eq!(modes.solution.eigenvalues.len(), 2 * n);
+        for value in &modes.solution.eigenvalues {
+            let s = value.s.expect("finite eigenvalue");
+            // The nearest closed-form root, and the closed form's own error from ω².
+            let nearest = expected.iter().map(|&(re, im)| (s.re - re).hypot(s.im - im)).fold(f64::INFINITY, f64::min);
+            let slack = 1e-9 * s.norm();
+            prop_assert!(nearest <= value.error_bound + slack, "s = {s}: nearest closed form {nearest:e} > bound {:e}", value.error_bound);
+        }
+        for mode in &modes.solution.modes {
+            if let Some(zeta) = mode.damping_ratio {
+                let kind = mode.kind;
+                if zeta < 0.9 {
+                    prop_assert_eq!(kind, QuadraticModeKind::Underdamped);
+                } else if zeta > 1.1 {
+                    prop_assert_eq!(kind, QuadraticModeKind::Overdamped);
+                }
+            }
+        }
+    }
+}
+
+/// Velocity-dependent potentials have no linearization in (A, C, G, B): refused, not ignored.
+#[test]
+fn damped_modes_refuse_velocity_potentials() {
+    use mechanica_dynamics::{ChargedPoint, DynamicsError, UniformFields};
+    use std::sync::Arc;
+    let mut rng = Rng::new(11);
+    let mut dynamics = chain(&mut rng, 2, 0.1, 0.01);
+    let field = Arc::new(UniformFields {
+        electric: Vector3::zeros(),
+        magnetic: Vector3::z(),
+    });
+    dynamics
+        .add_velocity_potential(ChargedPoint {
+            body: 0,
+            point: Vector3::zeros(),
+            charge: 1.0,
+            field,
+        })
+        .expect("charge");
+    let result = dynamics.damped_modes(&[0.0, 0.0], &QuadraticOptions::default());
+    assert!(matches!(result, Err(DynamicsError::OutOfRange { .. })), "{result:?}");
+}
