@@ -26,4 +26,4 @@ pub use mechanism::{Mechanism, RotatingFrame};
 pub use modes::{
     BodyDisplacement, GyroscopicModes, MechanismModes, Stability, mechanism_modes, mechanism_modes_with_locks,
 };
-pub use potentials::{Anchor, Potential, PotentialSum};
+pub use potentials::{Anchor, PointForce, Potential, PotentialSum};

@@ -210,6 +210,23 @@ impl Mechanism {
         Ok(sum)
     }
 
+    /// Each added potential evaluated on its own at q (the field of gravity and rotation is not
+    /// included): its name, U, ∂U/∂q and the point forces through which it acts (see
+    /// [`PotentialSum::point_forces`]). No Hessians. Errors name the potential that failed.
+    pub fn potential_terms(&self, q: &[f64]) -> Result<Vec<(String, PotentialSum)>, MechanismError> {
+        let ws = self.positions(q)?;
+        let config = Configuration::new(&self.tree, &ws, q, &self.bodies)?;
+        let mut terms = Vec::with_capacity(self.potentials.len());
+        for potential in &self.potentials {
+            let mut sum = PotentialSum::new(self.dof(), false);
+            potential.accumulate(&config, &mut sum)?;
+            crate::error::check_finite(sum.value, "potential energy")?;
+            crate::error::check_all_finite(&sum.gradient, "potential gradient")?;
+            terms.push((potential.name(), sum));
+        }
+        Ok(terms)
+    }
+
     /// The mass matrix A(q) (8.28) of the motion relative to the base.
     pub fn mass_matrix(&mut self, q: &[f64]) -> Result<Mat<f64>, MechanismError> {
         let ws = self.positions(q)?;

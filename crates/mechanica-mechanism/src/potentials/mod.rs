@@ -63,6 +63,17 @@ impl Anchor {
     }
 }
 
+/// A force −∂U/∂x that a potential applies at one point of a body (world components).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointForce {
+    /// The body that carries the point.
+    pub body: usize,
+    /// The point's world position x, m.
+    pub point: Vector3<f64>,
+    /// The force on the body at x, N (world components).
+    pub force: Vector3<f64>,
+}
+
 /// U, ∂U/∂q and (optionally) ∂²U/∂q∂q summed over potentials.
 #[derive(Debug, Clone)]
 pub struct PotentialSum {
@@ -72,6 +83,10 @@ pub struct PotentialSum {
     pub gradient: Vec<f64>,
     /// ∂²U/∂q∂q, when asked for.
     pub hessian: Option<Mat<f64>>,
+    /// The point forces −∂U/∂x_j of the potentials that act through body points
+    /// ([`PotentialSum::add_point_potential`]); forces on ground points are not listed. The
+    /// rest of −∂U/∂q acts on the coordinates themselves (joint springs, generalized forces).
+    pub point_forces: Vec<PointForce>,
 }
 
 impl PotentialSum {
@@ -81,6 +96,7 @@ impl PotentialSum {
             value: 0.0,
             gradient: vec![0.0; dof],
             hessian: with_hessian.then(|| Mat::zeros(dof, dof)),
+            point_forces: Vec::new(),
         }
     }
 
@@ -102,6 +118,13 @@ impl PotentialSum {
         for (anchor, c) in points {
             let x = config.point(anchor.body, &anchor.point)?;
             config.add_point_jacobian(anchor.body, &x, *c, &mut jacobian);
+            if let Some(body) = anchor.body {
+                self.point_forces.push(PointForce {
+                    body,
+                    point: x,
+                    force: -force * *c,
+                });
+            }
             world.push(x);
         }
         self.value += energy;

@@ -1,0 +1,209 @@
+//! Bad inputs give typed errors that name what was wrong; nothing panics and no NaN leaves.
+
+mod common;
+
+use common::{Rng, random_mechanism};
+use mechanica_dynamics::{ChargedPoint, Damper, Dynamics, DynamicsError, State, UniformFields};
+use mechanica_kinematics::tree::{Joint, TreeBuilder};
+use mechanica_mass::MassProperties;
+use mechanica_mechanism::{Anchor, Mechanism};
+use nalgebra::{Isometry3, Matrix3, Vector3};
+use std::sync::Arc;
+
+fn sample() -> Dynamics {
+    let mut rng = Rng::new(3);
+    let mut mechanism = random_mechanism(&mut rng, 5, 2.0, true);
+    mechanism.set_gravity(Vector3::new(0.0, 0.0, -9.81)).expect("gravity");
+    Dynamics::new(mechanism).expect("dynamics")
+}
+
+#[test]
+fn wrong_lengths_name_the_vector() {
+    let mut dynamics = sample();
+    let n = dynamics.dof();
+    let (q, v) = (vec![0.1; n], vec![0.2; n]);
+    let short = vec![0.0; n - 1];
+    let state = State::new(&q, &v);
+    let cases = [
+        dynamics.inverse_dynamics(&state, &short).err(),
+        dynamics.forward_dynamics(&state, &short).err(),
+        dynamics.forward_dynamics(&State::new(&short, &v), &q).err(),
+        dynamics.forward_dynamics(&State::new(&q, &short), &q).err(),
+    ];
+    for (case, what) in cases.into_iter().zip(["q_ddot", "tau", "q", "q_dot"]) {
+        match case {
+            Some(DynamicsError::WrongLength {
+                what: named,
+                expected,
+                got,
+            }) => {
+                assert_eq!((named, expected, got), (what, n, n - 1));
+            }
+            other => panic!("{what}: expected WrongLength, got {other:?}"),
+        }
+    }
+    let mut out = vec![0.0; n + 1];
+    assert!(matches!(
+        dynamics.rnea_into(&q, &v, &q, &mut out),
+        Err(DynamicsError::WrongLength { .. })
+    ));
+    assert!(matches!(
+        dynamics.aba_into(&q, &v, &q, &mut out),
+        Err(DynamicsError::WrongLength { .. })
+    ));
+    assert_eq!(out, vec![0.0; n + 1], "outputs are not written on failure");
+}
+
+#[test]
+fn non_finite_inputs_are_refused() {
+    let mut dynamics = sample();
+    let n = dynamics.dof();
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let mut q = vec![0.1; n];
+        q[n / 2] = bad;
+        let v = vec![0.0; n];
+        let result = dynamics.forward_dynamics(&State::new(&q, &v), &v);
+        assert!(
+            matches!(result, Err(DynamicsError::NonFiniteInput { what: "q", .. })),
+            "{result:?}"
+        );
+        let q = vec![0.1; n];
+        let result = dynamics.forward_dynamics(&State::new(&q, &v).at_time(bad), &v);
+        assert!(
+            matches!(result, Err(DynamicsError::NonFiniteInput { what: "time", .. })),
+            "{result:?}"
+        );
+    }
+}
+
+#[test]
+fn overflowing_states_give_non_finite_result_errors() {
+    let mut dynamics = sample();
+    let n = dynamics.dof();
+    let (q, v) = (vec![0.1; n], vec![1e200; n]);
+    let result = dynamics.forward_dynamics(&State::new(&q, &v), &vec![0.0; n]);
+    assert!(
+        matches!(
+            result,
+            Err(DynamicsError::NonFiniteResult { .. }) | Err(DynamicsError::Kinematics(_))
+        ),
+        "{result:?}"
+    );
+    let mut out = vec![0.0; n];
+    let result = dynamics.rnea_into(&q, &v, &vec![1e300; n], &mut out);
+    assert!(result.is_err(), "{result:?}");
+    assert!(out.iter().all(|x| x.is_finite()));
+}
+
+#[test]
+fn bad_dampers_and_charges_are_refused() {
+    let mut dynamics = sample();
+    let (n, bodies) = (dynamics.dof(), dynamics.tree().body_count());
+    for coefficient in [-1.0, f64::NAN, f64::INFINITY] {
+        let result = dynamics.add_damper(Damper::Joint {
+            coordinate: 0,
+            coefficient,
+        });
+        assert!(
+            matches!(
+                result,
+                Err(DynamicsError::OutOfRange {
+                    what: "damping coefficient",
+                    ..
+                })
+            ),
+            "{result:?}"
+        );
+    }
+    let result = dynamics.add_damper(Damper::Joint {
+        coordinate: n,
+        coefficient: 1.0,
+    });
+    assert!(
+        matches!(result, Err(DynamicsError::NoSuchCoordinate { .. })),
+        "{result:?}"
+    );
+    let far = Anchor {
+        body: Some(bodies),
+        point: Vector3::zeros(),
+    };
+    let ground = Anchor {
+        body: None,
+        point: Vector3::zeros(),
+    };
+    let result = dynamics.add_damper(Damper::Points {
+        a: far,
+        b: ground,
+        coefficient: 1.0,
+    });
+    assert!(matches!(result, Err(DynamicsError::NoSuchBody { .. })), "{result:?}");
+    let field = Arc::new(UniformFields {
+        electric: Vector3::zeros(),
+        magnetic: Vector3::z(),
+    });
+    let charge = ChargedPoint {
+        body: bodies,
+        point: Vector3::zeros(),
+        charge: 1.0,
+        field,
+    };
+    assert!(matches!(
+        dynamics.add_velocity_potential(charge),
+        Err(DynamicsError::NoSuchBody { .. })
+    ));
+    assert!(dynamics.dampers().is_empty() && dynamics.velocity_potentials().is_empty());
+}
+
+#[test]
+fn a_dashpot_whose_points_meet_has_no_direction() {
+    let mut dynamics = sample();
+    let n = dynamics.dof();
+    let a = Anchor {
+        body: Some(0),
+        point: Vector3::zeros(),
+    };
+    dynamics
+        .add_damper(Damper::Dashpot {
+            a,
+            b: a,
+            coefficient: 1.0,
+        })
+        .expect("valid damper");
+    let (q, v) = (vec![0.0; n], vec![0.1; n]);
+    let result = dynamics.forward_dynamics(&State::new(&q, &v), &vec![0.0; n]);
+    assert!(matches!(result, Err(DynamicsError::Dissipation { .. })), "{result:?}");
+}
+
+/// A massless leaf makes A(q) singular: both routes say so instead of returning NaN or ∞.
+#[test]
+fn massless_coordinates_are_a_singular_mass_matrix() {
+    let mut builder = TreeBuilder::new();
+    let root = builder.add_body(None, Joint::Revolute { axis: Vector3::z() }, Isometry3::identity());
+    builder.add_body(
+        Some(root),
+        Joint::Revolute { axis: Vector3::x() },
+        Isometry3::translation(1.0, 0.0, 0.0),
+    );
+    let tree = builder.build().expect("tree");
+    let heavy = MassProperties::new(2.0, Vector3::new(0.5, 0.0, 0.0), Matrix3::identity()).expect("mass");
+    let massless = MassProperties {
+        mass: 0.0,
+        p_oc: Vector3::zeros(),
+        inertia_c: Matrix3::zeros(),
+    };
+    let mut dynamics =
+        Dynamics::new(Mechanism::new(tree, vec![heavy, massless]).expect("mechanism")).expect("dynamics");
+    let (q, v) = ([0.3, 0.2], [0.1, 0.4]);
+    let result = dynamics.forward_dynamics(&State::new(&q, &v), &[1.0, 1.0]);
+    assert!(
+        matches!(result, Err(DynamicsError::SingularMassMatrix { pivot: 1, .. })),
+        "{result:?}"
+    );
+    let mut out = [7.0; 2];
+    let result = dynamics.aba_into(&q, &v, &[1.0, 1.0], &mut out);
+    assert!(
+        matches!(result, Err(DynamicsError::SingularMassMatrix { .. })),
+        "{result:?}"
+    );
+    assert_eq!(out, [7.0; 2]);
+}
