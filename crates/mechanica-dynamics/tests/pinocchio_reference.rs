@@ -174,7 +174,7 @@ fn check_all(what: &str, deviation: impl Fn(&Robot, &Reference, &mut Dynamics) -
             let mut dynamics = dynamics_for(&robot, state);
             let (d, note) = deviation(&robot, state, &mut dynamics);
             worst = worst.max(d);
-            if !(d <= RELATIVE) {
+            if d.is_nan() || d > RELATIVE {
                 failures.push(format!("{} state {index}: {d:e} {note}", robot.name));
             }
         }
