@@ -57,9 +57,9 @@ impl Dynamics {
         let mut q = q0.to_vec();
         self.mechanism.rebase(&mut q)?;
         let potential = self.mechanism.potential(&q, true)?;
-        let stiffness_matrix = potential
-            .hessian
-            .ok_or(DynamicsError::NonFiniteResult { what: "stiffness matrix" })?;
+        let stiffness_matrix = potential.hessian.ok_or(DynamicsError::NonFiniteResult {
+            what: "stiffness matrix",
+        })?;
         let gradient_norm = potential.gradient.iter().map(|g| g * g).sum::<f64>().sqrt();
         let mass_matrix = self.mechanism.mass_matrix(&q)?;
         let gyroscopic_matrix = self.mechanism.gyroscopic_matrix(&q)?;
