@@ -388,7 +388,7 @@ mod tests {
             }
             let sorted = |m: MatrixMarket| {
                 let mut e: Vec<(usize, usize, f64)> = m.entries.iter().map(|t| (t.row, t.col, t.val)).collect();
-                e.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+                e.sort_by_key(|a| (a.0, a.1));
                 e
             };
             let expected: Vec<(usize, usize, f64)> = (0..n)
