@@ -121,7 +121,7 @@ fn modes_to_c(solution: &QuadraticModes) -> Result<Vec<mech_damped_mode_t>, FfiE
 
 /// Computes the damped and gyroscopic modes of the mechanism about `q0` (n coordinates):
 /// det(s²A + s(C + G) + B) = 0 with A = A(q₀) the mass matrix, C the dampers' matrix, G the
-/// gyroscopic matrix of a rotating frame and B = ∂²U*/∂q² the stiffness matrix (FM 4.62–4.66,
+/// gyroscopic matrix of a rotating frame and B = ∂²U* / ∂q² the stiffness matrix (FM 4.62–4.66,
 /// §8e, §8g), solved by the certified quadratic eigensolver (docs/theory.md, "Quadratic
 /// eigenproblems (damped and gyroscopic modes)"). Writes one mech_damped_mode_t per mode to
 /// `modes_out`, by natural frequency ascending with infinite modes last, their number to
