@@ -77,10 +77,7 @@ fn roots(label: &str, members: &[&QuadraticEigenvalue]) -> Quantity {
         match e.s {
             Some(s) => {
                 values.extend([s.re, s.im]);
-                bounds.push(format!(
-                    "|Δs| ≤ {:.1e} (η = {:.1e})",
-                    e.error_bound, e.backward_error
-                ));
+                bounds.push(format!("|Δs| ≤ {:.1e} (η = {:.1e})", e.error_bound, e.backward_error));
             }
             None => bounds.push(format!("s = ∞ (|1/s| ≤ {:.1e})", e.error_bound)),
         }

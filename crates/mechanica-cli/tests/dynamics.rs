@@ -248,7 +248,12 @@ dynamics = {{}}
 /// two real roots −ω_n(ζ ± √(ζ²−1)) with ω_n² = s₁s₂; the text report names the kind.
 #[test]
 fn a_damped_oscillator_has_the_closed_form_damping_ratio_and_frequency() {
-    let cases = [(0.3, 40.0, 0.01), (2.5, 7.0, 0.5), (0.05, 900.0, 2.0), (12.0, 0.8, 0.25)];
+    let cases = [
+        (0.3, 40.0, 0.01),
+        (2.5, 7.0, 0.5),
+        (0.05, 900.0, 2.0),
+        (12.0, 0.8, 0.25),
+    ];
     for (m, k, zeta) in cases {
         let omega_n = f64::sqrt(k / m);
         let c = 2.0 * zeta * f64::sqrt(k * m);

@@ -82,7 +82,10 @@ fn kind_to_c(kind: QuadraticModeKind) -> mech_damped_kind_t {
 fn mode_to_c(mode: &QuadraticMode, eigenvalues: &[QuadraticEigenvalue]) -> Result<mech_damped_mode_t, FfiError> {
     let members: Vec<&QuadraticEigenvalue> = mode.eigenvalues.iter().filter_map(|&k| eigenvalues.get(k)).collect();
     let (Some(first), Some(last)) = (members.first(), members.last()) else {
-        return Err(FfiError::new(MECH_STATUS_INVALID_ARGUMENT, "a damped mode without eigenvalues"));
+        return Err(FfiError::new(
+            MECH_STATUS_INVALID_ARGUMENT,
+            "a damped mode without eigenvalues",
+        ));
     };
     let pair = [*first, *last];
     let s = pair.map(|e| e.s.map_or((0.0, 0.0), |s| (s.re, s.im)));
@@ -116,7 +119,11 @@ fn mode_to_c(mode: &QuadraticMode, eigenvalues: &[QuadraticEigenvalue]) -> Resul
 
 /// The C records of every mode of a solution, in its order.
 fn modes_to_c(solution: &QuadraticModes) -> Result<Vec<mech_damped_mode_t>, FfiError> {
-    solution.modes.iter().map(|m| mode_to_c(m, &solution.eigenvalues)).collect()
+    solution
+        .modes
+        .iter()
+        .map(|m| mode_to_c(m, &solution.eigenvalues))
+        .collect()
 }
 
 /// Computes the damped and gyroscopic modes of the mechanism about `q0` (n coordinates):
