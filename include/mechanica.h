@@ -153,6 +153,65 @@ typedef int32_t mech_status_t;
 
 #if defined(MECH_FEATURE_DYNAMICS)
 /**
+ * What a damped mode is physically (int32_t; see MECH_DAMPED_KIND_*).
+ */
+typedef int32_t mech_damped_kind_t;
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * One damped mode: one or two eigenvalues s of det(s²A + s(C + G) + B) = 0 with their
+ * accuracy. Every field is finite.
+ */
+typedef struct mech_damped_mode_t {
+    /**
+     * A MECH_DAMPED_KIND_* value.
+     */
+    mech_damped_kind_t kind;
+    /**
+     * Undamped natural frequency ω_n = √|s₁s₂| (|s| for a conjugate pair or a single root,
+     * rad/s); −1 for an infinite mode.
+     */
+    double natural_frequency;
+    /**
+     * Damped frequency |Im s| (rad/s); 0 for real roots and infinite modes.
+     */
+    double damped_frequency;
+    /**
+     * Damping ratio ζ = −(s₁ + s₂)/(2ω_n) (−σ/|s| for a conjugate pair or a single root); −1
+     * when it is not defined (ω_n = 0 or an infinite mode). A growing mode may have a genuine
+     * negative ζ: read `kind` before reading −1 as "undefined".
+     */
+    double damping_ratio;
+    /**
+     * Re s of the mode's eigenvalues (1/s): the conjugate pair with Im s > 0 first, or the two
+     * real roots; a single eigenvalue is repeated in both entries. 0 for an infinite
+     * eigenvalue.
+     */
+    double s_re[2];
+    /**
+     * Im s of the mode's eigenvalues (rad/s), as `s_re`.
+     */
+    double s_im[2];
+    /**
+     * Bound on |s_computed − s_exact| of each eigenvalue for the matrices A, C + G, B formed
+     * at q₀ (first-order η κ |s|, or a cluster bound for close roots); for an infinite
+     * eigenvalue a bound on |1/s| of the exact one.
+     */
+    double error_bound[2];
+    /**
+     * Backward error η of each eigenvalue (Tisseur's, relative to the coefficients).
+     */
+    double backward_error[2];
+    /**
+     * Number of distinct eigenvalues of the mode (1 or 2).
+     */
+    int32_t eigenvalue_count;
+} mech_damped_mode_t;
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
  * The route that produced q̈ (int32_t).
  */
 typedef int32_t mech_forward_method_t;
@@ -1502,6 +1561,70 @@ typedef struct mech_modal_sparse_details_t {
 
 #if defined(MECH_FEATURE_DYNAMICS)
 /**
+ * A conjugate pair s = σ ± iω, σ < 0 and ω ≠ 0 beyond their bounds: a decaying oscillation.
+ */
+#define MECH_DAMPED_KIND_UNDERDAMPED 0
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Two real negative roots separated by their bounds: decay without oscillation.
+ */
+#define MECH_DAMPED_KIND_OVERDAMPED 1
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Decaying, but the bounds cannot tell a double real root from a complex pair or two close
+ * real roots (critical damping within the accuracy).
+ */
+#define MECH_DAMPED_KIND_CRITICAL 2
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * s = 0 within its bound: a rigid-body or neutrally stable direction.
+ */
+#define MECH_DAMPED_KIND_RIGID 3
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Re s greater than its bound: the motion grows.
+ */
+#define MECH_DAMPED_KIND_UNSTABLE 4
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Re s = 0 within its bound and ω ≠ 0: an undamped (conservative or gyroscopic) oscillation.
+ */
+#define MECH_DAMPED_KIND_NEUTRAL 5
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * A single real negative root: first-order decay (a damper on a massless coordinate).
+ */
+#define MECH_DAMPED_KIND_RELAXATION 6
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * An infinite eigenvalue: a massless direction (A x = 0).
+ */
+#define MECH_DAMPED_KIND_INFINITE 7
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The bound contains points of more than one kind: the accuracy does not decide.
+ */
+#define MECH_DAMPED_KIND_UNDECIDED 8
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
  * The articulated-body recursion, O(n), accepted when the inverse dynamics confirms it to the
  * rounding level.
  */
@@ -2240,6 +2363,43 @@ mech_status_t mech_dynamics_dof(const struct mech_dynamics_t *dynamics,
  */
 mech_status_t mech_dynamics_body_count(const struct mech_dynamics_t *dynamics,
                                        size_t *bodies_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Computes the damped and gyroscopic modes of the mechanism about `q0` (n coordinates):
+ * det(s²A + s(C + G) + B) = 0 with A = A(q₀) the mass matrix, C the dampers' matrix, G the
+ * gyroscopic matrix of a rotating frame and B = ∂²U* / ∂q² the stiffness matrix (FM 4.62–4.66,
+ * §8e, §8g), solved by the certified quadratic eigensolver (docs/theory.md, "Quadratic
+ * eigenproblems (damped and gyroscopic modes)"). Writes one mech_damped_mode_t per mode to
+ * `modes_out`, by natural frequency ascending with infinite modes last, their number to
+ * `*count_out`, and ‖grad U*(q₀)‖ to `*gradient_norm_out` (may be NULL): the linearization is
+ * that of an equilibrium only when this is 0.
+ *
+ * The number of modes is between n (all pairs) and 2n (all single roots). Call with
+ * `capacity` = 2n to be sure it fits, or with `capacity` = 0 (`modes_out` may then be NULL) to
+ * learn the count.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_NON_FINITE for a NaN or
+ * infinite q0; MECH_STATUS_BUFFER_TOO_SMALL when `capacity` is below the number of modes, in
+ * which case (only) the needed number is written to `*count_out`; MECH_STATUS_INVALID_ARGUMENT
+ * for velocity-dependent potentials or a prescribed base motion (not modelled);
+ * MECH_STATUS_SINGULAR when det(s²A + s(C + G) + B) vanishes for every s or a dashpot's points
+ * coincide; MECH_STATUS_OUT_OF_RANGE when a result overflows. Apart from `*count_out` on
+ * BUFFER_TOO_SMALL, nothing is written on failure.
+ *
+ * # Safety
+ * `dynamics` must be a live handle not used by another thread during the call; `q0` must
+ * point to n readable doubles; `modes_out` to `capacity` writable records; `count_out`
+ * writable; `gradient_norm_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_damped_modes(struct mech_dynamics_t *dynamics,
+                                         const double *q0,
+                                         size_t n,
+                                         size_t capacity,
+                                         struct mech_damped_mode_t *modes_out,
+                                         size_t *count_out,
+                                         double *gradient_norm_out);
 #endif
 
 #if defined(MECH_FEATURE_DYNAMICS)

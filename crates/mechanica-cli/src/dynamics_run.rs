@@ -1,6 +1,7 @@
 //! The dynamics step of a scene: at q0, the forward dynamics q̈ for the applied forces τ and the
 //! inverse dynamics τ = A q̈ + c + g − Σ Q (Lagrange's equations (7.60)) with its split and the
-//! joint reactions, with the scene's dampers.
+//! joint reactions, with the scene's dampers; then the damped modes about q0
+//! ([`crate::damped_run`]).
 
 use crate::report::{Quantity, Step, timed_step};
 use crate::scene::{DynamicsSpec, Scene};
@@ -51,6 +52,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), St
         },
     )?;
     steps.push(step);
+    steps.push(crate::damped_run::step(&mut dynamics, &model.q0));
     Ok(())
 }
 

@@ -75,7 +75,9 @@
 //!                                      # inverse dynamics τ = A q̈ + c + g − Σ Q with its split and
 //!                                      # the joint reactions at q_ddot (default: that q̈); q_dot
 //!                                      # defaults to the joints' qd0; frame of the reactions:
-//!                                      # "world" (default), "body" or "joint"
+//!                                      # "world" (default), "body" or "joint"; then the
+//!                                      # damped modes det(s²A + s(C + G) + B) = 0 about q0
+//!                                      # (kind, ω_n, ω_d, ζ, s with its bound per mode)
 //! ```
 //!
 //! `inertia` lists the six independent entries (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) about the centre

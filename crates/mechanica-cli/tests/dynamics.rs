@@ -217,3 +217,77 @@ fn bad_dynamics_input_gives_located_errors() {
         assert!(err.contains(says), "{field}: {err}");
     }
 }
+
+/// A point mass m on a prismatic joint with a joint spring k and a joint damper c.
+fn oscillator(m: f64, k: f64, c: f64) -> String {
+    format!(
+        r#"title = "damped oscillator"
+[[body]]
+name = "mass"
+primitive = {{ shape = "point", mass = {m:?} }}
+[[joint]]
+name = "slide"
+type = "prismatic"
+parent = "ground"
+child = "mass"
+axis = [1.0, 0.0, 0.0]
+q0 = [0.0]
+[[joint_spring]]
+joint = "slide"
+stiffness = {k:?}
+[[joint_damper]]
+joint = "slide"
+damping = {c:?}
+[analyses]
+dynamics = {{}}
+"#
+    )
+}
+
+/// ω_n = √(k/m), ζ = c/(2√(km)); below ζ = 1 a conjugate pair s = −ζω_n ± iω_n√(1−ζ²), above it
+/// two real roots −ω_n(ζ ± √(ζ²−1)) with ω_n² = s₁s₂; the text report names the kind.
+#[test]
+fn a_damped_oscillator_has_the_closed_form_damping_ratio_and_frequency() {
+    let cases = [
+        (0.3, 40.0, 0.01),
+        (2.5, 7.0, 0.5),
+        (0.05, 900.0, 2.0),
+        (12.0, 0.8, 0.25),
+    ];
+    for (m, k, zeta) in cases {
+        let omega_n = f64::sqrt(k / m);
+        let c = 2.0 * zeta * f64::sqrt(k * m);
+        let scene = oscillator(m, k, c);
+        let json = run_json("oscillator", &scene);
+        let (kind, prefix) = if zeta < 1.0 {
+            ("underdamped", "damped mode 1 (underdamped): ω_n, ω_d, ζ")
+        } else {
+            ("overdamped", "damped mode 1 (overdamped): ω_n, ω_d, ζ")
+        };
+        let f = values(&json, prefix);
+        close(f[0], omega_n, 1e-12 * omega_n);
+        close(f[2], zeta, 1e-12 * (1.0 + zeta));
+        let s = values(&json, &format!("damped mode 1 ({kind}): s ="));
+        assert_eq!(s.len(), 4, "two eigenvalues: {s:?}");
+        if zeta < 1.0 {
+            let omega_d = omega_n * f64::sqrt(1.0 - zeta * zeta);
+            close(f[1], omega_d, 1e-12 * omega_n);
+            close(s[0], -zeta * omega_n, 1e-12 * omega_n);
+            close(s[1], omega_d, 1e-12 * omega_n);
+            close(s[3], -omega_d, 1e-12 * omega_n);
+        } else {
+            let fast = -omega_n * (zeta + f64::sqrt(zeta * zeta - 1.0));
+            let slow = omega_n * omega_n / fast;
+            let (lo, hi) = (s[0].min(s[2]), s[0].max(s[2]));
+            close(lo, fast, 1e-12 * fast.abs());
+            close(hi, slow, 1e-12 * fast.abs());
+            assert_eq!(f[1], 0.0);
+        }
+        close(values(&json, "‖grad U*(q0)‖")[0], 0.0, 0.0);
+        let path = scene_file("oscillator_text", &scene);
+        let (ok, text, err) = mechanica(&["run", path.to_str().expect("path")]);
+        assert!(ok, "{err}");
+        assert!(text.contains(&format!("damped mode 1 ({kind})")), "{text}");
+        assert!(text.contains("|Δs| ≤"), "{text}");
+    }
+}

@@ -1,7 +1,7 @@
 //! C entry points of the dynamics crate: a dynamics handle made from a mechanism (its gravity,
 //! rotating frame and potentials), with dampers and charged points added to it; inverse
 //! dynamics (τ, its split, joint reactions), forward dynamics (q̈ with its accuracy report) and
-//! the mass matrix, into caller buffers.
+//! the mass matrix, and the damped modes about a configuration, into caller buffers.
 
 use super::boundary::{FfiError, boundary};
 use super::handle::Handle;
@@ -10,10 +10,12 @@ use super::status::*;
 use super::validate::*;
 use mechanica_dynamics::{Dynamics, DynamicsError};
 
+mod damped;
 mod forward;
 mod inverse;
 mod loads;
 
+pub use damped::*;
 pub use forward::*;
 pub use inverse::*;
 pub use loads::*;
