@@ -116,8 +116,9 @@
 #if defined(MECH_FEATURE_DYNAMICS)
 /**
  * The dynamics of a mechanism (opaque): a copy of the mechanism (tree, bodies, gravity,
- * rotating frame, potentials) with its dampers and charged points, and the working storage of
- * its recursions. Created by mech_dynamics_create, freed by mech_dynamics_destroy.
+ * rotating frame, potentials) with its dampers and charged points, its holonomic constraints
+ * (used only by mech_dynamics_forward_constrained), and the working storage of its recursions.
+ * Created by mech_dynamics_create, freed by mech_dynamics_destroy.
  */
 typedef struct mech_dynamics_t mech_dynamics_t;
 #endif
@@ -150,6 +151,47 @@ typedef struct mech_tree_t mech_tree_t;
  * Values are stable across versions and never reused.
  */
 typedef int32_t mech_status_t;
+
+/**
+ * A 3-vector of doubles (x, y, z). Its frame is stated by each function that uses it.
+ */
+typedef struct mech_vec3_t {
+    /**
+     * x component.
+     */
+    double x;
+    /**
+     * y component.
+     */
+    double y;
+    /**
+     * z component.
+     */
+    double z;
+} mech_vec3_t;
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The drift and accuracy report of mech_dynamics_forward_constrained.
+ */
+typedef struct mech_constrained_report_t {
+    /**
+     * ‖f(q)‖₂, how far q is from the constraint manifold (mixed units when the equations mix
+     * lengths and angles).
+     */
+    double position_drift;
+    /**
+     * ‖J(q) q̇‖₂, how far q̇ is from the constraints' tangent space.
+     */
+    double velocity_drift;
+    /**
+     * The row-wise backward error η of the KKT solve: each residual of
+     * [τ + Q − h − A q̈ − Jᵀλ; γ − J q̈] against the size of the terms of its row. The error of
+     * q̈ and λ is roughly η times the conditioning of the KKT matrix, about κ(A)·κ(J A⁻¹ Jᵀ).
+     */
+    double backward_error;
+} mech_constrained_report_t;
+#endif
 
 #if defined(MECH_FEATURE_DYNAMICS)
 /**
@@ -256,24 +298,6 @@ typedef struct mech_forward_report_t {
  */
 typedef int32_t mech_reaction_frame_t;
 #endif
-
-/**
- * A 3-vector of doubles (x, y, z). Its frame is stated by each function that uses it.
- */
-typedef struct mech_vec3_t {
-    /**
-     * x component.
-     */
-    double x;
-    /**
-     * y component.
-     */
-    double y;
-    /**
-     * z component.
-     */
-    double z;
-} mech_vec3_t;
 
 /**
  * A 3×3 matrix of doubles in column-major order: m[row + 3*col].
@@ -2314,8 +2338,8 @@ uint32_t mech_features(void);
 /**
  * Creates the dynamics of a mechanism and writes its handle to `*dynamics_out`. The mechanism
  * is copied with its gravity, rotating frame and potentials: later changes to it, or its
- * destruction, do not affect the dynamics. The dynamics starts without dampers or charged
- * points. The caller owns the handle and frees it with mech_dynamics_destroy.
+ * destruction, do not affect the dynamics. The dynamics starts without dampers, charged
+ * points or constraints. The caller owns the handle and frees it with mech_dynamics_destroy.
  *
  * Errors: none beyond the pointer checks (MECH_STATUS_INVALID_ARGUMENT only if the mechanism's
  * rotating frame cannot be set up as the tree's base motion).
@@ -2363,6 +2387,148 @@ mech_status_t mech_dynamics_dof(const struct mech_dynamics_t *dynamics,
  */
 mech_status_t mech_dynamics_body_count(const struct mech_dynamics_t *dynamics,
                                        size_t *bodies_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Adds the constraint that the point `point_a` of body `body_a` and `point_b` of `body_b`
+ * (body coordinates, m; MECH_GROUND and base-frame coordinates for the ground) coincide along
+ * each of the `direction_count` (1 to 3) world directions `directions`: one equation
+ * f_r = d_r·(x_a − x_b) per direction, the directions normalised. Three independent
+ * directions close a loop with a ball joint; a planar loop closed by a pin needs only the two
+ * in-plane ones (the third would be redundant). Writes the constraint's index (0, 1, … in the
+ * order constraints are added) to `*index_out` (may be NULL).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a direction count outside 1..3, a zero direction, a body index below MECH_GROUND or out of
+ * range. Dependent directions are found by mech_dynamics_forward_constrained
+ * (MECH_STATUS_SINGULAR).
+ *
+ * # Safety
+ * `dynamics` must be a live handle; `directions` must point to `direction_count` readable
+ * vectors; `index_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_add_point_constraint(struct mech_dynamics_t *dynamics,
+                                                 int64_t body_a,
+                                                 struct mech_vec3_t point_a,
+                                                 int64_t body_b,
+                                                 struct mech_vec3_t point_b,
+                                                 const struct mech_vec3_t *directions,
+                                                 size_t direction_count,
+                                                 size_t *index_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Adds the constraint that the point `point` of body `body` (body coordinates, m) stays on
+ * the fixed plane n·x = `offset` (n = `normal`, base-frame components, normalised with the
+ * offset divided by its length): one equation f = n·x − offset; its λ is minus the normal
+ * force along n. Writes the constraint's index to `*index_out` (may be NULL).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * a zero normal, a body index below MECH_GROUND or out of range.
+ *
+ * # Safety
+ * `dynamics` must be a live handle; `index_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_add_plane_constraint(struct mech_dynamics_t *dynamics,
+                                                 int64_t body,
+                                                 struct mech_vec3_t point,
+                                                 struct mech_vec3_t normal,
+                                                 double offset,
+                                                 size_t *index_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Adds a massless rod of length `length` (m, > 0) between the point `point_a` of body
+ * `body_a` and `point_b` of `body_b` (body coordinates, m; MECH_GROUND and base-frame
+ * coordinates for the ground): one equation f = |x_a − x_b| − length, whose λ is the rod's
+ * tension (N, positive when it pulls the points together). Writes the constraint's index to
+ * `*index_out` (may be NULL).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
+ * length ≤ 0, a body index below MECH_GROUND or out of range.
+ *
+ * # Safety
+ * `dynamics` must be a live handle; `index_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_add_distance_constraint(struct mech_dynamics_t *dynamics,
+                                                    int64_t body_a,
+                                                    struct mech_vec3_t point_a,
+                                                    int64_t body_b,
+                                                    struct mech_vec3_t point_b,
+                                                    double length,
+                                                    size_t *index_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Adds the constraint that coordinate `coordinate` (0 ≤ coordinate < n) keeps the value
+ * `value` (rad or m): one equation f = q_coordinate − value, whose λ is the generalized force
+ * the lock applies with its sign reversed. Writes the constraint's index to `*index_out` (may
+ * be NULL).
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite value; MECH_STATUS_INVALID_ARGUMENT for
+ * a coordinate out of range.
+ *
+ * # Safety
+ * `dynamics` must be a live handle; `index_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_add_coordinate_constraint(struct mech_dynamics_t *dynamics,
+                                                      size_t coordinate,
+                                                      double value,
+                                                      size_t *index_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes the number of constraint equations m (the length of the multipliers of
+ * mech_dynamics_forward_constrained) to `*count_out`: the sum over the constraints of their
+ * equations (the direction count of a point constraint, 1 for the others), numbered in the
+ * order the constraints were added.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `dynamics` must be a live handle and `count_out` writable.
+ */
+mech_status_t mech_dynamics_constraint_equations(const struct mech_dynamics_t *dynamics,
+                                                 size_t *count_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Writes q̈ (n values) and the multipliers λ (m values, one per constraint equation) of the
+ * constrained equations of motion [A Jᵀ; J 0] [q̈; λ] = [τ + Q − h; γ] at (`q`, `q_dot`) and
+ * time `t` (s) for the applied forces `tau`, with every load of the dynamics, to `q_ddot_out`
+ * and `multipliers_out`, and the drift and backward error to `*report_out` (may be NULL).
+ * Solved by the mass matrix A = LLᵀ and the Schur complement J A⁻¹ Jᵀ with one step of
+ * iterative refinement; J q̈ = γ holds to the rounding level, so the drift of an integrated
+ * motion is the caller's to correct. With no constraints (m = 0) this is the unconstrained
+ * q̈ by the mass matrix.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof or m not the equation count;
+ * MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_SINGULAR when A(q) is
+ * singular, or when a constraint equation depends on the earlier ones at q (the message names
+ * the constraint, its index and equation); MECH_STATUS_OUT_OF_RANGE when a result overflows.
+ * Nothing is written on error.
+ *
+ * # Safety
+ * `dynamics` must be a live handle not used by another thread during the call; `q`, `q_dot`,
+ * `tau` must point to n readable doubles, `q_ddot_out` to n and `multipliers_out` to m
+ * writable doubles; `report_out` NULL or writable.
+ */
+mech_status_t mech_dynamics_forward_constrained(struct mech_dynamics_t *dynamics,
+                                                const double *q,
+                                                const double *q_dot,
+                                                const double *tau,
+                                                double t,
+                                                size_t n,
+                                                size_t m,
+                                                double *q_ddot_out,
+                                                double *multipliers_out,
+                                                struct mech_constrained_report_t *report_out);
 #endif
 
 #if defined(MECH_FEATURE_DYNAMICS)

@@ -1,20 +1,23 @@
 //! C entry points of the dynamics crate: a dynamics handle made from a mechanism (its gravity,
 //! rotating frame and potentials), with dampers and charged points added to it; inverse
 //! dynamics (τ, its split, joint reactions), forward dynamics (q̈ with its accuracy report) and
-//! the mass matrix, and the damped modes about a configuration, into caller buffers.
+//! the mass matrix, and the damped modes about a configuration, into caller buffers; holonomic
+//! constraints added to the handle and the forward dynamics with their multipliers.
 
 use super::boundary::{FfiError, boundary};
 use super::handle::Handle;
 use super::mechanism::mech_mechanism_t;
 use super::status::*;
 use super::validate::*;
-use mechanica_dynamics::{Dynamics, DynamicsError};
+use mechanica_dynamics::{ConstrainedDynamics, Dynamics, DynamicsError};
 
+mod constraints;
 mod damped;
 mod forward;
 mod inverse;
 mod loads;
 
+pub use constraints::*;
 pub use damped::*;
 pub use forward::*;
 pub use inverse::*;
@@ -46,10 +49,11 @@ impl From<DynamicsError> for FfiError {
 }
 
 /// The dynamics of a mechanism (opaque): a copy of the mechanism (tree, bodies, gravity,
-/// rotating frame, potentials) with its dampers and charged points, and the working storage of
-/// its recursions. Created by mech_dynamics_create, freed by mech_dynamics_destroy.
+/// rotating frame, potentials) with its dampers and charged points, its holonomic constraints
+/// (used only by mech_dynamics_forward_constrained), and the working storage of its recursions.
+/// Created by mech_dynamics_create, freed by mech_dynamics_destroy.
 pub struct mech_dynamics_t {
-    dynamics: Dynamics,
+    constrained: ConstrainedDynamics,
 }
 
 impl Handle for mech_dynamics_t {}
@@ -61,7 +65,7 @@ impl Handle for mech_dynamics_t {}
 /// As [`Handle::borrow_mut`].
 unsafe fn dynamics_mut<'a>(handle: *mut mech_dynamics_t) -> Result<&'a mut Dynamics, FfiError> {
     // SAFETY: caller's contract.
-    unsafe { mech_dynamics_t::borrow_mut(handle, "dynamics") }.map(|h| &mut h.dynamics)
+    unsafe { mech_dynamics_t::borrow_mut(handle, "dynamics") }.map(|h| h.constrained.dynamics_mut())
 }
 
 /// Reads a vector of the mechanism's `n` coordinates: BAD_DIMENSION unless `n` is the dof,
@@ -110,8 +114,8 @@ unsafe fn read_state<'a>(
 
 /// Creates the dynamics of a mechanism and writes its handle to `*dynamics_out`. The mechanism
 /// is copied with its gravity, rotating frame and potentials: later changes to it, or its
-/// destruction, do not affect the dynamics. The dynamics starts without dampers or charged
-/// points. The caller owns the handle and frees it with mech_dynamics_destroy.
+/// destruction, do not affect the dynamics. The dynamics starts without dampers, charged
+/// points or constraints. The caller owns the handle and frees it with mech_dynamics_destroy.
 ///
 /// Errors: none beyond the pointer checks (MECH_STATUS_INVALID_ARGUMENT only if the mechanism's
 /// rotating frame cannot be set up as the tree's base motion).
@@ -128,7 +132,7 @@ pub unsafe extern "C" fn mech_dynamics_create(
         // SAFETY: caller's contract.
         let mechanism = unsafe { mech_mechanism_t::borrow(mechanism, "mechanism") }?;
         let handle = mech_dynamics_t {
-            dynamics: Dynamics::new(mechanism.mechanism().clone())?,
+            constrained: ConstrainedDynamics::new(Dynamics::new(mechanism.mechanism().clone())?),
         };
         // SAFETY: caller's contract.
         unsafe { out.write(handle.into_raw()) };
@@ -160,7 +164,7 @@ pub unsafe extern "C" fn mech_dynamics_dof(dynamics: *const mech_dynamics_t, dof
         // SAFETY: caller's contract.
         let d = unsafe { mech_dynamics_t::borrow(dynamics, "dynamics") }?;
         // SAFETY: caller's contract.
-        unsafe { out.write(d.dynamics.dof()) };
+        unsafe { out.write(d.constrained.dof()) };
         Ok(())
     })
 }
@@ -182,7 +186,7 @@ pub unsafe extern "C" fn mech_dynamics_body_count(
         // SAFETY: caller's contract.
         let d = unsafe { mech_dynamics_t::borrow(dynamics, "dynamics") }?;
         // SAFETY: caller's contract.
-        unsafe { out.write(d.dynamics.tree().body_count()) };
+        unsafe { out.write(d.constrained.dynamics().tree().body_count()) };
         Ok(())
     })
 }
