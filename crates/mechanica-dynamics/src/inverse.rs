@@ -23,6 +23,9 @@ use crate::model::{Dynamics, State};
 use crate::spatial::Wrench;
 use nalgebra::{Matrix3, Vector3};
 
+/// The transmitted wrenches per body, τ, and τ's rounding estimate per coordinate.
+pub(crate) type JointForces = (Vec<Wrench>, Vec<f64>, Vec<f64>);
+
 /// The frame in which a joint reaction is expressed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Frame {
@@ -138,6 +141,7 @@ impl Dynamics {
         q_ddot: &[f64],
         tau_out: &mut [f64],
     ) -> Result<(), DynamicsError> {
+        self.update_state(state)?;
         self.rnea_state(state, q_ddot, false)?;
         let mut wrenches = std::mem::take(&mut self.wrenches);
         let result = self.accumulate_to_joints(&mut wrenches, tau_out);
@@ -149,14 +153,14 @@ impl Dynamics {
         check_result(tau_out.iter(), "joint force")
     }
 
-    /// Kinematics to accelerations, the loads, and the body wrenches at `state` and `q_ddot`.
-    fn rnea_state(
+    /// Accelerations, the loads, and the body wrenches at `state` and `q_ddot`, after
+    /// [`Dynamics::update_state`] at the same state.
+    pub(crate) fn rnea_state(
         &mut self,
         state: &State<'_>,
         q_ddot: &[f64],
         detail: bool,
     ) -> Result<(f64, Vec<LoadTerm>), DynamicsError> {
-        self.update_state(state)?;
         self.mechanism.tree().update_accelerations(&mut self.ws, q_ddot)?;
         let loads = self.evaluate_loads(state, detail)?;
         let g = self.gravity();
@@ -171,28 +175,16 @@ impl Dynamics {
         let n = self.dof();
         check_vector(q_ddot, n, "q_ddot")?;
         // The split first, so that the workspace ends with the accelerations at q̈.
-        let velocity_product = self.velocity_product_terms(state)?;
+        self.update_state(state)?;
+        let velocity_product = self.velocity_product_terms()?;
         let gravity = self.gravity_terms()?;
         let (dissipation, loads) = self.rnea_state(state, q_ddot, true)?;
-        let mut transmitted = self.wrenches.clone();
-        let mut tau = vec![0.0; n];
-        self.accumulate_to_joints(&mut transmitted, &mut tau)?;
-        let magnitudes = self.magnitudes()?;
-        for (t, j) in tau.iter_mut().zip(&self.joint_loads) {
-            *t -= j;
-        }
-        let factor = self.estimate_factor();
-        let error_estimate = magnitudes
-            .iter()
-            .zip(&self.joint_loads)
-            .map(|(m, j)| factor * (m + j.abs()))
-            .collect();
+        let (transmitted, tau, error_estimate) = self.joint_forces_with_estimate()?;
         let reactions = transmitted
             .iter()
             .enumerate()
             .map(|(body, wrench)| JointReaction { body, wrench: *wrench })
             .collect();
-        check_result(tau.iter(), "joint force")?;
         Ok(InverseDynamics {
             tau,
             velocity_product,
@@ -211,11 +203,31 @@ impl Dynamics {
         16.0 * (depth as f64 + 4.0) * f64::EPSILON
     }
 
-    /// c(q, q̇): the needed forces at q̈ = 0 without gravity or loads (velocities in place).
-    fn velocity_product_terms(&mut self, state: &State<'_>) -> Result<Vec<f64>, DynamicsError> {
+    /// From the body wrenches of the last `rnea_state`: the transmitted wrenches, τ and its
+    /// rounding estimate per coordinate (see [`InverseDynamics::error_estimate`]).
+    pub(crate) fn joint_forces_with_estimate(&self) -> Result<JointForces, DynamicsError> {
+        let mut transmitted = self.wrenches.clone();
+        let mut tau = vec![0.0; self.dof()];
+        self.accumulate_to_joints(&mut transmitted, &mut tau)?;
+        let magnitudes = self.magnitudes()?;
+        for (t, j) in tau.iter_mut().zip(&self.joint_loads) {
+            *t -= j;
+        }
+        let factor = self.estimate_factor();
+        let error_estimate = magnitudes
+            .iter()
+            .zip(&self.joint_loads)
+            .map(|(m, j)| factor * (m + j.abs()))
+            .collect();
+        check_result(tau.iter(), "joint force")?;
+        Ok((transmitted, tau, error_estimate))
+    }
+
+    /// c(q, q̇): the needed forces at q̈ = 0 without gravity or loads (positions and
+    /// velocities in place).
+    fn velocity_product_terms(&mut self) -> Result<Vec<f64>, DynamicsError> {
         let n = self.dof();
         let zeros = vec![0.0; n];
-        self.update_state(state)?;
         self.mechanism.tree().update_accelerations(&mut self.ws, &zeros)?;
         self.body_wrenches(&Vector3::zeros(), false)?;
         let mut wrenches = self.wrenches.clone();
