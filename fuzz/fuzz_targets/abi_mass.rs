@@ -156,13 +156,16 @@ fn combine_subtract(input: &mut Input) {
     }) else {
         return;
     };
-    // Subtraction cancels: errors grow like the whole over the remainder.
+    // Subtraction cancels: errors grow like the whole over the remainder. The stored total
+    // mass carries a rounding of u·M, which is relative u·M/m_a in the remainder's mass and
+    // moves the recovered centre by that fraction of its own distance |c_a − c_sum|; so the
+    // reach includes the first body's centre as well as the sum's and the hole's.
     let amplification = sum.mass / a.mass;
     if !(amplification < 1e6) {
         return;
     }
     let (m, c, _) = scale_of(&sum);
-    let reach = c + norm1(doubles_of(&hole.center_of_mass)) + 1.0;
+    let reach = c + norm1(doubles_of(&hole.center_of_mass)) + norm1(doubles_of(&a.center_of_mass)) + 1.0;
     let j = norm1(&sum.inertia_about_com.m) + m * reach * reach;
     let tol = 1e-12 * amplification;
     assert!(
