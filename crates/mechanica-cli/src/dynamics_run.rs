@@ -1,7 +1,7 @@
 //! The dynamics step of a scene: at q0, the forward dynamics q̈ for the applied forces τ and the
 //! inverse dynamics τ = A q̈ + c + g − Σ Q (Lagrange's equations (7.60)) with its split and the
 //! joint reactions, with the scene's dampers; then the damped modes about q0
-//! ([`crate::damped_run`]).
+//! ([`crate::damped_run`]). A scene with constraints goes to [`crate::constraint_run`].
 
 use crate::report::{Quantity, Step, timed_step};
 use crate::scene::{DynamicsSpec, Scene};
@@ -25,6 +25,14 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), St
     let q_dot = vector(&spec.q_dot, &model.qd0);
     let zeros = vec![0.0; n];
     let tau = vector(&spec.tau, &zeros);
+    if !scene.constraints.is_empty() {
+        let start = crate::constraint_run::StartState {
+            q: model.q0.clone(),
+            q_dot,
+            tau,
+        };
+        return crate::constraint_run::run(scene, model, dynamics, spec, start, steps);
+    }
     let state = State::new(&model.q0, &q_dot);
     let mut forward = None;
     steps.push(timed_step(

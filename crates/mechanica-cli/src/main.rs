@@ -2,6 +2,7 @@
 //! computes the mass properties of a mesh file, or the modes of a pencil from Matrix Market
 //! files, and prints a readable report, or JSON with `--json`.
 
+mod constraint_run;
 mod damped_run;
 mod default_scene;
 mod dynamics_run;

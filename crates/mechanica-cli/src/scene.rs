@@ -78,7 +78,16 @@
 //!                                      # "world" (default), "body" or "joint"; then the
 //!                                      # damped modes det(s²A + s(C + G) + B) = 0 about q0
 //!                                      # (kind, ω_n, ω_d, ζ, s with its bound per mode)
+//!                                      # With [[constraint]] tables (see `scene/constraints.rs`):
+//!                                      # q0 and q_dot are projected onto the constraints, the
+//!                                      # forward dynamics carries the multipliers and reactions,
+//!                                      # `equilibrium = true` adds the constrained equilibrium,
+//!                                      # and the damped modes are not computed
 //! ```
+//!
+//! Constraints (`[[constraint]]`, kinds "points", "plane", "distance", "coordinate") are used by
+//! the dynamics analysis only: a scene with constraints that asks for the unconstrained
+//! equilibrium, modes, free response or impact is refused rather than answered without them.
 //!
 //! `inertia` lists the six independent entries (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) about the centre
 //! of mass, in the body frame. Unknown fields are errors, and so are coordinate counts that do
@@ -86,6 +95,9 @@
 //! dynamics' q_dot, tau, q_ddot), and negative or non-finite damping. Every error names
 //! the file, the line and column, and the field.
 
+mod constraints;
+
+pub use constraints::ConstraintSpec;
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::fmt;
@@ -123,6 +135,9 @@ pub struct Scene {
     /// Linear dampers between body points or a body point and the ground (used by the dynamics).
     #[serde(default, rename = "damper")]
     pub dampers: Vec<DamperSpec>,
+    /// Holonomic constraints closing loops or holding points (used by the dynamics).
+    #[serde(default, rename = "constraint")]
+    pub constraints: Vec<ConstraintSpec>,
     /// The analyses requested; nothing else is computed.
     #[serde(default)]
     pub analyses: Analyses,
@@ -375,6 +390,9 @@ pub struct DynamicsSpec {
     pub q_ddot: Option<Spanned<Vec<f64>>>,
     /// "world" (default), "body" or "joint": the frame of the joint reactions.
     pub frame: Option<Spanned<String>>,
+    /// With constraints: also seek the constrained equilibrium near q0 (FM 4.83–4.86).
+    #[serde(default)]
+    pub equilibrium: bool,
 }
 
 /// Equilibrium search options.
@@ -559,6 +577,7 @@ impl Scene {
         validator.check_joint_values()?;
         validator.check_joint_springs()?;
         validator.check_dampers()?;
+        validator.check_constraints(&index_of)?;
         validator.check_analyses()
     }
 }
@@ -951,6 +970,7 @@ impl<'a> Validator<'a> {
         let analyses = &self.scene.analyses;
         let dof = self.dof();
         let whose = "the scene has";
+        self.check_constrained_analyses()?;
         if let Some(equilibrium) = &analyses.equilibrium {
             for (i, start) in equilibrium.starts.iter().enumerate() {
                 self.check_length(start, dof, format!("analyses.equilibrium.starts[{i}]"), whose)?;

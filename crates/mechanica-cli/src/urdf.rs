@@ -95,6 +95,7 @@ pub fn load(path: &Path, options: UrdfOptions) -> Result<(Scene, Vec<String>), S
         forces: Vec::new(),
         joint_dampers: Vec::new(),
         dampers: Vec::new(),
+        constraints: Vec::new(),
         analyses: Analyses {
             mass_properties: true,
             equilibrium: Some(EquilibriumSpec {
