@@ -421,8 +421,15 @@ static void test_mechanisms(void) {
     CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, &hit, 1, &dq, 0, &resp), MECH_STATUS_BAD_DIMENSION);
     CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, NULL, 1, &dq, 1, &resp), MECH_STATUS_NULL_POINTER);
     CHECK_STATUS(mech_impulse_mechanism_apply(NULL, &bob, 1, &hit, 1, &dq, 1, &resp), MECH_STATUS_NULL_POINTER);
+    /* A state whose velocities were refused is no state: the impulses must not use the old q̇. */
+    double q0 = 0.0, nan_rate = NAN;
+    CHECK_STATUS(mech_tree_set_state(tree, &q0, &nan_rate, 1), MECH_STATUS_NON_FINITE);
+    CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, &hit, 1, &dq, 1, &resp), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_impulse_mechanism_contacts(tree, &bob, 1, &wall, 1, NULL, res, &dq, 1, &imp),
+                 MECH_STATUS_INVALID_ARGUMENT);
     CHECK(mech_untouched(&dq, sizeof dq));
     CHECK(mech_untouched(&resp, sizeof resp));
+    CHECK(mech_untouched(res, sizeof res));
     CHECK_STATUS(mech_impulse_mechanism_apply(tree, &bob, 1, &hit, 1, &dq, 1, NULL), MECH_STATUS_NULL_POINTER);
 
     CHECK_STATUS(mech_impulse_mechanism_delassus(tree, &bob, 1, two, 2, w, 5, frames, &rank),

@@ -95,6 +95,7 @@
 //! dynamics' q_dot, tau, q_ddot), and negative or non-finite damping. Every error names
 //! the file, the line and column, and the field.
 
+#[path = "scene/constraints.rs"]
 mod constraints;
 
 pub use constraints::ConstraintSpec;

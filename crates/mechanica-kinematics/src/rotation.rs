@@ -371,7 +371,8 @@ pub struct Orthonormalized {
 /// SVD m = U Σ Vᵀ, computed on m scaled by a power of two (the polar factor of a positive
 /// multiple is the same), so that any finite m works. Fails for non-finite input, for
 /// det m ≤ 0 (a reflection or a singular matrix is not a drifted rotation), and with
-/// [`KinematicsError::NonFiniteResult`] when the correction ‖m − R‖_F exceeds f64::MAX.
+/// [`KinematicsError::NonFiniteResult`] when the correction ‖m − R‖_F exceeds f64::MAX. The
+/// result is checked: ‖RᵀR − I‖_F ≤ 64u and det R > 0, or [`KinematicsError::NotARotation`].
 pub fn orthonormalize_matrix(m: &Matrix3<f64>) -> Result<Orthonormalized, KinematicsError> {
     check_finite_mat(m, "matrix entry")?;
     let scale = power_of_two_above(m.amax());
@@ -390,13 +391,31 @@ pub fn orthonormalize_matrix(m: &Matrix3<f64>) -> Result<Orthonormalized, Kinema
             determinant,
         });
     };
-    let r = u * v_t;
+    let r = proper_polar_factor(u, &svd.singular_values, v_t);
+    let orthogonality_error = (r.transpose() * r - Matrix3::identity()).norm();
+    if !(orthogonality_error <= 64.0 * f64::EPSILON && r.determinant() > 0.0) {
+        return Err(KinematicsError::NotARotation {
+            orthogonality_error,
+            determinant: determinant * scale * scale * scale,
+        });
+    }
     let correction = scaling::frobenius_norm(&(m - r));
     check_result([correction].iter(), "correction ‖m − R‖")?;
     Ok(Orthonormalized {
         rotation: Rotation3::from_matrix_unchecked(r),
         correction,
     })
+}
+
+/// U Vᵀ with det +1: when rounding in a nearly singular m leaves det(U) det(Vᵀ) = −1 although
+/// det m > 0, the column of U of the smallest singular value changes sign (the rotation nearest
+/// to m among proper ones, as in the Kabsch construction).
+fn proper_polar_factor(mut u: Matrix3<f64>, singular_values: &Vector3<f64>, v_t: Matrix3<f64>) -> Matrix3<f64> {
+    if u.determinant() * v_t.determinant() < 0.0 {
+        let smallest = singular_values.imin();
+        u.column_mut(smallest).neg_mut();
+    }
+    u * v_t
 }
 
 /// The unit quaternion nearest to a drifted q = (w, x, y, z): q/‖q‖, with correction |‖q‖ − 1|.

@@ -130,6 +130,32 @@ proptest! {
         prop_assert!((fixed.correction - expected).abs() <= 16.0 * EPS * (expected + s));
     }
 
+    /// Matrices U diag(s) Vᵀ with det > 0 whose singular values span up to 300 decades (nearly
+    /// singular, or with entries of very different sizes): the result, when one is given, is a
+    /// proper rotation to rounding (never a reflection, never NaN), and it is U Vᵀ when the
+    /// singular values are well separated from zero.
+    #[test]
+    fn orthonormalize_never_returns_a_reflection(
+        a in -3.0..3.0f64, b in -3.0..3.0f64, c in -3.0..3.0f64,
+        d in -3.0..3.0f64, e in -3.0..3.0f64, f in -3.0..3.0f64,
+        e1 in -150.0..150.0f64, e2 in -150.0..150.0f64, e3 in -150.0..150.0f64,
+    ) {
+        let u = Rotation3::from_scaled_axis(Vector3::new(a, b, c));
+        let v = Rotation3::from_scaled_axis(Vector3::new(d, e, f));
+        let s = Vector3::new(10f64.powf(e1), 10f64.powf(e2), 10f64.powf(e3));
+        let m = u.matrix() * Matrix3::from_diagonal(&s) * v.matrix().transpose();
+        if let Ok(fixed) = orthonormalize_matrix(&m) {
+            let r = fixed.rotation.matrix();
+            prop_assert!((r.transpose() * r - Matrix3::identity()).norm() <= 64.0 * EPS);
+            prop_assert!(r.determinant() > 0.0);
+            let spread = s.max() / s.min();
+            if spread < 1e6 {
+                let exact = u.matrix() * v.matrix().transpose();
+                prop_assert!((r - exact).norm() <= 1e-9, "{r} vs {exact}");
+            }
+        }
+    }
+
     /// Normalising a quaternion of any finite size gives the same unit quaternion as its
     /// exactly rescaled copy (down to 2⁻¹⁰¹⁸, where the rescaled components are still normal
     /// numbers; below, they have lost bits, but still normalise).

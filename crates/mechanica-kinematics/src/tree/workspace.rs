@@ -231,6 +231,18 @@ impl Workspace {
         &self.q
     }
 
+    /// Ok when the velocities of the current positions are computed
+    /// ([`KinematicTree::update_velocities`] since the last position update), so that
+    /// [`Workspace::q_dot`] belongs to the state; [`KinematicsError::WorkspaceNotReady`] otherwise.
+    pub fn check_velocities(&self) -> Result<(), KinematicsError> {
+        if self.stage < Stage::Velocities {
+            return Err(KinematicsError::WorkspaceNotReady {
+                what: "velocities not computed (call update_velocities)",
+            });
+        }
+        Ok(())
+    }
+
     /// The velocities of the last [`KinematicTree::update_velocities`].
     pub fn q_dot(&self) -> &[f64] {
         &self.q_dot

@@ -111,6 +111,7 @@ pub unsafe extern "C" fn mech_impulse_mechanism_apply(
         let list = impulses_from_c(raw)?;
         // SAFETY: caller's contract.
         let inertia = unsafe { tree_inertia(kt, ws, bodies, body_count) }?;
+        ws.check_velocities()?; // the velocities of mech_tree_set_state must be in place
         let q_dot = ws.q_dot().to_vec();
         let r = apply_point_impulses(kt, ws, &inertia, &q_dot, &list)?;
         let value = mech_mechanism_response_t {

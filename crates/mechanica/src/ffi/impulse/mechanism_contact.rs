@@ -247,6 +247,7 @@ pub unsafe extern "C" fn mech_impulse_mechanism_contacts(
         let list = contacts_from_c(raw)?;
         // SAFETY: caller's contract.
         let inertia = unsafe { tree_inertia(kt, ws, bodies, body_count) }?;
+        ws.check_velocities()?; // the velocities of mech_tree_set_state must be in place
         let q_dot = ws.q_dot().to_vec();
         let r = resolve_contacts(kt, ws, &inertia, &q_dot, &list, &opts)?;
         let per_contact: Vec<mech_mechanism_contact_result_t> = r
@@ -329,6 +330,7 @@ pub unsafe extern "C" fn mech_impulse_mechanism_delassus(
         let list = contacts_from_c(raw)?;
         // SAFETY: caller's contract.
         let inertia = unsafe { tree_inertia(kt, ws, bodies, body_count) }?;
+        ws.check_velocities()?; // the velocities of mech_tree_set_state must be in place
         let q_dot = ws.q_dot().to_vec();
         let space = ContactSpace::new(kt, ws, &inertia, &q_dot, &list)?;
         let frame_values: Vec<mech_mat3_t> = (0..contact_count)

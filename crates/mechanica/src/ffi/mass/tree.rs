@@ -157,7 +157,7 @@ pub unsafe extern "C" fn mech_tree_kinetic_energy(
         // SAFETY: caller's contract.
         let (mass, kt, ws, _) = unsafe { tree_mass(tree, bodies, body_count) }?;
         check_dof(kt, n, "momenta_out")?;
-        ws.angular_velocity(0)?; // the velocities of mech_tree_set_state must be in place
+        ws.check_velocities()?; // the velocities of mech_tree_set_state must be in place
         let mut a = vec![0.0; n * n];
         let mut p = vec![0.0; n];
         let t = mass.momenta_and_energy(kt, ws, ws.q_dot(), &mut a, &mut p)?;
@@ -248,7 +248,7 @@ pub unsafe extern "C" fn mech_tree_energy_split(
         // SAFETY: caller's contract.
         let (mass, kt, ws, _) = unsafe { tree_mass(tree, bodies, body_count) }?;
         check_dof(kt, n, "b_out and momenta_out")?;
-        ws.angular_velocity(0)?; // the velocities of mech_tree_set_state must be in place
+        ws.check_velocities()?; // the velocities of mech_tree_set_state must be in place
         let drag = DragField {
             origin: ws.base().position,
             omega,
