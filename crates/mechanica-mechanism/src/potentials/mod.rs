@@ -134,10 +134,16 @@ impl PotentialSum {
         }
         if let Some(hessian) = self.hessian.as_mut() {
             let moved: Vec<usize> = (0..n).filter(|&k| column(k) != Vector3::zeros()).collect();
-            for &k in &moved {
+            // One triangle, mirrored: the two orders of c_lᵀ K c_k round differently, and with
+            // stiff springs on long lever arms the difference is not small next to the result.
+            for (i, &k) in moved.iter().enumerate() {
                 let kj = stiffness * column(k);
-                for &l in &moved {
-                    hessian[(l, k)] += column(l).dot(&kj);
+                for &l in &moved[i..] {
+                    let value = column(l).dot(&kj);
+                    hessian[(l, k)] += value;
+                    if l != k {
+                        hessian[(k, l)] += value;
+                    }
                 }
             }
             for ((anchor, c), x) in points.iter().zip(&world) {
