@@ -245,6 +245,8 @@ static void test_contacts(void) {
     bad = c;
     bad.tolerance = 0.0;
     CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_INVALID_ARGUMENT);
+    bad.tolerance = 0.5; /* would count a slip at half the approach speed as halted */
+    CHECK_STATUS(mech_impulse_resolve_contact(&g, &ball, &bad, &res), MECH_STATUS_INVALID_ARGUMENT);
     /* Two immovable bodies approaching. */
     mech_impulse_body_t wall = ground();
     wall.velocity = v3(0.0, -1.0, 0.0);

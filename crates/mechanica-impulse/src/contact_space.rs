@@ -117,10 +117,37 @@ impl ContactLaw {
 /// Accuracy and budget of the impact process.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImpactOptions {
-    /// Relative tolerance of the swerving-slip integration and of slip halting (default 1e-10).
+    /// Relative tolerance of the swerving-slip integration and of slip halting (default 1e-10;
+    /// at most [`MAX_IMPACT_TOLERANCE`]: a slip slower than tolerance·|u⁻| counts as halted, so
+    /// a larger value would end a slip that is still going on).
     pub tolerance: f64,
     /// Maximum number of integration steps (default 100 000).
     pub max_steps: usize,
+}
+
+/// The largest relative tolerance [`ImpactOptions`] accepts.
+pub const MAX_IMPACT_TOLERANCE: f64 = 1e-2;
+
+impl ImpactOptions {
+    /// Ok when 0 < tolerance ≤ [`MAX_IMPACT_TOLERANCE`] and at least one step is allowed;
+    /// [`ImpulseError::InvalidOption`] otherwise.
+    pub fn check(&self) -> Result<(), ImpulseError> {
+        if !(self.tolerance > 0.0 && self.tolerance <= MAX_IMPACT_TOLERANCE) {
+            return Err(ImpulseError::InvalidOption {
+                what: "tolerance",
+                range: "(0, 1e-2]",
+                value: self.tolerance,
+            });
+        }
+        if self.max_steps == 0 {
+            return Err(ImpulseError::InvalidOption {
+                what: "max_steps",
+                range: "[1, usize::MAX]",
+                value: 0.0,
+            });
+        }
+        Ok(())
+    }
 }
 
 impl Default for ImpactOptions {
@@ -249,12 +276,7 @@ pub(crate) fn resolve_framed(
     options: &ImpactOptions,
 ) -> Result<ContactImpulse, ImpulseError> {
     check_finite("tolerance", options.tolerance)?;
-    if options.tolerance <= 0.0 {
-        return Err(ImpulseError::Singular {
-            what: "tolerance must be positive",
-            value: options.tolerance,
-        });
-    }
+    options.check()?;
     let (w, u) = (&contact.w, &contact.u);
     if u.0.z + u.1.z >= 0.0 {
         return Ok(ContactImpulse {

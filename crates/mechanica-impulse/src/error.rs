@@ -46,6 +46,17 @@ pub enum ImpulseError {
     /// The coefficient of friction is negative (NaN is reported as NonFinite; +∞ is allowed).
     #[error("friction coefficient must be ≥ 0 (or +inf), got {0}")]
     NegativeFriction(f64),
+    /// The impact options ask for something meaningless: a relative tolerance outside
+    /// (0, [`crate::MAX_IMPACT_TOLERANCE`]], or no integration step at all.
+    #[error("impact options: {what} must lie in {range}, got {value}")]
+    InvalidOption {
+        /// The option.
+        what: &'static str,
+        /// Its allowed range, in words.
+        range: &'static str,
+        /// The value given.
+        value: f64,
+    },
     /// A direction that must be a unit vector (contact normal, hinge axis) is not.
     #[error("{what} must be a unit vector, but its length is {norm}")]
     NotUnit {

@@ -38,7 +38,8 @@ mod tangent_block;
 pub use body::{BodyResponse, RigidBody};
 pub use contact::{TwoBodyImpact, resolve_contact};
 pub use contact_space::{
-    ContactImpulse, ContactLaw, ContactMode, ImpactOptions, RestitutionLaw, resolve_in_contact_space,
+    ContactImpulse, ContactLaw, ContactMode, ImpactOptions, MAX_IMPACT_TOLERANCE, RestitutionLaw,
+    resolve_in_contact_space,
 };
 pub use error::ImpulseError;
 pub use fixation::{Fixation, fix_point};

@@ -363,3 +363,57 @@ fn hinged_pendulum_striking_a_wall_has_effective_mass_m_over_3() {
         assert!(close(out.contact.energy_change, dt, j_h * w * w));
     }
 }
+
+/// Tolerances that would end a slip still in progress (above 1e-2), zero, negative or NaN
+/// tolerances and a zero step budget are refused; the largest allowed tolerance still gives a
+/// sliding sphere's impulse to its closed form p_t = −f p_n.
+#[test]
+fn meaningless_impact_options_are_refused() {
+    let (m, radius, e, f) = (2.0, 0.1, 0.6, 0.1);
+    let ball = Body::sphere(
+        m,
+        radius,
+        Vector3::new(0.0, radius, 0.0),
+        Vector3::new(1.0, -3.0, 0.0),
+        Vector3::new(0.0, 0.0, 25.0),
+    );
+    let law = ContactLaw::new(e, f, RestitutionLaw::Poisson).expect("law");
+    let resolve = |options: ImpactOptions| {
+        resolve_contact(
+            &ground(),
+            &ball.rigid(),
+            &Vector3::zeros(),
+            &Vector3::y(),
+            &law,
+            &options,
+        )
+    };
+    for tolerance in [0.5, 1.0, 1e300, 0.0, -1e-10, f64::NAN, f64::INFINITY] {
+        let options = ImpactOptions {
+            tolerance,
+            ..ImpactOptions::default()
+        };
+        assert!(
+            matches!(
+                resolve(options),
+                Err(mechanica_impulse::ImpulseError::InvalidOption { .. }
+                    | mechanica_impulse::ImpulseError::NonFinite { .. })
+            ),
+            "tolerance {tolerance} accepted"
+        );
+    }
+    let no_steps = ImpactOptions {
+        max_steps: 0,
+        ..ImpactOptions::default()
+    };
+    assert!(resolve(no_steps).is_err());
+    let coarse = ImpactOptions {
+        tolerance: mechanica_impulse::MAX_IMPACT_TOLERANCE,
+        ..ImpactOptions::default()
+    };
+    let out = resolve(coarse).expect("coarse tolerance");
+    let p_n = (1.0 + e) * m * 3.0;
+    let impulse = out.contact.impulse_w;
+    assert!((impulse.y - p_n).abs() <= 1e-12 * p_n, "{impulse}");
+    assert!((impulse.x + f * p_n).abs() <= 1e-12 * p_n, "{impulse}");
+}

@@ -359,7 +359,11 @@ fn hessian_is_exactly_symmetric_for_stiff_springs_and_large_coordinates() {
             .expect("spring");
         let dof = mechanism.dof();
         let q = random_vector(dof, seed + 900, 10f64.powf(2.0 + 2.0 * scale[3]));
-        let hessian = mechanism.potential(&q, true).expect("potential").hessian.expect("hessian");
+        let hessian = mechanism
+            .potential(&q, true)
+            .expect("potential")
+            .hessian
+            .expect("hessian");
         for k in 0..dof {
             for l in 0..k {
                 assert_eq!(

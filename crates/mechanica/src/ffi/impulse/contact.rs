@@ -24,7 +24,7 @@ pub struct mech_impulse_contact_t {
     pub friction: f64,
     /// A MECH_RESTITUTION_* value.
     pub law: mech_restitution_law_t,
-    /// Relative tolerance of the 3-D swerving-slip integration (> 0, e.g. 1e-10).
+    /// Relative tolerance of the 3-D swerving-slip integration (0 < tolerance ≤ 1e-2, e.g. 1e-10).
     pub tolerance: f64,
 }
 
@@ -70,7 +70,7 @@ pub struct mech_impact_result_t {
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_BAD_ENUM for an
 /// unknown law or constraint; MECH_STATUS_INVALID_ARGUMENT for a non-unit normal, restitution
-/// outside [0, 1], negative friction, a non-positive tolerance or an invalid body (see
+/// outside [0, 1], negative friction, a tolerance outside (0, 1e-2] or an invalid body (see
 /// mech_impulse_apply); MECH_STATUS_SINGULAR when neither body can move along the normal;
 /// MECH_STATUS_NOT_CONVERGED for a frictional jam, including a contact that self-locks (friction
 /// holds it at rest, so the normal velocity stays zero) under MECH_RESTITUTION_NEWTON or

@@ -49,7 +49,7 @@ pub struct mech_multi_contact_options_t {
     pub tolerance: f64,
     /// Maximum Gauss–Seidel sweeps per phase (≥ 1; default 10000).
     pub max_iterations: u64,
-    /// Relative tolerance of the single-contact process (> 0; default 1e-10).
+    /// Relative tolerance of the single-contact process (0 < tolerance ≤ 1e-2; default 1e-10).
     pub process_tolerance: f64,
 }
 

@@ -44,6 +44,7 @@ impl From<ImpulseError> for FfiError {
             | ImpulseError::NegativeInverseMass { .. }
             | ImpulseError::RestitutionOutOfRange(_)
             | ImpulseError::NegativeFriction(_)
+            | ImpulseError::InvalidOption { .. }
             | ImpulseError::NotUnit { .. }
             | ImpulseError::ZeroInertiaAxisExcited { .. }
             | ImpulseError::ConstraintViolated { .. } => MECH_STATUS_INVALID_ARGUMENT,
