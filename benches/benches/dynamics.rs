@@ -10,9 +10,8 @@
 //! velocities, accelerations and forces uniform in [−2, 2] in mechanica's coordinates, mapped
 //! exactly to Pinocchio's (v_B = Rᵀṗ, ω_B = J_r(φ) φ̇, their rates, and the dual forces).
 //!
-//! Series: mechanica's allocation-free `rnea_into` and `aba_into`, its `mass_matrix` (which
-//! returns a new matrix) and the position, velocity and acceleration updates of the tree's
-//! workspace; Pinocchio's `rnea`, `aba`, `crba` (upper triangle) and `forwardKinematics` (to
+//! Series: mechanica's allocation-free `rnea_into`, `aba_into` and `mass_matrix_into` (the whole
+//! matrix) and the position, velocity and acceleration updates of the tree's workspace; Pinocchio's `rnea`, `aba`, `crba` (upper triangle) and `forwardKinematics` (to
 //! acceleration), through the C-ABI shim of tools/pinocchio_dynamics_bench.cpp. Build it with
 //! `bash tools/pinocchio_dynamics_bench.sh build` and set
 //! `MECHANICA_PINOCCHIO_SHIM=/path/to/libpin_bench.so` when building this bench (benches/build.rs
@@ -32,7 +31,6 @@ use mechanica::mass::MassProperties;
 use mechanica::mechanism::Mechanism;
 use mechanica_dynamics::Dynamics;
 use serde_json::Value;
-use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 const STATES: usize = 1000;
@@ -458,7 +456,9 @@ fn operations() -> [(&'static str, Call, Call); 4] {
         (
             "crba",
             |b, i| {
-                black_box(b.dynamics.mass_matrix(&b.samples[i].q).expect("mass matrix"));
+                b.dynamics
+                    .mass_matrix_into(&b.samples[i].q, &mut b.matrix)
+                    .expect("mass matrix");
             },
             |b, i| {
                 b.peer.as_mut().expect("peer").crba(&b.samples[i].pin_q, &mut b.matrix);

@@ -21,6 +21,22 @@ impl Dynamics {
         Ok(self.mechanism.mass_matrix(q)?)
     }
 
+    /// A(q) (8.28) into `out` (dof × dof, column-major, every entry overwritten) by the
+    /// composite-rigid-body recursion on this model's own workspace, allocating nothing: for
+    /// simulators' inner loops. Exact up to rounding and symmetric by construction.
+    pub fn mass_matrix_into(&mut self, q: &[f64], out: &mut [f64]) -> Result<(), DynamicsError> {
+        let n = self.dof();
+        check_vector(q, n, "q")?;
+        if out.len() != n * n {
+            return Err(DynamicsError::WrongLength {
+                what: "mass matrix output (dof²)",
+                expected: n * n,
+                got: out.len(),
+            });
+        }
+        Ok(self.mechanism.mass_matrix_into(q, &mut self.ws, out)?)
+    }
+
     /// q̈ for the applied forces `tau` at `state` by A(q) and Cholesky, with κ∞(A) and the
     /// error estimate of q̈ (see [`ForwardDynamics`]). Fails with
     /// [`DynamicsError::SingularMassMatrix`] when A is not positive definite.

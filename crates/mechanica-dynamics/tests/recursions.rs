@@ -178,8 +178,37 @@ fn mass_ratio(dynamics: &Dynamics) -> f64 {
     hi / lo
 }
 
+/// `mass_matrix_into` on the model's own workspace gives A(q) bit for bit as `mass_matrix`,
+/// over a buffer of garbage, and leaves the next inverse dynamics unchanged (it re-evaluates
+/// its state).
+fn check_mass_matrix_into(dynamics: &mut Dynamics, rng: &mut Rng) {
+    let (q, q_dot, q_ddot) = random_state(rng, dynamics.mechanism());
+    let (q2, _, _) = random_state(rng, dynamics.mechanism());
+    let n = q.len();
+    let state = State::new(&q, &q_dot);
+    let before = dynamics.inverse_dynamics(&state, &q_ddot).expect("rnea").tau;
+    let mut into = vec![f64::NAN; n * n];
+    dynamics.mass_matrix_into(&q2, &mut into).expect("mass matrix into");
+    let a = dynamics.mass_matrix(&q2).expect("mass matrix");
+    for k in 0..n {
+        for l in 0..n {
+            assert_eq!(into[k + n * l].to_bits(), a[(k, l)].to_bits(), "A[{k},{l}]");
+        }
+    }
+    let after = dynamics.inverse_dynamics(&state, &q_ddot).expect("rnea").tau;
+    assert_eq!(before, after);
+    let mut wrong = vec![0.0; n * n + 1];
+    assert!(dynamics.mass_matrix_into(&q2, &mut wrong).is_err());
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn mass_matrix_into_matches_mass_matrix(seed in any::<u64>(), bodies in 1usize..12, chain in any::<bool>()) {
+        let (mut dynamics, mut rng) = dynamics_with_gravity(seed, bodies, 12.0, chain);
+        check_mass_matrix_into(&mut dynamics, &mut rng);
+    }
 
     #[test]
     fn rnea_matches_the_mass_matrix(seed in any::<u64>(), bodies in 1usize..12, chain in any::<bool>()) {

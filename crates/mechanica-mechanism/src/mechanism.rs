@@ -229,11 +229,24 @@ impl Mechanism {
 
     /// The mass matrix A(q) (8.28) of the motion relative to the base.
     pub fn mass_matrix(&mut self, q: &[f64]) -> Result<Mat<f64>, MechanismError> {
-        let ws = self.positions(q)?;
+        let mut ws = self.tree.workspace();
         let n = self.dof();
         let mut a = vec![0.0; n * n];
-        self.tree_mass.mass_matrix(&self.tree, &ws, &mut a)?;
+        self.mass_matrix_into(q, &mut ws, &mut a)?;
         Ok(Mat::from_fn(n, n, |i, j| a[i + n * j]))
+    }
+
+    /// A(q) as [`Mechanism::mass_matrix`], written into `out` (dof × dof, column-major, every
+    /// entry overwritten) with the positions of q computed in `ws`, a workspace of this
+    /// mechanism's tree (its velocities and accelerations are discarded). Allocates nothing
+    /// once the mechanism has evaluated one mass matrix. Fails when q or `out` has the wrong
+    /// length, q is not finite, or `ws` belongs to another tree.
+    pub fn mass_matrix_into(&mut self, q: &[f64], ws: &mut Workspace, out: &mut [f64]) -> Result<(), MechanismError> {
+        self.check_q(q)?;
+        self.tree.update_positions(ws, q)?;
+        out.fill(0.0);
+        self.tree_mass.mass_matrix(&self.tree, ws, out)?;
+        Ok(())
     }
 
     /// The gyroscopic matrix G(q) of the motion relative to a rotating frame (zero without
