@@ -244,6 +244,18 @@ static void validity_and_repair(void) {
     nanp.inertia_about_com.m[0] = NAN;
     CHECK_STATUS(mech_mass_check(&nanp, 0.0, &v), MECH_STATUS_OK);
     CHECK(v.issues == MECH_MASS_ISSUE_NON_FINITE);
+    /* An asymmetric tensor near f64::MAX: J + Jᵀ would overflow, the moments must not.
+       Symmetric part diag(1e308) with 2e307 off the diagonal: moments 0.8e308, 1e308, 1.2e308. */
+    mech_mass_properties_t huge = make_box(1.0, 1.0, 1.0, 1.0, 0, 0, 0);
+    for (int k = 0; k < 9; ++k) huge.inertia_about_com.m[k] = 0.0;
+    huge.inertia_about_com.m[0] = huge.inertia_about_com.m[4] = huge.inertia_about_com.m[8] = 1e308;
+    huge.inertia_about_com.m[3] = 1e307;
+    huge.inertia_about_com.m[1] = 3e307;
+    CHECK_STATUS(mech_mass_check(&huge, 0.0, &v), MECH_STATUS_OK);
+    CHECK(v.issues & MECH_MASS_ISSUE_NOT_SYMMETRIC);
+    CHECK(fabs(v.moments.x - 0.8e308) <= 1e-14 * 1e308);
+    CHECK(fabs(v.moments.y - 1e308) <= 1e-14 * 1e308);
+    CHECK(fabs(v.moments.z - 1.2e308) <= 1e-14 * 1e308);
 
     mech_mass_properties_t fixed;
     double change = -1.0;

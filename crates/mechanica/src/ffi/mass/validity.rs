@@ -6,6 +6,8 @@ use crate::ffi::boundary::{FfiError, boundary};
 use crate::ffi::status::*;
 use crate::ffi::types::*;
 use crate::ffi::validate::*;
+use mechanica_kinematics::nalgebra::{Matrix3, Vector3};
+use mechanica_kinematics::scaling::power_of_two_above;
 use mechanica_mass::MassError;
 use mechanica_mass::validity::{self, InertiaClass, InertiaIssue, ValidityTolerance};
 
@@ -104,13 +106,7 @@ pub unsafe extern "C" fn mech_mass_check(
             },
             Err(MassError::InvalidInertia(issues)) => {
                 let flags = issues.iter().fold(0, |flags, issue| flags | issue_to_c(issue));
-                let moments = if props.inertia_c.iter().all(|v| v.is_finite()) {
-                    let mut l = ((props.inertia_c + props.inertia_c.transpose()) * 0.5).symmetric_eigenvalues();
-                    l.as_mut_slice().sort_by(f64::total_cmp);
-                    l.into()
-                } else {
-                    mech_vec3_t::default()
-                };
+                let moments = symmetric_part_eigenvalues(&props.inertia_c).map_or_else(mech_vec3_t::default, Into::into);
                 mech_mass_validity_t {
                     issues: flags,
                     inertia_class: MECH_INERTIA_INVALID,
@@ -123,6 +119,19 @@ pub unsafe extern "C" fn mech_mass_check(
         unsafe { out.write(result) };
         Ok(())
     })
+}
+
+/// The eigenvalues of ½(J + Jᵀ), ascending, computed on J scaled by a power of two so that
+/// entries near f64::MAX do not overflow the sum; None when J or an eigenvalue is not finite.
+fn symmetric_part_eigenvalues(j: &Matrix3<f64>) -> Option<Vector3<f64>> {
+    if !j.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let scale = power_of_two_above(j.amax());
+    let scaled = j / scale;
+    let mut l = ((scaled + scaled.transpose()) * 0.5).symmetric_eigenvalues() * scale;
+    l.as_mut_slice().sort_by(f64::total_cmp);
+    l.iter().all(|v| v.is_finite()).then_some(l)
 }
 
 /// The validity tolerance of a C `relative_tolerance` (0 selects the default).
