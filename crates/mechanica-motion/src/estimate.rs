@@ -3,9 +3,13 @@
 //! The companion integrates the same initial value problem with the same method at half the
 //! step (tolerances divided by 32 for the adaptive pair). If its error is at most ρ times the
 //! method's, e_c ≤ ρ e, then e ≤ ‖y − y_c‖ + e_c gives e ≤ ‖y − y_c‖ / (1 − ρ) (M.13). For a
-//! fixed step h of a method of order p, the leading global error term is C(t) hᵖ, so
-//! ρ = 2⁻ᵖ asymptotically and the bound is Richardson's correction of the difference; for the
-//! adaptive pair ρ = 1/2 is assumed, well above the 1/32 of exact tolerance proportionality.
+//! fixed step h of a method of order p, the leading global error term is C(t) hᵖ, so the
+//! ratio tends to 2⁻ᵖ and ‖y − y_c‖ / (1 − 2⁻ᵖ) is Richardson's estimate, which is
+//! asymptotically exact and so falls short of the true error about half the time. The
+//! estimate uses ρ = 1/2 for every method instead: the ratio of a first-order method, above
+//! the 2⁻ᵖ ≤ 1/4 of a halved step of order p ≥ 2 and the 1/32 of the adaptive pair's
+//! tolerance proportionality; the margin covers the higher-order terms. It overestimates by
+//! about 2(1 − 2⁻ᵖ).
 //! The argument holds for chaotic and growing errors as long as both runs follow the same
 //! trajectory to first order, because it compares global errors, not sums of local ones.
 //! Rounding adds 2u·√(N + 1)·‖y‖∞ after N steps, which the estimate includes as a floor.
