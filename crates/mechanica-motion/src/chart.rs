@@ -69,10 +69,9 @@ impl ReportingChart {
             let exp = exp_map(&phi).map_err(mechanica_dynamics::DynamicsError::from)?;
             let phi_r = log_map(&(r0.inverse() * r_now * exp));
             let omega = right_jacobian(&phi) * block(q_dot, s);
-            let rate = right_jacobian(&phi_r)
-                .try_inverse()
-                .ok_or(StepFailure::NonFinite { what: "rate in the reporting chart" })?
-                * omega;
+            let rate = right_jacobian(&phi_r).try_inverse().ok_or(StepFailure::NonFinite {
+                what: "rate in the reporting chart",
+            })? * omega;
             q[s..s + 3].copy_from_slice(phi_r.as_slice());
             q_dot[s..s + 3].copy_from_slice(rate.as_slice());
         }

@@ -10,9 +10,30 @@ const A: [[f64; 6]; 7] = [
     [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
     [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
     [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
-    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
-    [35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
 ];
 /// b₅ − b₄: the weights of the local error estimate.
 const E: [f64; 7] = [
@@ -179,7 +200,8 @@ impl DormandPrince {
             };
             let growth = error.powf(0.2 - 0.75 * BETA);
             if error <= 1.0 {
-                let factor = (growth / self.previous_error.powf(BETA) / SAFETY).clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
+                let factor =
+                    (growth / self.previous_error.powf(BETA) / SAFETY).clamp(1.0 / MAX_FACTOR, 1.0 / MIN_FACTOR);
                 self.previous_error = error.max(1e-4);
                 let factor = if rejected { factor.max(1.0) } else { factor };
                 self.accept(t, y, h);
@@ -187,7 +209,11 @@ impl DormandPrince {
                 return Ok(());
             }
             rejected = true;
-            let shrink = if error.is_finite() { (growth / SAFETY).min(1.0 / MIN_FACTOR) } else { 10.0 };
+            let shrink = if error.is_finite() {
+                (growth / SAFETY).min(1.0 / MIN_FACTOR)
+            } else {
+                10.0
+            };
             self.h = h / shrink;
         }
     }

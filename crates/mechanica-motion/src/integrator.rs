@@ -141,7 +141,11 @@ impl Integrator {
             }
             q.copy_from_slice(&q_new);
             v.copy_from_slice(&v_new);
-            self.t = if i + 1 == count as usize { target } else { start + (i + 1) as f64 * h };
+            self.t = if i + 1 == count as usize {
+                target
+            } else {
+                start + (i + 1) as f64 * h
+            };
         }
         Ok(self.point())
     }

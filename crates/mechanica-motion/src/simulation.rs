@@ -174,9 +174,9 @@ impl Session {
         let options = &simulation.options;
         let system = System::new(simulation.dynamics.clone(), options.forcing.clone());
         let mut main = Integrator::new(system.clone(), simulation.method, q0, q_dot0, options.max_steps);
-        let companion = options.estimate_error.then(|| {
-            Integrator::new(system, simulation.method.companion(), q0, q_dot0, options.max_steps)
-        });
+        let companion = options
+            .estimate_error
+            .then(|| Integrator::new(system, simulation.method.companion(), q0, q_dot0, options.max_steps));
         let invariant = match simulation.dynamics.mechanism().rotating_frame() {
             Some(_) => Invariant::JacobiIntegral,
             None => Invariant::Energy,
@@ -189,7 +189,9 @@ impl Session {
             cause,
         };
         let mut probe = vec![0.0; n];
-        main.system_mut().acceleration(0.0, q0, q_dot0, &mut probe).map_err(fail)?;
+        main.system_mut()
+            .acceleration(0.0, q0, q_dot0, &mut probe)
+            .map_err(fail)?;
         let (energy, kinetic, p) = measure(&mut main, &point).map_err(fail)?;
         let tracker = Tracker::new(invariant, energy, kinetic, &options.cyclic, &p);
         let sample = Sample {

@@ -42,7 +42,13 @@ impl System {
     }
 
     /// q̈ at (t, q, q̇) into `out` by the articulated-body algorithm.
-    pub(crate) fn acceleration(&mut self, t: f64, q: &[f64], q_dot: &[f64], out: &mut [f64]) -> Result<(), StepFailure> {
+    pub(crate) fn acceleration(
+        &mut self,
+        t: f64,
+        q: &[f64],
+        q_dot: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), StepFailure> {
         check_finite(q, "state q")?;
         check_finite(q_dot, "state q̇")?;
         self.forcing.evaluate(t, q, q_dot, &mut self.tau)?;

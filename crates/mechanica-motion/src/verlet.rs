@@ -88,7 +88,9 @@ fn drift(system: &mut System, q0: &[f64], v_start: &[f64], p: &[f64], h: f64) ->
     let mut convergence = Convergence::new("Störmer–Verlet drift");
     loop {
         let v_end = solve(&factor_mass(system, &q1)?, p);
-        let next: Vec<f64> = (0..q0.len()).map(|k| q0[k] + 0.5 * h * (v_start[k] + v_end[k])).collect();
+        let next: Vec<f64> = (0..q0.len())
+            .map(|k| q0[k] + 0.5 * h * (v_start[k] + v_end[k]))
+            .collect();
         let correction = distance(&next, &q1);
         q1 = next;
         if convergence.done(correction, norm(&q1).max(norm(q0)))? {

@@ -20,7 +20,10 @@ fn random_method(rng: &mut Rng, period: f64) -> Method {
         2 => Method::ImplicitMidpoint { step },
         _ => {
             let rtol = rng.decades(-10.0, -4.0);
-            Method::DormandPrince { rtol, atol: rtol * 1e-2 }
+            Method::DormandPrince {
+                rtol,
+                atol: rtol * 1e-2,
+            }
         }
     }
 }

@@ -36,7 +36,11 @@ impl Rng {
     }
     pub fn unit(&mut self) -> Vector3<f64> {
         loop {
-            let v = Vector3::new(self.uniform(-1.0, 1.0), self.uniform(-1.0, 1.0), self.uniform(-1.0, 1.0));
+            let v = Vector3::new(
+                self.uniform(-1.0, 1.0),
+                self.uniform(-1.0, 1.0),
+                self.uniform(-1.0, 1.0),
+            );
             if v.norm() > 0.1 {
                 return v.normalize();
             }
