@@ -67,7 +67,13 @@ fn main() {
     let v0 = vec![0.0; LINKS];
     let methods = [
         ("rk4 h=1e-3", Method::Rk4 { step: 1e-3 }),
-        ("dopri rtol=1e-8", Method::DormandPrince { rtol: 1e-8, atol: 1e-10 }),
+        (
+            "dopri rtol=1e-8",
+            Method::DormandPrince {
+                rtol: 1e-8,
+                atol: 1e-10,
+            },
+        ),
         ("verlet h=1e-3", Method::StormerVerlet { step: 1e-3 }),
         ("midpoint h=1e-3", Method::ImplicitMidpoint { step: 1e-3 }),
     ];
@@ -79,7 +85,11 @@ fn main() {
                 ..Options::default()
             };
             let simulation = Simulation::new(dynamics.clone(), method, options).expect("simulation");
-            let label = if estimate_error { format!("{name} + estimate") } else { name.to_string() };
+            let label = if estimate_error {
+                format!("{name} + estimate")
+            } else {
+                name.to_string()
+            };
             group.bench_function(label, |b| {
                 b.iter(|| black_box(simulation.run(&q0, &v0, 1.0, 0.1).expect("run")))
             });

@@ -223,7 +223,10 @@ fn the_motion_declarations_are_guarded_by_their_feature() {
             .unwrap_or_else(|e| panic!("could not run gcc: {e}"))
     };
     let without = compile(&[]);
-    assert!(!without.status.success(), "a motion call compiled without MECH_FEATURE_MOTION");
+    assert!(
+        !without.status.success(),
+        "a motion call compiled without MECH_FEATURE_MOTION"
+    );
     assert!(
         String::from_utf8_lossy(&without.stderr).contains("mech_simulation"),
         "failed for another reason:\n{}",

@@ -213,7 +213,12 @@ impl Dynamics {
 
     /// As [`Dynamics::aba_into`] at the time of `state` (read by a prescribed base motion and
     /// by time-dependent velocity potentials).
-    pub fn aba_state_into(&mut self, state: &State<'_>, tau: &[f64], q_ddot_out: &mut [f64]) -> Result<(), DynamicsError> {
+    pub fn aba_state_into(
+        &mut self,
+        state: &State<'_>,
+        tau: &[f64],
+        q_ddot_out: &mut [f64],
+    ) -> Result<(), DynamicsError> {
         let n = self.dof();
         check_vector(tau, n, "tau")?;
         if q_ddot_out.len() != n {

@@ -16,7 +16,7 @@ fn double_pendulum() -> Result<Dynamics, Box<dyn std::error::Error>> {
     builder.add_body(Some(0), Joint::Revolute { axis: Vector3::x() }, below);
     let tree = builder.build()?;
     let bob = MassProperties::new(1.0, Vector3::new(0.0, 0.0, -1.0), Matrix3::identity() * 0.01)?;
-    let mut mechanism = Mechanism::new(tree, vec![bob.clone(), bob])?;
+    let mut mechanism = Mechanism::new(tree, vec![bob, bob])?;
     mechanism.set_gravity(Vector3::new(0.0, 0.0, -9.81))?;
     Ok(Dynamics::new(mechanism)?)
 }

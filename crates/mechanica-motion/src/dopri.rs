@@ -190,7 +190,7 @@ impl DormandPrince {
         let mut rejected = false;
         loop {
             let h = self.h.min(limit - *t);
-            if !(h > 16.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE)) {
+            if h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE) {
                 return Err(StepFailure::StepSizeUnderflow { step: h });
             }
             let error = match self.stages(system, *t, y, h) {

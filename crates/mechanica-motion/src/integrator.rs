@@ -12,7 +12,7 @@ use crate::system::System;
 /// The stepping part of a method.
 #[derive(Debug, Clone)]
 enum Engine {
-    Rk4(Rk4, f64),
+    Rk4(Box<Rk4>, f64),
     Verlet(f64),
     Midpoint(f64),
     Adaptive(Box<DormandPrince>),
@@ -44,7 +44,7 @@ impl Integrator {
     pub(crate) fn new(system: System, method: Method, q0: &[f64], q_dot0: &[f64], max_steps: usize) -> Self {
         let n = system.dof();
         let engine = match method {
-            Method::Rk4 { step } => Engine::Rk4(Rk4::new(n), step),
+            Method::Rk4 { step } => Engine::Rk4(Box::new(Rk4::new(n)), step),
             Method::StormerVerlet { step } => Engine::Verlet(step),
             Method::ImplicitMidpoint { step } => Engine::Midpoint(step),
             Method::DormandPrince { rtol, atol } => Engine::Adaptive(Box::new(DormandPrince::new(n, rtol, atol))),
@@ -113,17 +113,14 @@ impl Integrator {
     /// `target`) and gives the state at `target` in the current charts. Fixed-step methods
     /// divide [t, target] into equal steps no longer than their step.
     pub(crate) fn advance_to(&mut self, target: f64, horizon: f64) -> Result<Point, StepFailure> {
-        if let Engine::Adaptive(_) = self.engine {
-            return self.advance_adaptive(target, horizon);
-        }
+        let largest = match self.engine {
+            Engine::Rk4(_, h) | Engine::Verlet(h) | Engine::Midpoint(h) => h,
+            Engine::Adaptive(_) => return self.advance_adaptive(target, horizon),
+        };
         let remaining = target - self.t;
         if remaining <= 0.0 {
             return Ok(self.point());
         }
-        let largest = match self.engine {
-            Engine::Rk4(_, h) | Engine::Verlet(h) | Engine::Midpoint(h) => h,
-            Engine::Adaptive(_) => unreachable_step(),
-        };
         let count = (remaining / largest * (1.0 - 1e-12)).ceil().max(1.0);
         let h = remaining / count;
         let start = self.t;
@@ -177,10 +174,4 @@ impl Integrator {
             q_dot: y[n..].to_vec(),
         })
     }
-}
-
-/// The fixed-step branch is never reached with the adaptive engine; its step size is then
-/// irrelevant.
-fn unreachable_step() -> f64 {
-    f64::INFINITY
 }

@@ -117,7 +117,7 @@ impl Simulation {
         positive(t_end, "t_end")?;
         positive(output_interval, "output interval")?;
         let requested = (t_end / output_interval).ceil() + 1.0;
-        if !(requested <= MAX_SAMPLES as f64) {
+        if requested.is_nan() || requested > MAX_SAMPLES as f64 {
             return Err(MotionError::TooManySamples {
                 requested,
                 limit: MAX_SAMPLES,

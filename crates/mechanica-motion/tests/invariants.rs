@@ -27,7 +27,7 @@ fn double_pendulum() -> Dynamics {
     builder.add_body(Some(0), Joint::Revolute { axis: Vector3::x() }, below);
     let tree = builder.build().expect("tree");
     let bob = MassProperties::new(1.0, Vector3::new(0.0, 0.0, -1.0), Matrix3::identity() * 0.01).expect("mass");
-    let mut mechanism = Mechanism::new(tree, vec![bob.clone(), bob]).expect("mechanism");
+    let mut mechanism = Mechanism::new(tree, vec![bob, bob]).expect("mechanism");
     mechanism.set_gravity(Vector3::new(0.0, 0.0, -9.81)).expect("gravity");
     Dynamics::new(mechanism).expect("dynamics")
 }

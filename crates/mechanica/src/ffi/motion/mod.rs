@@ -130,7 +130,10 @@ fn rust_options(o: &mech_motion_options_t, tau: Option<&[f64]>) -> Result<(Metho
         MethodKind::Rk4 => Method::Rk4 { step: o.step },
         MethodKind::StormerVerlet => Method::StormerVerlet { step: o.step },
         MethodKind::ImplicitMidpoint => Method::ImplicitMidpoint { step: o.step },
-        MethodKind::DormandPrince => Method::DormandPrince { rtol: o.rtol, atol: o.atol },
+        MethodKind::DormandPrince => Method::DormandPrince {
+            rtol: o.rtol,
+            atol: o.atol,
+        },
     };
     if o.estimate_error != 0 && o.estimate_error != 1 {
         return Err(FfiError::new(
@@ -181,10 +184,11 @@ pub unsafe extern "C" fn mech_simulation_create(
         }
         // SAFETY: caller's contract.
         let (q0, q_dot0) = unsafe { (read_slice(q0, n, "q0")?, read_slice(q_dot0, n, "q_dot0")?) };
-        let tau = match tau.is_null() {
-            true => None,
+        let tau = if tau.is_null() {
+            None
+        } else {
             // SAFETY: caller's contract.
-            false => Some(unsafe { read_slice(tau, n, "tau") }?),
+            Some(unsafe { read_slice(tau, n, "tau") }?)
         };
         let (method, options) = rust_options(&defaults, tau)?;
         let simulation = Simulation::new(d.clone(), method, options)?;
@@ -291,7 +295,12 @@ pub unsafe extern "C" fn mech_simulation_report(
             last_energy_drift: monitors.last_drift,
             steps: s.session.steps() as u64,
         };
-        let numbers = [report.energy, report.error_q, report.error_q_dot, report.max_energy_drift];
+        let numbers = [
+            report.energy,
+            report.error_q,
+            report.error_q_dot,
+            report.max_energy_drift,
+        ];
         finite_result(numbers.as_slice(), "simulation report")?;
         // SAFETY: caller's contract.
         unsafe { out.write(report) };
