@@ -6,6 +6,7 @@ use crate::chart::{ReportingChart, recentre};
 use crate::dopri::DormandPrince;
 use crate::error::StepFailure;
 use crate::method::Method;
+use crate::monitors::Tracker;
 use crate::rk4::Rk4;
 use crate::system::System;
 
@@ -37,6 +38,8 @@ pub(crate) struct Integrator {
     y: Vec<f64>,
     steps: usize,
     max_steps: usize,
+    /// The monitors, updated after every step when present.
+    tracker: Option<Tracker>,
 }
 
 impl Integrator {
@@ -58,7 +61,36 @@ impl Integrator {
             y: [q0, q_dot0].concat(),
             steps: 0,
             max_steps,
+            tracker: None,
         }
+    }
+
+    /// Follows the monitors after every step from now on.
+    pub(crate) fn set_tracker(&mut self, tracker: Tracker) {
+        self.tracker = Some(tracker);
+    }
+
+    /// The monitors, when followed.
+    pub(crate) fn tracker(&self) -> Option<&Tracker> {
+        self.tracker.as_ref()
+    }
+
+    /// The monitors, when followed, for recording.
+    pub(crate) fn tracker_mut(&mut self) -> Option<&mut Tracker> {
+        self.tracker.as_mut()
+    }
+
+    /// Records H, T₂ and the momenta of the state reached in the monitors.
+    fn monitor_step(&mut self) -> Result<(), StepFailure> {
+        if self.tracker.is_none() {
+            return Ok(());
+        }
+        let point = self.point();
+        let (energy, kinetic, p) = self.system.measure(&point.q, &point.q_dot)?;
+        if let Some(tracker) = &mut self.tracker {
+            tracker.record(energy, kinetic, &p);
+        }
+        Ok(())
     }
 
     /// Steps taken so far (accepted steps for the adaptive method).
@@ -158,6 +190,7 @@ impl Integrator {
             dopri.step(&mut self.system, &mut t, &mut y, horizon.max(target))?;
             self.y = y;
             self.t = t;
+            self.monitor_step()?;
         }
         if self.t == target {
             return Ok(self.point());

@@ -17,13 +17,13 @@ pub struct CyclicMomentum {
     pub coordinate: usize,
     /// p_k at the start.
     pub initial: f64,
-    /// p_k at the last sample.
+    /// p_k at the last step or sample.
     pub last: f64,
-    /// max |p_k − p_k(0)| over the samples.
+    /// max |p_k − p_k(0)| over the steps and samples.
     pub max_drift: f64,
 }
 
-/// The monitors of a run over its samples. H is conserved only without dampers, without
+/// The monitors of a run over every step of the main run and every sample. H is conserved only without dampers, without
 /// velocity-dependent potentials that do work, without a time-dependent base motion and with
 /// τ constant or zero; otherwise its change is the work of those forces, reported as drift.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,12 +32,12 @@ pub struct Monitors {
     pub invariant: Invariant,
     /// H at the start, J.
     pub initial: f64,
-    /// The energy scale, J: the largest kinetic energy T₂ over the samples (at least the
-    /// smallest positive f64).
+    /// The energy scale, J: the largest kinetic energy T₂ over the steps and samples (at
+    /// least the smallest positive f64).
     pub scale: f64,
-    /// max |H − H(0)| / scale over the samples.
+    /// max |H − H(0)| / scale over the steps and samples.
     pub max_drift: f64,
-    /// |H − H(0)| / scale at the last sample.
+    /// |H − H(0)| / scale at the last step or sample.
     pub last_drift: f64,
     /// The momenta of the coordinates named cyclic.
     pub cyclic: Vec<CyclicMomentum>,

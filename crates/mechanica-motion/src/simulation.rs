@@ -6,7 +6,7 @@
 use crate::error::{MotionError, StepFailure, check_vector};
 use crate::estimate::{ErrorEstimate, estimate};
 use crate::forcing::Forcing;
-use crate::integrator::{Integrator, Point};
+use crate::integrator::Integrator;
 use crate::method::Method;
 use crate::monitors::{Invariant, Monitors, Tracker};
 use crate::system::System;
@@ -159,7 +159,6 @@ pub struct Session {
     main: Integrator,
     companion: Option<Integrator>,
     ratio: f64,
-    tracker: Tracker,
     sample: Sample,
     /// Adaptive steps do not pass this time (the end of a run; the target of each advance
     /// when infinite).
@@ -192,8 +191,8 @@ impl Session {
         main.system_mut()
             .acceleration(0.0, q0, q_dot0, &mut probe)
             .map_err(fail)?;
-        let (energy, kinetic, p) = measure(&mut main, &point).map_err(fail)?;
-        let tracker = Tracker::new(invariant, energy, kinetic, &options.cyclic, &p);
+        let (energy, kinetic, p) = main.system_mut().measure(q0, q_dot0).map_err(fail)?;
+        main.set_tracker(Tracker::new(invariant, energy, kinetic, &options.cyclic, &p));
         let sample = Sample {
             t: 0.0,
             q: q0.to_vec(),
@@ -205,7 +204,6 @@ impl Session {
             main,
             companion,
             ratio: simulation.method.companion_ratio(),
-            tracker,
             sample,
             horizon: f64::INFINITY,
         })
@@ -216,9 +214,13 @@ impl Session {
         &self.sample
     }
 
-    /// The monitors over the samples recorded so far (the start and every advance).
+    /// The monitors over every step and sample so far.
     pub fn monitors(&self) -> Monitors {
-        self.tracker.monitors()
+        // The tracker is set when the session starts; the fallback is never used.
+        self.main.tracker().map_or_else(
+            || Tracker::new(Invariant::Energy, 0.0, 0.0, &[], &[]).monitors(),
+            Tracker::monitors,
+        )
     }
 
     /// Steps of the main run so far.
@@ -248,8 +250,11 @@ impl Session {
             }
             None => None,
         };
-        let (energy, kinetic, p) = measure(&mut self.main, &point).map_err(|c| failure(&self.main, c))?;
-        self.tracker.record(energy, kinetic, &p);
+        let measured = self.main.system_mut().measure(&point.q, &point.q_dot);
+        let (energy, kinetic, p) = measured.map_err(|c| failure(&self.main, c))?;
+        if let Some(tracker) = self.main.tracker_mut() {
+            tracker.record(energy, kinetic, &p);
+        }
         self.sample = Sample {
             t,
             q: reported.q,
@@ -259,18 +264,6 @@ impl Session {
         };
         Ok(&self.sample)
     }
-}
-
-/// H, T₂ and the momenta A q̇ at a point of the main run (in its current charts).
-fn measure(main: &mut Integrator, point: &Point) -> Result<(f64, f64, Vec<f64>), StepFailure> {
-    let system = main.system_mut();
-    let kinetic = system.kinetic_energy(&point.q, &point.q_dot)?;
-    let energy = kinetic + system.potential_energy(&point.q)?;
-    let p = system.momenta(&point.q, &point.q_dot)?;
-    if !energy.is_finite() {
-        return Err(StepFailure::NonFinite { what: "energy" });
-    }
-    Ok((energy, kinetic, p))
 }
 
 /// The typed error of a failed step, with the main run's last good state.

@@ -64,13 +64,6 @@ impl System {
         Ok(DMatrix::from_fn(n, n, |i, j| a[(i, j)]))
     }
 
-    /// ½ q̇ᵀ A(q) q̇, the kinetic energy of the motion relative to the base (T₂).
-    pub(crate) fn kinetic_energy(&mut self, q: &[f64], q_dot: &[f64]) -> Result<f64, StepFailure> {
-        let a = self.mass_matrix(q)?;
-        let v = DVector::from_column_slice(q_dot);
-        Ok(0.5 * v.dot(&(&a * &v)))
-    }
-
     /// U*(q) − τ_c·q: the mechanism's potentials (with −T₀ in a rotating frame, (8.56)) and
     /// the potential of a constant applied force.
     pub(crate) fn potential_energy(&self, q: &[f64]) -> Result<f64, StepFailure> {
@@ -83,10 +76,16 @@ impl System {
         Ok(u + self.forcing.potential(q))
     }
 
-    /// The generalized momenta A(q) q̇.
-    pub(crate) fn momenta(&mut self, q: &[f64], q_dot: &[f64]) -> Result<Vec<f64>, StepFailure> {
+    /// H (M.1), T₂ and the generalized momenta p = A(q) q̇, from one mass matrix.
+    pub(crate) fn measure(&mut self, q: &[f64], q_dot: &[f64]) -> Result<(f64, f64, Vec<f64>), StepFailure> {
         let a = self.mass_matrix(q)?;
-        let p = &a * DVector::from_column_slice(q_dot);
-        Ok(p.as_slice().to_vec())
+        let v = DVector::from_column_slice(q_dot);
+        let p = &a * &v;
+        let kinetic = 0.5 * v.dot(&p);
+        let energy = kinetic + self.potential_energy(q)?;
+        if !energy.is_finite() {
+            return Err(StepFailure::NonFinite { what: "energy" });
+        }
+        Ok((energy, kinetic, p.as_slice().to_vec()))
     }
 }
