@@ -2,13 +2,13 @@
 //!
 //! A spherical joint turns its body by R = R_ref exp(φ); the coordinates φ are a chart about
 //! R_ref that degrades as |φ| grows (J_r(φ) becomes singular at |φ| = 2π). The integrators
-//! re-centre the charts before every step ([`recentre`], (M.14)): R_ref ← R_ref exp(φ), φ ← 0,
+//! re-centre the charts before every step (`recentre`, (M.14)): R_ref ← R_ref exp(φ), φ ← 0,
 //! which moves no body. The rates must follow: the body-frame angular velocity relative to
 //! the parent is ω = J_r(φ) φ̇ in either chart, and J_r(0) = I, so the new rates are
 //! φ̇′ = J_r(φ) φ̇. Leaving φ̇ unchanged would change the angular velocity and the energy.
 //!
 //! The states a run reports are in the *reporting chart*, the charts of the mechanism as it
-//! was given ([`ReportingChart`]): φ_r = log(R_ref,0ᵀ R_ref exp(φ)) with |φ_r| ≤ π and
+//! was given (`ReportingChart`): φ_r = log(R_ref,0ᵀ R_ref exp(φ)) with |φ_r| ≤ π and
 //! φ̇_r = J_r(φ_r)⁻¹ ω. The mechanism that integrates keeps its own moving charts.
 
 use crate::error::StepFailure;

@@ -175,6 +175,7 @@ impl Integrator {
             } else {
                 start + (i + 1) as f64 * h
             };
+            self.monitor_step()?;
         }
         Ok(self.point())
     }
