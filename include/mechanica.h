@@ -52,6 +52,8 @@
 #define MECH_FEATURE_MECHANISM 1
 /** Declared by default: the dynamics functions (inverse and forward dynamics, joint reactions). */
 #define MECH_FEATURE_DYNAMICS 1
+/** Declared by default: the motion functions (integration of the equations of motion in time). */
+#define MECH_FEATURE_MOTION 1
 #endif
 
 /**
@@ -106,6 +108,11 @@
  */
 #define MECH_FEATURE_BIT_DYNAMICS (1 << 5)
 
+/**
+ * Bit of mech_features() set when the motion functions (integration in time) are compiled in.
+ */
+#define MECH_FEATURE_BIT_MOTION (1 << 6)
+
 #if defined(MECH_FEATURE_MECHANISM)
 /**
  * The ground, as a body index for mech_mechanism_add_point_spring.
@@ -136,6 +143,14 @@ typedef struct mech_mechanism_t mech_mechanism_t;
  * The opaque result of mech_modal_solve. Free it with mech_modal_result_destroy.
  */
 typedef struct mech_modal_result_t mech_modal_result_t;
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * A simulation (opaque): a copy of a dynamics with a method, integrating from an initial
+ * state. Created by mech_simulation_create, freed by mech_simulation_destroy.
+ */
+typedef struct mech_simulation_t mech_simulation_t;
 #endif
 
 #if defined(MECH_FEATURE_KINEMATICS)
@@ -1504,6 +1519,92 @@ typedef struct mech_modal_sparse_details_t {
 } mech_modal_sparse_details_t;
 #endif
 
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * An integration method (int32_t).
+ */
+typedef int32_t mech_motion_method_t;
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Options of a simulation. Start from mech_motion_options_default.
+ */
+typedef struct mech_motion_options_t {
+    /**
+     * The method (a mech_motion_method_t).
+     */
+    mech_motion_method_t method;
+    /**
+     * The largest step of the fixed-step methods, s (> 0).
+     */
+    double step;
+    /**
+     * Relative tolerance of MECH_MOTION_DORMAND_PRINCE (≥ 1e-14).
+     */
+    double rtol;
+    /**
+     * Absolute tolerance of MECH_MOTION_DORMAND_PRINCE (> 0).
+     */
+    double atol;
+    /**
+     * 1 to run the companion integration that gives the global error estimate, 0 not to.
+     */
+    int32_t estimate_error;
+} mech_motion_options_t;
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * The quantity H that the energy monitor follows (int32_t).
+ */
+typedef int32_t mech_motion_invariant_t;
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * The state of a simulation after its last successful advance. Estimates not computed read −1.
+ */
+typedef struct mech_motion_report_t {
+    /**
+     * The time reached, s.
+     */
+    double t;
+    /**
+     * H = T₂ + U* − τ·q at t, J (the energy, or the Jacobi integral in a rotating frame).
+     */
+    double energy;
+    /**
+     * The estimated global error of q (∞-norm), or −1 without the companion run.
+     */
+    double error_q;
+    /**
+     * The estimated global error of q̇ (∞-norm), or −1 without the companion run.
+     */
+    double error_q_dot;
+    /**
+     * What H is (a mech_motion_invariant_t).
+     */
+    mech_motion_invariant_t invariant;
+    /**
+     * The energy scale, J: the largest kinetic energy T₂ over the states reported so far.
+     */
+    double energy_scale;
+    /**
+     * max |H − H(0)| / energy_scale over the states reported so far.
+     */
+    double max_energy_drift;
+    /**
+     * |H − H(0)| / energy_scale at t.
+     */
+    double last_energy_drift;
+    /**
+     * Steps taken by the main integration.
+     */
+    uint64_t steps;
+} mech_motion_report_t;
+#endif
+
 /**
  * Success.
  */
@@ -2288,6 +2389,48 @@ typedef struct mech_modal_sparse_details_t {
  * resolution: neither the sign nor the size of ω² is known (rate 0).
  */
 #define MECH_MODAL_KIND_UNDECIDED 4
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * The classical explicit Runge–Kutta method of order 4, fixed step `step`.
+ */
+#define MECH_MOTION_RK4 0
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Dormand–Prince 5(4), adaptive with tolerances `rtol` and `atol`.
+ */
+#define MECH_MOTION_DORMAND_PRINCE 1
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Störmer–Verlet in (q, p = A q̇), symplectic, fixed step `step`.
+ */
+#define MECH_MOTION_STORMER_VERLET 2
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * The implicit midpoint rule with Newton's method, for stiff springs, fixed step `step`.
+ */
+#define MECH_MOTION_IMPLICIT_MIDPOINT 3
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * The energy T + U (fixed or prescribed base).
+ */
+#define MECH_MOTION_ENERGY 0
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * The Jacobi integral T₂ − T₀ + U of a steadily rotating frame.
+ */
+#define MECH_MOTION_JACOBI_INTEGRAL 1
 #endif
 
 #ifdef __cplusplus
@@ -4487,6 +4630,88 @@ mech_status_t mech_modal_sparse_solve(size_t n,
                                       double *vectors_out,
                                       struct mech_modal_sparse_report_t *report_out,
                                       struct mech_modal_sparse_details_t *details_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Writes the default options to `*options_out`: Dormand–Prince with rtol = 1e-8,
+ * atol = 1e-10, a step of 1e-3 s for the fixed-step methods, and the error estimate on.
+ *
+ * # Safety
+ * `options_out` must point to a writable mech_motion_options_t.
+ */
+mech_status_t mech_motion_options_default(struct mech_motion_options_t *options_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Creates a simulation of a copy of `dynamics` (with its dampers and loads) from (`q0`,
+ * `q_dot0`) (n values each) at t = 0, with the constant applied forces `tau` (n values, or
+ * NULL for none) and the options `*options` (NULL for the defaults), and writes its handle
+ * to `*simulation_out`. The caller frees it with mech_simulation_destroy.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_NON_FINITE for a NaN
+ * or infinite entry; MECH_STATUS_BAD_ENUM for an unknown method; MECH_STATUS_INVALID_ARGUMENT
+ * for a step or tolerance that is zero, negative or not finite, or rtol < 1e-14;
+ * MECH_STATUS_SINGULAR when the mass matrix is singular at q0.
+ *
+ * # Safety
+ * `dynamics` must be a live handle; `q0` and `q_dot0` must point to n readable doubles,
+ * `tau` be NULL or point to n readable doubles, `options` be NULL or readable, and
+ * `simulation_out` writable.
+ */
+mech_status_t mech_simulation_create(const struct mech_dynamics_t *dynamics,
+                                     const struct mech_motion_options_t *options,
+                                     const double *q0,
+                                     const double *q_dot0,
+                                     const double *tau,
+                                     size_t n,
+                                     struct mech_simulation_t **simulation_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Frees a simulation handle. NULL is accepted and ignored.
+ *
+ * # Safety
+ * `simulation` must be NULL or a live handle from mech_simulation_create, not used afterwards.
+ */
+void mech_simulation_destroy(struct mech_simulation_t *simulation);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Integrates to the time `t` (s, ≥ the time reached) and writes q and q̇ there (n values
+ * each) to `q_out` and `q_dot_out`. Rotation vectors of spherical and free joints are given
+ * in the charts of the mechanism as created (|φ| ≤ π). Adaptive steps end exactly at t.
+ *
+ * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_INVALID_ARGUMENT for
+ * a t before the time reached; MECH_STATUS_NON_FINITE for a NaN t. A step that fails stops
+ * the integration at the last good state (mech_last_error names the time): MECH_STATUS_SINGULAR
+ * for a singular mass matrix, MECH_STATUS_OUT_OF_RANGE for a non-finite state or
+ * acceleration, MECH_STATUS_NOT_CONVERGED when Newton's method or the step control fails.
+ *
+ * # Safety
+ * `simulation` must be a live handle not used by another thread during the call; `q_out` and
+ * `q_dot_out` must point to n writable doubles.
+ */
+mech_status_t mech_simulation_advance(struct mech_simulation_t *simulation,
+                                      double t,
+                                      size_t n,
+                                      double *q_out,
+                                      double *q_dot_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Writes the report of the last successful advance (or of the initial state) to
+ * `*report_out`: time, H, the global error estimates and the energy monitor.
+ *
+ * # Safety
+ * `simulation` must be a live handle and `report_out` writable.
+ */
+mech_status_t mech_simulation_report(const struct mech_simulation_t *simulation,
+                                     struct mech_motion_report_t *report_out);
 #endif
 
 #ifdef __cplusplus

@@ -19,7 +19,8 @@ What counts as a citation:
 - syllabus sections "§8e", "§8f–g", "syllabus 5c–d and 7h–k" (both ends of a range of
   letters);
 - "EB1911 (13)" and "EB1911 §22 (15)", with ranges "EB1911 (15)–(16)";
-- "FM 4.61" and "FM 4.83–4.86".
+- "FM 4.61" and "FM 4.83–4.86";
+- "(M.3)" and "(M.4)–(M.7)", the project's own equations of "Integration in time".
 
 A label is defined when docs/theory.md states it: in bold where its equation is given,
 "**(8.89)**" ("**`(7.87*)`**" for a starred label), "**EB1911 (13)**", "**EB1911 §22 (15)**",
@@ -50,6 +51,7 @@ SECTION_LIST_RE = re.compile(rf"(?:§\s*|syllabus\s+)({SECTION}(?:(?:\s*,\s*§?|
 SECTION_RE = re.compile(r"(?P<chapter>[1-9])(?P<first>[a-k])(?:\s*[–-]\s*(?P<last>[a-k]))?")
 EB_RE = re.compile(r"EB1911\s*(?P<section>§\s*2[12]\s*)?\((?P<first>[0-9]{1,2})\)(?:\s*[–-]\s*\((?P<last>[0-9]{1,2})\))?")
 FM_RE = re.compile(r"\bFM\s+(?P<first>4\.[0-9]{1,3})(?:\s*[–-]\s*(?P<last>4\.[0-9]{1,3}))?")
+MOTION_RE = re.compile(r"\(M\.(?P<first>[0-9]{1,2})\)(?:\s*[–-]\s*\(M\.(?P<last>[0-9]{1,2})\))?")
 THEORY_LABEL_RE = re.compile(rf"\(({NUMBER})\)")
 # The last equation of each syllabus chapter: a number beyond it is not a syllabus label.
 LAST_EQUATION = {1: 43, 2: 37, 3: 41, 4: 53, 5: 61, 6: 33, 7: 117, 8: 93, 9: 39}
@@ -200,6 +202,8 @@ def citations(text):
         found += [("EB1911", f"EB1911 {section}({number})", match.group(0), match.start()) for number in endpoints(match)]
     for match in FM_RE.finditer(text):
         found += [("FM", f"FM {number}", match.group(0), match.start()) for number in endpoints(match)]
+    for match in MOTION_RE.finditer(text):
+        found += [("motion", f"(M.{number})", match.group(0), match.start()) for number in endpoints(match)]
     return found
 
 
@@ -224,6 +228,7 @@ def defined_labels(theory):
     labels |= {f"EB1911 ({n})" for n in re.findall(r"\*\*EB1911 \(([0-9]{1,2})\)\*\*", theory)}
     labels |= {f"EB1911 §22 ({n})" for n in re.findall(r"\*\*EB1911 §22 \(([0-9]{1,2})\)\*\*", theory)}
     labels |= {f"FM {n}" for n in re.findall(r"\*\*FM (4\.[0-9]{1,3})\*\*", theory)}
+    labels |= {f"(M.{n})" for n in re.findall(r"\*\*\(M\.([0-9]{1,2})\)\*\*", theory)}
     return labels
 
 

@@ -191,3 +191,47 @@ fn the_dynamics_declarations_are_guarded_by_their_feature() {
     check_success("gcc with MECH_FEATURE_DYNAMICS", &compile(&["-DMECH_FEATURE_DYNAMICS"]))
         .unwrap_or_else(|e| panic!("{e}"));
 }
+
+/// A program for a library built with `dynamics` but without `motion` sees no motion
+/// declaration: a call to one does not compile, and compiles once MECH_FEATURE_MOTION is
+/// defined too (so the failure is the guard's).
+#[test]
+fn the_motion_declarations_are_guarded_by_their_feature() {
+    let dir = target_dir().join("ffi-tests/header");
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{e}"));
+    let source = dir.join("uses_motion.c");
+    let body = "#include \"mechanica.h\"\nint main(void) {\n    mech_simulation_t *s = NULL;\n    \
+                return (int)mech_simulation_create(NULL, NULL, NULL, NULL, NULL, 0, &s);\n}\n";
+    std::fs::write(&source, body).unwrap_or_else(|e| panic!("{e}"));
+    let dynamics_only = [
+        "-DMECH_FEATURES_EXPLICIT",
+        "-DMECH_FEATURE_KINEMATICS",
+        "-DMECH_FEATURE_MASS",
+        "-DMECH_FEATURE_MODAL",
+        "-DMECH_FEATURE_MECHANISM",
+        "-DMECH_FEATURE_DYNAMICS",
+    ];
+    let compile = |extra: &[&str]| {
+        std::process::Command::new("gcc")
+            .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic", "-fsyntax-only"])
+            .args(dynamics_only)
+            .args(extra)
+            .arg("-I")
+            .arg(workspace_root().join("include"))
+            .arg(&source)
+            .output()
+            .unwrap_or_else(|e| panic!("could not run gcc: {e}"))
+    };
+    let without = compile(&[]);
+    assert!(
+        !without.status.success(),
+        "a motion call compiled without MECH_FEATURE_MOTION"
+    );
+    assert!(
+        String::from_utf8_lossy(&without.stderr).contains("mech_simulation"),
+        "failed for another reason:\n{}",
+        String::from_utf8_lossy(&without.stderr)
+    );
+    check_success("gcc with MECH_FEATURE_MOTION", &compile(&["-DMECH_FEATURE_MOTION"]))
+        .unwrap_or_else(|e| panic!("{e}"));
+}

@@ -72,6 +72,7 @@ fn a_modal_only_build_links_and_leaves_out_the_other_declarations() {
         "mech_mass_point",
         "mech_collide_collinear",
         "mech_dynamics_create",
+        "mech_simulation_create",
     ] {
         assert!(!symbols.contains(absent), "{absent} is exported by a modal-only build");
     }

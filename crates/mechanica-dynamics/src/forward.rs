@@ -208,6 +208,17 @@ impl Dynamics {
         tau: &[f64],
         q_ddot_out: &mut [f64],
     ) -> Result<(), DynamicsError> {
+        self.aba_state_into(&State::new(q, q_dot), tau, q_ddot_out)
+    }
+
+    /// As [`Dynamics::aba_into`] at the time of `state` (read by a prescribed base motion and
+    /// by time-dependent velocity potentials).
+    pub fn aba_state_into(
+        &mut self,
+        state: &State<'_>,
+        tau: &[f64],
+        q_ddot_out: &mut [f64],
+    ) -> Result<(), DynamicsError> {
         let n = self.dof();
         check_vector(tau, n, "tau")?;
         if q_ddot_out.len() != n {
@@ -217,10 +228,9 @@ impl Dynamics {
                 got: q_ddot_out.len(),
             });
         }
-        let state = State::new(q, q_dot);
-        match self.aba_state(&state, tau, q_ddot_out) {
+        match self.aba_state(state, tau, q_ddot_out) {
             Err(DynamicsError::SingularArticulatedInertia { .. }) => {
-                let solved = self.forward_dynamics_crba(&state, tau)?;
+                let solved = self.forward_dynamics_crba(state, tau)?;
                 q_ddot_out.copy_from_slice(&solved.q_ddot);
                 Ok(())
             }

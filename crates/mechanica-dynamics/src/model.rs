@@ -160,6 +160,15 @@ impl Dynamics {
         Ok(self.velocity_potentials.len() - 1)
     }
 
+    /// Folds the rotation vectors of `q` into the tree's reference orientations and zeroes
+    /// them, without moving any body ([`Mechanism::rebase`]). The velocities of those
+    /// coordinates change with the chart: the caller maps φ̇ to J_r(φ) φ̇ (the body-frame
+    /// angular velocity relative to the parent, which is φ̇ in the new chart at φ = 0).
+    pub fn rebase(&mut self, q: &mut [f64]) -> Result<(), DynamicsError> {
+        self.mechanism.rebase(q)?;
+        Ok(())
+    }
+
     /// The kinematic workspace of the last evaluation (poses, velocities, accelerations).
     pub fn workspace(&self) -> &Workspace {
         &self.ws

@@ -58,6 +58,14 @@ pub struct mech_dynamics_t {
 
 impl Handle for mech_dynamics_t {}
 
+impl mech_dynamics_t {
+    /// The dynamics without its constraints (read by the other C modules).
+    #[allow(dead_code)]
+    pub(crate) fn dynamics(&self) -> &Dynamics {
+        self.constrained.dynamics()
+    }
+}
+
 /// Borrows the dynamics behind a handle for evaluating or changing it (NULL_POINTER,
 /// MISALIGNED_POINTER).
 ///

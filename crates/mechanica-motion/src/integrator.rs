@@ -1,0 +1,211 @@
+//! One integration of the equations of motion: a method, a copy of the system whose charts
+//! move with the motion, and the state reached. [`Integrator::advance_to`] integrates to a
+//! given time and gives the state there; a failed step leaves the last good state in place.
+
+use crate::chart::{ReportingChart, recentre};
+use crate::dopri::DormandPrince;
+use crate::error::StepFailure;
+use crate::method::Method;
+use crate::monitors::Tracker;
+use crate::rk4::Rk4;
+use crate::system::System;
+
+/// The stepping part of a method.
+#[derive(Debug, Clone)]
+enum Engine {
+    Rk4(Box<Rk4>, f64),
+    Verlet(f64),
+    Midpoint(f64),
+    Adaptive(Box<DormandPrince>),
+}
+
+/// A state (t, q, q̇) in the integrator's current charts.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Point {
+    pub t: f64,
+    pub q: Vec<f64>,
+    pub q_dot: Vec<f64>,
+}
+
+/// One run of one method (module docs).
+#[derive(Debug, Clone)]
+pub(crate) struct Integrator {
+    system: System,
+    chart: ReportingChart,
+    engine: Engine,
+    t: f64,
+    /// y = (q, q̇), 2n entries, in the current charts.
+    y: Vec<f64>,
+    steps: usize,
+    max_steps: usize,
+    /// The monitors, updated after every step when present.
+    tracker: Option<Tracker>,
+}
+
+impl Integrator {
+    /// An integration of `system` by `method` (validated) from (q₀, q̇₀) at t = 0.
+    pub(crate) fn new(system: System, method: Method, q0: &[f64], q_dot0: &[f64], max_steps: usize) -> Self {
+        let n = system.dof();
+        let engine = match method {
+            Method::Rk4 { step } => Engine::Rk4(Box::new(Rk4::new(n)), step),
+            Method::StormerVerlet { step } => Engine::Verlet(step),
+            Method::ImplicitMidpoint { step } => Engine::Midpoint(step),
+            Method::DormandPrince { rtol, atol } => Engine::Adaptive(Box::new(DormandPrince::new(n, rtol, atol))),
+        };
+        let chart = ReportingChart::of(system.dynamics().tree());
+        Self {
+            system,
+            chart,
+            engine,
+            t: 0.0,
+            y: [q0, q_dot0].concat(),
+            steps: 0,
+            max_steps,
+            tracker: None,
+        }
+    }
+
+    /// Follows the monitors after every step from now on.
+    pub(crate) fn set_tracker(&mut self, tracker: Tracker) {
+        self.tracker = Some(tracker);
+    }
+
+    /// The monitors, when followed.
+    pub(crate) fn tracker(&self) -> Option<&Tracker> {
+        self.tracker.as_ref()
+    }
+
+    /// The monitors, when followed, for recording.
+    pub(crate) fn tracker_mut(&mut self) -> Option<&mut Tracker> {
+        self.tracker.as_mut()
+    }
+
+    /// Records H, T₂ and the momenta of the state reached in the monitors.
+    fn monitor_step(&mut self) -> Result<(), StepFailure> {
+        if self.tracker.is_none() {
+            return Ok(());
+        }
+        let point = self.point();
+        let (energy, kinetic, p) = self.system.measure(&point.q, &point.q_dot)?;
+        if let Some(tracker) = &mut self.tracker {
+            tracker.record(energy, kinetic, &p);
+        }
+        Ok(())
+    }
+
+    /// Steps taken so far (accepted steps for the adaptive method).
+    pub(crate) fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// The system with its current charts.
+    pub(crate) fn system_mut(&mut self) -> &mut System {
+        &mut self.system
+    }
+
+    /// The state reached, in the current charts.
+    pub(crate) fn point(&self) -> Point {
+        let n = self.y.len() / 2;
+        Point {
+            t: self.t,
+            q: self.y[..n].to_vec(),
+            q_dot: self.y[n..].to_vec(),
+        }
+    }
+
+    /// `point` (in the current charts) rewritten in the reporting chart ([`crate::chart`]).
+    pub(crate) fn report(&self, point: &Point) -> Result<Point, StepFailure> {
+        let mut reported = point.clone();
+        if !self.chart.is_trivial() {
+            self.chart
+                .report(self.system.dynamics().tree(), &mut reported.q, &mut reported.q_dot)?;
+        }
+        Ok(reported)
+    }
+
+    /// Re-centres the charts at the current state and counts the step to come.
+    fn prepare_step(&mut self) -> Result<(), StepFailure> {
+        if self.steps >= self.max_steps {
+            return Err(StepFailure::TooManySteps { limit: self.max_steps });
+        }
+        self.steps += 1;
+        if self.chart.is_trivial() {
+            return Ok(());
+        }
+        let n = self.y.len() / 2;
+        let (q, v) = self.y.split_at_mut(n);
+        recentre(&mut self.system, q, v)?;
+        if let Engine::Adaptive(dopri) = &mut self.engine {
+            dopri.invalidate();
+        }
+        Ok(())
+    }
+
+    /// Integrates to `target` (≥ the time reached; adaptive steps never pass `horizon` ≥
+    /// `target`) and gives the state at `target` in the current charts. Fixed-step methods
+    /// divide [t, target] into equal steps no longer than their step.
+    pub(crate) fn advance_to(&mut self, target: f64, horizon: f64) -> Result<Point, StepFailure> {
+        let largest = match self.engine {
+            Engine::Rk4(_, h) | Engine::Verlet(h) | Engine::Midpoint(h) => h,
+            Engine::Adaptive(_) => return self.advance_adaptive(target, horizon),
+        };
+        let remaining = target - self.t;
+        if remaining <= 0.0 {
+            return Ok(self.point());
+        }
+        let count = (remaining / largest * (1.0 - 1e-12)).ceil().max(1.0);
+        let h = remaining / count;
+        let start = self.t;
+        let n = self.y.len() / 2;
+        for i in 0..count as usize {
+            self.prepare_step()?;
+            let (q, v) = self.y.split_at_mut(n);
+            let mut q_new = q.to_vec();
+            let mut v_new = v.to_vec();
+            match &mut self.engine {
+                Engine::Rk4(rk4, _) => rk4.step(&mut self.system, self.t, &mut q_new, &mut v_new, h)?,
+                Engine::Verlet(_) => crate::verlet::step(&mut self.system, self.t, &mut q_new, &mut v_new, h)?,
+                Engine::Midpoint(_) => crate::midpoint::step(&mut self.system, self.t, &mut q_new, &mut v_new, h)?,
+                Engine::Adaptive(_) => {}
+            }
+            q.copy_from_slice(&q_new);
+            v.copy_from_slice(&v_new);
+            self.t = if i + 1 == count as usize {
+                target
+            } else {
+                start + (i + 1) as f64 * h
+            };
+            self.monitor_step()?;
+        }
+        Ok(self.point())
+    }
+
+    fn advance_adaptive(&mut self, target: f64, horizon: f64) -> Result<Point, StepFailure> {
+        while self.t < target {
+            self.prepare_step()?;
+            let Engine::Adaptive(dopri) = &mut self.engine else {
+                break;
+            };
+            let mut y = self.y.clone();
+            let mut t = self.t;
+            dopri.step(&mut self.system, &mut t, &mut y, horizon.max(target))?;
+            self.y = y;
+            self.t = t;
+            self.monitor_step()?;
+        }
+        if self.t == target {
+            return Ok(self.point());
+        }
+        let mut y = vec![0.0; self.y.len()];
+        if let Engine::Adaptive(dopri) = &self.engine {
+            dopri.interpolate(target, &mut y);
+        }
+        crate::error::check_finite(&y, "interpolated state")?;
+        let n = y.len() / 2;
+        Ok(Point {
+            t: target,
+            q: y[..n].to_vec(),
+            q_dot: y[n..].to_vec(),
+        })
+    }
+}

@@ -1,0 +1,279 @@
+//! [`Simulation`]: the public entry point. A run integrates from (q₀, q̇₀) at t = 0 with the
+//! chosen [`Method`], alongside a companion run that gives the global error estimate (M.13),
+//! and records samples at a fixed output interval with the monitors of [`crate::monitors`].
+//! [`Session`] is the same step by step (advance to a time, read the state).
+
+use crate::error::{MotionError, StepFailure, check_vector};
+use crate::estimate::{ErrorEstimate, estimate};
+use crate::forcing::Forcing;
+use crate::integrator::Integrator;
+use crate::method::Method;
+use crate::monitors::{Invariant, Monitors, Tracker};
+use crate::system::System;
+use mechanica_dynamics::Dynamics;
+
+/// The most samples a run records: (t_end / output_interval) + 1 must not exceed it.
+pub const MAX_SAMPLES: usize = 1_000_000;
+
+/// The default limit of steps per run (each of the main and the companion run).
+pub const DEFAULT_MAX_STEPS: usize = 100_000_000;
+
+/// Options of a simulation.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// The applied generalized forces τ.
+    pub forcing: Forcing,
+    /// Coordinates whose momenta p_k = (A q̇)_k are monitored (cyclic coordinates).
+    pub cyclic: Vec<usize>,
+    /// Run the companion and report global error estimates (doubles the cost or more).
+    pub estimate_error: bool,
+    /// The most steps of each run; more fail with [`StepFailure::TooManySteps`].
+    pub max_steps: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            forcing: Forcing::None,
+            cyclic: Vec::new(),
+            estimate_error: true,
+            max_steps: DEFAULT_MAX_STEPS,
+        }
+    }
+}
+
+/// One recorded state. q and q̇ are in the reporting chart ([`crate::chart`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sample {
+    /// Time, s.
+    pub t: f64,
+    /// Coordinates q.
+    pub q: Vec<f64>,
+    /// Velocities q̇.
+    pub q_dot: Vec<f64>,
+    /// H = T₂ + U* − τ_c·q (M.1), J: the energy, or the Jacobi integral in a rotating frame.
+    pub energy: f64,
+    /// The global error estimate (M.13), when the companion runs.
+    pub error: Option<ErrorEstimate>,
+}
+
+/// The result of [`Simulation::run`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory {
+    /// Samples at t = 0, Δ, 2Δ, … and t_end.
+    pub samples: Vec<Sample>,
+    /// The monitors over the samples.
+    pub monitors: Monitors,
+    /// Steps of the main run.
+    pub steps: usize,
+    /// Steps of the companion run (0 without it).
+    pub companion_steps: usize,
+}
+
+/// A mechanism's dynamics with a method and options, ready to integrate.
+#[derive(Debug, Clone)]
+pub struct Simulation {
+    dynamics: Dynamics,
+    method: Method,
+    options: Options,
+}
+
+impl Simulation {
+    /// Checks the method's parameters, a constant τ's length and the cyclic coordinates.
+    pub fn new(dynamics: Dynamics, method: Method, options: Options) -> Result<Self, MotionError> {
+        method.validate()?;
+        let n = dynamics.dof();
+        options.forcing.validate(n)?;
+        if let Some(&index) = options.cyclic.iter().find(|&&k| k >= n) {
+            return Err(MotionError::NoSuchCoordinate {
+                what: "cyclic coordinate",
+                index,
+                dof: n,
+            });
+        }
+        Ok(Self {
+            dynamics,
+            method,
+            options,
+        })
+    }
+
+    /// The method.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// Starts a step-by-step integration from (q₀, q̇₀) at t = 0 (given in the mechanism's
+    /// charts). Fails when the initial state is not finite or the dynamics cannot be
+    /// evaluated there.
+    pub fn start(&self, q0: &[f64], q_dot0: &[f64]) -> Result<Session, MotionError> {
+        Session::new(self, q0, q_dot0)
+    }
+
+    /// Integrates from (q₀, q̇₀) at t = 0 to `t_end` (> 0) and records samples every
+    /// `output_interval` (> 0) and at t_end. Refuses more than [`MAX_SAMPLES`] samples. A
+    /// failed step stops the run with [`MotionError::StepFailed`].
+    pub fn run(&self, q0: &[f64], q_dot0: &[f64], t_end: f64, output_interval: f64) -> Result<Trajectory, MotionError> {
+        positive(t_end, "t_end")?;
+        positive(output_interval, "output interval")?;
+        let requested = (t_end / output_interval).ceil() + 1.0;
+        if requested.is_nan() || requested > MAX_SAMPLES as f64 {
+            return Err(MotionError::TooManySamples {
+                requested,
+                limit: MAX_SAMPLES,
+            });
+        }
+        let count = requested as usize;
+        let mut session = self.start(q0, q_dot0)?;
+        session.horizon = t_end;
+        let mut samples = Vec::with_capacity(count);
+        samples.push(session.sample().clone());
+        for i in 1..count {
+            let t = (i as f64 * output_interval).min(t_end);
+            samples.push(session.advance(t)?.clone());
+        }
+        Ok(Trajectory {
+            samples,
+            monitors: session.monitors(),
+            steps: session.main.steps(),
+            companion_steps: session.companion.as_ref().map_or(0, |c| c.steps()),
+        })
+    }
+}
+
+fn positive(value: f64, what: &'static str) -> Result<(), MotionError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(MotionError::OutOfRange {
+            what,
+            requirement: "> 0 and finite",
+            value,
+        })
+    }
+}
+
+/// A step-by-step integration (see [`Simulation::start`]).
+#[derive(Debug, Clone)]
+pub struct Session {
+    main: Integrator,
+    companion: Option<Integrator>,
+    ratio: f64,
+    sample: Sample,
+    /// Adaptive steps do not pass this time (the end of a run; the target of each advance
+    /// when infinite).
+    horizon: f64,
+}
+
+impl Session {
+    fn new(simulation: &Simulation, q0: &[f64], q_dot0: &[f64]) -> Result<Self, MotionError> {
+        let n = simulation.dynamics.dof();
+        check_vector(q0, n, "q0")?;
+        check_vector(q_dot0, n, "q_dot0")?;
+        let options = &simulation.options;
+        let system = System::new(simulation.dynamics.clone(), options.forcing.clone());
+        let mut main = Integrator::new(system.clone(), simulation.method, q0, q_dot0, options.max_steps);
+        let companion = options
+            .estimate_error
+            .then(|| Integrator::new(system, simulation.method.companion(), q0, q_dot0, options.max_steps));
+        let invariant = match simulation.dynamics.mechanism().rotating_frame() {
+            Some(_) => Invariant::JacobiIntegral,
+            None => Invariant::Energy,
+        };
+        let point = main.point();
+        let fail = |cause: StepFailure| MotionError::StepFailed {
+            t: 0.0,
+            q: q0.to_vec(),
+            q_dot: q_dot0.to_vec(),
+            cause,
+        };
+        let mut probe = vec![0.0; n];
+        main.system_mut()
+            .acceleration(0.0, q0, q_dot0, &mut probe)
+            .map_err(fail)?;
+        let (energy, kinetic, p) = main.system_mut().measure(q0, q_dot0).map_err(fail)?;
+        main.set_tracker(Tracker::new(invariant, energy, kinetic, &options.cyclic, &p));
+        let sample = Sample {
+            t: 0.0,
+            q: q0.to_vec(),
+            q_dot: q_dot0.to_vec(),
+            energy,
+            error: companion.as_ref().map(|_| estimate(&point, &point, 0.0, 0)),
+        };
+        Ok(Self {
+            main,
+            companion,
+            ratio: simulation.method.companion_ratio(),
+            sample,
+            horizon: f64::INFINITY,
+        })
+    }
+
+    /// The last recorded sample.
+    pub fn sample(&self) -> &Sample {
+        &self.sample
+    }
+
+    /// The monitors over every step and sample so far.
+    pub fn monitors(&self) -> Monitors {
+        // The tracker is set when the session starts; the fallback is never used.
+        self.main.tracker().map_or_else(
+            || Tracker::new(Invariant::Energy, 0.0, 0.0, &[], &[]).monitors(),
+            Tracker::monitors,
+        )
+    }
+
+    /// Steps of the main run so far.
+    pub fn steps(&self) -> usize {
+        self.main.steps()
+    }
+
+    /// Integrates to `t` (finite, ≥ the time of the last sample) and records the sample there.
+    /// A failed step gives [`MotionError::StepFailed`] with the last good state of the main
+    /// run; the session then stays at that state (a later advance retries from it).
+    pub fn advance(&mut self, t: f64) -> Result<&Sample, MotionError> {
+        if !t.is_finite() || t < self.sample.t {
+            return Err(MotionError::OutOfRange {
+                what: "target time",
+                requirement: "finite and ≥ the time reached",
+                value: t,
+            });
+        }
+        let horizon = if self.horizon.is_finite() { self.horizon } else { t };
+        let point = self.main.advance_to(t, horizon).map_err(|c| failure(&self.main, c))?;
+        let reported = self.main.report(&point).map_err(|c| failure(&self.main, c))?;
+        let error = match &mut self.companion {
+            Some(companion) => {
+                let other = companion.advance_to(t, horizon).map_err(|c| failure(&self.main, c))?;
+                let other = companion.report(&other).map_err(|c| failure(&self.main, c))?;
+                Some(estimate(&reported, &other, self.ratio, self.main.steps()))
+            }
+            None => None,
+        };
+        let measured = self.main.system_mut().measure(&point.q, &point.q_dot);
+        let (energy, kinetic, p) = measured.map_err(|c| failure(&self.main, c))?;
+        if let Some(tracker) = self.main.tracker_mut() {
+            tracker.record(energy, kinetic, &p);
+        }
+        self.sample = Sample {
+            t,
+            q: reported.q,
+            q_dot: reported.q_dot,
+            energy,
+            error,
+        };
+        Ok(&self.sample)
+    }
+}
+
+/// The typed error of a failed step, with the main run's last good state.
+fn failure(main: &Integrator, cause: StepFailure) -> MotionError {
+    let point = main.point();
+    let reported = main.report(&point).unwrap_or(point);
+    MotionError::StepFailed {
+        t: reported.t,
+        q: reported.q,
+        q_dot: reported.q_dot,
+        cause,
+    }
+}

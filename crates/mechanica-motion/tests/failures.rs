@@ -1,0 +1,123 @@
+//! Typed failures: refused options and sample counts, a singular mass matrix and a
+//! non-finite applied force stop the run with the time reached and the last good state.
+
+mod common;
+
+use common::{oscillator, pendulum};
+use mechanica_dynamics::Dynamics;
+use mechanica_kinematics::tree::{Joint, TreeBuilder};
+use mechanica_mass::MassProperties;
+use mechanica_mechanism::Mechanism;
+use mechanica_motion::{Forcing, Method, MotionError, Options, Simulation, StepFailure};
+use nalgebra::{Isometry3, Vector3};
+use std::sync::Arc;
+
+#[test]
+fn bad_tolerances_and_steps_are_refused() {
+    for (rtol, atol) in [
+        (0.0, 1e-9),
+        (-1e-6, 1e-9),
+        (f64::NAN, 1e-9),
+        (f64::INFINITY, 1e-9),
+        (1e-16, 1e-9),
+        (1e-6, 0.0),
+        (1e-6, -1.0),
+    ] {
+        let result = Simulation::new(
+            pendulum(1.0, 1.0, 9.81),
+            Method::DormandPrince { rtol, atol },
+            Options::default(),
+        );
+        assert!(
+            matches!(result, Err(MotionError::OutOfRange { .. })),
+            "rtol {rtol}, atol {atol}"
+        );
+    }
+    for step in [0.0, -0.1, f64::NAN, f64::INFINITY] {
+        for method in [
+            Method::Rk4 { step },
+            Method::StormerVerlet { step },
+            Method::ImplicitMidpoint { step },
+        ] {
+            let result = Simulation::new(pendulum(1.0, 1.0, 9.81), method, Options::default());
+            assert!(matches!(result, Err(MotionError::OutOfRange { .. })), "{method:?}");
+        }
+    }
+}
+
+#[test]
+fn sample_counts_and_times_are_checked() {
+    let simulation =
+        Simulation::new(pendulum(1.0, 1.0, 9.81), Method::Rk4 { step: 0.01 }, Options::default()).expect("simulation");
+    assert!(matches!(
+        simulation.run(&[0.1], &[0.0], 1e9, 1e-3),
+        Err(MotionError::TooManySamples { .. })
+    ));
+    assert!(matches!(
+        simulation.run(&[0.1], &[0.0], -1.0, 0.1),
+        Err(MotionError::OutOfRange { .. })
+    ));
+    assert!(matches!(
+        simulation.run(&[0.1], &[0.0], 1.0, 0.0),
+        Err(MotionError::OutOfRange { .. })
+    ));
+    assert!(matches!(
+        simulation.run(&[f64::NAN], &[0.0], 1.0, 0.1),
+        Err(MotionError::NonFiniteInput { .. })
+    ));
+    assert!(matches!(
+        simulation.run(&[0.1, 0.2], &[0.0], 1.0, 0.1),
+        Err(MotionError::WrongLength { .. })
+    ));
+    let mut session = simulation.start(&[0.1], &[0.0]).expect("session");
+    session.advance(0.5).expect("advance");
+    assert!(matches!(session.advance(0.2), Err(MotionError::OutOfRange { .. })));
+}
+
+/// A point mass on the axis of its revolute joint has no inertia about it: A = 0.
+#[test]
+fn singular_mass_matrix_stops_at_the_start() {
+    let mut builder = TreeBuilder::new();
+    builder.add_body(None, Joint::Revolute { axis: Vector3::x() }, Isometry3::identity());
+    let tree = builder.build().expect("tree");
+    let body = MassProperties::point(1.0, Vector3::new(0.5, 0.0, 0.0)).expect("mass");
+    let dynamics = Dynamics::new(Mechanism::new(tree, vec![body]).expect("mechanism")).expect("dynamics");
+    for method in [
+        Method::Rk4 { step: 0.01 },
+        Method::StormerVerlet { step: 0.01 },
+        Method::DormandPrince { rtol: 1e-6, atol: 1e-9 },
+    ] {
+        let result = Simulation::new(dynamics.clone(), method, Options::default())
+            .expect("simulation")
+            .run(&[0.0], &[1.0], 1.0, 0.1);
+        match result {
+            Err(MotionError::StepFailed { t, q, q_dot, .. }) => {
+                assert_eq!(t, 0.0);
+                assert_eq!((q, q_dot), (vec![0.0], vec![1.0]));
+            }
+            other => panic!("{method:?}: expected a failed step, got {other:?}"),
+        }
+    }
+}
+
+/// A force callback that returns NaN after t = 0.3 stops the run near there, with a finite
+/// last good state before it.
+#[test]
+fn non_finite_force_stops_the_run() {
+    let force: Arc<mechanica_motion::ForceFunction> =
+        Arc::new(|t, _q, _v, out| out[0] = if t > 0.3 { f64::NAN } else { 1.0 });
+    let options = Options {
+        forcing: Forcing::Function(force),
+        ..Options::default()
+    };
+    let simulation =
+        Simulation::new(oscillator(1.0, 1.0, 0.0), Method::Rk4 { step: 0.01 }, options).expect("simulation");
+    match simulation.run(&[0.0], &[0.0], 1.0, 0.1) {
+        Err(MotionError::StepFailed { t, q, q_dot, cause }) => {
+            assert!((0.28..=0.31).contains(&t), "t = {t}");
+            assert!(q[0].is_finite() && q_dot[0].is_finite() && q[0] > 0.0);
+            assert!(matches!(cause, StepFailure::NonFiniteForce { .. }));
+        }
+        other => panic!("expected a failed step, got {other:?}"),
+    }
+}
