@@ -11,7 +11,7 @@ use mechanica_mass::mesh::{
     DegeneratePolicy, InsideOutPolicy, MeshModel, MeshOptions, MeshTopology, OpenMeshPolicy, TopologySource,
     TriangleMesh,
 };
-use mechanica_mass::weld::{DEFAULT_WELD_TOLERANCE, WeldReport, weld_vertices};
+use mechanica_mass::weld::{WeldReport, weld_vertices};
 
 /// The mass model of a mesh.
 pub type mech_mesh_model_t = i32;
@@ -211,7 +211,7 @@ pub unsafe extern "C" fn mech_mass_mesh_same_connectivity(
 
 /// The relative weld tolerance that mech_mass_mesh_welded takes for "default": 1e-8 of the
 /// bounding-box diagonal, the tolerance the mesh file loaders apply.
-pub const MECH_DEFAULT_WELD_TOLERANCE: f64 = DEFAULT_WELD_TOLERANCE;
+pub const MECH_DEFAULT_WELD_TOLERANCE: f64 = 1e-8;
 
 /// What mech_mass_mesh_welded's welding did.
 #[repr(C)]
@@ -459,5 +459,10 @@ mod tests {
         // SAFETY: `written` is a writable mech_mesh_options_t.
         assert_eq!(unsafe { mech_mesh_options_default(&mut written) }, MECH_STATUS_OK);
         assert_eq!(written, mech_mesh_options_t::default());
+    }
+
+    #[test]
+    fn the_c_default_weld_tolerance_is_the_loaders() {
+        assert_eq!(MECH_DEFAULT_WELD_TOLERANCE, mechanica_mass::weld::DEFAULT_WELD_TOLERANCE);
     }
 }
