@@ -277,7 +277,10 @@ fn a_hairline_crack_is_welded_by_default_and_named_when_welding_is_off() {
     check_box_report(&report, 500.0, origin, size, TOL);
     assert_eq!(values(&report, "vertices (after welding)"), vec![8.0]);
     assert_eq!(values(&report, "vertices welded into another"), vec![1.0]);
-    assert_eq!(values(&report, "weld tolerance (relative to bounding-box diagonal)"), vec![1e-8]);
+    assert_eq!(
+        values(&report, "weld tolerance (relative to bounding-box diagonal)"),
+        vec![1e-8]
+    );
     let moved = values(&report, "largest vertex displacement by welding")[0];
     assert!(moved > 0.0 && moved < 1e-19, "{moved}");
 

@@ -463,6 +463,9 @@ mod tests {
 
     #[test]
     fn the_c_default_weld_tolerance_is_the_loaders() {
-        assert_eq!(MECH_DEFAULT_WELD_TOLERANCE, mechanica_mass::weld::DEFAULT_WELD_TOLERANCE);
+        assert_eq!(
+            MECH_DEFAULT_WELD_TOLERANCE,
+            mechanica_mass::weld::DEFAULT_WELD_TOLERANCE
+        );
     }
 }
