@@ -113,6 +113,14 @@
  */
 #define MECH_FEATURE_BIT_MOTION (1 << 6)
 
+#if defined(MECH_FEATURE_MASS)
+/**
+ * The relative weld tolerance that mech_mass_mesh_welded takes for "default": 1e-8 of the
+ * bounding-box diagonal, the tolerance the mesh file loaders apply.
+ */
+#define MECH_DEFAULT_WELD_TOLERANCE 1e-8
+#endif
+
 #if defined(MECH_FEATURE_MECHANISM)
 /**
  * The ground, as a body index for mech_mechanism_add_point_spring.
@@ -1063,6 +1071,42 @@ typedef struct mech_mesh_report_t {
      */
     size_t misoriented_edges;
 } mech_mesh_report_t;
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * What mech_mass_mesh_welded's welding did.
+ */
+typedef struct mech_weld_report_t {
+    /**
+     * The relative tolerance asked for.
+     */
+    double relative_tolerance;
+    /**
+     * The absolute tolerance applied: relative tolerance × bounding-box diagonal (m).
+     */
+    double tolerance;
+    /**
+     * The largest distance any vertex moved (m), at most `tolerance`.
+     */
+    double max_displacement;
+    /**
+     * Vertices given.
+     */
+    size_t vertices_before;
+    /**
+     * Vertices after welding (unused vertices removed).
+     */
+    size_t vertices_after;
+    /**
+     * Vertices merged into another one (bit-identical or within the tolerance).
+     */
+    size_t vertices_welded;
+    /**
+     * Triangles dropped because welding joined two of their corners.
+     */
+    size_t triangles_dropped;
+} mech_weld_report_t;
 #endif
 
 #if defined(MECH_FEATURE_MASS)
@@ -3867,6 +3911,39 @@ mech_status_t mech_mass_mesh_same_connectivity(const double *vertices,
                                                const struct mech_mesh_report_t *earlier,
                                                struct mech_mass_properties_t *out,
                                                struct mech_mesh_report_t *report_out);
+#endif
+
+#if defined(MECH_FEATURE_MASS)
+/**
+ * As mech_mass_mesh, after welding the vertices within `weld_tolerance` × the diagonal of
+ * their bounding box (MECH_DEFAULT_WELD_TOLERANCE = 1e-8 closes the hairline cracks CAD
+ * exporters leave between patches; 0 merges bit-identical positions only). The rule: the
+ * vertices are visited in index order and each one not yet merged claims every unmerged
+ * vertex within the tolerance, which takes its position; so every vertex moves at most the
+ * tolerance, chains of near points do not collapse, and the result is deterministic.
+ * Triangles whose corners welding joins are dropped. `report_out` describes the welded mesh
+ * (its `triangles` counts the triangles kept, so it is not an `earlier` report for
+ * mech_mass_mesh_same_connectivity of the caller's arrays); `weld_out` (may be NULL)
+ * receives what welding did.
+ *
+ * Errors: as mech_mass_mesh; MECH_STATUS_INVALID_ARGUMENT for a negative or non-finite
+ * `weld_tolerance` and for one so coarse that more than 64 distinct vertices lie in one cube
+ * of its size.
+ *
+ * # Safety
+ * As mech_mass_mesh; `weld_out` NULL or writable.
+ */
+mech_status_t mech_mass_mesh_welded(const double *vertices,
+                                    size_t vertex_count,
+                                    const uint32_t *indices,
+                                    size_t triangle_count,
+                                    double weld_tolerance,
+                                    mech_amount_t amount_kind,
+                                    double amount,
+                                    const struct mech_mesh_options_t *options,
+                                    struct mech_mass_properties_t *out,
+                                    struct mech_mesh_report_t *report_out,
+                                    struct mech_weld_report_t *weld_out);
 #endif
 
 #if defined(MECH_FEATURE_MASS)

@@ -418,6 +418,53 @@ static void meshes(void) {
     CHECK_STATUS(mech_mass_mesh(v, 8, tri, 12, MECH_AMOUNT_DENSITY, 1.0, NULL, NULL, &rs), MECH_STATUS_NULL_POINTER);
 }
 
+/* The box as a triangle soup (every corner its own vertex, as in an STL file), each copy of a
+ * corner moved along x by 0, 5e-9 or 1e-8 (m): open for mech_mass_mesh, welded closed by
+ * mech_mass_mesh_welded at the default tolerance 1e-8 × √14 ≈ 3.7e-8 m. */
+static void welded_mesh(void) {
+    double v[24];
+    uint32_t tri[36];
+    box_mesh(1e6, v, tri);
+    double soup[108];
+    uint32_t idx[36];
+    for (int c = 0; c < 36; ++c) {
+        for (int axis = 0; axis < 3; ++axis) {
+            soup[3 * c + axis] = v[3 * tri[c] + axis];
+        }
+        soup[3 * c] += 5e-9 * (double)(c % 3);
+        idx[c] = (uint32_t)c;
+    }
+    mech_mass_properties_t p;
+    mech_mesh_report_t rep;
+    mech_weld_report_t w;
+    CHECK_STATUS(mech_mass_mesh(soup, 36, idx, 12, MECH_AMOUNT_DENSITY, 2.0, NULL, &p, &rep),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    FILL_SENTINEL(&w, sizeof w);
+    CHECK_STATUS(mech_mass_mesh_welded(soup, 36, idx, 12, MECH_DEFAULT_WELD_TOLERANCE, MECH_AMOUNT_DENSITY, 2.0,
+                                       NULL, &p, &rep, &w),
+                 MECH_STATUS_OK);
+    CHECK(w.vertices_before == 36 && w.vertices_after == 8 && w.vertices_welded == 28 && w.triangles_dropped == 0);
+    CHECK(w.relative_tolerance == MECH_DEFAULT_WELD_TOLERANCE);
+    CHECK_NEAR(w.tolerance, 1e-8 * sqrt(14.0), 1e-6 * 1e-8 * sqrt(14.0));
+    CHECK(w.max_displacement > 0.0 && w.max_displacement <= w.tolerance);
+    CHECK(rep.triangles == 12 && rep.boundary_edges == 0);
+    /* Every corner within 1e-8 m of the box: volume within 22e-8 m³ (area × shift) of 6. */
+    CHECK_NEAR(p.mass, 12.0, 2.0 * 22e-8);
+    CHECK_NEAR(entry(&p.inertia_about_com, 0, 0), 12.0 * (4.0 + 9.0) / 12.0, 1e-6);
+    /* Off: only identical positions merge, the jittered soup stays open. */
+    CHECK_STATUS(mech_mass_mesh_welded(soup, 36, idx, 12, 0.0, MECH_AMOUNT_DENSITY, 2.0, NULL, &p, &rep, &w),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    /* Bad tolerances; a NULL weld report is allowed. */
+    CHECK_STATUS(mech_mass_mesh_welded(soup, 36, idx, 12, -1e-8, MECH_AMOUNT_DENSITY, 2.0, NULL, &p, &rep, &w),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_mesh_welded(soup, 36, idx, 12, NAN, MECH_AMOUNT_DENSITY, 2.0, NULL, &p, &rep, &w),
+                 MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_mesh_welded(soup, 36, idx, 12, 1e-8, MECH_AMOUNT_DENSITY, 2.0, NULL, &p, NULL, NULL),
+                 MECH_STATUS_OK);
+    CHECK_STATUS(mech_mass_mesh_welded(soup, 36, idx, 12, 1e-8, MECH_AMOUNT_DENSITY, 2.0, NULL, NULL, NULL, NULL),
+                 MECH_STATUS_NULL_POINTER);
+}
+
 /* mech_mesh_options_default writes the options a NULL pointer selects: the same properties and
  * report, bit for bit, for an inside-out box far from the origin (flipped by default). */
 static void mesh_options_default(void) {
@@ -791,6 +838,7 @@ int main(void) {
     validity_and_repair();
     momenta_and_energy();
     meshes();
+    welded_mesh();
     mesh_options_default();
     deforming_mesh();
     tree_mechanism();

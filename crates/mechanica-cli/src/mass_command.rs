@@ -11,9 +11,10 @@
 //! the thin-shell (surface-density) model.
 
 use crate::report::{Quantity, Report, timed_step};
-use mechanica::mass::io::load_mesh;
+use mechanica::mass::crack::crack_width;
+use mechanica::mass::io::load_mesh_welded;
 use mechanica::mass::mesh::{MeshMassProperties, MeshModel, MeshOptions, TriangleMesh};
-use mechanica::mass::{Amount, MassError};
+use mechanica::mass::{Amount, DEFAULT_WELD_TOLERANCE, MassError, WeldReport};
 
 /// Density of a solid when neither `--density` nor `--mass` is given (water), kg/m³.
 pub const DEFAULT_SOLID_DENSITY: f64 = 1000.0;
@@ -39,6 +40,10 @@ pub struct MassArgs {
     /// millimetres (the results are then in metres).
     #[arg(long, value_name = "S", default_value_t = 1.0, allow_negative_numbers = true)]
     pub scale: f64,
+    /// Welds vertices closer than TOL × the bounding-box diagonal (closes hairline cracks
+    /// between CAD patches); 0 merges identical positions only.
+    #[arg(long, value_name = "TOL", default_value_t = DEFAULT_WELD_TOLERANCE, allow_negative_numbers = true)]
+    pub weld: f64,
 }
 
 impl MassArgs {
@@ -66,14 +71,32 @@ fn count(name: &str, n: usize) -> Quantity {
     quantity(name, vec![n as f64], "")
 }
 
-/// Explains a mesh error with the file name and, where it helps, the option that accepts it.
-fn explain(file: &std::path::Path, error: &MassError) -> String {
+/// Explains a mesh error with the file name and, where it helps, the option that accepts it;
+/// `mesh` (when loaded) tells cracks, which a larger weld tolerance closes, from an open
+/// surface, which only the shell model accepts.
+fn explain(file: &std::path::Path, error: &MassError, mesh: Option<&TriangleMesh>) -> String {
     let hint = match error {
-        MassError::OpenMesh { .. } => " (use --shell for a thin-shell model with surface density)",
-        MassError::InconsistentOrientation { .. } => " (repair the mesh's triangle orientation first)",
-        _ => "",
+        MassError::OpenMesh { .. } => open_mesh_hint(mesh),
+        MassError::InconsistentOrientation { .. } => " (repair the mesh's triangle orientation first)".into(),
+        _ => String::new(),
     };
     format!("{}: {error}{hint}", file.display())
+}
+
+/// The advice for an open mesh: `--weld` with a tolerance above the crack width when the
+/// boundary is hairline cracks, `--shell` otherwise.
+fn open_mesh_hint(mesh: Option<&TriangleMesh>) -> String {
+    match mesh.and_then(crack_width) {
+        Some(width) => {
+            // The next power of ten at least twice the width, so that every crack end pairs.
+            let suggested = 10f64.powf((2.0 * width).max(f64::MIN_POSITIVE).log10().ceil());
+            format!(
+                " (its boundary edges pair up across cracks up to {width:.1e} of the mesh size wide: \
+                 try --weld {suggested:e} to close them; --shell only for a thin shell)"
+            )
+        }
+        None => " (a large open boundary: use --shell for a thin-shell model with surface density)".into(),
+    }
 }
 
 fn scaled(mut mesh: TriangleMesh, scale: f64) -> Result<TriangleMesh, String> {
@@ -88,6 +111,25 @@ fn scaled(mut mesh: TriangleMesh, scale: f64) -> Result<TriangleMesh, String> {
         }
     }
     Ok(mesh)
+}
+
+/// What welding did, in the units of the scaled mesh.
+fn weld_quantities(weld: &WeldReport, scale: f64) -> Vec<Quantity> {
+    vec![
+        quantity(
+            "weld tolerance (relative to bounding-box diagonal)",
+            vec![weld.relative_tolerance],
+            "",
+        ),
+        quantity("weld tolerance", vec![weld.tolerance * scale], "m"),
+        count("vertices welded into another", weld.vertices_welded),
+        count("triangles collapsed by welding, dropped", weld.triangles_dropped),
+        quantity(
+            "largest vertex displacement by welding",
+            vec![weld.max_displacement * scale],
+            "m",
+        ),
+    ]
 }
 
 /// The quantities of the mass-properties step.
@@ -157,12 +199,14 @@ pub fn run(args: &MassArgs) -> Result<Report, String> {
     let file = &args.file;
     let mut mesh = None;
     let load = timed_step("load mesh", || -> Result<Vec<Quantity>, String> {
-        let m = scaled(load_mesh(file).map_err(|e| explain(file, &e))?, args.scale)?;
-        let quantities = vec![
-            count("vertices (identical positions merged)", m.vertices.len()),
+        let (m, weld) = load_mesh_welded(file, args.weld).map_err(|e| explain(file, &e, None))?;
+        let m = scaled(m, args.scale)?;
+        let mut quantities = vec![
+            count("vertices (after welding)", m.vertices.len()),
             count("triangles", m.triangles.len()),
             quantity("coordinate scale", vec![args.scale], "m per file unit"),
         ];
+        quantities.extend(weld_quantities(&weld, args.scale));
         mesh = Some(m);
         Ok(quantities)
     })?;
@@ -180,8 +224,8 @@ pub fn run(args: &MassArgs) -> Result<Report, String> {
     let properties = timed_step(analysis, || -> Result<Vec<Quantity>, String> {
         let r = mesh
             .mass_properties(args.amount(), &options)
-            .map_err(|e| explain(file, &e))?;
-        let quantities = properties_quantities(&r).map_err(|e| explain(file, &e))?;
+            .map_err(|e| explain(file, &e, Some(&mesh)))?;
+        let quantities = properties_quantities(&r).map_err(|e| explain(file, &e, Some(&mesh)))?;
         result = Some(r);
         Ok(quantities)
     })?;

@@ -261,6 +261,39 @@ fn an_inside_out_box_is_flipped_and_reported() {
 }
 
 #[test]
+fn a_hairline_crack_is_welded_by_default_and_named_when_welding_is_off() {
+    let dir = temp_dir("crack");
+    let file = dir.join("crack.stl");
+    // One copy of the corner at the origin written as (1e-20, 0, 0), as CAD exporters do where
+    // patches meet: without welding, the four edges of that copy and of the origin are open.
+    let (origin, size) = ([0.0; 3], [1.0, 2.0, 0.5]);
+    let mut triangles = box_triangles(origin, size);
+    assert_eq!(triangles[0][0], [0.0; 3]);
+    triangles[0][0] = [1e-20, 0.0, 0.0];
+    write_ascii_stl(&file, &triangles);
+    let path = file.to_str().expect("utf-8");
+
+    let report = json_report(&[path, "--density", "500"]);
+    check_box_report(&report, 500.0, origin, size, TOL);
+    assert_eq!(values(&report, "vertices (after welding)"), vec![8.0]);
+    assert_eq!(values(&report, "vertices welded into another"), vec![1.0]);
+    assert_eq!(
+        values(&report, "weld tolerance (relative to bounding-box diagonal)"),
+        vec![1e-8]
+    );
+    let moved = values(&report, "largest vertex displacement by welding")[0];
+    assert!(moved > 0.0 && moved < 1e-19, "{moved}");
+
+    let out = mechanica(&["mass", path, "--weld", "0"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("4 boundary edges") && err.contains("try --weld"), "{err}");
+    let out = mechanica(&["mass", path, "--weld", "-1"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("weld tolerance must be finite and non-negative"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn an_open_mesh_is_rejected_with_its_boundary_edges_unless_shell() {
     let dir = temp_dir("open");
     let file = dir.join("open.stl");
@@ -274,6 +307,7 @@ fn an_open_mesh_is_rejected_with_its_boundary_edges_unless_shell() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("4 boundary edges") && err.contains("--shell"), "{err}");
+    assert!(!err.contains("--weld"), "{err}");
     assert!(out.stdout.is_empty());
 
     // As a shell: five unit squares with surface density 2 kg/m².

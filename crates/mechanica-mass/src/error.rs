@@ -127,6 +127,20 @@ pub enum MassError {
         /// The cube of the bounding-box diagonal, the scale it was compared against.
         scale: f64,
     },
+    /// A weld tolerance that is negative, NaN or infinite.
+    #[error("the weld tolerance must be finite and non-negative, got {0}")]
+    InvalidWeldTolerance(f64),
+    /// A weld tolerance so coarse that more than 64 distinct vertex positions lie in one cube
+    /// of its size: welding would collapse the tessellation itself.
+    #[error(
+        "the weld tolerance {tolerance} is too coarse for this mesh: {positions} distinct vertices lie within one cube of that size"
+    )]
+    WeldTooCoarse {
+        /// The absolute tolerance (m).
+        tolerance: f64,
+        /// Distinct positions found in one cube (the first count above the limit).
+        positions: usize,
+    },
     /// A slice argument has the wrong length.
     #[error("{what}: expected length {expected}, got {got}")]
     WrongLength {

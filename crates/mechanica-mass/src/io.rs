@@ -1,9 +1,13 @@
 //! Mesh loaders: STL (binary and ASCII, through `stl_io`) and Wavefront OBJ (through `tobj`).
-//! Identical vertex positions are merged, so closed meshes come out closed for
-//! [`crate::mesh::mesh_topology`].
+//! The readers ([`read_stl`], [`read_obj`], [`load_stl`], [`load_obj`]) merge identical vertex
+//! positions; [`load_mesh`] and [`load_mesh_welded`] also weld vertices within a tolerance
+//! relative to the mesh's size ([`crate::weld`], by default [`DEFAULT_WELD_TOLERANCE`] of the
+//! bounding-box diagonal), so that closed meshes with hairline cracks between their patches
+//! come out closed for [`crate::mesh::mesh_topology`].
 
 use crate::MassError;
 use crate::mesh::TriangleMesh;
+use crate::weld::{DEFAULT_WELD_TOLERANCE, WeldReport, weld_vertices};
 use std::collections::HashMap;
 use std::io::{BufRead, Read, Seek};
 use std::path::Path;
@@ -90,9 +94,26 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<TriangleMesh, MassError> {
     read_obj(&mut std::io::BufReader::new(file))
 }
 
-/// Reads a mesh file, choosing the format from the extension (`.stl` or `.obj`, any case).
+/// Reads a mesh file, choosing the format from the extension (`.stl` or `.obj`, any case),
+/// and welds its vertices within [`DEFAULT_WELD_TOLERANCE`] of its bounding-box diagonal
+/// (see [`load_mesh_welded`] for another tolerance and the weld report).
 pub fn load_mesh(path: impl AsRef<Path>) -> Result<TriangleMesh, MassError> {
-    let path = path.as_ref();
+    load_mesh_welded(path, DEFAULT_WELD_TOLERANCE).map(|(mesh, _)| mesh)
+}
+
+/// Reads a mesh file as [`load_mesh`] does, welding its vertices within `relative_tolerance`
+/// × its bounding-box diagonal (0 merges identical positions only), and reports the welding.
+///
+/// Errors: those of the readers and of [`weld_vertices`].
+pub fn load_mesh_welded(
+    path: impl AsRef<Path>,
+    relative_tolerance: f64,
+) -> Result<(TriangleMesh, WeldReport), MassError> {
+    weld_vertices(&load_mesh_unwelded(path.as_ref())?, relative_tolerance)
+}
+
+/// The mesh file as read, identical positions merged.
+fn load_mesh_unwelded(path: &Path) -> Result<TriangleMesh, MassError> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("stl") => load_stl(path),

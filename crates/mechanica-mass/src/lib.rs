@@ -8,6 +8,8 @@
 //! - [`validity`]: the physical validity check and repair;
 //! - [`primitives`]: closed forms for points, rods, laminae and solids;
 //! - [`mesh`], [`topology`] and [`io`]: triangle meshes, their edge checks and file formats;
+//! - [`weld`] and [`crack`]: welding near-coincident vertices, and telling cracks from open
+//!   boundaries;
 //! - [`mechanism`]: the mass matrix A(q) of a kinematic tree (composite-rigid-body recursion);
 //! - [`momenta`]: momentum, angular momentum and kinetic energy of a rigid body.
 //!
@@ -16,6 +18,7 @@
 //! [`MassError::MassUnderflow`] (a mass from a density that rounds to zero), never a NaN, an
 //! infinity or a zero mass.
 
+pub mod crack;
 pub mod error;
 #[cfg(feature = "io")]
 pub mod io;
@@ -30,6 +33,7 @@ pub mod properties;
 pub mod tessellation;
 pub mod topology;
 pub mod validity;
+pub mod weld;
 
 pub use error::MassError;
 pub use mesh::{MeshMassProperties, MeshOptions, TopologySource, TriangleMesh, mesh_mass_properties};
@@ -37,3 +41,4 @@ pub use primitives::Amount;
 pub use principal::PrincipalAxes;
 pub use properties::MassProperties;
 pub use validity::{InertiaClass, InertiaIssue, ValidityTolerance};
+pub use weld::{DEFAULT_WELD_TOLERANCE, WeldReport, weld_vertices};

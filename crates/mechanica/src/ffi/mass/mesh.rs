@@ -9,7 +9,9 @@ use crate::ffi::status::*;
 use crate::ffi::validate::*;
 use mechanica_mass::mesh::{
     DegeneratePolicy, InsideOutPolicy, MeshModel, MeshOptions, MeshTopology, OpenMeshPolicy, TopologySource,
+    TriangleMesh,
 };
+use mechanica_mass::weld::{WeldReport, weld_vertices};
 
 /// The mass model of a mesh.
 pub type mech_mesh_model_t = i32;
@@ -169,7 +171,7 @@ pub unsafe extern "C" fn mech_mass_mesh(
         triangle_count,
     };
     // SAFETY: the caller's contract is mesh_call's.
-    unsafe { mesh_call(mesh, amount_kind, amount, options, None, out, report_out) }
+    unsafe { mesh_call(mesh, amount_kind, amount, options, None, out, report_out, None) }
 }
 
 /// As mech_mass_mesh, for a mesh whose vertices moved since an earlier call on the same
@@ -204,7 +206,96 @@ pub unsafe extern "C" fn mech_mass_mesh_same_connectivity(
         triangle_count,
     };
     // SAFETY: the caller's contract is mesh_call's.
-    unsafe { mesh_call(mesh, amount_kind, amount, options, Some(earlier), out, report_out) }
+    unsafe { mesh_call(mesh, amount_kind, amount, options, Some(earlier), out, report_out, None) }
+}
+
+/// The relative weld tolerance that mech_mass_mesh_welded takes for "default": 1e-8 of the
+/// bounding-box diagonal, the tolerance the mesh file loaders apply.
+pub const MECH_DEFAULT_WELD_TOLERANCE: f64 = 1e-8;
+
+/// What mech_mass_mesh_welded's welding did.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct mech_weld_report_t {
+    /// The relative tolerance asked for.
+    pub relative_tolerance: f64,
+    /// The absolute tolerance applied: relative tolerance × bounding-box diagonal (m).
+    pub tolerance: f64,
+    /// The largest distance any vertex moved (m), at most `tolerance`.
+    pub max_displacement: f64,
+    /// Vertices given.
+    pub vertices_before: usize,
+    /// Vertices after welding (unused vertices removed).
+    pub vertices_after: usize,
+    /// Vertices merged into another one (bit-identical or within the tolerance).
+    pub vertices_welded: usize,
+    /// Triangles dropped because welding joined two of their corners.
+    pub triangles_dropped: usize,
+}
+
+/// As mech_mass_mesh, after welding the vertices within `weld_tolerance` × the diagonal of
+/// their bounding box (MECH_DEFAULT_WELD_TOLERANCE = 1e-8 closes the hairline cracks CAD
+/// exporters leave between patches; 0 merges bit-identical positions only). The rule: the
+/// vertices are visited in index order and each one not yet merged claims every unmerged
+/// vertex within the tolerance, which takes its position; so every vertex moves at most the
+/// tolerance, chains of near points do not collapse, and the result is deterministic.
+/// Triangles whose corners welding joins are dropped. `report_out` describes the welded mesh
+/// (its `triangles` counts the triangles kept, so it is not an `earlier` report for
+/// mech_mass_mesh_same_connectivity of the caller's arrays); `weld_out` (may be NULL)
+/// receives what welding did.
+///
+/// Errors: as mech_mass_mesh; MECH_STATUS_INVALID_ARGUMENT for a negative or non-finite
+/// `weld_tolerance` and for one so coarse that more than 64 distinct vertices lie in one cube
+/// of its size.
+///
+/// # Safety
+/// As mech_mass_mesh; `weld_out` NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_mass_mesh_welded(
+    vertices: *const f64,
+    vertex_count: usize,
+    indices: *const u32,
+    triangle_count: usize,
+    weld_tolerance: f64,
+    amount_kind: mech_amount_t,
+    amount: f64,
+    options: *const mech_mesh_options_t,
+    out: *mut mech_mass_properties_t,
+    report_out: *mut mech_mesh_report_t,
+    weld_out: *mut mech_weld_report_t,
+) -> mech_status_t {
+    let mesh = MeshInput {
+        vertices,
+        vertex_count,
+        indices,
+        triangle_count,
+    };
+    let weld = Weld {
+        tolerance: weld_tolerance,
+        report_out: weld_out,
+    };
+    // SAFETY: the caller's contract is mesh_call's.
+    unsafe { mesh_call(mesh, amount_kind, amount, options, None, out, report_out, Some(weld)) }
+}
+
+/// The weld step of mech_mass_mesh_welded: the relative tolerance and where its report goes.
+struct Weld {
+    tolerance: f64,
+    report_out: *mut mech_weld_report_t,
+}
+
+impl From<(&WeldReport, usize)> for mech_weld_report_t {
+    fn from((r, vertices_after): (&WeldReport, usize)) -> Self {
+        Self {
+            relative_tolerance: r.relative_tolerance,
+            tolerance: r.tolerance,
+            max_displacement: r.max_displacement,
+            vertices_before: r.vertices_before,
+            vertices_after,
+            vertices_welded: r.vertices_welded,
+            triangles_dropped: r.triangles_dropped,
+        }
+    }
 }
 
 /// The caller's vertex and index arrays.
@@ -215,11 +306,12 @@ struct MeshInput {
     triangle_count: usize,
 }
 
-/// The body of mech_mass_mesh and mech_mass_mesh_same_connectivity; `earlier` is the report
-/// whose topology is reused, if any.
+/// The body of mech_mass_mesh, mech_mass_mesh_same_connectivity and mech_mass_mesh_welded;
+/// `earlier` is the report whose topology is reused, if any, `weld` the weld step, if any.
 ///
 /// # Safety
-/// As mech_mass_mesh; `earlier`, when given, readable.
+/// As mech_mass_mesh; `earlier`, when given, readable; the weld report pointer NULL or
+/// writable.
 unsafe fn mesh_call(
     mesh: MeshInput,
     amount_kind: mech_amount_t,
@@ -228,6 +320,7 @@ unsafe fn mesh_call(
     earlier: Option<*const mech_mesh_report_t>,
     out: *mut mech_mass_properties_t,
     report_out: *mut mech_mesh_report_t,
+    weld: Option<Weld>,
 ) -> mech_status_t {
     boundary(|| {
         let triangle_count = mesh.triangle_count;
@@ -263,7 +356,11 @@ unsafe fn mesh_call(
         let amount = amount_of(amount_kind, amount)?;
         let (verts, _) = flat_v.as_chunks::<3>();
         let (tris, _) = flat_i.as_chunks::<3>();
-        let r = mechanica_mass::mesh_mass_properties(verts, tris, amount, &options)?;
+        let r = match weld {
+            None => mechanica_mass::mesh_mass_properties(verts, tris, amount, &options)?,
+            // SAFETY: caller's contract.
+            Some(weld) => unsafe { welded_mass_properties(verts, tris, weld, amount, &options) }?,
+        };
         let rep = report_to_c(&r);
         // SAFETY: caller's contract.
         unsafe {
@@ -274,6 +371,31 @@ unsafe fn mesh_call(
         }
         Ok(())
     })
+}
+
+/// The mass properties of the mesh (`verts`, `tris`) welded by `weld`, whose report is written
+/// (when its pointer is not NULL) once the welding succeeded.
+///
+/// # Safety
+/// `weld.report_out` NULL or writable.
+unsafe fn welded_mass_properties(
+    verts: &[[f64; 3]],
+    tris: &[[u32; 3]],
+    weld: Weld,
+    amount: mechanica_mass::Amount,
+    options: &MeshOptions,
+) -> Result<mechanica_mass::mesh::MeshMassProperties, FfiError> {
+    let weld_out = Out::optional(weld.report_out, "weld_out")?;
+    let given = TriangleMesh {
+        vertices: verts.to_vec(),
+        triangles: tris.to_vec(),
+    };
+    let (welded, report) = weld_vertices(&given, weld.tolerance)?;
+    if let Some(o) = weld_out {
+        // SAFETY: caller's contract.
+        unsafe { o.write((&report, welded.vertices.len()).into()) };
+    }
+    Ok(welded.mass_properties(amount, options)?)
 }
 
 /// The edge topology recorded in the report `earlier` of a mesh with `triangle_count`
@@ -337,5 +459,13 @@ mod tests {
         // SAFETY: `written` is a writable mech_mesh_options_t.
         assert_eq!(unsafe { mech_mesh_options_default(&mut written) }, MECH_STATUS_OK);
         assert_eq!(written, mech_mesh_options_t::default());
+    }
+
+    #[test]
+    fn the_c_default_weld_tolerance_is_the_loaders() {
+        assert_eq!(
+            MECH_DEFAULT_WELD_TOLERANCE,
+            mechanica_mass::weld::DEFAULT_WELD_TOLERANCE
+        );
     }
 }
