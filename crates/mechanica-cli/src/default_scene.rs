@@ -1,5 +1,6 @@
 //! The built-in default scene: two example scenes, a spring-loaded pendulum chain (mass
-//! properties, equilibrium, stability, modes, free response, an impact) and a bead on a
+//! properties, equilibrium, stability, modes, free response, an impact, the dynamics and a
+//! short simulation of the chain released from rest) and a bead on a
 //! rotating hoop (a relative equilibrium in a rotating frame), run through the same pipeline
 //! as any scene file and merged into one report, followed by Kane's double pendulum striking a
 //! rough floor under each restitution law (Newton's gains energy; the default, Stronge's, never

@@ -65,7 +65,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), St
 }
 
 /// The scene's mechanism (potentials, frame) with its joint and point dampers.
-fn build_dynamics(scene: &Scene, model: &Model) -> Result<Dynamics, String> {
+pub(crate) fn build_dynamics(scene: &Scene, model: &Model) -> Result<Dynamics, String> {
     let mechanism = crate::mechanism_run::build_mechanism(scene, model)?;
     let mut dynamics = Dynamics::new(mechanism).map_err(|e| format!("analyses.dynamics: {e}"))?;
     for (i, damper) in scene.joint_dampers.iter().enumerate() {

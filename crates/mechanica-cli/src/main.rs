@@ -14,6 +14,9 @@ mod progress;
 mod report;
 mod scene;
 mod scene_run;
+mod simulate_run;
+mod simulation_plots;
+mod trajectory_file;
 mod urdf;
 
 use clap::{Parser, Subcommand};

@@ -1,5 +1,6 @@
 //! `--plot DIR`: SVG plots of what a scene computed — the spectrum, bar charts of the mode
-//! shapes, the free response over time, and an impact's energy balance.
+//! shapes, the free response over time, an impact's energy balance, and a simulation
+//! ([`crate::simulation_plots`]).
 
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -29,6 +30,23 @@ pub struct EnergyBalance {
     pub laws: Vec<(String, f64, f64)>,
 }
 
+/// A simulated trajectory: the coordinates, the drift of H and the estimated errors per sample.
+#[derive(Debug, Clone)]
+pub struct SimulationSeries {
+    /// Sample times, s.
+    pub times: Vec<f64>,
+    /// The coordinates' names.
+    pub names: Vec<String>,
+    /// `coordinates[k][i]` = q_k(t_i).
+    pub coordinates: Vec<Vec<f64>>,
+    /// |H(t_i) − H(0)| / the energy scale.
+    pub drift: Vec<f64>,
+    /// The estimated global error of q (NaN without the companion run).
+    pub error_q: Vec<f64>,
+    /// The estimated global error of q̇.
+    pub error_q_dot: Vec<f64>,
+}
+
 /// Everything the scene computed that can be plotted.
 #[derive(Debug, Clone, Default)]
 pub struct PlotData {
@@ -40,6 +58,8 @@ pub struct PlotData {
     pub response: Option<ResponseSeries>,
     /// The impact energy balance.
     pub impact: Option<EnergyBalance>,
+    /// A simulated trajectory.
+    pub simulation: Option<SimulationSeries>,
 }
 
 fn failed(e: impl std::fmt::Display) -> String {
@@ -186,6 +206,9 @@ impl PlotData {
             )?;
             root.present().map_err(failed)?;
             written.push(path.clone());
+        }
+        if let Some(simulation) = &self.simulation {
+            written.extend(crate::simulation_plots::write(simulation, dir)?);
         }
         Ok(written)
     }

@@ -97,9 +97,12 @@
 
 #[path = "scene/constraints.rs"]
 mod constraints;
+#[path = "scene/simulate.rs"]
+mod simulate;
 
 pub use constraints::ConstraintSpec;
 use serde::Deserialize;
+pub use simulate::{DEFAULT_SIMULATE_STEPS, SimulateSpec};
 use std::collections::HashMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -374,6 +377,8 @@ pub struct Analyses {
     pub impact: Option<ImpactSpec>,
     /// Forward and inverse dynamics, with the joint reactions, at q0.
     pub dynamics: Option<DynamicsSpec>,
+    /// The motion from (q0, qd0) integrated in time (see `scene/simulate.rs`).
+    pub simulate: Option<SimulateSpec>,
 }
 
 /// The frames in which the dynamics step can report joint reactions.
@@ -988,6 +993,9 @@ impl<'a> Validator<'a> {
         }
         if let Some(dynamics) = &analyses.dynamics {
             self.check_dynamics(dynamics, dof)?;
+        }
+        if let Some(simulate) = &analyses.simulate {
+            self.check_simulate(simulate, dof)?;
         }
         match &analyses.response {
             Some(response) => self.check_response(response, dof),

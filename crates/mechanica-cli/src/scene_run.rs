@@ -44,6 +44,7 @@ pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report
     let mut plots = crate::plots::PlotData::default();
     crate::mechanism_run::run(scene, &model, &mut steps, &mut plots)?;
     crate::dynamics_run::run(scene, &model, &mut steps)?;
+    crate::simulate_run::run(scene, file, &model, &mut steps, &mut plots)?;
     for step in &steps {
         crate::report::check_finite(step, |name| {
             crate::mechanism_run::INFINITE_FOR_MASSLESS_MODES.contains(&name)

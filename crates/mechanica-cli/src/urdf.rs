@@ -107,6 +107,7 @@ pub fn load(path: &Path, options: UrdfOptions) -> Result<(Scene, Vec<String>), S
             response: None,
             impact: None,
             dynamics: None,
+            simulate: None,
         },
     };
     scene.check(path)?;

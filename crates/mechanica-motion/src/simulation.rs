@@ -114,6 +114,19 @@ impl Simulation {
     /// `output_interval` (> 0) and at t_end. Refuses more than [`MAX_SAMPLES`] samples. A
     /// failed step stops the run with [`MotionError::StepFailed`].
     pub fn run(&self, q0: &[f64], q_dot0: &[f64], t_end: f64, output_interval: f64) -> Result<Trajectory, MotionError> {
+        self.run_observed(q0, q_dot0, t_end, output_interval, &mut |_| ())
+    }
+
+    /// [`Simulation::run`], calling `observe` with each sample as it is recorded (for progress
+    /// reports).
+    pub fn run_observed(
+        &self,
+        q0: &[f64],
+        q_dot0: &[f64],
+        t_end: f64,
+        output_interval: f64,
+        observe: &mut dyn FnMut(&Sample),
+    ) -> Result<Trajectory, MotionError> {
         positive(t_end, "t_end")?;
         positive(output_interval, "output interval")?;
         let requested = (t_end / output_interval).ceil() + 1.0;
@@ -128,9 +141,12 @@ impl Simulation {
         session.horizon = t_end;
         let mut samples = Vec::with_capacity(count);
         samples.push(session.sample().clone());
+        observe(session.sample());
         for i in 1..count {
             let t = (i as f64 * output_interval).min(t_end);
-            samples.push(session.advance(t)?.clone());
+            let sample = session.advance(t)?;
+            observe(sample);
+            samples.push(sample.clone());
         }
         Ok(Trajectory {
             samples,

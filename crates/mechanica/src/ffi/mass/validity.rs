@@ -106,7 +106,8 @@ pub unsafe extern "C" fn mech_mass_check(
             },
             Err(MassError::InvalidInertia(issues)) => {
                 let flags = issues.iter().fold(0, |flags, issue| flags | issue_to_c(issue));
-                let moments = symmetric_part_eigenvalues(&props.inertia_c).map_or_else(mech_vec3_t::default, Into::into);
+                let moments =
+                    symmetric_part_eigenvalues(&props.inertia_c).map_or_else(mech_vec3_t::default, Into::into);
                 mech_mass_validity_t {
                     issues: flags,
                     inertia_class: MECH_INERTIA_INVALID,

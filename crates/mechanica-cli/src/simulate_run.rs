@@ -1,0 +1,210 @@
+//! The `simulate` step of a scene: the motion from (q0, qd0) integrated to t_end by the chosen
+//! method of `mechanica-motion` (docs/theory.md, "Integration in time"), with the global error
+//! estimate of its companion run (M.12)–(M.13) and the drift of the energy or Jacobi integral
+//! (M.1)–(M.2); the trajectory optionally written as CSV and JSON, and plotted with `--plot`.
+
+use crate::plots::{PlotData, SimulationSeries};
+use crate::report::{Step, timed_step};
+use crate::scene::{DEFAULT_SIMULATE_STEPS, Scene, SimulateSpec};
+use crate::scene_run::{Model, quantity};
+use mechanica::motion::{Forcing, Invariant, Method, MotionError, Options, Simulation, Trajectory};
+use std::path::Path;
+
+/// Runs the simulation when the scene asks for it.
+pub fn run(
+    scene: &Scene,
+    file: &Path,
+    model: &Model,
+    steps: &mut Vec<Step>,
+    plots: &mut PlotData,
+) -> Result<(), String> {
+    let Some(spec) = &scene.analyses.simulate else {
+        return Ok(());
+    };
+    let dynamics = crate::dynamics_run::build_dynamics(scene, model)?;
+    let options = Options {
+        forcing: spec
+            .tau
+            .as_ref()
+            .map_or(Forcing::None, |tau| Forcing::Constant(tau.get_ref().clone())),
+        estimate_error: spec.estimate_error.unwrap_or(true),
+        max_steps: spec.max_steps.as_ref().map_or(DEFAULT_SIMULATE_STEPS, |m| *m.get_ref()),
+        ..Options::default()
+    };
+    let method = method_of(spec);
+    let simulation = Simulation::new(dynamics, method, options).map_err(|e| format!("analyses.simulate: {e}"))?;
+    let names = coordinate_names(model);
+    let mut trajectory = None;
+    let title = format!(
+        "simulate: motion from (q0, qd0) to t = {} s by {} (M.3)–(M.11), error by a companion run (M.13)",
+        spec.t_end.get_ref(),
+        describe(spec)
+    );
+    let mut step = timed_step(&title, || {
+        let result = integrate(&simulation, model, spec)?;
+        let quantities = summary(&result, &names);
+        trajectory = Some(result);
+        Ok::<_, String>(quantities)
+    })?;
+    let trajectory = trajectory.ok_or("internal: trajectory missing")?;
+    step.notes.push(monitor_note(&trajectory));
+    for (path, text) in outputs(spec, file, &trajectory, &names)? {
+        std::fs::write(&path, text).map_err(|e| format!("analyses.simulate: {}: {e}", path.display()))?;
+        step.notes.push(format!("trajectory written to {}", path.display()));
+    }
+    plots.simulation = Some(series(&trajectory, names));
+    steps.push(step);
+    Ok(())
+}
+
+/// The library's method for the scene's name and parameters (validated by the scene).
+fn method_of(spec: &SimulateSpec) -> Method {
+    let step = spec.step.as_ref().map_or(0.0, |s| *s.get_ref());
+    match spec.method_name() {
+        "rk4" => Method::Rk4 { step },
+        "verlet" => Method::StormerVerlet { step },
+        "midpoint" => Method::ImplicitMidpoint { step },
+        _ => {
+            let rtol = spec.tolerance.as_ref().map_or(1e-8, |t| *t.get_ref());
+            Method::DormandPrince {
+                rtol,
+                atol: spec.atol.as_ref().map_or(rtol, |a| *a.get_ref()),
+            }
+        }
+    }
+}
+
+/// The method in words, with its parameter.
+fn describe(spec: &SimulateSpec) -> String {
+    match method_of(spec) {
+        Method::Rk4 { step } => format!("RK4 with step {step} s"),
+        Method::StormerVerlet { step } => format!("Störmer–Verlet with step {step} s"),
+        Method::ImplicitMidpoint { step } => format!("the implicit midpoint rule with step {step} s"),
+        Method::DormandPrince { rtol, atol } => format!("Dormand–Prince 5(4), rtol {rtol:e}, atol {atol:e}"),
+        _ => "an integrator".into(),
+    }
+}
+
+/// The run, with a progress bar over the samples; a failed step names the time and state.
+fn integrate(simulation: &Simulation, model: &Model, spec: &SimulateSpec) -> Result<Trajectory, String> {
+    let (t_end, interval) = (*spec.t_end.get_ref(), spec.interval());
+    let samples = ((t_end / interval).ceil() + 1.0) as u64;
+    let bar = crate::progress::bar(samples, "simulate");
+    let q_dot = spec.q_dot.as_ref().map_or(&model.qd0, |v| v.get_ref());
+    let result = simulation.run_observed(&model.q0, q_dot, t_end, interval, &mut |_| bar.inc(1));
+    bar.finish_and_clear();
+    result.map_err(|e| match e {
+        MotionError::StepFailed { t, q, q_dot, cause } => format!(
+            "analyses.simulate: the integration failed at t = {t} s ({cause}); last good q = {q:?}, q̇ = {q_dot:?}"
+        ),
+        other => format!("analyses.simulate: {other}"),
+    })
+}
+
+/// The final state with its estimated error, the largest estimate over the run and the costs.
+fn summary(trajectory: &Trajectory, names: &[String]) -> Vec<crate::report::Quantity> {
+    let Some(last) = trajectory.samples.last() else {
+        return Vec::new();
+    };
+    let (error_q, error_q_dot) = last.error.map_or((None, None), |e| {
+        (
+            Some(format!("estimated global error ≤ {:.1e} (∞-norm)", e.q)),
+            Some(format!("estimated global error ≤ {:.1e} (∞-norm)", e.q_dot)),
+        )
+    });
+    let mut out = vec![
+        quantity(
+            &format!("q(t_end) of {}", names.join(", ")),
+            last.q.clone(),
+            "rad | m",
+            error_q,
+        ),
+        quantity("q̇(t_end)", last.q_dot.clone(), "rad/s | m/s", error_q_dot),
+    ];
+    let worst = trajectory
+        .samples
+        .iter()
+        .filter_map(|s| s.error)
+        .fold((0.0f64, 0.0f64), |(a, b), e| (a.max(e.q), b.max(e.q_dot)));
+    if last.error.is_some() {
+        out.push(quantity(
+            "largest estimated error over the samples: q, q̇",
+            vec![worst.0, worst.1],
+            "rad | m, rad/s | m/s",
+            None,
+        ));
+    }
+    out.push(quantity(
+        "steps: main run, companion run",
+        vec![trajectory.steps as f64, trajectory.companion_steps as f64],
+        "",
+        None,
+    ));
+    out
+}
+
+/// The monitor of the conserved quantity in words.
+fn monitor_note(trajectory: &Trajectory) -> String {
+    let m = &trajectory.monitors;
+    let what = match m.invariant {
+        Invariant::Energy => "energy T + U",
+        Invariant::JacobiIntegral => "Jacobi integral T₂ − T₀ + U",
+    };
+    format!(
+        "{what}: initial {:.6e} J; drift max {:.1e}, final {:.1e} of the energy scale {:.3e} J \
+         (conserved only without dampers and velocity-dependent forces)",
+        m.initial, m.max_drift, m.last_drift, m.scale
+    )
+}
+
+/// One name per coordinate: the joint's name, indexed within joints of several coordinates.
+fn coordinate_names(model: &Model) -> Vec<String> {
+    let mut names = vec![String::new(); model.q0.len()];
+    for (joint, body) in &model.joint_body {
+        let range = model.tree.dof_range(*body);
+        let several = range.len() > 1;
+        for (i, k) in range.enumerate() {
+            names[k] = if several {
+                format!("{joint}[{i}]")
+            } else {
+                joint.clone()
+            };
+        }
+    }
+    names
+}
+
+/// The CSV and JSON files the scene asks for, with their contents.
+fn outputs(
+    spec: &SimulateSpec,
+    file: &Path,
+    trajectory: &Trajectory,
+    names: &[String],
+) -> Result<Vec<(std::path::PathBuf, String)>, String> {
+    let dir = file.parent().unwrap_or(Path::new("."));
+    let mut out = Vec::new();
+    if let Some(csv) = &spec.csv {
+        out.push((dir.join(csv), crate::trajectory_file::csv(trajectory, names)));
+    }
+    if let Some(json) = &spec.json {
+        out.push((dir.join(json), crate::trajectory_file::json(trajectory, names)?));
+    }
+    Ok(out)
+}
+
+/// The series of the plots: motion, energy drift and estimated error over time.
+fn series(trajectory: &Trajectory, names: Vec<String>) -> SimulationSeries {
+    let samples = &trajectory.samples;
+    let initial = trajectory.monitors.initial;
+    let scale = trajectory.monitors.scale;
+    SimulationSeries {
+        times: samples.iter().map(|s| s.t).collect(),
+        coordinates: (0..names.len())
+            .map(|k| samples.iter().map(|s| s.q[k]).collect())
+            .collect(),
+        names,
+        drift: samples.iter().map(|s| (s.energy - initial).abs() / scale).collect(),
+        error_q: samples.iter().map(|s| s.error.map_or(f64::NAN, |e| e.q)).collect(),
+        error_q_dot: samples.iter().map(|s| s.error.map_or(f64::NAN, |e| e.q_dot)).collect(),
+    }
+}
