@@ -10,6 +10,7 @@
 //! | `modal`      | [`modal`]                | `mechanica-modal`       |
 //! | `mechanism`  | [`mechanism`]            | `mechanica-mechanism`   |
 //! | `dynamics`   | [`dynamics`]             | `mechanica-dynamics`    |
+//! | `urdf`       | [`urdf`]                 | `mechanica-urdf`        |
 //!
 //! C and C++ programs use the same capabilities through [`ffi`], declared in the generated
 //! header `include/mechanica.h`.
@@ -26,6 +27,8 @@ pub use mechanica_mass as mass;
 pub use mechanica_mechanism as mechanism;
 #[cfg(feature = "modal")]
 pub use mechanica_modal as modal;
+#[cfg(feature = "urdf")]
+pub use mechanica_urdf as urdf;
 
 pub mod ffi;
 
