@@ -17,7 +17,8 @@
         feature = "impulse",
         feature = "modal",
         feature = "mechanism",
-        feature = "dynamics"
+        feature = "dynamics",
+        feature = "urdf"
     )),
     allow(dead_code, unused_imports, unused_macros)
 )]
@@ -44,6 +45,8 @@ mod mass;
 mod mechanism;
 #[cfg(feature = "modal")]
 mod modal;
+#[cfg(feature = "urdf")]
+mod urdf;
 
 pub use boundary::*;
 pub use status::*;
@@ -62,3 +65,5 @@ pub use mass::*;
 pub use mechanism::*;
 #[cfg(feature = "modal")]
 pub use modal::*;
+#[cfg(feature = "urdf")]
+pub use urdf::*;

@@ -25,6 +25,9 @@ pub const MECH_FEATURE_BIT_MECHANISM: u32 = 1 << 4;
 /// Bit of mech_features() set when the dynamics functions (inverse and forward dynamics, joint
 /// reactions) are compiled in.
 pub const MECH_FEATURE_BIT_DYNAMICS: u32 = 1 << 5;
+/// Bit of mech_features() set when the URDF readers (trees and mechanisms from URDF) are
+/// compiled in.
+pub const MECH_FEATURE_BIT_URDF: u32 = 1 << 6;
 
 /// The library version as a static NUL-terminated string "MAJOR.MINOR.PATCH".
 #[unsafe(no_mangle)]
@@ -59,6 +62,9 @@ pub extern "C" fn mech_features() -> u32 {
     }
     if cfg!(feature = "dynamics") {
         bits |= MECH_FEATURE_BIT_DYNAMICS;
+    }
+    if cfg!(feature = "urdf") {
+        bits |= MECH_FEATURE_BIT_URDF;
     }
     bits
 }
