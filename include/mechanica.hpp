@@ -198,9 +198,15 @@ private:
 class modal_result : public handle<mech_modal_result_t, mech_modal_result_destroy> {
 public:
     using handle::handle;
-    /** Solves the pencil of order n (A and B column-major n·n; mech_modal_solve). */
+    /** Solves the pencil of order n (A and B column-major n·n; mech_modal_solve); NULL
+     * options: mech_modal_options_default(). */
     static modal_result solve(std::size_t n, const_span a, const_span b, const mech_modal_options_t *options = nullptr) {
         if (a.size() != n * n || b.size() != n * n) throw error(MECH_STATUS_BAD_DIMENSION, "A and B must hold n·n values");
+        mech_modal_options_t defaults;
+        if (options == nullptr) {
+            detail::check(mech_modal_options_default(&defaults));
+            options = &defaults;
+        }
         mech_modal_result_t *raw = nullptr;
         detail::check(mech_modal_solve(n, a.data(), b.data(), options, &raw));
         return modal_result(raw);

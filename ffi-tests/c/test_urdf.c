@@ -88,9 +88,10 @@ static void from_string_and_file(void) {
     mech_tree_t *tree = NULL;
     CHECK_STATUS(mech_tree_from_urdf_string(PENDULUM, strlen(PENDULUM), NULL, &options, &tree), MECH_STATUS_OK);
     names_of_the_tree(tree);
-    /* A mechanism made from the URDF tree keeps its names. */
+    /* A mechanism made from the URDF tree keeps its names (mech_mechanism_create wants a
+     * positive mass for every body: the fixed base gets one at its origin). */
     const mech_mass_properties_t point = {1.0, {0.0, 0.0, -L}, {{0}}};
-    const mech_mass_properties_t masses[3] = {{0.0, {0, 0, 0}, {{0}}}, point, point};
+    const mech_mass_properties_t masses[3] = {{1.0, {0, 0, 0}, {{0}}}, point, point};
     mech_mechanism_t *copy = NULL;
     CHECK_STATUS(mech_mechanism_create(tree, masses, 3, &copy), MECH_STATUS_OK);
     size_t length = 0;

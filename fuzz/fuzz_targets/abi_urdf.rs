@@ -29,10 +29,16 @@ fuzz_target!(|data: &[u8]| {
     let dir = std::env::temp_dir().join(format!("mechanica-fuzz-abi-urdf-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("scratch directory");
     let mesh_dir = std::ffi::CString::new(dir.to_string_lossy().as_bytes()).expect("no NUL in the path");
-    for options in [mech_urdf_options_t { repair_inertia: 0, allow_missing_mesh: 0 }, mech_urdf_options_t {
-        repair_inertia: 1,
-        allow_missing_mesh: 1,
-    }] {
+    for options in [
+        mech_urdf_options_t {
+            repair_inertia: 0,
+            allow_missing_mesh: 0,
+        },
+        mech_urdf_options_t {
+            repair_inertia: 1,
+            allow_missing_mesh: 1,
+        },
+    ] {
         let text = data.as_ptr().cast::<c_char>();
         let sentinel = 0x10 as *mut mech_tree_t;
         let mut tree = sentinel;
@@ -57,11 +63,17 @@ fuzz_target!(|data: &[u8]| {
             assert_eq!(unsafe { mech_tree_size(tree, &mut bodies, &mut dof) }, MECH_STATUS_OK);
             for b in 0..bodies {
                 // SAFETY: `tree` is live; the buffers are sized by name_of.
-                name_of(|p, c, l| unsafe { mech_tree_link_name(tree, b, p, c, l) }, "mech_tree_link_name");
+                name_of(
+                    |p, c, l| unsafe { mech_tree_link_name(tree, b, p, c, l) },
+                    "mech_tree_link_name",
+                );
             }
             for k in 0..dof {
                 // SAFETY: as above.
-                name_of(|p, c, l| unsafe { mech_tree_coordinate_name(tree, k, p, c, l) }, "mech_tree_coordinate_name");
+                name_of(
+                    |p, c, l| unsafe { mech_tree_coordinate_name(tree, k, p, c, l) },
+                    "mech_tree_coordinate_name",
+                );
             }
             if status_m == MECH_STATUS_OK {
                 let mut n = 0;
