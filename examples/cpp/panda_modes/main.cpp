@@ -1,5 +1,7 @@
-// Reads the Franka Panda arm from URDF through the C++ header, finds its stable equilibrium
-// hanging under gravity within the joint limits, and prints the modes about it.
+// Reads the Franka Panda arm from URDF through the C++ header, seeks the minimum of its
+// potential under gravity within the joint limits, and prints the modes about it. Coordinates
+// that end on a joint limit are held there by the limit, not by gravity: the modes about such
+// a configuration can include unstable directions along them.
 //
 //   panda_modes [path/to/panda.urdf]
 #include <cstdio>
