@@ -54,6 +54,8 @@
 #define MECH_FEATURE_DYNAMICS 1
 /** Declared by default: the motion functions (integration of the equations of motion in time). */
 #define MECH_FEATURE_MOTION 1
+/** Declared by default: the URDF readers (trees and mechanisms from URDF robot descriptions). */
+#define MECH_FEATURE_URDF 1
 #endif
 
 /**
@@ -113,6 +115,12 @@
  */
 #define MECH_FEATURE_BIT_MOTION (1 << 6)
 
+/**
+ * Bit of mech_features() set when the URDF readers (trees and mechanisms from URDF) are
+ * compiled in.
+ */
+#define MECH_FEATURE_BIT_URDF (1 << 7)
+
 #if defined(MECH_FEATURE_MASS)
 /**
  * The relative weld tolerance that mech_mass_mesh_welded takes for "default": 1e-8 of the
@@ -126,6 +134,14 @@
  * The ground, as a body index for mech_mechanism_add_point_spring.
  */
 #define MECH_GROUND -1
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * The longest URDF file or text the readers accept, in bytes (64 MiB); longer ones give
+ * MECH_STATUS_BAD_DIMENSION before anything is parsed.
+ */
+#define MECH_URDF_MAX_BYTES 67108864
 #endif
 
 #if defined(MECH_FEATURE_DYNAMICS)
@@ -1647,6 +1663,25 @@ typedef struct mech_motion_report_t {
      */
     uint64_t steps;
 } mech_motion_report_t;
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * How the URDF readers treat links that are not physical as written. Start from
+ * mech_urdf_options_default().
+ */
+typedef struct mech_urdf_options_t {
+    /**
+     * 1: replace an invalid `<inertia>` by the nearest physical tensor (the relative change is
+     * the Frobenius distance over the tensor's norm); 0 (default): refuse the robot.
+     */
+    int32_t repair_inertia;
+    /**
+     * 1: a link without `<inertial>` whose mesh cannot be used (missing file, a format other
+     * than STL or OBJ, no volume) is massless; 0 (default): refuse the robot.
+     */
+    int32_t allow_missing_mesh;
+} mech_urdf_options_t;
 #endif
 
 /**
@@ -4789,6 +4824,197 @@ mech_status_t mech_simulation_advance(struct mech_simulation_t *simulation,
  */
 mech_status_t mech_simulation_report(const struct mech_simulation_t *simulation,
                                      struct mech_motion_report_t *report_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * Copies the name of the link of body `body` of a tree read from URDF into `buffer` (UTF-8
+ * with a terminating NUL) and writes its length in bytes (without the NUL) to `*length_out`.
+ * With `buffer = NULL, capacity = 0` only the length is written: allocate length + 1 bytes.
+ *
+ * Errors: MECH_STATUS_BUFFER_TOO_SMALL when `capacity` < length + 1 (nothing is written);
+ * MECH_STATUS_INVALID_ARGUMENT for a body index out of range or a tree not read from URDF.
+ *
+ * # Safety
+ * `tree` must be a live handle, `buffer` NULL or `capacity` writable bytes, `length_out`
+ * writable.
+ */
+mech_status_t mech_tree_link_name(struct mech_tree_t *tree,
+                                  size_t body,
+                                  char *buffer,
+                                  size_t capacity,
+                                  size_t *length_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * As mech_tree_link_name, the name of the joint between body `body` and its parent (the empty
+ * string for the root link, which hangs on the base frame by a fixed joint).
+ *
+ * Errors: as mech_tree_link_name.
+ *
+ * # Safety
+ * As mech_tree_link_name.
+ */
+mech_status_t mech_tree_joint_name(struct mech_tree_t *tree,
+                                   size_t body,
+                                   char *buffer,
+                                   size_t capacity,
+                                   size_t *length_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * As mech_tree_link_name, the name of coordinate `k` (0 ≤ k < dof): its joint's name for a
+ * one-coordinate joint, `joint[i]` (i = 0, 1, …) for the coordinates of spherical, planar and
+ * free joints.
+ *
+ * Errors: as mech_tree_link_name, for a coordinate index out of range.
+ *
+ * # Safety
+ * As mech_tree_link_name.
+ */
+mech_status_t mech_tree_coordinate_name(struct mech_tree_t *tree,
+                                        size_t k,
+                                        char *buffer,
+                                        size_t capacity,
+                                        size_t *length_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * As mech_tree_link_name, for a mechanism read from URDF (or created from a tree read from
+ * URDF).
+ *
+ * Errors: as mech_tree_link_name.
+ *
+ * # Safety
+ * `mechanism` must be a live handle, `buffer` NULL or `capacity` writable bytes,
+ * `length_out` writable.
+ */
+mech_status_t mech_mechanism_link_name(const struct mech_mechanism_t *mechanism,
+                                       size_t body,
+                                       char *buffer,
+                                       size_t capacity,
+                                       size_t *length_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * As mech_tree_coordinate_name, for a mechanism read from URDF (or created from a tree read
+ * from URDF).
+ *
+ * Errors: as mech_tree_link_name.
+ *
+ * # Safety
+ * As mech_mechanism_link_name.
+ */
+mech_status_t mech_mechanism_coordinate_name(const struct mech_mechanism_t *mechanism,
+                                             size_t k,
+                                             char *buffer,
+                                             size_t capacity,
+                                             size_t *length_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * Writes the default URDF options (both 0: strict) to `*options_out`.
+ *
+ * Errors: none beyond the pointer checks.
+ *
+ * # Safety
+ * `options_out` must be writable.
+ */
+mech_status_t mech_urdf_options_default(struct mech_urdf_options_t *options_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * Reads a robot from the URDF file at `path` (NUL-terminated, UTF-8) into a finalized tree
+ * and writes its handle to `*tree_out` (freed with mech_tree_destroy). Body b is link b of
+ * the file (file order); the root link hangs on the base frame by a fixed joint at the
+ * identity, every other link on its parent by its joint: revolute and continuous → revolute,
+ * prismatic, fixed, floating → free, spherical, planar (normal along the joint's z only);
+ * the joint frame sits at `<origin xyz rpy>` (R = R_z(yaw) R_y(pitch) R_x(roll)) in the parent
+ * link frame and is the child link's frame at q = 0. Mesh references (for links without
+ * `<inertial>`) are resolved next to the file. mech_tree_link_name, mech_tree_joint_name and
+ * mech_tree_coordinate_name give the names. `options` may be NULL (the defaults).
+ *
+ * Errors (mech_last_error names the file, and the link or joint and field): MECH_STATUS_IO_ERROR
+ * when the file or a needed mesh cannot be read; MECH_STATUS_BAD_DIMENSION for a file longer
+ * than MECH_URDF_MAX_BYTES; MECH_STATUS_PARSE_ERROR when it is not a URDF robot;
+ * MECH_STATUS_NON_FINITE for a NaN or infinite joint origin; MECH_STATUS_INVALID_ARGUMENT for
+ * an invalid inertia, an unusable axis, a joint naming no link, not exactly one root link, a
+ * cycle, a path that is not UTF-8 or an option flag other than 0 and 1.
+ *
+ * # Safety
+ * `path` must be a NUL-terminated string, `options` NULL or readable, `tree_out` writable.
+ */
+mech_status_t mech_tree_from_urdf(const char *path,
+                                  const struct mech_urdf_options_t *options,
+                                  struct mech_tree_t **tree_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * As mech_tree_from_urdf, from the URDF text `text` of `length` bytes (UTF-8, no NUL needed,
+ * at most MECH_URDF_MAX_BYTES). Mesh file names, with `package://` and `file://` stripped,
+ * are looked for in the directory `mesh_dir` (NUL-terminated; NULL: the working directory),
+ * then relative to the working directory.
+ *
+ * Errors: as mech_tree_from_urdf; MECH_STATUS_PARSE_ERROR also for a text that is not UTF-8.
+ *
+ * # Safety
+ * `text` must point to `length` readable bytes, `mesh_dir` be NULL or a NUL-terminated
+ * string, `options` NULL or readable, `tree_out` writable.
+ */
+mech_status_t mech_tree_from_urdf_string(const char *text,
+                                         size_t length,
+                                         const char *mesh_dir,
+                                         const struct mech_urdf_options_t *options,
+                                         struct mech_tree_t **tree_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * Reads a robot from the URDF file at `path` into a mechanism and writes its handle to
+ * `*mechanism_out` (freed with mech_mechanism_destroy): the tree of mech_tree_from_urdf, each
+ * body with its link's mass properties (`<inertial>`: centre of mass at the inertial origin,
+ * the tensor rotated by its rpy into the link frame; a link without one takes its collision
+ * (else visual) STL or OBJ mesh at 1000 kg/m³, or is a massless frame when it has no mesh),
+ * gravity −9.81 m/s² along the base frame's z axis, and the finite limits (lower < upper) of
+ * revolute and prismatic joints as coordinate limits. Every link's tensor is checked for
+ * symmetry, semidefiniteness and the triangle inequality; all invalid links are named in one
+ * message. `options` may be NULL (the defaults). mech_mechanism_link_name and
+ * mech_mechanism_coordinate_name give the names.
+ *
+ * Errors: as mech_tree_from_urdf.
+ *
+ * # Safety
+ * `path` must be a NUL-terminated string, `options` NULL or readable, `mechanism_out`
+ * writable.
+ */
+mech_status_t mech_mechanism_from_urdf(const char *path,
+                                       const struct mech_urdf_options_t *options,
+                                       struct mech_mechanism_t **mechanism_out);
+#endif
+
+#if defined(MECH_FEATURE_URDF)
+/**
+ * As mech_mechanism_from_urdf, from the URDF text `text` of `length` bytes with meshes looked
+ * for in `mesh_dir` (see mech_tree_from_urdf_string).
+ *
+ * Errors: as mech_tree_from_urdf_string.
+ *
+ * # Safety
+ * `text` must point to `length` readable bytes, `mesh_dir` be NULL or a NUL-terminated
+ * string, `options` NULL or readable, `mechanism_out` writable.
+ */
+mech_status_t mech_mechanism_from_urdf_string(const char *text,
+                                              size_t length,
+                                              const char *mesh_dir,
+                                              const struct mech_urdf_options_t *options,
+                                              struct mech_mechanism_t **mechanism_out);
 #endif
 
 #ifdef __cplusplus

@@ -11,7 +11,7 @@ static void versions_agree(void) {
     CHECK(mech_abi_version() == MECH_ABI_VERSION);
     CHECK(mech_features() == (MECH_FEATURE_BIT_KINEMATICS | MECH_FEATURE_BIT_MASS | MECH_FEATURE_BIT_IMPULSE |
                               MECH_FEATURE_BIT_MODAL | MECH_FEATURE_BIT_MECHANISM | MECH_FEATURE_BIT_DYNAMICS |
-                              MECH_FEATURE_BIT_MOTION));
+                              MECH_FEATURE_BIT_MOTION | MECH_FEATURE_BIT_URDF));
 }
 
 static void status_strings(void) {

@@ -11,6 +11,7 @@
 //! | `mechanism`  | [`mechanism`]            | `mechanica-mechanism`   |
 //! | `dynamics`   | [`dynamics`]             | `mechanica-dynamics`    |
 //! | `motion`     | [`motion`]               | `mechanica-motion`      |
+//! | `urdf`       | [`urdf`]                 | `mechanica-urdf`        |
 //!
 //! C and C++ programs use the same capabilities through [`ffi`], declared in the generated
 //! header `include/mechanica.h`.
@@ -29,6 +30,8 @@ pub use mechanica_mechanism as mechanism;
 pub use mechanica_modal as modal;
 #[cfg(feature = "motion")]
 pub use mechanica_motion as motion;
+#[cfg(feature = "urdf")]
+pub use mechanica_urdf as urdf;
 
 pub mod ffi;
 

@@ -18,7 +18,8 @@
         feature = "modal",
         feature = "mechanism",
         feature = "dynamics",
-        feature = "motion"
+        feature = "motion",
+        feature = "urdf"
     )),
     allow(dead_code, unused_imports, unused_macros)
 )]
@@ -47,6 +48,8 @@ mod mechanism;
 mod modal;
 #[cfg(feature = "motion")]
 mod motion;
+#[cfg(feature = "urdf")]
+mod urdf;
 
 pub use boundary::*;
 pub use status::*;
@@ -67,3 +70,5 @@ pub use mechanism::*;
 pub use modal::*;
 #[cfg(feature = "motion")]
 pub use motion::*;
+#[cfg(feature = "urdf")]
+pub use urdf::*;

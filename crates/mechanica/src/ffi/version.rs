@@ -27,6 +27,9 @@ pub const MECH_FEATURE_BIT_MECHANISM: u32 = 1 << 4;
 pub const MECH_FEATURE_BIT_DYNAMICS: u32 = 1 << 5;
 /// Bit of mech_features() set when the motion functions (integration in time) are compiled in.
 pub const MECH_FEATURE_BIT_MOTION: u32 = 1 << 6;
+/// Bit of mech_features() set when the URDF readers (trees and mechanisms from URDF) are
+/// compiled in.
+pub const MECH_FEATURE_BIT_URDF: u32 = 1 << 7;
 
 /// The library version as a static NUL-terminated string "MAJOR.MINOR.PATCH".
 #[unsafe(no_mangle)]
@@ -64,6 +67,9 @@ pub extern "C" fn mech_features() -> u32 {
     }
     if cfg!(feature = "motion") {
         bits |= MECH_FEATURE_BIT_MOTION;
+    }
+    if cfg!(feature = "urdf") {
+        bits |= MECH_FEATURE_BIT_URDF;
     }
     bits
 }

@@ -54,6 +54,9 @@ pub struct mech_tree_t {
     /// The validated body mass properties of the last mass call, with their recursion's state.
     #[cfg(feature = "mass")]
     pub(crate) mass_cache: Option<crate::ffi::mass::TreeMassCache>,
+    /// The link, joint and coordinate names of a tree read from URDF.
+    #[cfg(feature = "urdf")]
+    pub(crate) names: Option<std::sync::Arc<crate::ffi::urdf::UrdfNames>>,
 }
 
 impl Handle for mech_tree_t {}
@@ -99,6 +102,8 @@ pub unsafe extern "C" fn mech_tree_create(tree_out: *mut *mut mech_tree_t) -> me
             built: None,
             #[cfg(feature = "mass")]
             mass_cache: None,
+            #[cfg(feature = "urdf")]
+            names: None,
         };
         // SAFETY: caller's contract.
         unsafe { out.write(tree.into_raw()) };

@@ -47,7 +47,11 @@ impl From<MechanismError> for FfiError {
 /// A mechanism (opaque): a copy of a finalized tree with body mass properties and loads.
 /// Created by mech_mechanism_create, freed by mech_mechanism_destroy.
 pub struct mech_mechanism_t {
-    mechanism: Mechanism,
+    pub(crate) mechanism: Mechanism,
+    /// The link, joint and coordinate names of a mechanism read from URDF (or made from such
+    /// a tree).
+    #[cfg(feature = "urdf")]
+    pub(crate) names: Option<std::sync::Arc<crate::ffi::urdf::UrdfNames>>,
 }
 
 impl Handle for mech_mechanism_t {}
@@ -111,8 +115,10 @@ pub unsafe extern "C" fn mech_mechanism_create(
     boundary(|| {
         let out = Out::new(mechanism_out, "mechanism_out")?;
         // SAFETY: caller's contract.
-        let tree = unsafe { mech_tree_t::borrow_mut(tree, "tree") }?;
-        let (tree, _) = tree.built()?;
+        let tree_handle = unsafe { mech_tree_t::borrow_mut(tree, "tree") }?;
+        #[cfg(feature = "urdf")]
+        let names = tree_handle.names.clone();
+        let (tree, _) = tree_handle.built()?;
         // SAFETY: caller's contract.
         let raw = unsafe { read_slice(bodies, n_bodies, "bodies") }?;
         let mut masses = Vec::with_capacity(raw.len());
@@ -128,6 +134,8 @@ pub unsafe extern "C" fn mech_mechanism_create(
         }
         let mechanism = mech_mechanism_t {
             mechanism: Mechanism::new(tree.clone(), masses)?,
+            #[cfg(feature = "urdf")]
+            names,
         };
         // SAFETY: caller's contract.
         unsafe { out.write(mechanism.into_raw()) };

@@ -1,0 +1,38 @@
+//! URDF robot descriptions (read through the `urdf-rs` crate) as link mass properties, joints
+//! and kinematic trees.
+//!
+//! - **Links** get explicit mass properties from `<inertial>`: the centre of mass at the
+//!   inertial origin and the tensor rotated by its `rpy` into the link frame. Every link's
+//!   tensor is checked (mass crate validity: symmetry, semidefiniteness, triangle inequality);
+//!   all invalid links are reported at once, and [`UrdfOptions::repair_inertia`] replaces each
+//!   by the nearest physical tensor (documented in `mechanica_mass::validity::repair`).
+//! - A link without `<inertial>` (or with a zero mass there) whose collision (or else visual)
+//!   geometry is a mesh gets the mesh's mass properties at [`MESH_DENSITY`] (water; URDF gives
+//!   no density); the file name, with `package://` and `file://` prefixes stripped, is resolved
+//!   in the mesh directory (the URDF file's directory for [`read_file`]), then relative to the
+//!   working directory. A mesh that cannot be used (missing file, a format other than STL or
+//!   OBJ such as `.dae`, a mesh without a volume) is an error naming the link and the mesh;
+//!   with [`UrdfOptions::allow_missing_mesh`] the link is massless instead and a warning is
+//!   added to the notes. A link with neither `<inertial>` nor a mesh is a massless frame.
+//! - **Joints**: revolute and continuous → revolute, prismatic, fixed, floating → free,
+//!   spherical, planar (normal along the joint's z only). Placements use the joint origin
+//!   (xyz, rpy = R_z(yaw) R_y(pitch) R_x(roll)); the child link frame is the joint frame at
+//!   q = 0. Finite revolute/prismatic limits with lower < upper become joint limits. Mimic
+//!   joints are not followed (each joint is free).
+//! - **Trees** ([`UrdfRobot::tree`]): one body per link in the file's order, the root link
+//!   attached to the base frame by a fixed joint, every other link by its URDF joint.
+//!
+//! The text is at most [`MAX_URDF_BYTES`] long; every allocation is proportional to it.
+
+mod error;
+mod links;
+mod robot;
+mod tree;
+
+pub use error::UrdfError;
+pub use links::MESH_DENSITY;
+pub use robot::{JointKind, UrdfDocument, UrdfJoint, UrdfLink, UrdfOptions, UrdfRobot, read_file, read_str};
+pub use tree::UrdfTree;
+
+/// The longest URDF text read (64 MiB): larger files and strings are refused before parsing.
+pub const MAX_URDF_BYTES: usize = 64 << 20;
