@@ -133,7 +133,8 @@ impl LieIntegrator {
     }
 
     /// (R, ω) at t = `duration` from (R(0), ω(0)) = (`r0`, `omega0`) with n = ⌈duration/max_step⌉
-    /// equal steps (n = 0 for duration = 0).
+    /// equal steps (n = 0 for duration = 0; a quotient within 4ε of an integer is taken as that
+    /// integer).
     ///
     /// R(t) is a product of exact rotations, so ‖RᵀR − I‖ grows at most like c·n·ε. The global
     /// error is O(hᵖ), p = [`LieMethod::order`]; [`Self::integrate_with_estimate`] estimates it.
@@ -323,7 +324,12 @@ fn step_count(duration: f64, max_step: f64, factor: u64) -> Result<u64, Dynamics
             value: max_step,
         });
     }
-    let steps = (duration / max_step).ceil();
+    let quotient = duration / max_step;
+    let mut steps = quotient.ceil();
+    // A quotient within 4ε of an integer n (duration = n·max_step to rounding) counts n steps.
+    if steps >= 1.0 && quotient - (steps - 1.0) <= 4.0 * f64::EPSILON * quotient {
+        steps -= 1.0;
+    }
     let requested = steps * factor as f64;
     if !(requested <= MAX_LIE_STEPS as f64) {
         return Err(DynamicsError::TooManySteps {

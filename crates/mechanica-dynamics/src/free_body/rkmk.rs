@@ -1,18 +1,20 @@
 //! The Runge–Kutta–Munthe-Kaas method of order 4 for (R, ω) ∈ SO(3) × ℝ³: R = R₀ exp([u]×) with
 //! u̇ = dexp⁻¹_u(ω), u(0) = 0, and Euler's equations (7.41) for ω, both by the classical RK4
-//! tableau; R₁ = R₀ exp([Θ]×) with Θ the RK4 value of u(h). The series
-//! dexp⁻¹_u(v) = v − ½ u × v + (1/12) u × (u × v) + O(|u|⁴|v|) is truncated after the terms of
-//! order 2 in u, which order 4 requires (the omitted terms are O(h⁴) in the stages, O(h⁵) in Θ).
+//! tableau; R₁ = R₀ exp([Θ]×) with Θ the RK4 value of u(h). With the body-frame ω the group
+//! acts on the right (Ṙ = R[ω]×), so ω = dexp_{−u}(u̇) and u̇ = dexp⁻¹_{−u}(ω); the series
+//! dexp⁻¹_{−u}(v) = v + ½ u × v + (1/12) u × (u × v) + O(|u|⁴|v|) is truncated after the terms
+//! of order 2 in u, which order 4 requires (the omitted terms are O(h⁴) in the stages, O(h⁵)
+//! in Θ).
 
 use mechanica_kinematics::rotation::exp_map;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::error::DynamicsError;
 
-/// dexp⁻¹_u(v) truncated after the double commutator.
+/// dexp⁻¹_{−u}(v) truncated after the double commutator.
 fn dexp_inverse(u: &Vector3<f64>, v: &Vector3<f64>) -> Vector3<f64> {
     let uv = u.cross(v);
-    v - uv * 0.5 + u.cross(&uv) / 12.0
+    v + uv * 0.5 + u.cross(&uv) / 12.0
 }
 
 /// Euler's equations (7.41) without torque, for validated moments.
