@@ -23,7 +23,7 @@ import mpmath as mp
 import numpy as np
 from scipy.integrate import solve_ivp
 
-DOP853_RTOL = [10.0**-e for e in (4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14)]
+DOP853_RTOL = [10.0**-e for e in (4, 5, 6, 7, 8, 9, 10, 11, 12)] + [3e-13, 1e-13, 5e-14, 3e-14]
 RADAU_RTOL = [10.0**-e for e in (4, 5, 6, 7, 8)]
 RADAU_TIME_LIMIT = 120.0
 

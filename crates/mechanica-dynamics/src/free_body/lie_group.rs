@@ -331,7 +331,7 @@ fn step_count(duration: f64, max_step: f64, factor: u64) -> Result<u64, Dynamics
         steps -= 1.0;
     }
     let requested = steps * factor as f64;
-    if !(requested <= MAX_LIE_STEPS as f64) {
+    if requested > MAX_LIE_STEPS as f64 {
         return Err(DynamicsError::TooManySteps {
             what: "free-body integration",
             steps: requested,

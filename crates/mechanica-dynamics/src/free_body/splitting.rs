@@ -121,7 +121,7 @@ impl MomentumInvariants {
         let w = momentum.component_mul(inverse_moments);
         let (a, b, c) = (momentum.dot(momentum), momentum.dot(&w), w.dot(&w));
         let gram = a * c - b * b;
-        if !(gram > 1e-8 * a * c) {
+        if gram.is_nan() || gram <= 1e-8 * a * c {
             return;
         }
         let (r_sphere, r_ellipsoid) = (a - self.sphere, b - self.ellipsoid);
