@@ -4,7 +4,8 @@ solve_ivp (DOP853, Radau), in one invocation, on the problem of
 crates/mechanica-dynamics/examples/free_body_work_precision.rs (moments (1, 2, 3), 1e-3 from the
 separatrix, 100 periods).
 
-Usage: pip install scipy mpmath; python3 tools/free_body_work_precision.py
+Usage: pip install scipy mpmath; python3 tools/free_body_work_precision.py [--from-csv]
+(--from-csv redraws the SVG and the summary from the committed CSV without running anything.)
 Writes tools/free_body_work_precision.csv (both sides), tools/free_body_work_precision.svg
 (attitude error against wall time, log-log) and prints, for the target attitude error 1e-10,
 the fastest run of each method that reaches it, the ratio of SciPy DOP853's time to mechanica's
@@ -93,7 +94,7 @@ def write_svg(rows):
         path = " ".join(f"{x(t):.1f},{y(e):.1f}" for t, e in pts)
         parts.append(f'<polyline points="{path}" fill="none" stroke="{colour}" stroke-width="1.5"/>')
         parts.extend(f'<circle cx="{x(t):.1f}" cy="{y(e):.1f}" r="2.5" fill="{colour}"/>' for t, e in pts)
-        parts.append(f'<text x="{width - margin - 150}" y="{margin + 15 + 14 * i}" fill="{colour}">{name}</text>')
+        parts.append(f'<text x="{margin + 10}" y="{height - margin - 110 + 14 * i}" fill="{colour}">{name}</text>')
     parts.append("</svg>\n")
     with open(SVG_OUT, "w") as f:
         f.write("\n".join(parts))
@@ -130,9 +131,13 @@ def summary(rows):
 
 
 def main():
-    with tempfile.TemporaryDirectory() as workdir:
-        rows = run_both(workdir)
-    write_csv(rows)
+    if "--from-csv" in sys.argv:
+        with open(CSV_OUT) as f:
+            rows = list(csv.DictReader(f))
+    else:
+        with tempfile.TemporaryDirectory() as workdir:
+            rows = run_both(workdir)
+        write_csv(rows)
     write_svg(rows)
     summary(rows)
 
