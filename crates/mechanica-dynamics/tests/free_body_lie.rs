@@ -137,16 +137,20 @@ proptest! {
             prop_assert!((order - p).abs() <= 0.6, "{method:?}: observed order {order} for {case:?}");
         }
     }
+}
 
-    /// The estimate bounds the true error of the reported run (attitude and ω) for at least 38 of
-    /// a family of 40 random bodies (generic, near-axisymmetric, 1e-6..1e-2 from the separatrix),
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+
+    /// The estimate bounds the true error of the reported run (attitude and ω) for at least 95 of
+    /// a family of 100 random bodies (generic, near-axisymmetric, 1e-6..1e-2 from the separatrix),
     /// methods, durations (0.5..5 radians of the fastest rate, times 1..20) and steps.
     #[test]
     fn the_error_estimate_bounds_the_true_error(seed in any::<u64>()) {
         let mut rng = Rng::new(seed);
         let mut honest = 0;
         let mut report = Vec::new();
-        for _ in 0..40 {
+        for _ in 0..100 {
             let case = random_case(&mut rng);
             let method = LieMethod::ALL[rng.below(5)];
             let t = rng.uniform(0.5, 5.0) * rng.uniform(1.0, 20.0) / rate(&case);
@@ -162,7 +166,7 @@ proptest! {
                 report.push((method, attitude, estimate.attitude_error, omega, estimate.omega_error));
             }
         }
-        prop_assert!(honest >= 38, "{honest} of 40 honest; failures {report:?}");
+        prop_assert!(honest >= 95, "{honest} of 100 honest; failures {report:?}");
     }
 }
 
