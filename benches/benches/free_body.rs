@@ -18,7 +18,7 @@ const STEPS: f64 = 90_950.0;
 
 fn problem() -> (Vector3<f64>, Vector3<f64>, Rotation3<f64>) {
     let moments = Vector3::new(1.0, 2.0, 3.0);
-    let (w1, w2, delta) = (0.8, 0.1, 1e-3);
+    let (w1, w2, delta): (f64, f64, f64) = (0.8, 0.1, 1e-3);
     let ratio =
         moments.x * (moments.y - moments.x) * (1.0 + delta) / (moments.z * (moments.z - moments.y) * (1.0 - delta));
     let omega0 = Vector3::new(w1, w2, w1 * ratio.sqrt());

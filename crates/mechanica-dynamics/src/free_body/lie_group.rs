@@ -2,7 +2,7 @@
 //! Ṙ = R[ω]× (7.24)) and the body-frame angular velocity ω in principal axes (Euler's equations
 //! (7.41) with M = 0), advanced so that R stays a rotation to rounding without renormalisation.
 //!
-//! - [`LieMethod::Rkmk4`]: Runge–Kutta–Munthe-Kaas of order 4 ([`super::rkmk`]).
+//! - [`LieMethod::Rkmk4`]: Runge–Kutta–Munthe-Kaas of order 4.
 //! - [`LieMethod::Splitting2`], [`LieMethod::Splitting4`], [`LieMethod::Splitting6`],
 //!   [`LieMethod::Splitting8`]: the Lie–Poisson splitting into three rotations about the
 //!   principal axes ([`super::splitting`]), symmetric (order 2) and composed to order 4, 6, 8.
