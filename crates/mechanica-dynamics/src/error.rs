@@ -121,6 +121,16 @@ pub enum DynamicsError {
         /// The size of the matrix.
         scale: f64,
     },
+    /// A fixed-step integration would need more steps than its documented cap.
+    #[error("{what} needs {steps:e} steps, more than the cap of {cap}")]
+    TooManySteps {
+        /// Which integration.
+        what: &'static str,
+        /// The steps it would need.
+        steps: f64,
+        /// The cap.
+        cap: u64,
+    },
     /// An iterative solve did not converge.
     #[error("{what} did not converge after {iterations} iterations (residual {residual:e})")]
     NotConverged {
