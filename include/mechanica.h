@@ -331,13 +331,6 @@ typedef struct mech_forward_report_t {
 } mech_forward_report_t;
 #endif
 
-#if defined(MECH_FEATURE_DYNAMICS)
-/**
- * The frame in which a joint reaction is expressed (int32_t).
- */
-typedef int32_t mech_reaction_frame_t;
-#endif
-
 /**
  * A 3×3 matrix of doubles in column-major order: m[row + 3*col].
  */
@@ -347,6 +340,57 @@ typedef struct mech_mat3_t {
      */
     double m[9];
 } mech_mat3_t;
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The state of a free rigid body: its attitude and its angular velocity.
+ */
+typedef struct mech_free_body_state_t {
+    /**
+     * R, body → space (a rotation matrix, column-major).
+     */
+    struct mech_mat3_t rotation;
+    /**
+     * ω in body (principal-axes) components, rad/s.
+     */
+    struct mech_vec3_t omega;
+} mech_free_body_state_t;
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * A Lie-group method of mech_free_body_integrate (docs/theory.md, "Lie-group integration of
+ * the free body").
+ */
+typedef int32_t mech_lie_method_t;
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * What mech_free_body_integrate reports besides the state.
+ */
+typedef struct mech_free_body_report_t {
+    /**
+     * Estimated error of the attitude: the angle of R_n⁻¹ R_2n, rad.
+     */
+    double attitude_error;
+    /**
+     * Estimated error of ω relative to |ω|.
+     */
+    double omega_error;
+    /**
+     * Steps of the reported run.
+     */
+    uint64_t steps;
+} mech_free_body_report_t;
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The frame in which a joint reaction is expressed (int32_t).
+ */
+typedef int32_t mech_reaction_frame_t;
+#endif
 
 #if defined(MECH_FEATURE_MASS)
 /**
@@ -1845,6 +1889,41 @@ typedef struct mech_urdf_options_t {
 
 #if defined(MECH_FEATURE_DYNAMICS)
 /**
+ * The symmetric splitting into rotations about the principal axes, order 2.
+ */
+#define MECH_LIE_SPLITTING2 0
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Runge–Kutta–Munthe-Kaas with the classical RK4 tableau, order 4.
+ */
+#define MECH_LIE_RKMK4 1
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The splitting composed to order 4.
+ */
+#define MECH_LIE_SPLITTING4 2
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The splitting composed to order 6.
+ */
+#define MECH_LIE_SPLITTING6 3
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The splitting composed to order 8.
+ */
+#define MECH_LIE_SPLITTING8 4
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
  * World (base-frame) components.
  */
 #define MECH_REACTION_FRAME_WORLD 0
@@ -2876,6 +2955,53 @@ mech_status_t mech_dynamics_mass_matrix(struct mech_dynamics_t *dynamics,
                                         const double *q,
                                         size_t n,
                                         double *a_out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * The exact state at time `t` of the torque-free body with principal `moments` (> 0, kg·m²)
+ * that starts from `initial` at t = 0: Euler's equations (7.41) without torque solved by
+ * Jacobi's elliptic functions, the attitude through the invariable plane (EB1911 §21), in every
+ * regime (either side of the separatrix, on it, axisymmetric, steady rotation). Accurate to
+ * a few ulps of the elliptic functions times the growth of the phase with t.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT
+ * for a moment ≤ 0 or an initial rotation that is not orthonormal with det +1 to 1e-12;
+ * MECH_STATUS_OUT_OF_RANGE when the energy, the momentum or the phase overflow.
+ *
+ * # Safety
+ * `moments` and `initial` must be readable, `out` writable.
+ */
+mech_status_t mech_free_body_exact(const struct mech_vec3_t *moments,
+                                   const struct mech_free_body_state_t *initial,
+                                   double t,
+                                   struct mech_free_body_state_t *out);
+#endif
+
+#if defined(MECH_FEATURE_DYNAMICS)
+/**
+ * Integrates the torque-free body with principal `moments` from `initial` over `duration`
+ * (≥ 0, s) by a Lie-group method that keeps R on SO(3) without renormalising: runs of n₀,
+ * 2n₀, 4n₀, … steps, n₀ = ⌈duration / max_step⌉, until the difference of the last two, the
+ * error estimate, is ≤ `tolerance` (> 0) for the attitude (rad) and for ω (relative). Writes
+ * the finer run's state and the estimate.
+ *
+ * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_BAD_ENUM for an
+ * unknown method; MECH_STATUS_INVALID_ARGUMENT for a moment ≤ 0, a rotation that is not one,
+ * a negative duration, max_step ≤ 0, tolerance ≤ 0, or when the tolerance is not met within
+ * 2³⁰ steps; MECH_STATUS_OUT_OF_RANGE on overflow.
+ *
+ * # Safety
+ * `moments` and `initial` must be readable, `out` and `report` writable.
+ */
+mech_status_t mech_free_body_integrate(const struct mech_vec3_t *moments,
+                                       const struct mech_free_body_state_t *initial,
+                                       double duration,
+                                       mech_lie_method_t method,
+                                       double max_step,
+                                       double tolerance,
+                                       struct mech_free_body_state_t *out,
+                                       struct mech_free_body_report_t *report);
 #endif
 
 #if defined(MECH_FEATURE_DYNAMICS)

@@ -2,7 +2,8 @@
 //! rotating frame and potentials), with dampers and charged points added to it; inverse
 //! dynamics (τ, its split, joint reactions), forward dynamics (q̈ with its accuracy report) and
 //! the mass matrix, and the damped modes about a configuration, into caller buffers; holonomic
-//! constraints added to the handle and the forward dynamics with their multipliers.
+//! constraints added to the handle and the forward dynamics with their multipliers; the
+//! torque-free rigid body, exact and integrated.
 
 use super::boundary::{FfiError, boundary};
 use super::handle::Handle;
@@ -14,12 +15,14 @@ use mechanica_dynamics::{ConstrainedDynamics, Dynamics, DynamicsError};
 mod constraints;
 mod damped;
 mod forward;
+mod free_body;
 mod inverse;
 mod loads;
 
 pub use constraints::*;
 pub use damped::*;
 pub use forward::*;
+pub use free_body::*;
 pub use inverse::*;
 pub use loads::*;
 
