@@ -105,14 +105,16 @@ fn worst_true_error(case: &Case, method: LieMethod, t: f64, steps: f64) -> f64 {
 }
 
 /// The observed order log₂(e(n)/e(2n)) with n the first power of two at which the error over
-/// two radians of the fastest rate falls below 1e-3 (the asymptotic range), or None when the
-/// 2n run is already at rounding level.
+/// two radians of the fastest rate falls below 1e-3 for orders up to 4 and 1e-6 above (the
+/// asymptotic range: the terms after the leading one of an order-8 composition still weigh
+/// at 1e-3), or None when the 2n run is already at rounding level.
 fn observed_order(case: &Case, method: LieMethod) -> Option<f64> {
     let t = 2.0 / rate(case);
+    let asymptotic = if method.order() > 4 { 1e-6 } else { 1e-3 };
     let mut steps = 2.0;
     loop {
         let coarse = worst_true_error(case, method, t, steps);
-        if coarse < 1e-3 {
+        if coarse < asymptotic {
             let fine = worst_true_error(case, method, t, 2.0 * steps);
             return (fine > 1e-12).then(|| (coarse / fine).log2());
         }
@@ -124,7 +126,8 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
     /// Halving the step divides the error by 2ᵖ, p the method's order (within ±0.6 at the first
-    /// step count with error below 1e-3; higher-order terms and rounding blur it).
+    /// step count in the asymptotic range of [`observed_order`]; higher-order terms and rounding
+    /// blur it).
     #[test]
     fn each_method_converges_with_its_order(seed in any::<u64>(), which in 0usize..5) {
         let mut rng = Rng::new(seed);
@@ -140,17 +143,19 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(12))]
+    #![proptest_config(ProptestConfig::with_cases(2))]
 
-    /// The estimate bounds the true error of the reported run (attitude and ω) for at least 95 of
-    /// a family of 100 random bodies (generic, near-axisymmetric, 1e-6..1e-2 from the separatrix),
-    /// methods, durations (0.5..5 radians of the fastest rate, times 1..20) and steps.
+    /// The estimate bounds the true error of the reported run (attitude and ω) for at least 95%
+    /// of a family of 600 random bodies (generic, near-axisymmetric, 1e-6..1e-2 from the
+    /// separatrix), methods, durations (0.5..5 radians of the fastest rate, times 1..20) and
+    /// steps. (The misses, about 1.5%, are runs at the rounding level near the separatrix; a
+    /// family of 600 keeps the count's spread well inside the 5% allowed.)
     #[test]
     fn the_error_estimate_bounds_the_true_error(seed in any::<u64>()) {
         let mut rng = Rng::new(seed);
         let mut honest = 0;
         let mut report = Vec::new();
-        for _ in 0..100 {
+        for _ in 0..600 {
             let case = random_case(&mut rng);
             let method = LieMethod::ALL[rng.below(5)];
             let t = rng.uniform(0.5, 5.0) * rng.uniform(1.0, 20.0) / rate(&case);
@@ -166,7 +171,7 @@ proptest! {
                 report.push((method, attitude, estimate.attitude_error, omega, estimate.omega_error));
             }
         }
-        prop_assert!(honest >= 95, "{honest} of 100 honest; failures {report:?}");
+        prop_assert!(honest >= 570, "{honest} of 600 honest; failures {report:?}");
     }
 }
 
