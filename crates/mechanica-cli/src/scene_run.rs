@@ -29,9 +29,16 @@ pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report
     let mut model = None;
     steps.push(timed_step("build: bodies and kinematic tree", || {
         let built = build_model(scene, file)?;
+        let names = coordinate_names(&built);
         let quantities = vec![
             quantity("bodies", vec![built.bodies.len() as f64], "", None),
             quantity("degrees of freedom", vec![built.tree.dof() as f64], "", None),
+            quantity(
+                &format!("q0, the start of every analysis, of {}", names.join(", ")),
+                built.q0.clone(),
+                "rad | m",
+                None,
+            ),
         ];
         model = Some(built);
         Ok::<_, String>(quantities)
@@ -333,4 +340,24 @@ mod tests {
                 && (moments[2] - 2.0 / 3.0).abs() < 1e-15
         );
     }
+}
+
+/// One name per coordinate, in coordinate order: the joint's name, indexed within joints of
+/// several coordinates.
+pub(crate) fn coordinate_names(model: &Model) -> Vec<String> {
+    let mut names = vec![String::new(); model.q0.len()];
+    for (joint, body) in &model.joint_body {
+        let range = model.tree.dof_range(*body);
+        let several = range.len() > 1;
+        for (i, k) in range.enumerate() {
+            if let Some(name) = names.get_mut(k) {
+                *name = if several {
+                    format!("{joint}[{i}]")
+                } else {
+                    joint.clone()
+                };
+            }
+        }
+    }
+    names
 }

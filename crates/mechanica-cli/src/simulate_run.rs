@@ -33,7 +33,7 @@ pub fn run(
     };
     let method = method_of(spec);
     let simulation = Simulation::new(dynamics, method, options).map_err(|e| format!("analyses.simulate: {e}"))?;
-    let names = coordinate_names(model);
+    let names = crate::scene_run::coordinate_names(model);
     let mut trajectory = None;
     let title = format!(
         "simulate: motion from (q0, qd0) to t = {} s by {} (M.3)–(M.11), error by a companion run (M.13)",
@@ -155,23 +155,6 @@ fn monitor_note(trajectory: &Trajectory) -> String {
          (conserved only without dampers and velocity-dependent forces)",
         m.initial, m.max_drift, m.last_drift, m.scale
     )
-}
-
-/// One name per coordinate: the joint's name, indexed within joints of several coordinates.
-fn coordinate_names(model: &Model) -> Vec<String> {
-    let mut names = vec![String::new(); model.q0.len()];
-    for (joint, body) in &model.joint_body {
-        let range = model.tree.dof_range(*body);
-        let several = range.len() > 1;
-        for (i, k) in range.enumerate() {
-            names[k] = if several {
-                format!("{joint}[{i}]")
-            } else {
-                joint.clone()
-            };
-        }
-    }
-    names
 }
 
 /// The CSV and JSON files the scene asks for, with their contents.

@@ -106,6 +106,9 @@ fn a_usable_mesh_gives_the_link_its_mass_at_water_density() {
     let exact = G * (0.5 + m_cube) / (1.0 / 12.0 + 0.25 + i_cube + m_cube);
     let got = lowest_omega_sq(&out);
     assert!((got - exact).abs() <= 1e-10 * exact, "{got} vs {exact}");
+    // The start of the analyses is printed, with the coordinate named after its URDF joint.
+    let json: serde_json::Value = serde_json::from_str(&out).expect("JSON report");
+    assert_eq!(values(&json, "q0, the start of every analysis, of hinge"), vec![0.0]);
 }
 
 #[test]
