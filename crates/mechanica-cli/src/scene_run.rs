@@ -287,6 +287,26 @@ fn mass_report(model: &Model, gravity: Option<Vector3<f64>>) -> Result<Vec<Quant
     Ok(quantities)
 }
 
+/// One name per coordinate, in coordinate order: the joint's name, indexed within joints of
+/// several coordinates.
+pub(crate) fn coordinate_names(model: &Model) -> Vec<String> {
+    let mut names = vec![String::new(); model.q0.len()];
+    for (joint, body) in &model.joint_body {
+        let range = model.tree.dof_range(*body);
+        let several = range.len() > 1;
+        for (i, k) in range.enumerate() {
+            if let Some(name) = names.get_mut(k) {
+                *name = if several {
+                    format!("{joint}[{i}]")
+                } else {
+                    joint.clone()
+                };
+            }
+        }
+    }
+    names
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -340,24 +360,4 @@ mod tests {
                 && (moments[2] - 2.0 / 3.0).abs() < 1e-15
         );
     }
-}
-
-/// One name per coordinate, in coordinate order: the joint's name, indexed within joints of
-/// several coordinates.
-pub(crate) fn coordinate_names(model: &Model) -> Vec<String> {
-    let mut names = vec![String::new(); model.q0.len()];
-    for (joint, body) in &model.joint_body {
-        let range = model.tree.dof_range(*body);
-        let several = range.len() > 1;
-        for (i, k) in range.enumerate() {
-            if let Some(name) = names.get_mut(k) {
-                *name = if several {
-                    format!("{joint}[{i}]")
-                } else {
-                    joint.clone()
-                };
-            }
-        }
-    }
-    names
 }
