@@ -3,7 +3,7 @@
 //!
 //! - [`Simulation`]: a [`mechanica_dynamics::Dynamics`] with a [`Method`] and [`Options`]
 //!   (applied forces [`Forcing`], cyclic coordinates, error estimation). [`Simulation::run`]
-//!   records samples (t, q, q̇, H, estimated error) at a fixed interval; [`Session`] advances
+//!   records samples (t, q, q̇, H, estimated error) at a fixed interval; [`Stepper`] advances
 //!   step by step.
 //! - Methods ([`Method`]): explicit RK4 (M.3); Dormand–Prince 5(4) with PI control and dense
 //!   output (M.4)–(M.7); Störmer–Verlet in (q, p = A q̇) (M.8)–(M.9); the implicit midpoint
@@ -36,4 +36,4 @@ pub use estimate::ErrorEstimate;
 pub use forcing::{ForceFunction, Forcing};
 pub use method::{MIN_RTOL, Method};
 pub use monitors::{CyclicMomentum, Invariant, Monitors};
-pub use simulation::{DEFAULT_MAX_STEPS, MAX_SAMPLES, Options, Sample, Session, Simulation, Trajectory};
+pub use simulation::{DEFAULT_MAX_STEPS, MAX_SAMPLES, Options, Sample, Simulation, Stepper, Trajectory};

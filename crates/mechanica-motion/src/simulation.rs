@@ -1,7 +1,7 @@
 //! [`Simulation`]: the public entry point. A run integrates from (q₀, q̇₀) at t = 0 with the
 //! chosen [`Method`], alongside a companion run that gives the global error estimate (M.13),
 //! and records samples at a fixed output interval with the monitors of [`crate::monitors`].
-//! [`Session`] is the same step by step (advance to a time, read the state).
+//! [`Stepper`] is the same step by step (advance to a time, read the state).
 
 use crate::error::{MotionError, StepFailure, check_vector};
 use crate::estimate::{ErrorEstimate, estimate};
@@ -106,8 +106,8 @@ impl Simulation {
     /// Starts a step-by-step integration from (q₀, q̇₀) at t = 0 (given in the mechanism's
     /// charts). Fails when the initial state is not finite or the dynamics cannot be
     /// evaluated there.
-    pub fn start(&self, q0: &[f64], q_dot0: &[f64]) -> Result<Session, MotionError> {
-        Session::new(self, q0, q_dot0)
+    pub fn start(&self, q0: &[f64], q_dot0: &[f64]) -> Result<Stepper, MotionError> {
+        Stepper::new(self, q0, q_dot0)
     }
 
     /// Integrates from (q₀, q̇₀) at t = 0 to `t_end` (> 0) and records samples every
@@ -137,22 +137,22 @@ impl Simulation {
             });
         }
         let count = requested as usize;
-        let mut session = self.start(q0, q_dot0)?;
-        session.horizon = t_end;
+        let mut stepper = self.start(q0, q_dot0)?;
+        stepper.horizon = t_end;
         let mut samples = Vec::with_capacity(count);
-        samples.push(session.sample().clone());
-        observe(session.sample());
+        samples.push(stepper.sample().clone());
+        observe(stepper.sample());
         for i in 1..count {
             let t = (i as f64 * output_interval).min(t_end);
-            let sample = session.advance(t)?;
+            let sample = stepper.advance(t)?;
             observe(sample);
             samples.push(sample.clone());
         }
         Ok(Trajectory {
             samples,
-            monitors: session.monitors(),
-            steps: session.main.steps(),
-            companion_steps: session.companion.as_ref().map_or(0, |c| c.steps()),
+            monitors: stepper.monitors(),
+            steps: stepper.main.steps(),
+            companion_steps: stepper.companion.as_ref().map_or(0, |c| c.steps()),
         })
     }
 }
@@ -171,7 +171,7 @@ fn positive(value: f64, what: &'static str) -> Result<(), MotionError> {
 
 /// A step-by-step integration (see [`Simulation::start`]).
 #[derive(Debug, Clone)]
-pub struct Session {
+pub struct Stepper {
     main: Integrator,
     companion: Option<Integrator>,
     ratio: f64,
@@ -181,7 +181,7 @@ pub struct Session {
     horizon: f64,
 }
 
-impl Session {
+impl Stepper {
     fn new(simulation: &Simulation, q0: &[f64], q_dot0: &[f64]) -> Result<Self, MotionError> {
         let n = simulation.dynamics.dof();
         check_vector(q0, n, "q0")?;
@@ -232,7 +232,7 @@ impl Session {
 
     /// The monitors over every step and sample so far.
     pub fn monitors(&self) -> Monitors {
-        // The tracker is set when the session starts; the fallback is never used.
+        // The tracker is set when the stepper starts; the fallback is never used.
         self.main.tracker().map_or_else(
             || Tracker::new(Invariant::Energy, 0.0, 0.0, &[], &[]).monitors(),
             Tracker::monitors,
@@ -246,7 +246,7 @@ impl Session {
 
     /// Integrates to `t` (finite, ≥ the time of the last sample) and records the sample there.
     /// A failed step gives [`MotionError::StepFailed`] with the last good state of the main
-    /// run; the session then stays at that state (a later advance retries from it).
+    /// run; the stepper then stays at that state (a later advance retries from it).
     pub fn advance(&mut self, t: f64) -> Result<&Sample, MotionError> {
         if !t.is_finite() || t < self.sample.t {
             return Err(MotionError::OutOfRange {

@@ -69,9 +69,9 @@ fn sample_counts_and_times_are_checked() {
         simulation.run(&[0.1, 0.2], &[0.0], 1.0, 0.1),
         Err(MotionError::WrongLength { .. })
     ));
-    let mut session = simulation.start(&[0.1], &[0.0]).expect("session");
-    session.advance(0.5).expect("advance");
-    assert!(matches!(session.advance(0.2), Err(MotionError::OutOfRange { .. })));
+    let mut stepper = simulation.start(&[0.1], &[0.0]).expect("stepper");
+    stepper.advance(0.5).expect("advance");
+    assert!(matches!(stepper.advance(0.2), Err(MotionError::OutOfRange { .. })));
 }
 
 /// A point mass on the axis of its revolute joint has no inertia about it: A = 0.

@@ -8,7 +8,7 @@ use super::dynamics::mech_dynamics_t;
 use super::handle::Handle;
 use super::status::*;
 use super::validate::*;
-use mechanica_motion::{Forcing, Invariant, Method, MotionError, Options, Session, Simulation, StepFailure};
+use mechanica_motion::{Forcing, Invariant, Method, MotionError, Options, Simulation, StepFailure, Stepper};
 
 /// An integration method (int32_t).
 pub type mech_motion_method_t = i32;
@@ -86,7 +86,7 @@ pub struct mech_motion_report_t {
 /// A simulation (opaque): a copy of a dynamics with a method, integrating from an initial
 /// state. Created by mech_simulation_create, freed by mech_simulation_destroy.
 pub struct mech_simulation_t {
-    session: Session,
+    stepper: Stepper,
 }
 
 impl Handle for mech_simulation_t {}
@@ -192,9 +192,9 @@ pub unsafe extern "C" fn mech_simulation_create(
         };
         let (method, options) = rust_options(&defaults, tau)?;
         let simulation = Simulation::new(d.clone(), method, options)?;
-        let session = simulation.start(q0, q_dot0)?;
+        let stepper = simulation.start(q0, q_dot0)?;
         // SAFETY: caller's contract.
-        unsafe { out.write(mech_simulation_t { session }.into_raw()) };
+        unsafe { out.write(mech_simulation_t { stepper }.into_raw()) };
         Ok(())
     })
 }
@@ -246,7 +246,7 @@ pub unsafe extern "C" fn mech_simulation_advance(
         // SAFETY: caller's contract.
         let s = unsafe { mech_simulation_t::borrow_mut(simulation, "simulation") }?;
         finite(&t, "t")?;
-        let dof = s.session.sample().q.len();
+        let dof = s.stepper.sample().q.len();
         if n != dof {
             return Err(FfiError::new(
                 MECH_STATUS_BAD_DIMENSION,
@@ -255,7 +255,7 @@ pub unsafe extern "C" fn mech_simulation_advance(
         }
         let q = OutSlice::new(q_out, n, "q_out")?;
         let q_dot = OutSlice::new(q_dot_out, n, "q_dot_out")?;
-        let sample = s.session.advance(t)?;
+        let sample = s.stepper.advance(t)?;
         // SAFETY: caller's contract.
         unsafe {
             q.write(&sample.q);
@@ -279,8 +279,8 @@ pub unsafe extern "C" fn mech_simulation_report(
         let out = Out::new(report_out, "report_out")?;
         // SAFETY: caller's contract.
         let s = unsafe { mech_simulation_t::borrow(simulation, "simulation") }?;
-        let sample = s.session.sample();
-        let monitors = s.session.monitors();
+        let sample = s.stepper.sample();
+        let monitors = s.stepper.monitors();
         let report = mech_motion_report_t {
             t: sample.t,
             energy: sample.energy,
@@ -293,7 +293,7 @@ pub unsafe extern "C" fn mech_simulation_report(
             energy_scale: monitors.scale,
             max_energy_drift: monitors.max_drift,
             last_energy_drift: monitors.last_drift,
-            steps: s.session.steps() as u64,
+            steps: s.stepper.steps() as u64,
         };
         let numbers = [
             report.energy,
