@@ -57,6 +57,20 @@ pub struct AccuracyReport {
 }
 
 impl AccuracyReport {
+    /// Reorders the per-mode entries: entry k becomes the old entry `order[k]`.
+    pub(crate) fn permute(&mut self, order: &[usize]) {
+        fn take<T: Copy>(v: &mut Vec<T>, order: &[usize]) {
+            if v.len() == order.len() {
+                *v = order.iter().map(|&k| v[k]).collect();
+            }
+        }
+        take(&mut self.backward_errors, order);
+        take(&mut self.error_bounds, order);
+        take(&mut self.bound_kinds, order);
+        take(&mut self.residual_norms_a_inv, order);
+        take(&mut self.refinement_steps, order);
+    }
+
     pub(crate) fn empty() -> Self {
         Self {
             norm_a: 0.0,

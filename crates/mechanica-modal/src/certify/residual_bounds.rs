@@ -219,14 +219,37 @@ impl SplitResiduals {
             .map(|&(col, _)| vector_norm(self.rest.col(col)).powi(2))
             .sum::<f64>()
             .sqrt();
+        // The gap-weighted bounds hold for the eigenvalues of H = XᵀBX, not for its diagonal
+        // (the members' values): Weyl's theorem puts them within ‖H − diag(ω²)‖_F of it.
+        let Some(coupling) = self.in_block_coupling(group, columns) else {
+            return eps;
+        };
+        let gap = gap - coupling;
         let mut bound = eps;
         if gap > eps {
-            bound = bound.min(eps * eps / gap);
+            bound = bound.min(coupling + eps * eps / gap);
             if usable && gap > eps_rest {
-                bound = bound.min(weighted + eps_rest * eps_rest / gap);
+                bound = bound.min(coupling + weighted + eps_rest * eps_rest / gap);
             }
         }
         bound
+    }
+
+    /// ‖H − diag(ω²)‖_F for the block's members, with H = X_GᵀBX_G: for A-orthonormal X, the
+    /// in-block components C_GG = X_Gᵀ R_G of the residuals (8n·u·‖R_G‖_F allows for forming
+    /// them in double). None when a member is not in the basis.
+    fn in_block_coupling(&self, group: &Range<usize>, columns: &[(usize, f64)]) -> Option<f64> {
+        let rows = group.clone().map(|g| self.column_of[g]).collect::<Option<Vec<usize>>>()?;
+        let mut sum = 0.0;
+        let mut residual_sq = 0.0;
+        for &(col, _) in columns {
+            residual_sq += vector_norm(self.rest.col(col)).powi(2);
+            for &row in &rows {
+                sum += self.c[(row, col)].powi(2);
+            }
+        }
+        let rounding = 8.0 * self.rest.nrows() as f64 * f64::EPSILON * (sum + residual_sq).sqrt();
+        Some(sum.sqrt() + rounding)
     }
 }
 

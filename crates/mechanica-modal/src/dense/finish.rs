@@ -124,6 +124,7 @@ impl Finish<'_> {
             report.orthogonality_error = None;
         }
         let mut modes = finite_modes(&omega, &report, &resolution);
+        sort_ascending(&mut modes, &mut report, x.as_mut());
         order_above_positive_modes(&mut modes);
         certify_positive_stiffness(self.problem, &mut modes, self.par);
         if matches!(self.options.selection, Selection::All) && !infinite.is_empty() {
@@ -300,6 +301,25 @@ fn finite_modes(omega: &[f64], report: &AccuracyReport, resolution: &[f64]) -> V
             }
         })
         .collect()
+}
+
+/// Puts the finite modes in ascending order of ω², with their report entries and vector
+/// columns: refinement moves values by up to their first-order bounds, which can exceed the
+/// distance between neighbours (wide-range pencils), and every later step relies on the order.
+fn sort_ascending(modes: &mut Vec<Mode>, report: &mut AccuracyReport, x: Option<&mut Mat<f64>>) {
+    if modes.is_sorted_by(|p, q| p.omega_sq <= q.omega_sq) {
+        return;
+    }
+    let mut order: Vec<usize> = (0..modes.len()).collect();
+    order.sort_by(|&p, &q| modes[p].omega_sq.total_cmp(&modes[q].omega_sq));
+    *modes = order.iter().map(|&k| modes[k]).collect();
+    report.permute(&order);
+    if let Some(x) = x {
+        let old = x.clone();
+        for (k, &from) in order.iter().enumerate().filter(|&(k, &from)| k.max(from) < old.ncols()) {
+            x.col_mut(k).copy_from(old.col(from));
+        }
+    }
 }
 
 /// A mode called zero or undecided above an oscillatory mode whose interval lies entirely above

@@ -101,11 +101,13 @@ impl PencilScale {
                 self.bound_to_stored(mode.error_bound, mode.omega_sq),
             )?;
             mode.kind = match mode.kind {
+                // A mode certified oscillatory (or unstable) by the order or by Sylvester's law
+                // may have a computed ω² of the other sign within its bound: its rate is then 0.
                 ModeKind::Oscillatory { .. } => ModeKind::Oscillatory {
-                    omega: mode.omega_sq.sqrt(),
+                    omega: mode.omega_sq.max(0.0).sqrt(),
                 },
                 ModeKind::Unstable { .. } => ModeKind::Unstable {
-                    growth_rate: (-mode.omega_sq).sqrt(),
+                    growth_rate: (-mode.omega_sq).max(0.0).sqrt(),
                 },
                 other => other,
             };
