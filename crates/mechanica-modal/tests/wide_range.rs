@@ -11,8 +11,8 @@
 use faer::Mat;
 use faer::sparse::Triplet;
 use mechanica_modal::{
-    Mode, ModeKind, PencilProblem, Refinement, Selection, SolveOptions, SparsePencil, SparseSolveOptions, solve,
-    solve_sparse,
+    ModalError, Mode, ModeKind, PencilProblem, Refinement, Selection, SolveOptions, SparsePencil, SparseSolveOptions,
+    solve, solve_sparse,
 };
 
 /// One stored pencil with its exact spectrum as (hi, lo) pairs, ascending.
@@ -71,18 +71,18 @@ fn triplets(m: &Mat<f64>) -> Vec<Triplet<usize, usize, f64>> {
     t
 }
 
-/// The modes, or None for a typed refusal.
-fn modes_of(case: &Case, usage: Use) -> Option<Vec<Mode>> {
+/// The modes, or the typed refusal.
+fn modes_of(case: &Case, usage: Use) -> Result<Vec<Mode>, mechanica_modal::ModalError> {
     let n = case.a.nrows();
     if let Use::Sparse(count) = usage {
-        let pencil = SparsePencil::from_triplets(n, &triplets(&case.a), &triplets(&case.b)).ok()?;
+        let pencil = SparsePencil::from_triplets(n, &triplets(&case.a), &triplets(&case.b))?;
         let options = SparseSolveOptions {
             count,
             ..SparseSolveOptions::default()
         };
-        return solve_sparse(&pencil, &options).ok().map(|s| s.modes);
+        return solve_sparse(&pencil, &options).map(|s| s.modes);
     }
-    let problem = PencilProblem::new(case.a.as_ref(), case.b.as_ref()).ok()?;
+    let problem = PencilProblem::new(case.a.as_ref(), case.b.as_ref())?;
     let mut options = SolveOptions::default();
     match usage {
         Use::All(refinement) => options.refinement = refinement,
@@ -90,7 +90,7 @@ fn modes_of(case: &Case, usage: Use) -> Option<Vec<Mode>> {
         Use::Lowest(k) => options.selection = Selection::Lowest(k),
         Use::Sparse(_) => {}
     }
-    solve(&problem, &options).ok().map(|s| s.modes)
+    solve(&problem, &options).map(|s| s.modes)
 }
 
 /// Every mode against the exact ω² of the same rank; a description of each failure.
@@ -100,8 +100,17 @@ fn failures(case: &Case, modes: &[Mode]) -> Vec<String> {
         out.push(format!("{} modes for order {}", modes.len(), case.exact.len()));
     }
     for (k, (mode, &(hi, lo))) in modes.iter().zip(&case.exact).enumerate() {
+        if hi.is_infinite() || mode.kind == ModeKind::Infinite {
+            if !(hi.is_infinite() && mode.kind == ModeKind::Infinite && mode.omega_sq == f64::INFINITY) {
+                out.push(format!(
+                    "mode {k}: {:?} ω² {:e}, exact {hi:e}",
+                    mode.kind, mode.omega_sq
+                ));
+            }
+            continue;
+        }
         let error = ((mode.omega_sq - hi) - lo).abs();
-        if !(error <= mode.error_bound * (1.0 + 4.0 * f64::EPSILON)) {
+        if error.is_nan() || error > mode.error_bound * (1.0 + 4.0 * f64::EPSILON) {
             out.push(format!(
                 "mode {k}: ω² {:e} exact {hi:e}, error {error:e} above bound {:e}",
                 mode.omega_sq, mode.error_bound
@@ -110,7 +119,6 @@ fn failures(case: &Case, modes: &[Mode]) -> Vec<String> {
         let wrong_sign = match mode.kind {
             ModeKind::Oscillatory { .. } => hi <= 0.0,
             ModeKind::Unstable { .. } => hi >= 0.0,
-            ModeKind::Infinite => true,
             _ => false,
         };
         let rate_ok = match mode.kind {
@@ -132,25 +140,40 @@ fn every_bound_holds_on_pencils_spanning_eighty_decades() {
     let (mut solved, mut refused, mut problems) = (0, 0, Vec::new());
     for (c, case) in cases.iter().enumerate() {
         let n = case.a.nrows();
+        let massless = (0..n).any(|i| case.a[(i, i)] == 0.0);
+        let finite = case.exact.iter().filter(|(hi, _)| hi.is_finite()).count();
         let uses = [
             Use::All(Refinement::Auto),
             Use::All(Refinement::Always),
             Use::All(Refinement::Off),
             Use::ValuesOnly,
-            Use::Lowest(1 + c % n),
-            Use::Sparse(1 + c % n.saturating_sub(1).max(1)),
+            Use::Lowest(1 + c % finite),
+            Use::Sparse(1 + c % finite.saturating_sub(1).max(1)),
         ];
         for usage in uses {
             match modes_of(case, usage) {
-                Some(modes) => {
+                Ok(modes) => {
                     solved += 1;
-                    problems.extend(failures(case, &modes).into_iter().map(|f| format!("case {c} {usage:?}: {f}")));
+                    problems.extend(
+                        failures(case, &modes)
+                            .into_iter()
+                            .map(|f| format!("case {c} {usage:?}: {f}")),
+                    );
                 }
-                None => refused += 1,
+                // B restricted to the massless directions may be singular within rounding of ‖B‖
+                // (entries 40 decades below it): a typed refusal is then a right answer.
+                Err(ModalError::SingularPencil { .. }) if massless => refused += 1,
+                // The sparse solver may find fewer modes than asked in a tiny pencil.
+                Err(_) if matches!(usage, Use::Sparse(_)) => refused += 1,
+                Err(e) => problems.push(format!("case {c} {usage:?}: refused: {e}")),
             }
         }
     }
-    assert!(problems.is_empty(), "{} wrong results:\n{}", problems.len(), problems.join("\n"));
-    // The dense solves must answer: a refusal is allowed for the sparse path only in a minority.
-    assert!(refused * 10 <= solved, "{refused} refusals against {solved} answers");
+    assert!(
+        problems.is_empty(),
+        "{} wrong results:\n{}",
+        problems.len(),
+        problems.join("\n")
+    );
+    assert!(refused * 5 <= solved, "{refused} refusals against {solved} answers");
 }

@@ -239,7 +239,10 @@ impl SplitResiduals {
     /// in-block components C_GG = X_Gᵀ R_G of the residuals (8n·u·‖R_G‖_F allows for forming
     /// them in double). None when a member is not in the basis.
     fn in_block_coupling(&self, group: &Range<usize>, columns: &[(usize, f64)]) -> Option<f64> {
-        let rows = group.clone().map(|g| self.column_of[g]).collect::<Option<Vec<usize>>>()?;
+        let rows = group
+            .clone()
+            .map(|g| self.column_of[g])
+            .collect::<Option<Vec<usize>>>()?;
         let mut sum = 0.0;
         let mut residual_sq = 0.0;
         for &(col, _) in columns {

@@ -125,6 +125,7 @@ impl Finish<'_> {
         }
         let mut modes = finite_modes(&omega, &report, &resolution);
         sort_ascending(&mut modes, &mut report, x.as_mut());
+        widen_overlapping_estimates(&mut modes, &mut report);
         order_above_positive_modes(&mut modes);
         certify_positive_stiffness(self.problem, &mut modes, self.par);
         if matches!(self.options.selection, Selection::All) && !infinite.is_empty() {
@@ -319,6 +320,50 @@ fn sort_ascending(modes: &mut Vec<Mode>, report: &mut AccuracyReport, x: Option<
         for (k, &from) in order.iter().enumerate().filter(|&(k, &from)| k.max(from) < old.ncols()) {
             x.col_mut(k).copy_from(old.col(from));
         }
+    }
+}
+
+/// Makes the unrefined bounds (first-order and a-priori) hold for the mode of the same rank: a
+/// run of modes whose intervals ω² ± bound overlap is one cluster, and its exact values can only
+/// be matched to its members as a set, so each unrefined member's bound is widened to reach both
+/// ends of the cluster (a mode with a tight interval inside a wide neighbour's may otherwise
+/// stand for an eigenvalue of another rank). The classification is redone with the new bound.
+fn widen_overlapping_estimates(modes: &mut [Mode], report: &mut AccuracyReport) {
+    let mut start = 0;
+    while start < modes.len() {
+        let mut end = start + 1;
+        let mut reach = modes[start].omega_sq + modes[start].error_bound;
+        while end < modes.len() && modes[end].omega_sq - modes[end].error_bound <= reach {
+            reach = reach.max(modes[end].omega_sq + modes[end].error_bound);
+            end += 1;
+        }
+        let low = modes[start..end]
+            .iter()
+            .map(|m| m.omega_sq - m.error_bound)
+            .fold(f64::INFINITY, f64::min);
+        for k in (start..end).filter(|&k| end - start > 1 && report.bound_kinds[k] != BoundKind::Residual) {
+            let mode = &mut modes[k];
+            let widened = (mode.omega_sq - low).max(reach - mode.omega_sq).max(mode.error_bound);
+            if widened > mode.error_bound {
+                mode.error_bound = widened;
+                report.error_bounds[k] = widened;
+                if !matches!(mode.kind, ModeKind::Zero) {
+                    mode.kind = reclassified(mode);
+                }
+            }
+        }
+        start = end;
+    }
+}
+
+/// The class of a mode whose bound grew: oscillatory or unstable only while its interval still
+/// excludes zero, else undecided.
+fn reclassified(mode: &Mode) -> ModeKind {
+    match mode.kind {
+        ModeKind::Oscillatory { .. } | ModeKind::Unstable { .. } if mode.omega_sq.abs() <= mode.error_bound => {
+            ModeKind::Undecided
+        }
+        other => other,
     }
 }
 

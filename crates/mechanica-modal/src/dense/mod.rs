@@ -207,7 +207,10 @@ fn solve_semidefinite(
 ) -> Result<ModalSolution, ModalError> {
     let clock = Instant::now();
     let mut condensed = condense(problem, pivot, norm_b, par)?;
-    let want_vectors = options.vectors || options.refinement == Refinement::Always;
+    // Always with vectors: an a-priori bound would measure the condensed pencil (S, A₁), not
+    // the stored one, and forming S = B₁₁ − B₁₀B₀₀⁻¹B₀₁ can cancel far beyond it; only the
+    // residuals of the lifted vectors in (A, B) see that error. Values only drops them at the end.
+    let want_vectors = true;
     let condensation_time = clock.elapsed();
     let l1 = condensed.condensation.l1.as_ref();
     let mut def = solve_definite(l1, condensed.stiffness.as_ref(), options.selection, want_vectors, par)?;

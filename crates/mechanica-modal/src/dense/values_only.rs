@@ -75,9 +75,12 @@ pub(crate) fn sharpen(
     let (a, b) = (pencil.a, pencil.b);
     let mut products = PairProducts::new(a, b, x.as_ref(), pencil.residuals, None, pencil.par);
     for (col, &i) in flagged.iter().enumerate() {
-        let (_, bound) = products.pair_error(x.as_ref(), col, omega[i], report.norm_a, report.norm_b);
+        let (eta, bound) = products.pair_error(x.as_ref(), col, omega[i], report.norm_a, report.norm_b);
         report.error_bounds[i] = bound;
         report.bound_kinds[i] = BoundKind::FirstOrder;
+        report.backward_errors[i] = Some(eta);
+        // The same rounding allowance as the pairs of a solve with vectors.
+        report.error_bounds[i] = report.bound_with_rounding(i, x.nrows());
     }
     if let PairProducts::Sketched { .. } = products {
         report.residuals = Residuals::Sketched;
