@@ -260,8 +260,12 @@ fn principal_axes(input: &mut Input) {
     let j = p.inertia_about_com.m;
     let sym: Vec<f64> = (0..9).map(|k| 0.5 * (j[k] + j[(k % 3) * 3 + k / 3])).collect();
     let scale = norm1(&j);
+    // Moments within 1e-10 of the largest are merged into one repeated value (the documented
+    // contract): the rebuilt tensor then differs by up to half their gap.
+    let largest = i[0].abs().max(i[2].abs());
+    let merged = if i[0] == i[1] || i[1] == i[2] { 1e-10 * largest } else { 0.0 };
     assert!(
-        close(&rebuilt, &sym, 1e-13 * scale),
+        close(&rebuilt, &sym, 1e-13 * scale + merged),
         "R diag(I) Rᵀ = {rebuilt:?}, sym(J) = {sym:?}"
     );
 }

@@ -192,9 +192,12 @@ fn check_modes(p: &Pencil, s: &Solved) {
         let x = &s.vectors[k * n..(k + 1) * n];
         let x_norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
         let mut residual = 0.0f64;
+        // The solver decomposes the symmetric parts (entries symmetric within its tolerance are
+        // accepted): the residual is theirs.
+        let sym = |m: &[f64], i: usize, j: usize| 0.5 * m[i + n * j] + 0.5 * m[j + n * i];
         for i in 0..n {
             let r: f64 = (0..n)
-                .map(|j| (m.lambda * p.a[i + n * j] + p.b[i + n * j]) * x[j])
+                .map(|j| (m.lambda * sym(&p.a, i, j) + sym(&p.b, i, j)) * x[j])
                 .sum();
             residual += r * r;
         }
@@ -202,8 +205,13 @@ fn check_modes(p: &Pencil, s: &Solved) {
         let allowed = 2.0 * m.backward_error * scale + 4.0 * n as f64 * f64::EPSILON * scale;
         assert!(
             residual.sqrt() <= allowed,
-            "mode {k}: residual {} above η·scale = {allowed}",
-            residual.sqrt()
+            "mode {k}: residual {} above η·scale = {allowed} (λ {}, η {}, kind {}); A = {:?}, B = {:?}",
+            residual.sqrt(),
+            m.lambda,
+            m.backward_error,
+            m.kind,
+            p.a,
+            p.b
         );
     }
 }
@@ -288,7 +296,8 @@ fn sparse(input: &mut Input) {
     let p = pencil(input);
     let (mut a_ptr, mut a_rows, a_vals) = csc(p.n, &p.a);
     let (b_ptr, b_rows, b_vals) = csc(p.n, &p.b);
-    if input.u8() >= 224 && !a_rows.is_empty() {
+    let corrupted = input.u8() >= 224 && !a_rows.is_empty();
+    if corrupted {
         let k = input.below(a_rows.len());
         a_rows[k] = input.below(p.n + 3);
         let j = input.below(p.n);
@@ -352,7 +361,9 @@ fn sparse(input: &mut Input) {
     );
     let Some(dense) = solve(&p, input) else { return };
     let spectrum = finite_omega(&dense);
-    if spectrum.len() == p.n {
+    trace!("sparse vs dense: A = {:?}, B = {:?}", p.a, p.b);
+    // A corrupted structure that is still valid stores another A: nothing to compare with.
+    if spectrum.len() == p.n && !corrupted {
         spectra_agree("sparse vs dense", &sparse, &spectrum[..count.min(spectrum.len())]);
     }
 }
