@@ -232,7 +232,10 @@ fn steiner_and_line(input: &mut Input) {
     let want = e[0] * je[0] + e[1] * je[1] + e[2] * je[2];
     assert!(
         (moment - want).abs() <= 1e-13 * scale,
-        "moment about a line {moment} vs {want}"
+        "moment about a line {moment} vs {want}; mass {}, centre {:?}, J {:?}, point {point:?}, direction {direction:?}",
+        p.mass,
+        c,
+        p.inertia_about_com.m
     );
 }
 

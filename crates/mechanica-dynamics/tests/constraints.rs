@@ -478,7 +478,7 @@ fn bad_input_gives_typed_errors() {
             Constraint::PointsCoincide {
                 a: body,
                 b: ground,
-                directions: vec![Vector3::new(1e300, 1e300, 0.0)]
+                directions: vec![Vector3::new(1e-300, 0.0, 0.0), Vector3::zeros()]
             }
         ),
         Err(DynamicsError::OutOfRange { .. })

@@ -85,6 +85,22 @@ pub fn norm(v: &Vector3<f64>) -> f64 {
     (v / scale).norm() * scale
 }
 
+/// v/|v| formed on v/2^k (k from its largest entry), so that neither the squares of tiny or
+/// subnormal entries (whose rounding would leave the result off unit length by 1e-5 and more)
+/// nor those of huge ones spoil it; None for a zero or non-finite v.
+pub fn unit(v: &Vector3<f64>) -> Option<Vector3<f64>> {
+    if !v.iter().all(|x| x.is_finite()) || v.amax() == 0.0 {
+        return None;
+    }
+    let scaled = v / power_of_two_above(v.amax());
+    let scaled = if scaled.amax() < 0.5 {
+        scaled / scaled.amax()
+    } else {
+        scaled
+    };
+    Some(scaled / scaled.norm())
+}
+
 /// The Frobenius norm of `m`, scaled like [`norm`].
 pub fn frobenius_norm(m: &Matrix3<f64>) -> f64 {
     let scale = power_of_two_above(m.amax());
@@ -101,6 +117,26 @@ pub fn norm_of(values: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unit_vectors_have_unit_length_at_both_ends_of_the_range() {
+        for v in [
+            Vector3::new(5.5065031927300575e-160, 3.090332484e-314, 0.0),
+            Vector3::new(3e-320, -4e-320, 0.0),
+            Vector3::new(1.7e308, -1.7e308, 1e308),
+            Vector3::new(1.0, 1e-300, -2.0),
+        ] {
+            let e = unit(&v).expect("a non-zero finite vector");
+            // The exact length of e, from its entries in double-double: within a few ulps of 1.
+            let length_sq: f64 = e.iter().map(|x| x * x).sum();
+            assert!((length_sq - 1.0).abs() <= 4.0 * f64::EPSILON, "{v:?} → {e:?}");
+            // e is parallel to v: their cross product vanishes relative to the scale.
+            let s = v / v.amax();
+            assert!(e.cross(&s).amax() <= 4.0 * f64::EPSILON, "{v:?} → {e:?}");
+        }
+        assert!(unit(&Vector3::zeros()).is_none());
+        assert!(unit(&Vector3::new(f64::NAN, 1.0, 0.0)).is_none());
+    }
 
     #[test]
     fn scaled_norms_are_exact_at_both_ends_of_the_range() {

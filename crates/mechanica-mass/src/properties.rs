@@ -116,11 +116,7 @@ impl MassProperties {
     pub fn moment_about_line(&self, p_oa: &Vector3<f64>, direction: &Vector3<f64>) -> Result<f64, MassError> {
         check_all_finite(p_oa.iter(), "point on the line")?;
         check_all_finite(direction.iter(), "line direction")?;
-        let norm = direction.norm();
-        if norm == 0.0 || !norm.is_finite() {
-            return Err(MassError::ZeroDirection("line direction"));
-        }
-        let e = direction / norm;
+        let e = mechanica_kinematics::scaling::unit(direction).ok_or(MassError::ZeroDirection("line direction"))?;
         // Moment about the parallel line through the centre, plus m·(distance between lines)².
         let d = self.p_oc - p_oa;
         let d_perp = d - e * e.dot(&d);
@@ -278,6 +274,29 @@ mod tests {
         assert!((back - b.inertia_c).norm() <= 1e-13 * j_a.norm());
         let rebuilt = MassProperties::from_inertia_about(b.mass, b.p_oc, j_a, a).expect("valid");
         assert!((rebuilt.inertia_c - b.inertia_c).norm() <= 1e-13 * j_a.norm());
+    }
+
+    #[test]
+    fn moment_about_line_ignores_the_scale_of_the_direction() {
+        let body = MassProperties {
+            mass: 4.0,
+            p_oc: Vector3::new(0.8, -0.7, 0.03),
+            inertia_c: Matrix3::new(2.3, -0.2, -0.03, -0.2, 0.97, 0.14, -0.03, 0.14, 3.2),
+        };
+        let point = Vector3::new(0.1, 0.2, -0.3);
+        for direction in [Vector3::new(1.0, 0.5, -0.25), Vector3::new(1.0, 5e-155, 0.0)] {
+            let reference = body.moment_about_line(&point, &direction).expect("line");
+            // Scalings by powers of two reaching the subnormal range and near f64::MAX.
+            for k in [-1040, -1000, -530, -100, 100, 1000] {
+                let half = 2f64.powi(k / 2);
+                let scaled = direction * half * half;
+                let moment = body.moment_about_line(&point, &scaled).expect("line");
+                assert!(
+                    (moment - reference).abs() <= 8.0 * f64::EPSILON * reference,
+                    "2^{k}: {moment} vs {reference}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -164,16 +164,13 @@ fn check_anchor(anchor: &Anchor, tree: &KinematicTree, what: &'static str) -> Re
     }
 }
 
-/// v/|v| for a finite, non-zero v whose length does not overflow.
+/// v/|v| for a finite, non-zero v (formed without underflow or overflow, see
+/// `mechanica_kinematics::scaling::unit`).
 fn unit_vector(v: &Vector3<f64>, what: &'static str) -> Result<Vector3<f64>, DynamicsError> {
     check_input(v.as_slice(), what)?;
-    let length = v.norm();
-    if !(length > 0.0 && length.is_finite()) {
-        return Err(DynamicsError::OutOfRange {
-            what,
-            requirement: "a non-zero vector of finite length",
-            value: length,
-        });
-    }
-    Ok(v / length)
+    mechanica_kinematics::scaling::unit(v).ok_or(DynamicsError::OutOfRange {
+        what,
+        requirement: "a non-zero vector",
+        value: 0.0,
+    })
 }

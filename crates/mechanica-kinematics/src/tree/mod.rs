@@ -259,8 +259,12 @@ fn check_placement_and_axis(body: usize, spec: &BodySpec) -> Result<(), Kinemati
 /// The joint with its revolute or prismatic axis normalised exactly.
 fn normalized_joint(joint: Joint) -> Joint {
     match joint {
-        Joint::Revolute { axis } => Joint::Revolute { axis: axis.normalize() },
-        Joint::Prismatic { axis } => Joint::Prismatic { axis: axis.normalize() },
+        Joint::Revolute { axis } => Joint::Revolute {
+            axis: crate::scaling::unit(&axis).unwrap_or(axis),
+        },
+        Joint::Prismatic { axis } => Joint::Prismatic {
+            axis: crate::scaling::unit(&axis).unwrap_or(axis),
+        },
         other => other,
     }
 }
@@ -271,8 +275,9 @@ fn revolute_terms(b: &BodySpec) -> (Matrix3<f64>, Matrix3<f64>, Vector3<f64>) {
     let r = *b.placement.rotation.to_rotation_matrix().matrix();
     match b.joint {
         Joint::Revolute { axis } => {
-            let k = crate::rotation::skew(&axis.normalize());
-            (r * k, r * k * k, r * axis.normalize())
+            let axis = crate::scaling::unit(&axis).unwrap_or(axis);
+            let k = crate::rotation::skew(&axis);
+            (r * k, r * k * k, r * axis)
         }
         _ => (Matrix3::zeros(), Matrix3::zeros(), Vector3::zeros()),
     }
