@@ -108,6 +108,10 @@ pub struct ValidityReport {
     pub absolute_tolerance: f64,
 }
 
+/// The smallest violation [`check`] reports: eight spacings of the subnormal grid (2⁻¹⁰⁷⁴),
+/// the rounding that tensors of order 1e-320 cannot avoid.
+pub const SUBNORMAL_ALLOWANCE: f64 = 8.0 * 4.9406564584124654e-324;
+
 /// Checks that `props` could be the mass properties of a real body and reports every problem
 /// found (not only the first) in [`MassError::InvalidInertia`]. Semidefinite tensors of rods,
 /// laminae and points are valid and reported through [`InertiaClass`]. The tests run on the
@@ -133,7 +137,9 @@ pub fn check(props: &MassProperties, tol: &ValidityTolerance) -> Result<Validity
     let scale = power_of_two_above(props.inertia_c.amax());
     let j = props.inertia_c / scale;
     let trace_scale = (0..3).map(|i| j[(i, i)].abs()).sum::<f64>();
-    let abs_tol = tol.relative * trace_scale;
+    // Entries on the subnormal grid carry an absolute rounding of half its spacing 2⁻¹⁰⁷⁴, which
+    // moves each moment by up to three such halves: the tests allow eight spacings at least.
+    let abs_tol = (tol.relative * trace_scale).max(SUBNORMAL_ALLOWANCE / scale);
     if props.mass == 0.0 && trace_scale > 0.0 {
         issues.push(InertiaIssue::ZeroMassWithInertia);
     }
@@ -309,6 +315,21 @@ pub(crate) fn sorted_eigenvalues(j: &Matrix3<f64>) -> Vector3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// On the subnormal grid a tensor is judged within a few of its spacings: the rounding of
+    /// a repaired tensor there is accepted, a violation of many spacings is not.
+    #[test]
+    fn subnormal_tensors_are_judged_on_their_grid() {
+        let tiny = f64::from_bits(1);
+        let rounded = Matrix3::new(2.0, 1.0, 1.0, 1.0, 2.0, 1.0, 1.0, 1.0, 2.0) * tiny;
+        assert!(check(&props(1.0, rounded), &ValidityTolerance::default()).is_ok());
+        let rod_too_far = Matrix3::from_diagonal(&Vector3::new(0.0, 0.0, 100.0)) * tiny;
+        assert!(matches!(
+            check(&props(1.0, rod_too_far), &ValidityTolerance::default()),
+            Err(MassError::InvalidInertia(ref issues))
+                if issues.iter().any(|i| matches!(i, InertiaIssue::TriangleInequality { .. }))
+        ));
+    }
 
     fn props(mass: f64, j: Matrix3<f64>) -> MassProperties {
         MassProperties {
