@@ -206,7 +206,8 @@ mod tests {
     fn numbers_are_rounded_and_trimmed() {
         assert_eq!(number(3.0, 10), "3");
         assert_eq!(number(2.0 / 3.0, 4), "0.6667");
-        assert_eq!(number(123456.789, 7), "1.234568e5");
+        assert_eq!(number(1234567.89, 7), "1.234568e6");
+        assert_eq!(number(123456.789, 7), "123456.8");
         assert_eq!(number(98765.4321, 7), "98765.43");
         assert_eq!(number(-1.5e-7, 3), "-1.5e-7");
         assert_eq!(number(0.0, 5), "0");
