@@ -8,13 +8,13 @@ pub(crate) mod records;
 use crate::report::{Step, timed_step};
 use crate::scene::{ConstraintSpec, DynamicsSpec, Scene};
 use crate::scene_run::{Model, coordinate_names};
-use records::{ConstrainedEquilibriumRecord, ConstrainedForwardRecord, ConstraintReactionRecord, ProjectionRecord};
 use mechanica::dynamics::{
     ConstrainedDynamics, ConstrainedEquilibriumOptions, ConstrainedForward, Constraint, ConstraintReaction, Dynamics,
     ProjectionOptions, State,
 };
 use mechanica::kinematics::nalgebra::Vector3;
 use mechanica::mechanism::Anchor;
+use records::{ConstrainedEquilibriumRecord, ConstrainedForwardRecord, ConstraintReactionRecord, ProjectionRecord};
 
 /// The state of a scene with constraints: coordinates, velocities and applied forces.
 pub struct StartState {
@@ -167,11 +167,17 @@ fn forward_record(
 }
 
 /// Per constraint: the force on its first point and the generalized force −Jᵢᵀλᵢ.
-fn reaction_records(constrained: &ConstrainedDynamics, reactions: &[ConstraintReaction]) -> Vec<ConstraintReactionRecord> {
+fn reaction_records(
+    constrained: &ConstrainedDynamics,
+    reactions: &[ConstraintReaction],
+) -> Vec<ConstraintReactionRecord> {
     reactions
         .iter()
         .map(|reaction| ConstraintReactionRecord {
-            constraint: constrained.constraint_name(reaction.constraint).unwrap_or("?").to_string(),
+            constraint: constrained
+                .constraint_name(reaction.constraint)
+                .unwrap_or("?")
+                .to_string(),
             force: reaction.point.map(|_| reaction.force.into()),
             generalized_force: reaction.generalized_force.clone(),
         })

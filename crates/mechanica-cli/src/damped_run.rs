@@ -2,9 +2,7 @@
 //! A δ̈ + (C + G) δ̇ + B δ = 0 about q0 (FM 4.62–4.66, §8e, §8g), each with its kind, natural
 //! frequency ω_n, damped frequency ω_d, damping ratio ζ and eigenvalues s with their bounds.
 
-use crate::dynamics_run::records::{
-    DampedEigenvalue, DampedKind, DampedModeRecord, DampedModesRecord, DampedVerdict,
-};
+use crate::dynamics_run::records::{DampedEigenvalue, DampedKind, DampedModeRecord, DampedModesRecord, DampedVerdict};
 use crate::report::Step;
 use mechanica::dynamics::{DampedModes, Dynamics};
 use mechanica::modal::{QuadraticModeKind, QuadraticOptions};

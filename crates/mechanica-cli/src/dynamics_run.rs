@@ -8,10 +8,10 @@ pub(crate) mod records;
 use crate::report::{Step, timed_step};
 use crate::scene::{DynamicsSpec, Scene};
 use crate::scene_run::{Model, coordinate_names};
-use records::{ForwardMethodName, ForwardRecord, InverseRecord, JointReaction, LoadRecord};
 use mechanica::dynamics::{Damper, Dynamics, ForwardDynamics, ForwardMethod, Frame, InverseDynamics, State};
 use mechanica::kinematics::nalgebra::Vector3;
 use mechanica::mechanism::Anchor;
+use records::{ForwardMethodName, ForwardRecord, InverseRecord, JointReaction, LoadRecord};
 
 /// Runs the dynamics step when the scene asks for it.
 pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), String> {

@@ -13,13 +13,11 @@
 pub(crate) mod records;
 
 use crate::report::{Command, Report, timed_step};
-use records::{
-    InertiaSix, MeshDiagnosticsRecord, MeshLoadRecord, MeshMassRecord, MeshModelName, WeldRecord,
-};
 use mechanica::mass::crack::crack_width;
 use mechanica::mass::io::load_mesh_welded;
 use mechanica::mass::mesh::{MeshMassProperties, MeshModel, MeshOptions, TriangleMesh};
 use mechanica::mass::{Amount, DEFAULT_WELD_TOLERANCE, MassError, WeldReport};
+use records::{InertiaSix, MeshDiagnosticsRecord, MeshLoadRecord, MeshMassRecord, MeshModelName, WeldRecord};
 
 /// Density of a solid when neither `--density` nor `--mass` is given (water), kg/m³.
 pub const DEFAULT_SOLID_DENSITY: f64 = 1000.0;

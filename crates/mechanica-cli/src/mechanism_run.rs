@@ -8,10 +8,6 @@ use crate::plots::{EnergyBalance, ModeShape, PlotData, ResponseSeries};
 use crate::report::{Step, timed_step};
 use crate::scene::Scene;
 use crate::scene_run::{Model, coordinate_names};
-use records::{
-    EquilibriumRecord, FoundEquilibrium, GyroscopicRecord, ImpactLawRecord, ImpactRecord, MechanismRecord,
-    ModalAccuracy, ModesRecord, MultiStartRecord, ResponseRecord, StabilityRecord, SturmStatus, Verdict,
-};
 use mechanica::impulse::{
     BodyPoint, ContactLaw, ImpactOptions, MechanismContact, MechanismInertia, RestitutionLaw, resolve_single_contact,
 };
@@ -24,6 +20,10 @@ use mechanica::mechanism::{
 };
 use mechanica::modal::response::FreeResponse;
 use mechanica::modal::{ModeKind, PencilProblem, Selection, SolveOptions};
+use records::{
+    EquilibriumRecord, FoundEquilibrium, GyroscopicRecord, ImpactLawRecord, ImpactRecord, MechanismRecord,
+    ModalAccuracy, ModesRecord, MultiStartRecord, ResponseRecord, StabilityRecord, SturmStatus, Verdict,
+};
 
 /// Builds the mechanism of a scene: tree, masses, gravity, rotating frame, springs, forces,
 /// limits.

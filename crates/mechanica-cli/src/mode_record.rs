@@ -95,11 +95,18 @@ impl ModeRecord {
         let mut text = name_of(&self.kind);
         if let Some(w2) = self.omega_sq {
             let digits = Precision::Absolute(self.bound).digits(w2);
-            text.push_str(&format!(", ω² = {} ± {} rad²/s²", number(w2, digits), bound(self.bound)));
+            text.push_str(&format!(
+                ", ω² = {} ± {} rad²/s²",
+                number(w2, digits),
+                bound(self.bound)
+            ));
         }
         if let (Some(f), Some(w2)) = (self.frequency_hz, self.omega_sq) {
             let relative = if w2 == 0.0 { 0.0 } else { 0.5 * self.bound / w2.abs() };
-            text.push_str(&format!(", f = {} Hz", number(f, Precision::Relative(relative).digits(f))));
+            text.push_str(&format!(
+                ", f = {} Hz",
+                number(f, Precision::Relative(relative).digits(f))
+            ));
         }
         if let (Some(gamma), Some(w2)) = (self.growth_rate, self.omega_sq) {
             let relative = 0.5 * self.bound / w2.abs();
@@ -121,10 +128,21 @@ pub fn write_modes(out: &mut Text, modes: &[ModeRecord], coordinates: &[String],
     }
     for (k, mode) in modes.iter().enumerate().take(shown) {
         if let Some(shape) = &mode.shape {
-            out.named(&format!("mode {} shape (A-normalised)", k + 1), coordinates, shape, "", Precision::Exact);
+            out.named(
+                &format!("mode {} shape (A-normalised)", k + 1),
+                coordinates,
+                shape,
+                "",
+                Precision::Exact,
+            );
         }
         if let Some(mass) = &mode.effective_mass {
-            out.values(&format!("mode {} effective mass (x, y, z)", k + 1), mass, "kg", Precision::Exact);
+            out.values(
+                &format!("mode {} effective mass (x, y, z)", k + 1),
+                mass,
+                "kg",
+                Precision::Exact,
+            );
         }
     }
     for (k, mode) in modes.iter().enumerate().take(shown.min(3)) {
@@ -139,6 +157,8 @@ pub fn write_modes(out: &mut Text, modes: &[ModeRecord], coordinates: &[String],
         }
     }
     if modes.len() > shown && modes.iter().any(|m| m.shape.is_some()) {
-        out.note(&format!("shapes of the first {shown} modes shown; the JSON report has all"));
+        out.note(&format!(
+            "shapes of the first {shown} modes shown; the JSON report has all"
+        ));
     }
 }

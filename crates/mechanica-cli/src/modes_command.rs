@@ -11,14 +11,14 @@ pub(crate) mod records;
 use crate::mechanism_run::records::SturmStatus;
 use crate::mode_record::ModeRecord;
 use crate::report::{Command, Record, Report, Step, timed_step};
-use records::{
-    PencilAccuracyRecord, PencilFactorRecord, PencilModesRecord, PencilReadRecord, PencilRefineRecord, ResidualsName,
-    SolverName, SturmRecord,
-};
 use mechanica::modal::faer::Mat;
 use mechanica::modal::{
     PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparsePencil, SparseSolveOptions, Tuning,
     read_matrix_market, solve, solve_sparse,
+};
+use records::{
+    PencilAccuracyRecord, PencilFactorRecord, PencilModesRecord, PencilReadRecord, PencilRefineRecord, ResidualsName,
+    SolverName, SturmRecord,
 };
 use std::path::{Path, PathBuf};
 use std::time::Duration;

@@ -3,13 +3,13 @@
 pub(crate) mod records;
 
 use crate::report::{Command, Report, Step, timed_step};
-use records::{BodyRecord, BuildRecord, MassRecord, PlotsRecord};
 use crate::scene::{BodySpec, JointKind, JointSpec, Scene};
 use mechanica::kinematics::nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use mechanica::kinematics::tree::{Joint, KinematicTree, TreeBuilder};
 use mechanica::mass::MassProperties;
 use mechanica::mass::mesh::MeshOptions;
 use mechanica::mass::primitives::{self, Amount};
+use records::{BodyRecord, BuildRecord, MassRecord, PlotsRecord};
 use std::path::Path;
 
 /// A scene turned into library objects: the tree, each body's mass properties in its own
@@ -65,11 +65,7 @@ pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report
         let start = std::time::Instant::now();
         let written = plots.write_all(dir)?;
         let files = written.iter().map(|p| p.display().to_string()).collect();
-        steps.push(Step::new(
-            "plots",
-            start.elapsed().as_secs_f64(),
-            PlotsRecord { files },
-        ));
+        steps.push(Step::new("plots", start.elapsed().as_secs_f64(), PlotsRecord { files }));
     }
     Ok(Report::new(Command::Run, scene.title.clone(), steps))
 }

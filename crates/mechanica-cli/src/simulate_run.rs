@@ -9,9 +9,9 @@ use crate::plots::{PlotData, SimulationSeries};
 use crate::report::{Step, timed_step};
 use crate::scene::{DEFAULT_SIMULATE_STEPS, Scene, SimulateSpec};
 use crate::scene_run::Model;
+use mechanica::motion::{Forcing, Invariant, Method, MotionError, Options, Simulation, Trajectory};
 pub use record::SimulateRecord;
 use record::{InvariantName, MethodName, MonitorRecord};
-use mechanica::motion::{Forcing, Invariant, Method, MotionError, Options, Simulation, Trajectory};
 use std::path::Path;
 
 /// Runs the simulation when the scene asks for it.

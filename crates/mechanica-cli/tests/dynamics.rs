@@ -17,7 +17,9 @@ fn load(json: &serde_json::Value, name: &str) -> Vec<f64> {
 
 /// The force and moment of the reaction at `joint`, six numbers.
 fn reaction_at(json: &serde_json::Value, joint: &str) -> Vec<f64> {
-    let reactions = step(json, "inverse_dynamics")["reactions"].as_array().expect("reactions");
+    let reactions = step(json, "inverse_dynamics")["reactions"]
+        .as_array()
+        .expect("reactions");
     let reaction = reactions
         .iter()
         .find(|r| r["joint"] == joint)
@@ -284,7 +286,12 @@ fn a_damped_oscillator_has_the_closed_form_damping_ratio_and_frequency() {
         let kind = if zeta < 1.0 { "underdamped" } else { "overdamped" };
         let mode = &step(&json, "damped_modes")["modes"][0];
         assert_eq!(mode["kind"], kind);
-        let f = [&mode["natural_frequency"], &mode["damped_frequency"], &mode["damping_ratio"]].map(|v| numbers(v)[0]);
+        let f = [
+            &mode["natural_frequency"],
+            &mode["damped_frequency"],
+            &mode["damping_ratio"],
+        ]
+        .map(|v| numbers(v)[0]);
         close(f[0], omega_n, 1e-12 * omega_n);
         close(f[2], zeta, 1e-12 * (1.0 + zeta));
         let s: Vec<f64> = mode["eigenvalues"]

@@ -4,7 +4,12 @@
 mod common;
 use common::mechanica;
 
-const RUN_OPTIONS: [&str; 4] = ["--repair-inertia", "--allow-missing-mesh", "--max-response-values", "--plot"];
+const RUN_OPTIONS: [&str; 4] = [
+    "--repair-inertia",
+    "--allow-missing-mesh",
+    "--max-response-values",
+    "--plot",
+];
 
 #[test]
 fn run_options_appear_in_run_help_only() {
@@ -24,7 +29,10 @@ fn run_options_appear_in_run_help_only() {
     let (ok, mass, _) = mechanica(&["mass", "--help"]);
     assert!(ok && mass.contains("--density") && !mass.contains("--lowest"), "{mass}");
     let (ok, modes, _) = mechanica(&["modes", "--help"]);
-    assert!(ok && modes.contains("--lowest") && !modes.contains("--density"), "{modes}");
+    assert!(
+        ok && modes.contains("--lowest") && !modes.contains("--density"),
+        "{modes}"
+    );
     // An option of another subcommand is refused, not ignored.
     let (ok, _, err) = mechanica(&["mass", "--plot", "somewhere", "x.stl"]);
     assert!(!ok && err.contains("--plot"), "{err}");
@@ -34,7 +42,10 @@ fn run_options_appear_in_run_help_only() {
 fn a_bare_command_runs_the_default_scene() {
     let (ok, out, err) = mechanica(&[]);
     assert!(ok, "{err}");
-    assert!(out.contains("default scene") && out.contains("## ") && out.contains("stable"), "{out}");
+    assert!(
+        out.contains("default scene") && out.contains("## ") && out.contains("stable"),
+        "{out}"
+    );
     let (ok, json, err) = mechanica(&["--json"]);
     assert!(ok, "{err}");
     let report: serde_json::Value = serde_json::from_str(&json).expect("JSON");

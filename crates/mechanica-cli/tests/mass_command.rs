@@ -125,7 +125,12 @@ fn check_box_report(report: &serde_json::Value, mass: f64, origin: [f64; 3], siz
     let m = values(report, "mesh_mass_properties", "mass")[0];
     assert_close(m, mass, tol * mass, "mass");
     let volume = size[0] * size[1] * size[2];
-    assert_close(values(report, "mesh_mass_properties", "measure")[0], volume, tol * volume, "volume");
+    assert_close(
+        values(report, "mesh_mass_properties", "measure")[0],
+        volume,
+        tol * volume,
+        "volume",
+    );
     let c = values(report, "mesh_mass_properties", "centre_of_mass");
     for k in 0..3 {
         let expected = origin[k] + 0.5 * size[k];
@@ -318,8 +323,18 @@ fn an_open_mesh_is_rejected_with_its_boundary_edges_unless_shell() {
 
     // As a shell: five unit squares with surface density 2 kg/m².
     let report = json_report(&[path, "--shell", "--density", "2"]);
-    assert_close(values(&report, "mesh_mass_properties", "measure")[0], 5.0, TOL * 5.0, "area");
-    assert_close(values(&report, "mesh_mass_properties", "mass")[0], 10.0, TOL * 10.0, "mass");
+    assert_close(
+        values(&report, "mesh_mass_properties", "measure")[0],
+        5.0,
+        TOL * 5.0,
+        "area",
+    );
+    assert_close(
+        values(&report, "mesh_mass_properties", "mass")[0],
+        10.0,
+        TOL * 10.0,
+        "mass",
+    );
     assert_eq!(values(&report, "mesh_diagnostics", "boundary_edges"), vec![4.0]);
     // Centre: the bottom face at z = 0 and four walls centred at z = 1/2, each of mass 2.
     let c = values(&report, "mesh_mass_properties", "centre_of_mass");

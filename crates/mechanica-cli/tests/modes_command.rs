@@ -83,7 +83,10 @@ fn free_chain_dense_all_modes_match_the_closed_form() {
     assert_eq!(check["count_below"], check["computed_below"], "the Sturm count agrees");
     // Every stage has a wall time.
     for analysis in ["pencil_read", "pencil_factor", "pencil_modes", "sturm_check"] {
-        assert!(step(&json, analysis)["seconds"].as_f64().is_some_and(|t| t >= 0.0), "{analysis}");
+        assert!(
+            step(&json, analysis)["seconds"].as_f64().is_some_and(|t| t >= 0.0),
+            "{analysis}"
+        );
     }
 }
 

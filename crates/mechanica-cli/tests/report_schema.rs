@@ -42,7 +42,10 @@ fn scratch(name: &str) -> PathBuf {
 
 /// A symmetric Matrix Market file of order n from (row, col, value) entries, lower triangle.
 fn write_matrix(path: &Path, n: usize, entries: &[(usize, usize, f64)]) {
-    let mut text = format!("%%MatrixMarket matrix coordinate real symmetric\n{n} {n} {}\n", entries.len());
+    let mut text = format!(
+        "%%MatrixMarket matrix coordinate real symmetric\n{n} {n} {}\n",
+        entries.len()
+    );
     for (r, c, v) in entries {
         text.push_str(&format!("{} {} {v:?}\n", r + 1, c + 1));
     }
@@ -82,7 +85,11 @@ fn pencil_reports() -> Vec<(String, serde_json::Value)> {
     let dir = scratch("pencils");
     let (a, b) = (dir.join("a.mtx"), dir.join("b.mtx"));
     write_matrix(&a, 3, &[(0, 0, 2.0), (1, 1, 1.0), (2, 2, 0.0)]);
-    write_matrix(&b, 3, &[(0, 0, 2.0), (1, 0, -1.0), (1, 1, 2.0), (2, 1, -1.0), (2, 2, 2.0)]);
+    write_matrix(
+        &b,
+        3,
+        &[(0, 0, 2.0), (1, 0, -1.0), (1, 1, 2.0), (2, 1, -1.0), (2, 2, 2.0)],
+    );
     let (a, b) = (a.to_str().expect("utf-8"), b.to_str().expect("utf-8"));
     let side = 25;
     let mut grid = Vec::new();
@@ -104,9 +111,18 @@ fn pencil_reports() -> Vec<(String, serde_json::Value)> {
     write_matrix(&gb, side * side, &grid);
     let (ga, gb) = (ga.to_str().expect("utf-8"), gb.to_str().expect("utf-8"));
     vec![
-        ("modes --shapes".into(), report(&["modes", "--mass", a, "--stiffness", b, "--shapes"])),
-        ("modes --values-only".into(), report(&["modes", "--mass", a, "--stiffness", b, "--values-only"])),
-        ("modes sparse".into(), report(&["modes", "--mass", ga, "--stiffness", gb, "--lowest", "4"])),
+        (
+            "modes --shapes".into(),
+            report(&["modes", "--mass", a, "--stiffness", b, "--shapes"]),
+        ),
+        (
+            "modes --values-only".into(),
+            report(&["modes", "--mass", a, "--stiffness", b, "--values-only"]),
+        ),
+        (
+            "modes sparse".into(),
+            report(&["modes", "--mass", ga, "--stiffness", gb, "--lowest", "4"]),
+        ),
     ]
 }
 
@@ -140,7 +156,12 @@ fn every_command_s_report_validates_against_the_schema() {
 fn the_plots_step_validates_too() {
     let dir = scratch("plots");
     let chain = repo().join("examples/scenes/spring_pendulum_chain.toml");
-    let json = report(&["run", chain.to_str().expect("utf-8"), "--plot", dir.to_str().expect("utf-8")]);
+    let json = report(&[
+        "run",
+        chain.to_str().expect("utf-8"),
+        "--plot",
+        dir.to_str().expect("utf-8"),
+    ]);
     let plots = common::step(&json, "plots");
     assert!(plots["files"].as_array().is_some_and(|f| !f.is_empty()), "{plots}");
     assert_eq!(violations(&validator(), &json), Vec::<String>::new());
@@ -175,11 +196,15 @@ fn a_mutated_report_fails_validation() {
             let k = modes_step(r);
             r["steps"][k]["modes"][0]["kind"] = "wobbly".into();
         }),
-        ("an unknown key in a step", |r| r["steps"][0]["quantities"] = serde_json::json!([])),
+        ("an unknown key in a step", |r| {
+            r["steps"][0]["quantities"] = serde_json::json!([])
+        }),
         ("a step without its time", |r| {
             r["steps"][0].as_object_mut().expect("step").remove("seconds");
         }),
-        ("an unknown analysis", |r| r["steps"][0]["analysis"] = "astrology".into()),
+        ("an unknown analysis", |r| {
+            r["steps"][0]["analysis"] = "astrology".into()
+        }),
         ("a count that is not an integer", |r| r["steps"][0]["dof"] = 2.5.into()),
         ("a stability verdict in words", |r| {
             let k = modes_step(r);

@@ -226,7 +226,12 @@ fn two_rods(m1: f64, l1: f64, m2: f64, l2: f64) -> String {
 #[test]
 fn a_script_finds_the_first_frequency_and_the_coordinate_that_moves_most() {
     let dir = scratch("script");
-    let cases = [(1.0, 1.0, 1.0, 1.0), (2.0, 0.5, 0.1, 1.5), (0.3, 1.2, 4.0, 0.2), (1.0, 0.8, 0.5, 2.0)];
+    let cases = [
+        (1.0, 1.0, 1.0, 1.0),
+        (2.0, 0.5, 0.1, 1.5),
+        (0.3, 1.2, 4.0, 0.2),
+        (1.0, 0.8, 0.5, 2.0),
+    ];
     let mut movers = std::collections::BTreeSet::new();
     for (case, (m1, l1, m2, l2)) in cases.into_iter().enumerate() {
         let urdf = dir.join(format!("rods{case}.urdf"));
@@ -238,19 +243,37 @@ fn a_script_finds_the_first_frequency_and_the_coordinate_that_moves_most() {
         let first = &modes["modes"][0];
         assert_eq!(first["kind"], "oscillatory");
         let frequency = first["frequency_hz"].as_f64().expect("frequency");
-        let shape: Vec<f64> = first["shape"].as_array().expect("shape").iter().filter_map(|v| v.as_f64()).collect();
-        let largest = (0..shape.len()).max_by(|&a, &b| shape[a].abs().total_cmp(&shape[b].abs())).expect("entries");
+        let shape: Vec<f64> = first["shape"]
+            .as_array()
+            .expect("shape")
+            .iter()
+            .filter_map(|v| v.as_f64())
+            .collect();
+        let largest = (0..shape.len())
+            .max_by(|&a, &b| shape[a].abs().total_cmp(&shape[b].abs()))
+            .expect("entries");
         let mover = modes["coordinates"][largest].as_str().expect("name");
         // The closed form.
-        let (a11, a12, a22) = (m1 * l1 * l1 / 3.0 + m2 * l1 * l1, 0.5 * m2 * l1 * l2, m2 * l2 * l2 / 3.0);
+        let (a11, a12, a22) = (
+            m1 * l1 * l1 / 3.0 + m2 * l1 * l1,
+            0.5 * m2 * l1 * l2,
+            m2 * l2 * l2 / 3.0,
+        );
         let (k1, k2) = (G * (0.5 * m1 * l1 + m2 * l1), G * 0.5 * m2 * l2);
         let (a, b, c) = (a11 * a22 - a12 * a12, -(k1 * a22 + k2 * a11), k1 * k2);
         let w2 = (-b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
         let exact = w2.sqrt() / std::f64::consts::TAU;
-        assert!((frequency - exact).abs() <= 1e-10 * exact, "case {case}: {frequency} vs {exact}");
+        assert!(
+            (frequency - exact).abs() <= 1e-10 * exact,
+            "case {case}: {frequency} vs {exact}"
+        );
         let phi = [a12 * w2, k1 - a11 * w2];
         let theta = [phi[0], phi[1] - phi[0]];
-        let expected = if theta[0].abs() > theta[1].abs() { "shoulder" } else { "elbow" };
+        let expected = if theta[0].abs() > theta[1].abs() {
+            "shoulder"
+        } else {
+            "elbow"
+        };
         assert_eq!(mover, expected, "case {case}: θ ∝ {theta:?}, shape {shape:?}");
         movers.insert(expected);
     }

@@ -30,7 +30,13 @@ pub struct ProjectionRecord {
 impl ProjectionRecord {
     pub(crate) fn write_text(&self, out: &mut Text) {
         let names = &self.coordinates;
-        out.named("q on the constraints", names, &self.q, "rad | m", Precision::Absolute(self.constraint_residual));
+        out.named(
+            "q on the constraints",
+            names,
+            &self.q,
+            "rad | m",
+            Precision::Absolute(self.constraint_residual),
+        );
         out.line(
             "‖q − q0‖₂, ‖f(q)‖₂",
             &format!(
@@ -88,8 +94,19 @@ impl ConstrainedForwardRecord {
         let relative = self.backward_error * self.mass_condition.max(self.schur_condition);
         let names = &self.coordinates;
         let precision = Precision::Relative(relative);
-        out.named("q̈ (constrained forward dynamics)", names, &self.q_ddot, "rad/s² | m/s²", precision);
-        out.values("λ (one per constraint equation)", &self.multipliers, "N | N·m", precision);
+        out.named(
+            "q̈ (constrained forward dynamics)",
+            names,
+            &self.q_ddot,
+            "rad/s² | m/s²",
+            precision,
+        );
+        out.values(
+            "λ (one per constraint equation)",
+            &self.multipliers,
+            "N | N·m",
+            precision,
+        );
         out.line(
             "accuracy",
             &format!(
@@ -146,7 +163,13 @@ pub struct ConstrainedEquilibriumRecord {
 impl ConstrainedEquilibriumRecord {
     pub(crate) fn write_text(&self, out: &mut Text) {
         let names = &self.coordinates;
-        out.named("q at the constrained equilibrium", names, &self.q, "rad | m", Precision::Exact);
+        out.named(
+            "q at the constrained equilibrium",
+            names,
+            &self.q,
+            "rad | m",
+            Precision::Exact,
+        );
         out.line(
             "accuracy",
             &format!(

@@ -38,18 +38,35 @@ pub struct ForwardRecord {
 impl ForwardRecord {
     pub(crate) fn write_text(&self, out: &mut Text) {
         let precision = Precision::Relative(self.error_estimate.unwrap_or(self.backward_error));
-        out.named("q̈ (forward dynamics)", &self.coordinates, &self.q_ddot, "rad/s² | m/s²", precision);
+        out.named(
+            "q̈ (forward dynamics)",
+            &self.coordinates,
+            &self.q_ddot,
+            "rad/s² | m/s²",
+            precision,
+        );
         out.line(
             "method",
             &format!(
                 "{}; backward error {}{}",
                 name_of(&self.method),
                 bound(self.backward_error),
-                self.condition.map_or(String::new(), |c| format!("; κ∞(A) = {}", bound(c)))
+                self.condition
+                    .map_or(String::new(), |c| format!("; κ∞(A) = {}", bound(c)))
             ),
         );
-        out.values("residual τ − RNEA(q, q̇, q̈)", &self.residual, "N·m | N", Precision::Exact);
-        out.value("dissipation function D of the dampers", self.dissipation, "W", Precision::Exact);
+        out.values(
+            "residual τ − RNEA(q, q̇, q̈)",
+            &self.residual,
+            "N·m | N",
+            Precision::Exact,
+        );
+        out.value(
+            "dissipation function D of the dampers",
+            self.dissipation,
+            "W",
+            Precision::Exact,
+        );
     }
 }
 
@@ -104,7 +121,13 @@ impl InverseRecord {
         out.named("q̈ of the inverse dynamics", names, &self.q_ddot, "rad/s² | m/s²", exact);
         let rounding = Precision::Absolute(self.rounding_estimate);
         out.named("τ (inverse dynamics)", names, &self.tau, "N·m | N", rounding);
-        out.named("c(q, q̇): velocity-product terms", names, &self.velocity_product, "N·m | N", exact);
+        out.named(
+            "c(q, q̇): velocity-product terms",
+            names,
+            &self.velocity_product,
+            "N·m | N",
+            exact,
+        );
         out.named("g(q): gravity terms", names, &self.gravity, "N·m | N", exact);
         for load in &self.loads {
             out.named(&format!("Q of {}", load.name), names, &load.force, "N·m | N", exact);
@@ -205,17 +228,25 @@ impl DampedModesRecord {
             out.line("‖grad U*(q0)‖", &format!("{} N·m | N", bound(g)));
         }
         for (k, mode) in self.modes.iter().enumerate() {
-            out.line(&format!("damped mode {} ({})", k + 1, kind_text(mode.kind)), &frequencies(mode));
+            out.line(
+                &format!("damped mode {} ({})", k + 1, kind_text(mode.kind)),
+                &frequencies(mode),
+            );
             let roots: Vec<String> = mode.eigenvalues.iter().map(root).collect();
             out.line("  s = Re s ± i Im s", &roots.join("; "));
         }
         match self.stability {
-            Some(DampedVerdict::Unstable) => out.note(&format!("{} growing mode(s): q0 is unstable", self.growing_modes)),
+            Some(DampedVerdict::Unstable) => {
+                out.note(&format!("{} growing mode(s): q0 is unstable", self.growing_modes))
+            }
             Some(DampedVerdict::NoGrowth) => out.note("no mode grows beyond its bound"),
             None => {}
         }
         if self.undecided_modes > 0 {
-            out.note(&format!("{} mode(s) whose kind the accuracy does not decide", self.undecided_modes));
+            out.note(&format!(
+                "{} mode(s) whose kind the accuracy does not decide",
+                self.undecided_modes
+            ));
         }
     }
 }

@@ -38,11 +38,21 @@ impl MeshLoadRecord {
         out.count("triangles", self.triangles);
         out.value("coordinate scale", self.scale, "m per file unit", Precision::Exact);
         let w = &self.weld;
-        out.value("weld tolerance (relative to bounding-box diagonal)", w.relative_tolerance, "", Precision::Exact);
+        out.value(
+            "weld tolerance (relative to bounding-box diagonal)",
+            w.relative_tolerance,
+            "",
+            Precision::Exact,
+        );
         out.value("weld tolerance", w.tolerance, "m", Precision::Exact);
         out.count("vertices welded into another", w.vertices_welded);
         out.count("triangles collapsed by welding, dropped", w.triangles_dropped);
-        out.value("largest vertex displacement by welding", w.max_displacement, "m", Precision::Exact);
+        out.value(
+            "largest vertex displacement by welding",
+            w.max_displacement,
+            "m",
+            Precision::Exact,
+        );
     }
 }
 
@@ -118,17 +128,35 @@ impl MeshMassRecord {
         let reach = self.centre_of_mass.iter().fold(0.0, |a: f64, b| a.max(b.abs()));
         let centre = Precision::Absolute(self.relative_error_bound * reach);
         out.values("centre of mass (file frame)", &self.centre_of_mass, "m", centre);
-        out.values("inertia about centre of mass (rows of 3×3)", self.inertia.as_flattened(), "kg·m²", moment);
+        out.values(
+            "inertia about centre of mass (rows of 3×3)",
+            self.inertia.as_flattened(),
+            "kg·m²",
+            moment,
+        );
         let j = &self.inertia_urdf;
         let six = [j.ixx, j.ixy, j.ixz, j.iyy, j.iyz, j.izz];
         out.values("inertia about c.o.m. ixx ixy ixz iyy iyz izz", &six, "kg·m²", moment);
         let origin = self.inertia_about_origin.as_flattened();
-        out.values("inertia about file origin (rows of 3×3)", origin, "kg·m²", Precision::Exact);
+        out.values(
+            "inertia about file origin (rows of 3×3)",
+            origin,
+            "kg·m²",
+            Precision::Exact,
+        );
         let residual = Precision::Absolute(self.principal_relative_residual.max(self.relative_error_bound) * size);
-        out.values("principal moments I1 ≤ I2 ≤ I3", &self.principal_moments, "kg·m²", residual);
+        out.values(
+            "principal moments I1 ≤ I2 ≤ I3",
+            &self.principal_moments,
+            "kg·m²",
+            residual,
+        );
         let axes = self.principal_axes.as_flattened();
         out.values("principal axes (axis 1, axis 2, axis 3)", axes, "", Precision::Exact);
-        out.line("accuracy", &format!("relative rounding-error bound {}", bound(self.relative_error_bound)));
+        out.line(
+            "accuracy",
+            &format!("relative rounding-error bound {}", bound(self.relative_error_bound)),
+        );
     }
 }
 
@@ -156,6 +184,9 @@ impl MeshDiagnosticsRecord {
         out.count("boundary edges (used by one triangle)", self.boundary_edges);
         out.count("non-manifold edges (used by > 2 triangles)", self.non_manifold_edges);
         out.count("misoriented edges", self.misoriented_edges);
-        out.line("inside out, orientation flipped", if self.flipped { "yes" } else { "no" });
+        out.line(
+            "inside out, orientation flipped",
+            if self.flipped { "yes" } else { "no" },
+        );
     }
 }

@@ -139,7 +139,13 @@ impl EquilibriumRecord {
                 multi.failed
             ));
             for (i, eq) in multi.equilibria.iter().enumerate() {
-                out.named(&format!("equilibrium {i}"), &self.coordinates, &eq.q, "rad | m", Precision::Exact);
+                out.named(
+                    &format!("equilibrium {i}"),
+                    &self.coordinates,
+                    &eq.q,
+                    "rad | m",
+                    Precision::Exact,
+                );
                 match (&eq.stability, &eq.stability_error) {
                     (Some(s), _) => out.note(&format!("equilibrium {i}: {}", s.sentence())),
                     (None, Some(e)) => out.note(&format!("equilibrium {i}: stability unknown: {e}")),
@@ -232,7 +238,11 @@ impl ModesRecord {
                 "rotating frame: gyroscopic problem det(s²A + sG + B) = 0 solved; max Re s = {} (bound {}) → {}",
                 bound(g.max_real_part),
                 bound(g.real_part_bound),
-                if g.stable { "stable (possibly gyroscopically stabilised)" } else { "unstable" }
+                if g.stable {
+                    "stable (possibly gyroscopically stabilised)"
+                } else {
+                    "unstable"
+                }
             ));
         }
         if !self.locked.is_empty() {
@@ -266,10 +276,20 @@ pub struct ResponseRecord {
 impl ResponseRecord {
     pub(crate) fn write_text(&self, out: &mut Text) {
         let precision = Precision::Absolute(self.end_bound);
-        out.named("δ(T) at the end of the span", &self.coordinates, &self.end, "rad | m", precision);
+        out.named(
+            "δ(T) at the end of the span",
+            &self.coordinates,
+            &self.end,
+            "rad | m",
+            precision,
+        );
         out.line(
             "initial-state fit residual (δ, δ̇)",
-            &format!("{}, {}", bound(self.displacement_fit_residual), bound(self.velocity_fit_residual)),
+            &format!(
+                "{}, {}",
+                bound(self.displacement_fit_residual),
+                bound(self.velocity_fit_residual)
+            ),
         );
     }
 }
@@ -314,7 +334,13 @@ impl ImpactRecord {
                 "N·s",
                 Precision::Absolute(law.integration_error),
             );
-            out.named(&format!("{name}: q̇ after"), &self.coordinates, &law.q_dot_after, "rad/s | m/s", Precision::Exact);
+            out.named(
+                &format!("{name}: q̇ after"),
+                &self.coordinates,
+                &law.q_dot_after,
+                "rad/s | m/s",
+                Precision::Exact,
+            );
             out.values(
                 &format!("{name}: T before, ΔT (7.107)"),
                 &[law.energy_before, law.energy_change],
@@ -347,10 +373,17 @@ pub struct ShowcaseRecord {
 impl ShowcaseRecord {
     pub(crate) fn write_text(&self, out: &mut Text) {
         for law in &self.laws {
-            let verdict = if law.energy_change > 0.0 { "energy GAINED (Kane's paradox)" } else { "energy lost" };
+            let verdict = if law.energy_change > 0.0 {
+                "energy GAINED (Kane's paradox)"
+            } else {
+                "energy lost"
+            };
             let values = [law.energy_before, law.energy_change];
             let shown: Vec<String> = values.iter().map(|&v| number(v, 10)).collect();
-            out.line(&format!("{}: T before, ΔT", law.law), &format!("[{}] J   ({verdict})", shown.join(", ")));
+            out.line(
+                &format!("{}: T before, ΔT", law.law),
+                &format!("[{}] J   ({verdict})", shown.join(", ")),
+            );
         }
     }
 }

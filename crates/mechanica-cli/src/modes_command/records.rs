@@ -20,7 +20,10 @@ pub struct PencilReadRecord {
 impl PencilReadRecord {
     pub(crate) fn write_text(&self, out: &mut Text) {
         out.count("order n", self.order);
-        out.line("stored entries of A, B", &format!("{}, {}", self.mass_entries, self.stiffness_entries));
+        out.line(
+            "stored entries of A, B",
+            &format!("{}, {}", self.mass_entries, self.stiffness_entries),
+        );
     }
 }
 
@@ -78,7 +81,10 @@ impl PencilModesRecord {
         write_modes(out, &self.modes, &coordinates, 6);
         out.line("max error bound of ω²", &bound(self.max_bound));
         if let (Some(eta), Some(orthogonality)) = (self.max_backward_error, self.orthogonality_error) {
-            out.line("max backward error, A-orthogonality error", &format!("{}, {}", bound(eta), bound(orthogonality)));
+            out.line(
+                "max backward error, A-orthogonality error",
+                &format!("{}, {}", bound(eta), bound(orthogonality)),
+            );
         }
     }
 }
@@ -109,7 +115,12 @@ impl PencilAccuracyRecord {
         if let (Some(eta), Some(orthogonality)) = (self.max_backward_error, self.orthogonality_error) {
             out.line(
                 "max backward error, A-orthogonality error",
-                &format!("{}, {}   ({} residuals)", bound(eta), bound(orthogonality), name_of(&self.residuals)),
+                &format!(
+                    "{}, {}   ({} residuals)",
+                    bound(eta),
+                    bound(orthogonality),
+                    name_of(&self.residuals)
+                ),
             );
         }
     }

@@ -272,14 +272,27 @@ mod tests {
         assert_eq!((path.as_str(), value), ("[1].values[1]", f64::INFINITY));
         assert_eq!(path_of(&vec![inner(vec![0.0; 3])]), None);
         let mut map = std::collections::BTreeMap::new();
-        map.insert("modes", vec![Inner { values: vec![], omega_sq: Some(f64::NAN) }]);
+        map.insert(
+            "modes",
+            vec![Inner {
+                values: vec![],
+                omega_sq: Some(f64::NAN),
+            }],
+        );
         let (path, value) = path_of(&map).expect("found");
         assert!(path == "modes[0].omega_sq" && value.is_nan(), "{path}");
     }
 
     #[test]
     fn a_finite_step_passes() {
-        let step = Step::new("library", 0.0, LibraryRecord { abi_version: 1, feature_bits: 3 });
+        let step = Step::new(
+            "library",
+            0.0,
+            LibraryRecord {
+                abi_version: 1,
+                feature_bits: 3,
+            },
+        );
         assert_eq!(check_finite(&step), Ok(()));
     }
 }

@@ -29,8 +29,11 @@ impl Precision {
             Precision::Absolute(_) => return MAX_DIGITS,
             Precision::Relative(bound) => bound,
         };
-        if !(relative > 0.0) || !relative.is_finite() {
-            return if relative.is_infinite() { 1 } else { MAX_DIGITS };
+        if relative.is_infinite() {
+            return 1;
+        }
+        if relative.is_nan() || relative <= 0.0 {
+            return MAX_DIGITS;
         }
         let digits = 1.0 - relative.log10().ceil();
         digits.clamp(1.0, MAX_DIGITS as f64) as usize
@@ -229,10 +232,19 @@ mod tests {
             let d = Precision::Relative(relative).digits(value);
             let back: f64 = number(value, d).parse().expect("a plain number");
             let unit = 10f64.powf(value.abs().log10().floor() + 1.0 - d as f64);
-            assert!((back - value).abs() <= 0.5 * unit * (1.0 + 1e-9), "{value} to {d} digits: {back}");
+            assert!(
+                (back - value).abs() <= 0.5 * unit * (1.0 + 1e-9),
+                "{value} to {d} digits: {back}"
+            );
             let unit_relative = 10f64.powf(1.0 - d as f64);
-            assert!(unit_relative >= relative * (1.0 - 1e-12) || d == 1, "{relative}: {d} digits");
-            assert!(10f64.powf(-(d as f64)) <= relative || d == MAX_DIGITS, "{relative}: {d}");
+            assert!(
+                unit_relative >= relative * (1.0 - 1e-12) || d == 1,
+                "{relative}: {d} digits"
+            );
+            assert!(
+                10f64.powf(-(d as f64)) <= relative || d == MAX_DIGITS,
+                "{relative}: {d}"
+            );
         }
     }
 }

@@ -32,7 +32,13 @@ impl BuildRecord {
         let masses: Vec<f64> = self.bodies.iter().map(|b| b.mass).collect();
         out.named("body masses", &names, &masses, "kg", Precision::Exact);
         out.count("degrees of freedom", self.dof);
-        out.named("q0, the start of every analysis", &self.coordinates, &self.q0, "rad | m", Precision::Exact);
+        out.named(
+            "q0, the start of every analysis",
+            &self.coordinates,
+            &self.q0,
+            "rad | m",
+            Precision::Exact,
+        );
     }
 }
 

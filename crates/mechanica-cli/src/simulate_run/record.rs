@@ -85,14 +85,23 @@ impl SimulateRecord {
         let names = &self.coordinates;
         let precision = |e: Option<f64>| e.map_or(Precision::Exact, Precision::Absolute);
         out.named("q(t_end)", names, &self.q_end, "rad | m", precision(self.error_q_end));
-        out.named("q̇(t_end)", names, &self.q_dot_end, "rad/s | m/s", precision(self.error_q_dot_end));
+        out.named(
+            "q̇(t_end)",
+            names,
+            &self.q_dot_end,
+            "rad/s | m/s",
+            precision(self.error_q_dot_end),
+        );
         if let (Some(q), Some(q_dot)) = (self.max_error_q, self.max_error_q_dot) {
             out.line(
                 "largest estimated error over the samples",
                 &format!("q {}, q̇ {}", bound(q), bound(q_dot)),
             );
         }
-        out.line("steps: main run, companion run", &format!("{}, {}", self.steps, self.companion_steps));
+        out.line(
+            "steps: main run, companion run",
+            &format!("{}, {}", self.steps, self.companion_steps),
+        );
         let m = &self.monitor;
         let what = match m.invariant {
             InvariantName::Energy => "energy T + U",
