@@ -9,7 +9,8 @@ use crate::report::{Step, timed_step};
 use crate::scene::Scene;
 use crate::scene_run::{Model, coordinate_names};
 use mechanica::impulse::{
-    BodyPoint, ContactLaw, ImpactOptions, MechanismContact, MechanismInertia, RestitutionLaw, resolve_single_contact,
+    BodyPoint, ContactLaw, ContactMode, ImpactOptions, MechanismContact, MechanismInertia, RestitutionLaw,
+    resolve_single_contact,
 };
 use mechanica::kinematics::nalgebra::{Unit, Vector3};
 use mechanica::mass::mechanism::TreeMass;
@@ -21,8 +22,9 @@ use mechanica::mechanism::{
 use mechanica::modal::response::FreeResponse;
 use mechanica::modal::{ModeKind, PencilProblem, Selection, SolveOptions};
 use records::{
-    EquilibriumRecord, FoundEquilibrium, GyroscopicRecord, ImpactLawRecord, ImpactRecord, MechanismRecord,
-    ModalAccuracy, ModesRecord, MultiStartRecord, ResponseRecord, StabilityRecord, SturmStatus, Verdict,
+    ContactModeName, EquilibriumRecord, FoundEquilibrium, GyroscopicRecord, ImpactLawRecord, ImpactRecord,
+    MechanismRecord, ModalAccuracy, ModesRecord, MultiStartRecord, ResponseRecord, StabilityRecord, SturmStatus,
+    Verdict,
 };
 
 /// Builds the mechanism of a scene: tree, masses, gravity, rotating frame, springs, forces,
@@ -560,7 +562,7 @@ fn impact_record(
             law: name.to_string(),
             impulse: outcome.impulse_w.into(),
             integration_error: impact.integration_error,
-            contact_mode: snake_case(&format!("{:?}", outcome.mode)),
+            contact_mode: contact_mode(outcome.mode),
             q_dot_after: impact.q_dot_after.clone(),
             energy_before: impact.energy_before,
             energy_change: impact.energy_change,
@@ -573,14 +575,14 @@ fn impact_record(
     })
 }
 
-/// `SlipThenStick` → `slip_then_stick`.
-fn snake_case(name: &str) -> String {
-    let mut out = String::new();
-    for (i, c) in name.chars().enumerate() {
-        if c.is_uppercase() && i > 0 {
-            out.push('_');
-        }
-        out.extend(c.to_lowercase());
+/// The record's name of a contact mode.
+fn contact_mode(mode: ContactMode) -> ContactModeName {
+    match mode {
+        ContactMode::NoImpact => ContactModeName::NoImpact,
+        ContactMode::Frictionless => ContactModeName::Frictionless,
+        ContactMode::Stick => ContactModeName::Stick,
+        ContactMode::Slip => ContactModeName::Slip,
+        ContactMode::SlipThenStick => ContactModeName::SlipThenStick,
+        ContactMode::Reversed => ContactModeName::Reversed,
     }
-    out
 }

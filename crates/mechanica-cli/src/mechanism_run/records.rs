@@ -294,6 +294,24 @@ impl ResponseRecord {
     }
 }
 
+/// How a contact behaved during an impact (mechanica::impulse::ContactMode).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactModeName {
+    /// No impulse: separating or grazing.
+    NoImpact,
+    /// Smooth contact: no tangential impulse.
+    Frictionless,
+    /// Stuck from the start.
+    Stick,
+    /// Slipped throughout.
+    Slip,
+    /// Slipped, then stuck.
+    SlipThenStick,
+    /// Slipped, halted and slipped again in a new direction.
+    Reversed,
+}
+
 /// One restitution law's outcome of an impact.
 #[derive(Debug, Clone, Serialize)]
 pub struct ImpactLawRecord {
@@ -303,8 +321,8 @@ pub struct ImpactLawRecord {
     pub impulse: [f64; 3],
     /// Error of the impulse-parameterised integration, N·s.
     pub integration_error: f64,
-    /// How the contact ended (snake_case of mechanica::impulse::ContactMode).
-    pub contact_mode: String,
+    /// How the contact behaved.
+    pub contact_mode: ContactModeName,
     /// q̇ after the impact, rad/s | m/s.
     pub q_dot_after: Vec<f64>,
     /// Kinetic energy before, J.
@@ -347,7 +365,7 @@ impl ImpactRecord {
                 "J",
                 Precision::Exact,
             );
-            out.line(&format!("{name}: contact"), &law.contact_mode);
+            out.line(&format!("{name}: contact"), &name_of(&law.contact_mode));
         }
     }
 }
