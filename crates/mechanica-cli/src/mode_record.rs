@@ -114,7 +114,7 @@ impl ModeRecord {
             text.push_str(&format!(", γ = {} 1/s", number(gamma, digits)));
         }
         if self.multiplicity > 1 {
-            text.push_str(&format!(", group {} of {}", self.group, self.multiplicity));
+            text.push_str(&format!(", multiplicity {} (group {})", self.multiplicity, self.group));
         }
         text
     }

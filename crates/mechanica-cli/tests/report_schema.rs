@@ -71,12 +71,42 @@ fn every_report() -> Vec<(String, serde_json::Value)> {
     reports.push(("default scene".into(), report(&[])));
     let panda = path("examples/cpp/panda_modes/panda.urdf");
     reports.push((panda.clone(), report(&["run", &panda])));
+    reports.push(("URDF with massless links".into(), urdf_with_warnings()));
     let mesh = path("crates/mechanica-mass/tests/data/robot-meshes/allegro_link_0.0.stl");
     reports.push((format!("mass {mesh}"), report(&["mass", &mesh])));
     reports.push((format!("mass --shell {mesh}"), report(&["mass", &mesh, "--shell"])));
     reports.extend(pencil_reports());
     reports.push(("version".into(), report(&["version"])));
     reports
+}
+
+/// A URDF pendulum with a tool link whose mesh is missing, run with `--allow-missing-mesh`: the
+/// report carries a warning.
+fn urdf_with_warnings() -> serde_json::Value {
+    let urdf = scratch("warnings").join("tool.urdf");
+    std::fs::write(
+        &urdf,
+        r#"<?xml version="1.0"?>
+<robot name="tooled">
+  <link name="base"/>
+  <link name="arm">
+    <inertial><origin xyz="0 0 -0.5"/><mass value="1"/>
+      <inertia ixx="0.08" ixy="0" ixz="0" iyy="0.08" iyz="0" izz="1e-6"/></inertial>
+  </link>
+  <link name="tool"><collision><geometry><mesh filename="missing.stl"/></geometry></collision></link>
+  <joint name="hinge" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/></joint>
+  <joint name="mount" type="fixed"><parent link="arm"/><child link="tool"/><origin xyz="0 0 -1"/></joint>
+</robot>
+"#,
+    )
+    .expect("urdf");
+    let json = report(&["run", urdf.to_str().expect("utf-8"), "--allow-missing-mesh"]);
+    let warnings = common::step(&json, "build")["warnings"]
+        .as_array()
+        .expect("warnings")
+        .len();
+    assert_eq!(warnings, 1, "{json}");
+    json
 }
 
 /// `modes` on a dense pencil with shapes, with values only, and on a sparse one (the grid

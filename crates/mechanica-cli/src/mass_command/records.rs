@@ -125,7 +125,13 @@ impl MeshMassRecord {
         // Moments and the centre are accurate relative to the body's scale, not entrywise.
         let size = self.inertia.iter().flatten().fold(0.0, |a: f64, b| a.max(b.abs()));
         let moment = Precision::Absolute(self.relative_error_bound * size);
-        let reach = self.centre_of_mass.iter().fold(0.0, |a: f64, b| a.max(b.abs()));
+        // The body's scale: the larger of its distance from the origin and its radius of gyration.
+        let gyration = if self.mass > 0.0 {
+            (size / self.mass).sqrt()
+        } else {
+            0.0
+        };
+        let reach = self.centre_of_mass.iter().fold(gyration, |a: f64, b| a.max(b.abs()));
         let centre = Precision::Absolute(self.relative_error_bound * reach);
         out.values("centre of mass (file frame)", &self.centre_of_mass, "m", centre);
         out.values(
