@@ -1,5 +1,5 @@
-//! Each subcommand's `--help` lists its own options only, and a bare `mechanica` still runs
-//! the default scene.
+//! The command line's surface: each subcommand's `--help` lists its own options only, a bare
+//! `mechanica` still runs the default scene, and `version` names the compiled-in features.
 
 mod common;
 use common::mechanica;
@@ -51,4 +51,35 @@ fn a_bare_command_runs_the_default_scene() {
     let report: serde_json::Value = serde_json::from_str(&json).expect("JSON");
     assert_eq!(report["command"], "run");
     assert_eq!(report["schema_version"], 2);
+}
+
+#[test]
+fn the_version_report_names_the_compiled_in_features() {
+    let (ok, json, err) = mechanica(&["version", "--json"]);
+    assert!(ok, "{err}");
+    let report: serde_json::Value = serde_json::from_str(&json).expect("JSON");
+    let library = &report["steps"][0];
+    assert_eq!(library["analysis"], "library");
+    // The CLI enables every feature of the facade (crates/mechanica-cli/Cargo.toml), one bit each.
+    let mut names: Vec<&str> = library["features"]
+        .as_array()
+        .expect("features")
+        .iter()
+        .filter_map(|f| f.as_str())
+        .collect();
+    names.sort_unstable();
+    let mut expected = [
+        "kinematics",
+        "mass",
+        "impulse",
+        "modal",
+        "mechanism",
+        "dynamics",
+        "motion",
+        "urdf",
+    ];
+    expected.sort_unstable();
+    assert_eq!(names, expected);
+    let bits = library["feature_bits"].as_u64().expect("bits");
+    assert_eq!(bits.count_ones() as usize, names.len());
 }

@@ -291,6 +291,7 @@ mod tests {
             LibraryRecord {
                 abi_version: 1,
                 feature_bits: 3,
+                features: vec!["kinematics".into(), "mass".into()],
             },
         );
         assert_eq!(check_finite(&step), Ok(()));

@@ -191,21 +191,47 @@ pub struct LibraryRecord {
     pub abi_version: u32,
     /// `mech_features()`: one bit per compiled-in feature (include/mechanica.h).
     pub feature_bits: u32,
+    /// The compiled-in features by name (the facade's cargo features).
+    pub features: Vec<String>,
+}
+
+/// The facade's features and their `MECH_FEATURE_BIT_*` bits.
+fn feature_names(bits: u32) -> Vec<String> {
+    use mechanica::ffi::*;
+    [
+        ("kinematics", MECH_FEATURE_BIT_KINEMATICS),
+        ("mass", MECH_FEATURE_BIT_MASS),
+        ("impulse", MECH_FEATURE_BIT_IMPULSE),
+        ("modal", MECH_FEATURE_BIT_MODAL),
+        ("mechanism", MECH_FEATURE_BIT_MECHANISM),
+        ("dynamics", MECH_FEATURE_BIT_DYNAMICS),
+        ("motion", MECH_FEATURE_BIT_MOTION),
+        ("urdf", MECH_FEATURE_BIT_URDF),
+    ]
+    .into_iter()
+    .filter(|(_, bit)| bits & bit != 0)
+    .map(|(name, _)| name.to_string())
+    .collect()
 }
 
 impl LibraryRecord {
     fn write_text(&self, out: &mut text::Text) {
         out.count("C ABI version", self.abi_version as usize);
-        out.line("feature bits", &format!("{:#x}", self.feature_bits));
+        out.line(
+            "features",
+            &format!("{} ({:#x})", self.features.join(", "), self.feature_bits),
+        );
     }
 }
 
 /// The `version` command's report.
 pub fn version_report() -> Result<Report, String> {
     use mechanica::ffi::{mech_abi_version, mech_features};
+    let bits = mech_features();
     let record = LibraryRecord {
         abi_version: mech_abi_version(),
-        feature_bits: mech_features(),
+        feature_bits: bits,
+        features: feature_names(bits),
     };
     Ok(Report::new(
         Command::Version,
