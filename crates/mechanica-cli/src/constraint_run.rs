@@ -3,15 +3,18 @@
 //! FM 4.61) and the reactions of every constraint, and on request the constrained equilibrium
 //! (FM 4.83–4.86).
 
-use crate::report::{Quantity, Step, timed_step};
+pub(crate) mod records;
+
+use crate::report::{Step, timed_step};
 use crate::scene::{ConstraintSpec, DynamicsSpec, Scene};
-use crate::scene_run::{Model, quantity};
+use crate::scene_run::{Model, coordinate_names};
 use mechanica::dynamics::{
     ConstrainedDynamics, ConstrainedEquilibriumOptions, ConstrainedForward, Constraint, ConstraintReaction, Dynamics,
     ProjectionOptions, State,
 };
 use mechanica::kinematics::nalgebra::Vector3;
 use mechanica::mechanism::Anchor;
+use records::{ConstrainedEquilibriumRecord, ConstrainedForwardRecord, ConstraintReactionRecord, ProjectionRecord};
 
 /// The state of a scene with constraints: coordinates, velocities and applied forces.
 pub struct StartState {
@@ -33,13 +36,14 @@ pub fn run(
     steps: &mut Vec<Step>,
 ) -> Result<(), String> {
     let mut constrained = build(scene, model, dynamics)?;
+    let names = coordinate_names(model);
     let mut state = None;
     steps.push(timed_step(
         "constraints: q0 and q̇ projected onto f(q) = 0 and J q̇ = 0 (least kinetic metric)",
         || {
-            let (quantities, q, q_dot) = project(&mut constrained, &start)?;
-            state = Some((q, q_dot));
-            Ok::<_, String>(quantities)
+            let record = project(&mut constrained, &start, &names)?;
+            state = Some((record.q.clone(), record.q_dot.clone()));
+            Ok::<_, String>(record)
         },
     )?);
     let (q, q_dot) = state.ok_or("internal: projected state missing")?;
@@ -49,13 +53,13 @@ pub fn run(
             let result = constrained
                 .forward_dynamics(&State::new(&q, &q_dot), &start.tau)
                 .map_err(|e| format!("analyses.dynamics: constrained forward dynamics: {e}"))?;
-            Ok::<_, String>(forward_quantities(&constrained, &result))
+            Ok::<_, String>(forward_record(&constrained, &result, &names))
         },
     )?);
     if spec.equilibrium {
         steps.push(timed_step(
             "equilibrium: ∇U + Jᵀλ = 0, f(q) = 0 near q0 (FM 4.83–4.86)",
-            || equilibrium_quantities(&mut constrained, &q),
+            || equilibrium_record(&mut constrained, &q, &names),
         )?);
     }
     Ok(())
@@ -118,11 +122,12 @@ fn constraint_of(scene: &Scene, model: &Model, spec: &ConstraintSpec) -> Result<
     })
 }
 
-/// The report of a projection, the projected q and the projected q̇.
-type Projected = (Vec<Quantity>, Vec<f64>, Vec<f64>);
-
 /// The projected (q, q̇) with what the projection moved and what is left.
-fn project(constrained: &mut ConstrainedDynamics, start: &StartState) -> Result<Projected, String> {
+fn project(
+    constrained: &mut ConstrainedDynamics,
+    start: &StartState,
+    names: &[String],
+) -> Result<ProjectionRecord, String> {
     let positions = constrained
         .project_positions(&start.q, &ProjectionOptions::default())
         .map_err(|e| format!("analyses.dynamics: q0 cannot be brought onto the constraints: {e}"))?;
@@ -130,102 +135,73 @@ fn project(constrained: &mut ConstrainedDynamics, start: &StartState) -> Result<
         .project_velocities(&positions.q, &start.q_dot)
         .map_err(|e| format!("analyses.dynamics: velocity projection: {e}"))?;
     let moved: f64 = positions.q.iter().zip(&start.q).map(|(a, b)| (a - b).powi(2)).sum();
-    let quantities = vec![
-        quantity("q on the constraints", positions.q.clone(), "rad | m", None),
-        quantity(
-            "‖q − q0‖₂, ‖f(q)‖₂",
-            vec![moved.sqrt(), positions.residual],
-            "",
-            Some(format!(
-                "{} Gauss–Newton iteration(s); tolerance on ‖f‖₂ {:.1e}",
-                positions.iterations, positions.tolerance
-            )),
-        ),
-        quantity("q̇ with J q̇ = 0", velocities.q_dot.clone(), "rad/s | m/s", None),
-        quantity(
-            "‖J q̇‖₂ before, after",
-            vec![velocities.removed, velocities.residual],
-            "m/s | rad/s",
-            None,
-        ),
-    ];
-    Ok((quantities, positions.q, velocities.q_dot))
+    Ok(ProjectionRecord {
+        coordinates: names.to_vec(),
+        q: positions.q,
+        moved: moved.sqrt(),
+        constraint_residual: positions.residual,
+        iterations: positions.iterations,
+        tolerance: positions.tolerance,
+        q_dot: velocities.q_dot,
+        velocity_removed: velocities.removed,
+        velocity_residual: velocities.residual,
+    })
 }
 
-fn forward_quantities(constrained: &ConstrainedDynamics, result: &ConstrainedForward) -> Vec<Quantity> {
-    let accuracy = format!(
-        "backward error {:.1e}; κ(A) = {:.2e}, κ(J A⁻¹ Jᵀ) = {:.2e}",
-        result.backward_error, result.mass_condition, result.schur_condition
-    );
-    let mut out = vec![
-        quantity(
-            "q̈ (constrained forward dynamics)",
-            result.q_ddot.clone(),
-            "rad/s² | m/s²",
-            Some(accuracy),
-        ),
-        quantity(
-            "λ (one per constraint equation)",
-            result.multipliers.clone(),
-            "N | N·m",
-            None,
-        ),
-        quantity(
-            "drift ‖f(q)‖₂, ‖J q̇‖₂",
-            vec![result.position_drift, result.velocity_drift],
-            "",
-            None,
-        ),
-    ];
-    out.extend(reaction_quantities(constrained, &result.reactions));
-    out
+fn forward_record(
+    constrained: &ConstrainedDynamics,
+    result: &ConstrainedForward,
+    names: &[String],
+) -> ConstrainedForwardRecord {
+    ConstrainedForwardRecord {
+        coordinates: names.to_vec(),
+        q_ddot: result.q_ddot.clone(),
+        multipliers: result.multipliers.clone(),
+        backward_error: result.backward_error,
+        mass_condition: result.mass_condition,
+        schur_condition: result.schur_condition,
+        position_drift: result.position_drift,
+        velocity_drift: result.velocity_drift,
+        reactions: reaction_records(constrained, &result.reactions),
+    }
 }
 
 /// Per constraint: the force on its first point and the generalized force −Jᵢᵀλᵢ.
-fn reaction_quantities(constrained: &ConstrainedDynamics, reactions: &[ConstraintReaction]) -> Vec<Quantity> {
-    let mut out = Vec::with_capacity(2 * reactions.len());
-    for reaction in reactions {
-        let name = constrained.constraint_name(reaction.constraint).unwrap_or("?");
-        if reaction.point.is_some() {
-            out.push(quantity(
-                &format!("reaction of \"{name}\": force on its first point (world)"),
-                reaction.force.iter().copied().collect(),
-                "N",
-                None,
-            ));
-        }
-        out.push(quantity(
-            &format!("reaction of \"{name}\": generalized force −Jᵀλ"),
-            reaction.generalized_force.clone(),
-            "N·m | N",
-            None,
-        ));
-    }
-    out
+fn reaction_records(
+    constrained: &ConstrainedDynamics,
+    reactions: &[ConstraintReaction],
+) -> Vec<ConstraintReactionRecord> {
+    reactions
+        .iter()
+        .map(|reaction| ConstraintReactionRecord {
+            constraint: constrained
+                .constraint_name(reaction.constraint)
+                .unwrap_or("?")
+                .to_string(),
+            force: reaction.point.map(|_| reaction.force.into()),
+            generalized_force: reaction.generalized_force.clone(),
+        })
+        .collect()
 }
 
-fn equilibrium_quantities(constrained: &mut ConstrainedDynamics, q: &[f64]) -> Result<Vec<Quantity>, String> {
+fn equilibrium_record(
+    constrained: &mut ConstrainedDynamics,
+    q: &[f64],
+    names: &[String],
+) -> Result<ConstrainedEquilibriumRecord, String> {
     let result = constrained
         .equilibrium(q, &ConstrainedEquilibriumOptions::default())
         .map_err(|e| format!("analyses.dynamics: constrained equilibrium: {e}"))?;
-    let accuracy = format!(
-        "‖∇U + Jᵀλ‖₂ = {:.1e} ≤ {:.1e}, ‖f‖₂ = {:.1e} ≤ {:.1e}; {} Newton iteration(s)",
-        result.stationarity,
-        result.stationarity_tolerance,
-        result.constraint_norm,
-        result.constraint_tolerance,
-        result.iterations
-    );
-    let mut out = vec![
-        quantity(
-            "q at the constrained equilibrium",
-            result.q.clone(),
-            "rad | m",
-            Some(accuracy),
-        ),
-        quantity("U at the equilibrium", vec![result.potential], "J", None),
-        quantity("λ at the equilibrium", result.multipliers.clone(), "N | N·m", None),
-    ];
-    out.extend(reaction_quantities(constrained, &result.reactions));
-    Ok(out)
+    Ok(ConstrainedEquilibriumRecord {
+        coordinates: names.to_vec(),
+        q: result.q.clone(),
+        potential: result.potential,
+        multipliers: result.multipliers.clone(),
+        stationarity: result.stationarity,
+        stationarity_tolerance: result.stationarity_tolerance,
+        constraint_norm: result.constraint_norm,
+        constraint_tolerance: result.constraint_tolerance,
+        iterations: result.iterations,
+        reactions: reaction_records(constrained, &result.reactions),
+    })
 }

@@ -6,7 +6,8 @@
 //! rough floor under each restitution law (Newton's gains energy; the default, Stronge's, never
 //! does).
 
-use crate::report::Report;
+use crate::mechanism_run::records::{ShowcaseLaw, ShowcaseRecord};
+use crate::report::{Command, Report};
 use crate::scene::Scene;
 use std::path::Path;
 
@@ -33,7 +34,7 @@ pub fn run(plot_dir: Option<&Path>) -> Result<Report, String> {
         let dir = plot_dir.map(|d| d.join(name));
         let report = crate::scene_run::run(&scene, path, dir.as_deref())?;
         for mut step in report.steps {
-            step.analysis = format!("[{}] {}", scene.title, step.analysis);
+            step.scene = Some(scene.title.clone());
             steps.push(step);
         }
     }
@@ -41,28 +42,20 @@ pub fn run(plot_dir: Option<&Path>) -> Result<Report, String> {
         "impulse: Kane's double pendulum on a rough floor, e = f = 0.5, every law",
         || {
             let outcomes = mechanica::impulse::showcase::kane_double_pendulum_demo().map_err(|e| e.to_string())?;
-            Ok::<_, String>(
-                outcomes
-                    .iter()
-                    .map(|o| {
-                        crate::scene_run::quantity(
-                            &format!("{}: T before, ΔT", o.law),
-                            vec![o.energy_before, o.energy_change],
-                            "J",
-                            Some(if o.energy_change > 0.0 {
-                                "energy GAINED (Kane's paradox)".into()
-                            } else {
-                                "energy lost".into()
-                            }),
-                        )
-                    })
-                    .collect(),
-            )
+            let laws = outcomes
+                .iter()
+                .map(|o| ShowcaseLaw {
+                    law: o.law.to_string(),
+                    energy_before: o.energy_before,
+                    energy_change: o.energy_change,
+                })
+                .collect();
+            Ok::<_, String>(ShowcaseRecord { laws })
         },
     )?);
-    Ok(Report {
-        title: "default scene: spring-loaded pendulum chain and a bead on a rotating hoop".into(),
-        version: mechanica::version().into(),
+    Ok(Report::new(
+        Command::Run,
+        "default scene: spring-loaded pendulum chain and a bead on a rotating hoop".into(),
         steps,
-    })
+    ))
 }

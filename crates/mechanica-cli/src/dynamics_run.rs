@@ -3,12 +3,15 @@
 //! joint reactions, with the scene's dampers; then the damped modes about q0
 //! ([`crate::damped_run`]). A scene with constraints goes to [`crate::constraint_run`].
 
-use crate::report::{Quantity, Step, timed_step};
+pub(crate) mod records;
+
+use crate::report::{Step, timed_step};
 use crate::scene::{DynamicsSpec, Scene};
-use crate::scene_run::{Model, quantity};
+use crate::scene_run::{Model, coordinate_names};
 use mechanica::dynamics::{Damper, Dynamics, ForwardDynamics, ForwardMethod, Frame, InverseDynamics, State};
 use mechanica::kinematics::nalgebra::Vector3;
 use mechanica::mechanism::Anchor;
+use records::{ForwardMethodName, ForwardRecord, InverseRecord, JointReaction, LoadRecord};
 
 /// Runs the dynamics step when the scene asks for it.
 pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), String> {
@@ -34,6 +37,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), St
         return crate::constraint_run::run(scene, model, dynamics, spec, start, steps);
     }
     let state = State::new(&model.q0, &q_dot);
+    let names = coordinate_names(model);
     let mut forward = None;
     steps.push(timed_step(
         "dynamics: forward q̈ = A⁻¹ (τ + Σ Q − c − g) at q0 (7.60)",
@@ -41,9 +45,9 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), St
             let result = dynamics
                 .forward_dynamics(&state, &tau)
                 .map_err(|e| format!("analyses.dynamics: forward dynamics: {e}"))?;
-            let quantities = forward_quantities(&result);
+            let record = forward_record(&result, &names);
             forward = Some(result);
-            Ok::<_, String>(quantities)
+            Ok::<_, String>(record)
         },
     )?);
     let forward = forward.ok_or("internal: forward dynamics missing")?;
@@ -54,9 +58,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>) -> Result<(), St
             let result = dynamics
                 .inverse_dynamics(&state, &q_ddot)
                 .map_err(|e| format!("analyses.dynamics: inverse dynamics: {e}"))?;
-            let mut quantities = inverse_quantities(&result, &q_ddot);
-            quantities.extend(reaction_quantities(&dynamics, &result, model, spec)?);
-            Ok::<_, String>(quantities)
+            inverse_record(&dynamics, &result, &q_ddot, model, spec)
         },
     )?;
     steps.push(step);
@@ -104,76 +106,38 @@ pub(crate) fn build_dynamics(scene: &Scene, model: &Model) -> Result<Dynamics, S
     Ok(dynamics)
 }
 
-fn forward_quantities(result: &ForwardDynamics) -> Vec<Quantity> {
-    let method = match result.method {
-        ForwardMethod::ArticulatedBody => "articulated-body recursion, confirmed by the inverse dynamics",
-        ForwardMethod::MassMatrix => "mass matrix and Cholesky",
-    };
-    let mut accuracy = format!("{method}; backward error {:.1e}", result.backward_error);
-    if let (Some(condition), Some(estimate)) = (result.condition, result.error_estimate) {
-        accuracy.push_str(&format!("; κ∞(A) = {condition:.2e}, error estimate {estimate:.1e}"));
+fn forward_record(result: &ForwardDynamics, names: &[String]) -> ForwardRecord {
+    ForwardRecord {
+        coordinates: names.to_vec(),
+        q_ddot: result.q_ddot.clone(),
+        method: match result.method {
+            ForwardMethod::ArticulatedBody => ForwardMethodName::ArticulatedBody,
+            _ => ForwardMethodName::MassMatrix,
+        },
+        backward_error: result.backward_error,
+        condition: result.condition,
+        error_estimate: result.error_estimate,
+        residual: result.residual.clone(),
+        dissipation: result.dissipation,
     }
-    vec![
-        quantity(
-            "q̈ (forward dynamics)",
-            result.q_ddot.clone(),
-            "rad/s² | m/s²",
-            Some(accuracy),
-        ),
-        quantity("residual τ − RNEA(q, q̇, q̈)", result.residual.clone(), "N·m | N", None),
-        quantity(
-            "dissipation function D of the dampers",
-            vec![result.dissipation],
-            "W",
-            None,
-        ),
-    ]
 }
 
-fn inverse_quantities(result: &InverseDynamics, q_ddot: &[f64]) -> Vec<Quantity> {
-    let rounding = result.error_estimate.iter().copied().fold(0.0, f64::max);
-    let mut out = vec![
-        quantity("q̈ of the inverse dynamics", q_ddot.to_vec(), "rad/s² | m/s²", None),
-        quantity(
-            "τ (inverse dynamics)",
-            result.tau.clone(),
-            "N·m | N",
-            Some(format!("rounding estimate {rounding:.1e}")),
-        ),
-        quantity(
-            "c(q, q̇): velocity-product terms",
-            result.velocity_product.clone(),
-            "N·m | N",
-            None,
-        ),
-        quantity("g(q): gravity terms", result.gravity.clone(), "N·m | N", None),
-    ];
-    for load in &result.loads {
-        out.push(quantity(
-            &format!("Q of {}", load.name),
-            load.force.clone(),
-            "N·m | N",
-            None,
-        ));
-    }
-    out
-}
-
-/// One quantity per joint: the force and the moment about the joint origin that the parent
-/// exerts on the body through the joint, in the requested frame.
-fn reaction_quantities(
+/// τ with its split, and one reaction per joint: the force and the moment about the joint
+/// origin that the parent exerts on the body through the joint, in the requested frame.
+fn inverse_record(
     dynamics: &Dynamics,
     result: &InverseDynamics,
+    q_ddot: &[f64],
     model: &Model,
     spec: &DynamicsSpec,
-) -> Result<Vec<Quantity>, String> {
+) -> Result<InverseRecord, String> {
     let name = spec.frame.as_ref().map_or("world", |f| f.get_ref().as_str());
     let frame = match name {
         "body" => Frame::Body,
         "joint" => Frame::Joint,
         _ => Frame::World,
     };
-    let mut out = Vec::with_capacity(result.reactions.len());
+    let mut reactions = Vec::with_capacity(result.reactions.len());
     for reaction in &result.reactions {
         let wrench = reaction
             .expressed_in(dynamics, frame)
@@ -183,12 +147,28 @@ fn reaction_quantities(
             .iter()
             .find(|(_, b)| *b == reaction.body)
             .map_or("?", |(n, _)| n.as_str());
-        out.push(quantity(
-            &format!("reaction at joint \"{joint}\": force, moment about its origin ({name} frame)"),
-            wrench.force.iter().chain(wrench.moment.iter()).copied().collect(),
-            "N | N·m",
-            None,
-        ));
+        reactions.push(JointReaction {
+            joint: joint.to_string(),
+            force: wrench.force.into(),
+            moment: wrench.moment.into(),
+        });
     }
-    Ok(out)
+    Ok(InverseRecord {
+        coordinates: coordinate_names(model),
+        q_ddot: q_ddot.to_vec(),
+        tau: result.tau.clone(),
+        rounding_estimate: result.error_estimate.iter().copied().fold(0.0, f64::max),
+        velocity_product: result.velocity_product.clone(),
+        gravity: result.gravity.clone(),
+        loads: result
+            .loads
+            .iter()
+            .map(|load| LoadRecord {
+                name: load.name.clone(),
+                force: load.force.clone(),
+            })
+            .collect(),
+        frame: name.to_string(),
+        reactions,
+    })
 }

@@ -8,6 +8,7 @@ mod default_scene;
 mod dynamics_run;
 mod mass_command;
 mod mechanism_run;
+mod mode_record;
 mod modes_command;
 mod plots;
 mod progress;
@@ -26,36 +27,53 @@ use std::process::ExitCode;
 #[derive(Debug, Parser)]
 #[command(name = "mechanica", version, about, long_about = None)]
 struct Cli {
-    /// Print the machine-readable JSON report instead of the text report.
+    /// Print the machine-readable JSON report (docs/json-report.md) instead of the text report.
     #[arg(long, global = true)]
     json: bool,
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+/// Arguments of `mechanica run`.
+#[derive(Debug, clap::Args)]
+struct RunArgs {
+    /// The scene file (TOML) or URDF robot; the built-in default scene when omitted.
+    scene: Option<std::path::PathBuf>,
     /// URDF input: replace invalid link inertias by the nearest physical tensors (and say so)
     /// instead of refusing the file.
-    #[arg(long, global = true)]
+    #[arg(long)]
     repair_inertia: bool,
     /// URDF input: make a link without <inertial> whose mesh cannot be used (missing file,
     /// unsupported format) massless, with a warning in the report, instead of refusing the file.
-    #[arg(long, global = true)]
+    #[arg(long)]
     allow_missing_mesh: bool,
     /// Scene input: the most values a free response may store, samples × (dof + 1); a scene
     /// asking for more is refused.
-    #[arg(long, global = true, value_name = "N", default_value_t = scene::SceneLimits::DEFAULT.max_response_values)]
+    #[arg(long, value_name = "N", default_value_t = scene::SceneLimits::DEFAULT.max_response_values)]
     max_response_values: usize,
     /// Write SVG plots (spectrum, mode shapes, free response, impact energy) into this directory.
-    #[arg(long, global = true, value_name = "DIR")]
+    #[arg(long, value_name = "DIR")]
     plot: Option<std::path::PathBuf>,
-    #[command(subcommand)]
-    command: Option<Command>,
+}
+
+impl Default for RunArgs {
+    /// The default scene with the default options (a bare `mechanica`).
+    fn default() -> RunArgs {
+        RunArgs {
+            scene: None,
+            repair_inertia: false,
+            allow_missing_mesh: false,
+            max_response_values: scene::SceneLimits::DEFAULT.max_response_values,
+            plot: None,
+        }
+    }
 }
 
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Run a scene file (TOML; see the format in the README) or a URDF robot, or the built-in default scene
     /// when no file is given (also what a bare `mechanica` does).
-    Run {
-        /// The scene file.
-        scene: Option<std::path::PathBuf>,
-    },
+    Run(RunArgs),
     /// The inertia calculator: mass, centre of mass, inertia, principal moments and axes of a
     /// triangle mesh file (STL or OBJ), with the mesh's diagnostics.
     Mass(mass_command::MassArgs),
@@ -67,53 +85,69 @@ enum Command {
     Version,
 }
 
-fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let report = match cli.command.unwrap_or(Command::Run { scene: None }) {
-        Command::Run { scene: None } => default_scene::run(cli.plot.as_deref()),
-        Command::Run { scene: Some(path) } if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) => {
+/// Runs a scene file, a URDF robot (by its extension) or the default scene.
+fn run(args: &RunArgs) -> Result<report::Report, String> {
+    let plot = args.plot.as_deref();
+    match &args.scene {
+        None => default_scene::run(plot),
+        Some(path) if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) => {
             let options = urdf::UrdfOptions {
-                repair_inertia: cli.repair_inertia,
-                allow_missing_mesh: cli.allow_missing_mesh,
+                repair_inertia: args.repair_inertia,
+                allow_missing_mesh: args.allow_missing_mesh,
             };
-            urdf::load(&path, options).and_then(|(scene, notes)| {
-                let mut report = scene_run::run(&scene, &path, cli.plot.as_deref())?;
-                if let Some(first) = report.steps.first_mut() {
-                    first.notes.extend(notes);
-                }
-                Ok(report)
-            })
+            let (scene, notes) = urdf::load(path, options)?;
+            let mut report = scene_run::run(&scene, path, plot)?;
+            if let Some(first) = report.steps.first_mut() {
+                let (warnings, remarks): (Vec<String>, Vec<String>) =
+                    notes.into_iter().partition(|n| n.starts_with("warning:"));
+                first.warnings.extend(warnings);
+                first.notes.extend(remarks);
+            }
+            Ok(report)
         }
-        Command::Run { scene: Some(path) } => {
+        Some(path) => {
             let limits = scene::SceneLimits {
-                max_response_values: cli.max_response_values,
+                max_response_values: args.max_response_values,
             };
-            scene::Scene::load_with(&path, &limits)
-                .map_err(|e| e.to_string())
-                .and_then(|scene| scene_run::run(&scene, &path, cli.plot.as_deref()))
+            let scene = scene::Scene::load_with(path, &limits).map_err(|e| e.to_string())?;
+            scene_run::run(&scene, path, plot)
         }
+    }
+}
+
+/// The report of the command, checked finite.
+fn report_of(command: Command) -> Result<report::Report, String> {
+    let report = match command {
+        Command::Run(args) => run(&args),
         Command::Mass(args) => mass_command::run(&args),
         Command::Modes(args) => modes_command::run(&args),
         Command::Version => report::version_report(),
-    };
-    match report {
-        Ok(report) => {
-            if cli.json {
-                match serde_json::to_string_pretty(&report) {
-                    Ok(text) => println!("{text}"),
-                    Err(error) => {
-                        eprintln!("mechanica: could not encode the report as JSON: {error}");
-                        return ExitCode::FAILURE;
-                    }
-                }
-            } else {
-                print!("{}", report.to_text());
-            }
-            ExitCode::SUCCESS
-        }
+    }?;
+    for step in &report.steps {
+        report::check_finite(step).map_err(|e| e.to_string())?;
+    }
+    Ok(report)
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let report = match report_of(cli.command.unwrap_or(Command::Run(RunArgs::default()))) {
+        Ok(report) => report,
         Err(error) => {
             eprintln!("mechanica: {error}");
-            ExitCode::FAILURE
+            return ExitCode::FAILURE;
         }
+    };
+    if cli.json {
+        match serde_json::to_string_pretty(&report) {
+            Ok(text) => println!("{text}"),
+            Err(error) => {
+                eprintln!("mechanica: could not encode the report as JSON: {error}");
+                return ExitCode::FAILURE;
+            }
+        }
+    } else {
+        print!("{}", report.to_text());
     }
+    ExitCode::SUCCESS
 }

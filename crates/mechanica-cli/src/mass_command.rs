@@ -10,11 +10,14 @@
 //! closed mesh: an open one is rejected with its boundary-edge count unless `--shell` asks for
 //! the thin-shell (surface-density) model.
 
-use crate::report::{Quantity, Report, timed_step};
+pub(crate) mod records;
+
+use crate::report::{Command, Report, timed_step};
 use mechanica::mass::crack::crack_width;
 use mechanica::mass::io::load_mesh_welded;
 use mechanica::mass::mesh::{MeshMassProperties, MeshModel, MeshOptions, TriangleMesh};
 use mechanica::mass::{Amount, DEFAULT_WELD_TOLERANCE, MassError, WeldReport};
+use records::{InertiaSix, MeshDiagnosticsRecord, MeshLoadRecord, MeshMassRecord, MeshModelName, WeldRecord};
 
 /// Density of a solid when neither `--density` nor `--mass` is given (water), kg/m³.
 pub const DEFAULT_SOLID_DENSITY: f64 = 1000.0;
@@ -56,19 +59,6 @@ impl MassArgs {
             (None, None) => Amount::Density(DEFAULT_SOLID_DENSITY),
         }
     }
-}
-
-fn quantity(name: &str, values: Vec<f64>, unit: &str) -> Quantity {
-    Quantity {
-        name: name.into(),
-        values,
-        unit: unit.into(),
-        accuracy: None,
-    }
-}
-
-fn count(name: &str, n: usize) -> Quantity {
-    quantity(name, vec![n as f64], "")
 }
 
 /// Explains a mesh error with the file name and, where it helps, the option that accepts it;
@@ -114,101 +104,69 @@ fn scaled(mut mesh: TriangleMesh, scale: f64) -> Result<TriangleMesh, String> {
 }
 
 /// What welding did, in the units of the scaled mesh.
-fn weld_quantities(weld: &WeldReport, scale: f64) -> Vec<Quantity> {
-    vec![
-        quantity(
-            "weld tolerance (relative to bounding-box diagonal)",
-            vec![weld.relative_tolerance],
-            "",
-        ),
-        quantity("weld tolerance", vec![weld.tolerance * scale], "m"),
-        count("vertices welded into another", weld.vertices_welded),
-        count("triangles collapsed by welding, dropped", weld.triangles_dropped),
-        quantity(
-            "largest vertex displacement by welding",
-            vec![weld.max_displacement * scale],
-            "m",
-        ),
-    ]
+fn weld_record(weld: &WeldReport, scale: f64) -> WeldRecord {
+    WeldRecord {
+        relative_tolerance: weld.relative_tolerance,
+        tolerance: weld.tolerance * scale,
+        vertices_welded: weld.vertices_welded,
+        triangles_dropped: weld.triangles_dropped,
+        max_displacement: weld.max_displacement * scale,
+    }
 }
 
-/// The quantities of the mass-properties step.
-fn properties_quantities(result: &MeshMassProperties) -> Result<Vec<Quantity>, MassError> {
+/// The rows of a 3 × 3 matrix.
+fn rows(m: &mechanica::kinematics::nalgebra::Matrix3<f64>) -> [[f64; 3]; 3] {
+    [0, 1, 2].map(|r| [0, 1, 2].map(|c| m[(r, c)]))
+}
+
+/// The record of the mass-properties step.
+fn properties_record(result: &MeshMassProperties) -> Result<MeshMassRecord, MassError> {
     let p = &result.properties;
-    let bound = result.relative_error_bound;
-    let accuracy = Some(format!("relative rounding-error bound {bound:.1e}"));
-    let moment_accuracy = Some(format!("rounding error ≲ {bound:.1e} relative to the body's scale"));
-    let (measure_name, measure_unit, density_unit) = match result.model {
-        MeshModel::Solid => ("volume", "m³", "kg/m³"),
-        MeshModel::Shell => ("surface area", "m²", "kg/m²"),
-    };
     let j = &p.inertia_c;
     let principal = p.principal_axes()?;
     let axes = principal.r_fp.matrix();
     let j_origin = p.inertia_about(&mechanica::kinematics::nalgebra::Vector3::zeros());
-    Ok(vec![
-        quantity("mass", vec![p.mass], "kg"),
-        Quantity {
-            name: measure_name.into(),
-            values: vec![result.measure],
-            unit: measure_unit.into(),
-            accuracy,
+    Ok(MeshMassRecord {
+        model: match result.model {
+            MeshModel::Solid => MeshModelName::Solid,
+            MeshModel::Shell => MeshModelName::Shell,
         },
-        quantity("density", vec![p.mass / result.measure], density_unit),
-        Quantity {
-            name: "centre of mass (file frame)".into(),
-            values: p.p_oc.iter().copied().collect(),
-            unit: "m".into(),
-            accuracy: moment_accuracy.clone(),
+        mass: p.mass,
+        measure: result.measure,
+        density: p.mass / result.measure,
+        centre_of_mass: p.p_oc.into(),
+        inertia: rows(j),
+        inertia_urdf: InertiaSix {
+            ixx: j[(0, 0)],
+            ixy: j[(0, 1)],
+            ixz: j[(0, 2)],
+            iyy: j[(1, 1)],
+            iyz: j[(1, 2)],
+            izz: j[(2, 2)],
         },
-        Quantity {
-            name: "inertia about centre of mass (rows of 3×3)".into(),
-            values: (0..3).flat_map(|r| (0..3).map(move |c| j[(r, c)])).collect(),
-            unit: "kg·m²".into(),
-            accuracy: moment_accuracy,
-        },
-        quantity(
-            "inertia about c.o.m. ixx ixy ixz iyy iyz izz",
-            vec![j[(0, 0)], j[(0, 1)], j[(0, 2)], j[(1, 1)], j[(1, 2)], j[(2, 2)]],
-            "kg·m²",
-        ),
-        quantity(
-            "inertia about file origin (rows of 3×3)",
-            (0..3).flat_map(|r| (0..3).map(move |c| j_origin[(r, c)])).collect(),
-            "kg·m²",
-        ),
-        Quantity {
-            name: "principal moments I1 ≤ I2 ≤ I3".into(),
-            values: principal.moments.iter().copied().collect(),
-            unit: "kg·m²".into(),
-            accuracy: Some(format!(
-                "relative residual ‖RᵀJR − diag‖/‖J‖ = {:.1e}",
-                principal.relative_residual
-            )),
-        },
-        quantity(
-            "principal axes (axis 1, axis 2, axis 3; right-handed)",
-            axes.iter().copied().collect(),
-            "",
-        ),
-    ])
+        inertia_about_origin: rows(&j_origin),
+        principal_moments: principal.moments.into(),
+        principal_axes: [0, 1, 2].map(|c| [0, 1, 2].map(|r| axes[(r, c)])),
+        principal_relative_residual: principal.relative_residual,
+        relative_error_bound: result.relative_error_bound,
+    })
 }
 
 /// Runs the inertia calculator on one mesh file.
 pub fn run(args: &MassArgs) -> Result<Report, String> {
     let file = &args.file;
     let mut mesh = None;
-    let load = timed_step("load mesh", || -> Result<Vec<Quantity>, String> {
+    let load = timed_step("load mesh", || -> Result<MeshLoadRecord, String> {
         let (m, weld) = load_mesh_welded(file, args.weld).map_err(|e| explain(file, &e, None))?;
         let m = scaled(m, args.scale)?;
-        let mut quantities = vec![
-            count("vertices (after welding)", m.vertices.len()),
-            count("triangles", m.triangles.len()),
-            quantity("coordinate scale", vec![args.scale], "m per file unit"),
-        ];
-        quantities.extend(weld_quantities(&weld, args.scale));
+        let record = MeshLoadRecord {
+            vertices: m.vertices.len(),
+            triangles: m.triangles.len(),
+            scale: args.scale,
+            weld: weld_record(&weld, args.scale),
+        };
         mesh = Some(m);
-        Ok(quantities)
+        Ok(record)
     })?;
     let mesh = mesh.ok_or_else(|| format!("{}: no mesh was loaded", file.display()))?;
     let options = MeshOptions {
@@ -221,32 +179,29 @@ pub fn run(args: &MassArgs) -> Result<Report, String> {
     } else {
         "mass properties (solid, volume density)"
     };
-    let properties = timed_step(analysis, || -> Result<Vec<Quantity>, String> {
+    let properties = timed_step(analysis, || -> Result<MeshMassRecord, String> {
         let r = mesh
             .mass_properties(args.amount(), &options)
             .map_err(|e| explain(file, &e, Some(&mesh)))?;
-        let quantities = properties_quantities(&r).map_err(|e| explain(file, &e, Some(&mesh)))?;
+        let record = properties_record(&r).map_err(|e| explain(file, &e, Some(&mesh)))?;
         result = Some(r);
-        Ok(quantities)
+        Ok(record)
     })?;
     let result = result.ok_or_else(|| format!("{}: no mass properties were computed", file.display()))?;
     let d = &result.diagnostics;
-    let diagnostics = timed_step("mesh diagnostics", || -> Result<Vec<Quantity>, String> {
-        Ok(vec![
-            count("triangles", d.triangles),
-            count("degenerate triangles skipped", d.degenerate_triangles),
-            count("boundary edges (used by one triangle)", d.topology.boundary_edges),
-            count(
-                "non-manifold edges (used by > 2 triangles)",
-                d.topology.non_manifold_edges,
-            ),
-            count("misoriented edges", d.topology.misoriented_edges),
-            count("inside out, orientation flipped (1 = yes)", usize::from(d.flipped)),
-        ])
+    let diagnostics = timed_step("mesh diagnostics", || -> Result<MeshDiagnosticsRecord, String> {
+        Ok(MeshDiagnosticsRecord {
+            triangles: d.triangles,
+            degenerate_triangles: d.degenerate_triangles,
+            boundary_edges: d.topology.boundary_edges,
+            non_manifold_edges: d.topology.non_manifold_edges,
+            misoriented_edges: d.topology.misoriented_edges,
+            flipped: d.flipped,
+        })
     })?;
-    Ok(Report {
-        title: format!("mass properties of {}", file.display()),
-        version: mechanica::version().into(),
-        steps: vec![load, properties, diagnostics],
-    })
+    Ok(Report::new(
+        Command::Mass,
+        format!("mass properties of {}", file.display()),
+        vec![load, properties, diagnostics],
+    ))
 }

@@ -1,12 +1,16 @@
 //! The mechanism analyses of a scene (equilibrium, stability, modes, free response), run only
 //! when the scene asks for them.
 
+pub(crate) mod records;
+
+use crate::mode_record::{BodyMotion, ModeRecord};
 use crate::plots::{EnergyBalance, ModeShape, PlotData, ResponseSeries};
 use crate::report::{Step, timed_step};
 use crate::scene::Scene;
-use crate::scene_run::{Model, quantity};
+use crate::scene_run::{Model, coordinate_names};
 use mechanica::impulse::{
-    BodyPoint, ContactLaw, ImpactOptions, MechanismContact, MechanismInertia, RestitutionLaw, resolve_single_contact,
+    BodyPoint, ContactLaw, ContactMode, ImpactOptions, MechanismContact, MechanismInertia, RestitutionLaw,
+    resolve_single_contact,
 };
 use mechanica::kinematics::nalgebra::{Unit, Vector3};
 use mechanica::mass::mechanism::TreeMass;
@@ -17,6 +21,11 @@ use mechanica::mechanism::{
 };
 use mechanica::modal::response::FreeResponse;
 use mechanica::modal::{ModeKind, PencilProblem, Selection, SolveOptions};
+use records::{
+    ContactModeName, EquilibriumRecord, FoundEquilibrium, GyroscopicRecord, ImpactLawRecord, ImpactRecord,
+    MechanismRecord, ModalAccuracy, ModesRecord, MultiStartRecord, ResponseRecord, StabilityRecord, SturmStatus,
+    Verdict,
+};
 
 /// Builds the mechanism of a scene: tree, masses, gravity, rotating frame, springs, forces,
 /// limits.
@@ -90,16 +99,30 @@ pub fn build_mechanism(scene: &Scene, model: &Model) -> Result<Mechanism, String
     Ok(mechanism)
 }
 
-fn stability_note(stability: &Stability) -> String {
-    match stability {
-        Stability::Stable => "stable: every mode oscillates (B positive definite relative to A)".into(),
+/// The typed verdict of `stability`.
+pub(crate) fn stability_record(stability: &Stability) -> StabilityRecord {
+    match *stability {
+        Stability::Stable => StabilityRecord {
+            verdict: Verdict::Stable,
+            unstable_directions: 0,
+            max_growth_rate: None,
+            zero_modes: 0,
+        },
         Stability::Unstable {
             directions,
             max_growth_rate,
-        } => format!("unstable: {directions} unstable direction(s), fastest growth rate {max_growth_rate:.6e} 1/s"),
-        Stability::Marginal { zero_modes } => {
-            format!("marginal: {zero_modes} zero mode(s) within their error bounds, none unstable")
-        }
+        } => StabilityRecord {
+            verdict: Verdict::Unstable,
+            unstable_directions: directions,
+            max_growth_rate: Some(max_growth_rate),
+            zero_modes: 0,
+        },
+        Stability::Marginal { zero_modes } => StabilityRecord {
+            verdict: Verdict::Marginal,
+            unstable_directions: 0,
+            max_growth_rate: None,
+            zero_modes,
+        },
     }
 }
 
@@ -114,6 +137,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     }
     let (build, mut mechanism) = build_step(scene, model)?;
     steps.push(build);
+    let names = coordinate_names(model);
     let mut q = model.q0.clone();
     let mut locked: Vec<usize> = Vec::new();
     if let Some(spec) = &analyses.equilibrium {
@@ -125,19 +149,25 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
             max_iterations: spec.max_iterations.unwrap_or(100),
             ..EquilibriumOptions::default()
         };
-        let mut step = equilibrium_step(&mut mechanism, &mut q, &mut locked, &options)?;
+        let mut step = timed_step("equilibrium: Newton on grad U* (8.74)", || {
+            equilibrium_search(&mut mechanism, &mut q, &mut locked, &options, &names)
+        })?;
         if !spec.starts.is_empty() {
             let starts: Vec<Vec<f64>> = spec.starts.iter().map(|s| s.get_ref().clone()).collect();
-            add_equilibria_from_starts(&mut step, &mut mechanism, &q, &starts, &options)?;
+            let multi = equilibria_from_starts(&mut mechanism, &q, &starts, &options)?;
+            if let crate::report::Record::Equilibrium(r) = &mut step.record {
+                r.multi_start = Some(multi);
+            }
         }
         steps.push(step);
     }
     let Some(spec) = &analyses.modes else { return Ok(()) };
-    let (step, modes) = modes_step(&mut mechanism, &q, &locked, spec)?;
+    let bodies: Vec<String> = scene.bodies.iter().map(|b| b.name.get_ref().clone()).collect();
+    let (step, modes) = modes_step(&mut mechanism, &q, &locked, spec, &names, &bodies)?;
     steps.push(step);
     record_mode_plots(&modes, plots);
     if let Some(response) = &analyses.response {
-        steps.push(response_step(&modes, response.get_ref(), plots)?);
+        steps.push(response_step(&modes, response.get_ref(), plots, &names)?);
     }
     Ok(())
 }
@@ -147,67 +177,60 @@ fn build_step(scene: &Scene, model: &Model) -> Result<(Step, Mechanism), String>
     let mut built = None;
     let step = timed_step("build: mechanism (potentials, frame)", || {
         let mechanism = build_mechanism(scene, model)?;
-        let quantities = vec![quantity(
-            "potentials",
-            vec![mechanism.potentials().len() as f64],
-            "",
-            None,
-        )];
+        let record = MechanismRecord {
+            potentials: mechanism.potentials().len(),
+        };
         built = Some(mechanism);
-        Ok::<_, String>(quantities)
+        Ok::<_, String>(record)
     })?;
     let mechanism = built.ok_or("internal: mechanism not built")?;
     Ok((step, mechanism))
 }
 
-/// The timed equilibrium search from `q`: on success `q` becomes the equilibrium and `locked`
-/// the coordinates resting on a joint limit there.
-fn equilibrium_step(
+/// The equilibrium search from `q`: on success `q` becomes the equilibrium and `locked` the
+/// coordinates resting on a joint limit there.
+fn equilibrium_search(
     mechanism: &mut Mechanism,
     q: &mut Vec<f64>,
     locked: &mut Vec<usize>,
     options: &EquilibriumOptions,
-) -> Result<Step, String> {
+    names: &[String],
+) -> Result<EquilibriumRecord, String> {
     let recentred = mechanism.has_rotation_vectors();
-    let mut notes = Vec::new();
-    let mut step = timed_step("equilibrium: Newton on grad U* (8.74)", || {
-        let eq = find_equilibrium(mechanism, q, options).map_err(|e| e.to_string())?;
-        let quantities = vec![
-            quantity("q at equilibrium", eq.q.clone(), "rad | m", None),
-            quantity(
-                "|grad U*| at equilibrium",
-                vec![eq.gradient_norm],
-                "J",
-                Some(format!(
-                    "tolerance {:.1e}, {} Newton iterations, last step {:.1e}",
-                    eq.tolerance, eq.iterations, eq.last_step
-                )),
-            ),
-            quantity("U* at equilibrium", vec![eq.potential], "J", None),
-        ];
-        *q = eq.q;
-        *locked = eq.at_limit;
-        if recentred {
-            notes.push(
-                "spherical/free joints were re-centred on the equilibrium: their rotation vectors read 0 in the new chart; bodies did not move"
-                    .to_string(),
-            );
-        }
-        Ok::<_, String>(quantities)
-    })?;
-    step.notes.append(&mut notes);
-    Ok(step)
+    let eq = find_equilibrium(mechanism, q, options).map_err(|e| e.to_string())?;
+    let record = EquilibriumRecord {
+        coordinates: names.to_vec(),
+        q: eq.q.clone(),
+        gradient_norm: eq.gradient_norm,
+        tolerance: eq.tolerance,
+        iterations: eq.iterations,
+        last_step: eq.last_step,
+        potential: eq.potential,
+        locked: named(names, &eq.at_limit),
+        recentred,
+        multi_start: None,
+    };
+    *q = eq.q;
+    *locked = eq.at_limit;
+    Ok(record)
 }
 
-/// Searches from `q` and every further start, and adds to `step` each distinct equilibrium
-/// found (apart by more than 1e-8 in some coordinate) with its stability.
-fn add_equilibria_from_starts(
-    step: &mut Step,
+/// The names of the coordinates `indices`.
+fn named(names: &[String], indices: &[usize]) -> Vec<String> {
+    indices
+        .iter()
+        .map(|&k| names.get(k).cloned().unwrap_or_else(|| format!("q[{k}]")))
+        .collect()
+}
+
+/// Searches from `q` and every further start; each distinct equilibrium found (apart by more
+/// than 1e-8 in some coordinate) with its stability.
+fn equilibria_from_starts(
     mechanism: &mut Mechanism,
     q: &[f64],
     further_starts: &[Vec<f64>],
     options: &EquilibriumOptions,
-) -> Result<(), String> {
+) -> Result<MultiStartRecord, String> {
     let mut starts = further_starts.to_vec();
     starts.insert(0, q.to_vec());
     let progress = crate::progress::bar(starts.len() as u64, "equilibria from several starts");
@@ -227,30 +250,33 @@ fn add_equilibria_from_starts(
         progress.inc(1);
     }
     progress.finish_and_clear();
-    step.notes.push(format!(
-        "{} distinct equilibria from {} starts ({} did not converge)",
-        found.len(),
-        starts.len(),
-        failed
-    ));
-    for (i, eq) in found.iter().enumerate() {
-        step.quantities
-            .push(quantity(&format!("equilibrium {i}"), eq.clone(), "rad | m", None));
-        let verdict = mechanism_modes(&mut mechanism.clone(), eq, &SolveOptions::default())
-            .map(|m| stability_note(&m.stability))
-            .unwrap_or_else(|e| format!("stability unknown: {e}"));
-        step.notes.push(format!("equilibrium {i}: {verdict}"));
-    }
-    Ok(())
+    let equilibria = found
+        .into_iter()
+        .map(|eq| {
+            let modes = mechanism_modes(&mut mechanism.clone(), &eq, &SolveOptions::default());
+            FoundEquilibrium {
+                q: eq,
+                stability: modes.as_ref().ok().map(|m| stability_record(&m.stability)),
+                stability_error: modes.err().map(|e| e.to_string()),
+            }
+        })
+        .collect();
+    Ok(MultiStartRecord {
+        starts: starts.len(),
+        failed,
+        equilibria,
+    })
 }
 
-/// The timed modes at `q` with the `locked` coordinates held fixed, with notes on stability,
-/// the gyroscopic problem, a non-equilibrium `q` and the locks; and the modes.
+/// The timed modes at `q` with the `locked` coordinates held fixed, with the stability, the
+/// gyroscopic problem, and a warning when `q` is not an equilibrium; and the modes.
 fn modes_step(
     mechanism: &mut Mechanism,
     q: &[f64],
     locked: &[usize],
     spec: &crate::scene::ModesSpec,
+    names: &[String],
+    bodies: &[String],
 ) -> Result<(Step, MechanismModes), String> {
     let options = SolveOptions {
         selection: spec
@@ -262,51 +288,95 @@ fn modes_step(
     let mut modes: Option<MechanismModes> = None;
     let mut step = timed_step("modes: det(λA + B) = 0 at the equilibrium (8.84–8.92)", || {
         let m = mechanism_modes_with_locks(mechanism, q, locked, &options).map_err(|e| e.to_string())?;
-        let quantities = mode_quantities(&m);
+        let record = modes_record(&m, names, &named(names, locked), bodies);
         modes = Some(m);
-        Ok::<_, String>(quantities)
+        Ok::<_, String>(record)
     })?;
     let modes = modes.ok_or("internal: modes missing")?;
-    let finite = |m: &&mechanica::modal::Mode| m.omega_sq.is_finite() && m.error_bound.is_finite();
-    let massive = |m: &&mechanica::modal::Mode| !matches!(m.kind, ModeKind::Infinite);
-    if let Some(mode) = modes.solution.modes.iter().filter(massive).find(|m| !finite(m)) {
-        let value = if mode.omega_sq.is_finite() {
-            mode.error_bound
-        } else {
-            mode.omega_sq
-        };
-        return Err(crate::report::NonFiniteResult {
-            analysis: step.analysis.clone(),
-            quantity: "ω² of a finite mode or its error bound".into(),
-            value,
-        }
-        .to_string());
-    }
-    step.notes.push(stability_note(&modes.stability));
-    if let Some(gyro) = &modes.gyroscopic {
-        step.notes.push(format!(
-            "rotating frame: gyroscopic problem det(s²A + sG + B) = 0 solved; max Re s = {:.3e} (bound {:.1e}) → {}",
-            gyro.max_real_part,
-            gyro.real_part_bound,
-            if gyro.stable {
-                "stable (possibly gyroscopically stabilised)"
-            } else {
-                "unstable"
-            }
-        ));
-    }
+    check_finite_modes(&modes, &step.title)?;
     if modes.gradient_norm > 1e-6 * modes.stiffness_matrix.norm_l2().max(1.0) {
-        step.notes.push(format!(
+        step.warnings.push(format!(
             "warning: |grad U*| = {:.2e} at this configuration: it is not an equilibrium; the modes are those of the linearisation",
             modes.gradient_norm
         ));
     }
-    if !locked.is_empty() {
-        step.notes.push(format!(
-            "coordinates {locked:?} rest on joint limits at the equilibrium and are held fixed for the modes"
-        ));
-    }
     Ok((step, modes))
+}
+
+/// An error when a finite mode's ω² or error bound is not a finite number.
+fn check_finite_modes(modes: &MechanismModes, analysis: &str) -> Result<(), String> {
+    let finite = |m: &&mechanica::modal::Mode| m.omega_sq.is_finite() && m.error_bound.is_finite();
+    let massive = |m: &&mechanica::modal::Mode| !matches!(m.kind, ModeKind::Infinite);
+    match modes.solution.modes.iter().filter(massive).find(|m| !finite(m)) {
+        Some(mode) => Err(crate::report::NonFiniteResult {
+            analysis: analysis.into(),
+            quantity: "ω² of a finite mode or its error bound".into(),
+            value: if mode.omega_sq.is_finite() {
+                mode.error_bound
+            } else {
+                mode.omega_sq
+            },
+        }
+        .to_string()),
+        None => Ok(()),
+    }
+}
+
+/// The typed modes of `m`: every mode with its shape, effective masses and body motions.
+fn modes_record(m: &MechanismModes, names: &[String], locked: &[String], bodies: &[String]) -> ModesRecord {
+    let solution = &m.solution;
+    let records = solution
+        .modes
+        .iter()
+        .enumerate()
+        .map(|(k, mode)| {
+            let shape = solution
+                .vectors
+                .as_ref()
+                .filter(|x| k < x.ncols())
+                .map(|x| (0..x.nrows()).map(|r| x[(r, k)]).collect());
+            let mut record = ModeRecord::new(mode, &solution.groups, shape);
+            record.effective_mass = m.effective_masses.get(k).copied();
+            record.bodies = m.body_displacements.get(k).map(|motions| {
+                motions
+                    .iter()
+                    .zip(bodies)
+                    .map(|(d, body)| BodyMotion {
+                        body: body.clone(),
+                        translation: d.translation.into(),
+                        rotation: d.rotation.into(),
+                    })
+                    .collect()
+            });
+            record
+        })
+        .collect();
+    let accuracy = &solution.accuracy;
+    ModesRecord {
+        coordinates: names.to_vec(),
+        locked: locked.to_vec(),
+        stability: stability_record(&m.stability),
+        modes: records,
+        accuracy: ModalAccuracy {
+            max_bound: solution.modes.iter().map(|mode| mode.error_bound).fold(0.0, f64::max),
+            max_backward_error: accuracy.max_backward_error,
+            orthogonality_error: accuracy.orthogonality_error,
+            sturm_check: match &accuracy.inertia_check {
+                Some(c) if c.consistent => SturmStatus::Consistent,
+                Some(_) => SturmStatus::Inconsistent,
+                None => SturmStatus::NotRun,
+            },
+        },
+        gradient_norm: m.gradient_norm,
+        total_mass: m.total_mass,
+        gyroscopic: m.gyroscopic.as_ref().map(|g| GyroscopicRecord {
+            eigenvalues: g.eigenvalues.iter().map(|&(re, im)| [re, im]).collect(),
+            backward_errors: g.backward_errors.clone(),
+            max_real_part: g.max_real_part,
+            real_part_bound: g.real_part_bound,
+            stable: g.stable,
+        }),
+    }
 }
 
 /// Puts the spectrum and the first six mode shapes into the plot data.
@@ -337,79 +407,6 @@ fn mode_label(modes: &MechanismModes, k: usize) -> String {
     }
 }
 
-/// The mode quantities that are +∞ for the infinite modes of massless directions.
-pub(crate) const INFINITE_FOR_MASSLESS_MODES: [&str; 3] = [OMEGA_SQ, OMEGA, FREQUENCY];
-const OMEGA_SQ: &str = "ω² (8.89: λ = −ω²)";
-const OMEGA: &str = "ω";
-const FREQUENCY: &str = "f = ω/2π";
-
-fn mode_quantities(m: &MechanismModes) -> Vec<crate::report::Quantity> {
-    let modes = &m.solution.modes;
-    let omega: Vec<f64> = modes
-        .iter()
-        .map(|mode| match mode.kind {
-            ModeKind::Oscillatory { omega } => omega,
-            ModeKind::Infinite => f64::INFINITY,
-            _ => 0.0,
-        })
-        .collect();
-    let bound = modes.iter().map(|mode| mode.error_bound).fold(0.0, f64::max);
-    let accuracy = &m.solution.accuracy;
-    let mut out = vec![
-        quantity(
-            OMEGA_SQ,
-            modes.iter().map(|mode| mode.omega_sq).collect(),
-            "rad²/s²",
-            Some(format!(
-                "max error bound {bound:.1e}; max backward error {:.1e}; A-orthogonality error {:.1e}; Sturm check {}",
-                accuracy.max_backward_error.unwrap_or(0.0),
-                accuracy.orthogonality_error.unwrap_or(0.0),
-                match &accuracy.inertia_check {
-                    Some(c) if c.consistent => "consistent",
-                    Some(_) => "INCONSISTENT",
-                    None => "not run",
-                }
-            )),
-        ),
-        quantity(OMEGA, omega.clone(), "rad/s", None),
-        quantity(
-            FREQUENCY,
-            omega.iter().map(|w| w / std::f64::consts::TAU).collect(),
-            "Hz",
-            None,
-        ),
-    ];
-    for (k, masses) in m.effective_masses.iter().enumerate().take(6) {
-        out.push(quantity(
-            &format!("mode {} effective mass (x, y, z)", k + 1),
-            masses.to_vec(),
-            "kg",
-            None,
-        ));
-    }
-    for (k, bodies) in m.body_displacements.iter().enumerate().take(3) {
-        for (i, d) in bodies.iter().enumerate() {
-            out.push(quantity(
-                &format!("mode {} body {i}: centre-of-mass translation, rotation", k + 1),
-                d.translation.iter().chain(d.rotation.iter()).copied().collect(),
-                "m | rad per unit amplitude",
-                None,
-            ));
-        }
-    }
-    if let Some(x) = &m.solution.vectors {
-        for k in 0..x.ncols().min(6) {
-            out.push(quantity(
-                &format!("mode {} shape in q (A-normalised)", k + 1),
-                (0..x.nrows()).map(|r| x[(r, k)]).collect(),
-                "",
-                None,
-            ));
-        }
-    }
-    out
-}
-
 /// The free response δ(t) from the scene's initial disturbance, sampled `spec.samples` times
 /// over the span (the sample count was checked against the scene limits when the scene was
 /// read; the series are still allocated fallibly).
@@ -417,6 +414,7 @@ fn response_step(
     modes: &MechanismModes,
     spec: &crate::scene::ResponseSpec,
     plots: &mut PlotData,
+    names: &[String],
 ) -> Result<Step, String> {
     let n = modes.q.len();
     timed_step("free response δ(t) by modal superposition (8.91)", || {
@@ -437,22 +435,17 @@ fn response_step(
         let (series, end) = sample_response(&response, duration, *spec.samples.get_ref(), n)?;
         let fit = response.fit();
         let end_bound = response.error_bound(duration).map_err(|e| e.to_string())?;
-        let quantities = vec![
-            quantity(
-                "δ(T) at the end of the span",
-                end,
-                "rad | m",
-                Some(format!("error bound {end_bound:.1e}")),
-            ),
-            quantity(
-                "initial-state fit residual (δ, δ̇)",
-                vec![fit.displacement_residual, fit.velocity_residual],
-                "",
-                None,
-            ),
-        ];
+        let record = ResponseRecord {
+            coordinates: names.to_vec(),
+            duration,
+            samples: *spec.samples.get_ref(),
+            end,
+            end_bound,
+            displacement_fit_residual: fit.displacement_residual,
+            velocity_fit_residual: fit.velocity_residual,
+        };
         plots.response = Some(series);
-        Ok(quantities)
+        Ok(record)
     })
 }
 
@@ -504,83 +497,92 @@ fn impact_step(
     spec: &crate::scene::ImpactSpec,
     plots: &mut PlotData,
 ) -> Result<Step, String> {
-    let text = |e: &dyn std::fmt::Display| format!("analyses.impact: {e}");
     let chosen = spec.law.as_ref().map_or("stronge", |l| l.get_ref().as_str());
-    timed_step(
+    let mut step = timed_step(
         &format!("impact: body point on the ground, {chosen} law (7.115–7.117)"),
-        || {
-            let body = scene
-                .bodies
-                .iter()
-                .position(|b| b.name.get_ref() == spec.body.get_ref())
-                .ok_or_else(|| text(&"unknown body"))?;
-            let tree = &model.tree;
-            let mut ws = tree.workspace();
-            tree.update_positions(&mut ws, &model.q0).map_err(|e| text(&e))?;
-            tree.update_velocities(&mut ws, &model.qd0).map_err(|e| text(&e))?;
-            let mut masses = TreeMass::new(tree, model.bodies.clone()).map_err(|e| text(&e))?;
-            let inertia = MechanismInertia::new(tree, &ws, &mut masses).map_err(|e| text(&e))?;
-            let mut laws = vec![chosen];
-            if spec.compare_laws {
-                laws.extend(["newton", "poisson", "stronge"].into_iter().filter(|l| *l != chosen));
-            }
-            let mut quantities = Vec::new();
-            let mut balance = EnergyBalance { laws: Vec::new() };
-            for name in laws {
-                let law = ContactLaw::new(spec.restitution, spec.friction, law_named(name)).map_err(|e| text(&e))?;
-                let contact = MechanismContact {
-                    point: BodyPoint {
-                        body,
-                        p_bq: Vector3::from(spec.point),
-                    },
-                    other: None,
-                    normal_w: Vector3::from(spec.normal),
-                    law,
-                };
-                let impact =
-                    resolve_single_contact(tree, &ws, &inertia, &model.qd0, &contact, &ImpactOptions::default())
-                        .map_err(|e| text(&e))?;
-                let outcome = impact.contacts.first().ok_or_else(|| text(&"no contact outcome"))?;
-                let after = impact.energy_before + impact.energy_change;
-                balance.laws.push((name.to_string(), impact.energy_before, after));
-                let accuracy = Some(format!(
-                    "integration error {:.1e} N·s, mode {:?}",
-                    impact.integration_error, outcome.mode
+        || impact_record(scene, model, spec, chosen),
+    )?;
+    let mut balance = EnergyBalance { laws: Vec::new() };
+    if let crate::report::Record::Impact(record) = &step.record {
+        for law in &record.laws {
+            let after = law.energy_before + law.energy_change;
+            balance.laws.push((law.law.clone(), law.energy_before, after));
+            if law.energy_change > 0.0 {
+                step.notes.push(format!(
+                    "{}: the impact GAINS energy ({:.4e} J): Kane's paradox",
+                    law.law, law.energy_change
                 ));
-                quantities.push(quantity(
-                    &format!("{name}: impulse on the body (world)"),
-                    outcome.impulse_w.iter().copied().collect(),
-                    "N·s",
-                    accuracy,
-                ));
-                quantities.push(quantity(
-                    &format!("{name}: q̇ after"),
-                    impact.q_dot_after.clone(),
-                    "rad/s | m/s",
-                    None,
-                ));
-                quantities.push(quantity(
-                    &format!("{name}: T before, ΔT (7.107)"),
-                    vec![impact.energy_before, impact.energy_change],
-                    "J",
-                    None,
-                ));
-            }
-            plots.impact = Some(balance);
-            Ok(quantities)
-        },
-    )
-    .map(|mut step| {
-        if let Some(impact) = &plots.impact {
-            for (law, before, after) in &impact.laws {
-                if after > before {
-                    step.notes.push(format!(
-                        "{law}: the impact GAINS energy ({:.4e} J): Kane's paradox",
-                        after - before
-                    ));
-                }
             }
         }
-        step
+    }
+    plots.impact = Some(balance);
+    Ok(step)
+}
+
+/// The impact of the scene's body point under the `chosen` law, and the others when the scene
+/// compares laws.
+fn impact_record(
+    scene: &Scene,
+    model: &Model,
+    spec: &crate::scene::ImpactSpec,
+    chosen: &str,
+) -> Result<ImpactRecord, String> {
+    let text = |e: &dyn std::fmt::Display| format!("analyses.impact: {e}");
+    let body = scene
+        .bodies
+        .iter()
+        .position(|b| b.name.get_ref() == spec.body.get_ref())
+        .ok_or_else(|| text(&"unknown body"))?;
+    let tree = &model.tree;
+    let mut ws = tree.workspace();
+    tree.update_positions(&mut ws, &model.q0).map_err(|e| text(&e))?;
+    tree.update_velocities(&mut ws, &model.qd0).map_err(|e| text(&e))?;
+    let mut masses = TreeMass::new(tree, model.bodies.clone()).map_err(|e| text(&e))?;
+    let inertia = MechanismInertia::new(tree, &ws, &mut masses).map_err(|e| text(&e))?;
+    let mut laws = vec![chosen];
+    if spec.compare_laws {
+        laws.extend(["newton", "poisson", "stronge"].into_iter().filter(|l| *l != chosen));
+    }
+    let mut records = Vec::new();
+    for name in laws {
+        let law = ContactLaw::new(spec.restitution, spec.friction, law_named(name)).map_err(|e| text(&e))?;
+        let contact = MechanismContact {
+            point: BodyPoint {
+                body,
+                p_bq: Vector3::from(spec.point),
+            },
+            other: None,
+            normal_w: Vector3::from(spec.normal),
+            law,
+        };
+        let impact = resolve_single_contact(tree, &ws, &inertia, &model.qd0, &contact, &ImpactOptions::default())
+            .map_err(|e| text(&e))?;
+        let outcome = impact.contacts.first().ok_or_else(|| text(&"no contact outcome"))?;
+        records.push(ImpactLawRecord {
+            law: name.to_string(),
+            impulse: outcome.impulse_w.into(),
+            integration_error: impact.integration_error,
+            contact_mode: contact_mode(outcome.mode),
+            q_dot_after: impact.q_dot_after.clone(),
+            energy_before: impact.energy_before,
+            energy_change: impact.energy_change,
+        });
+    }
+    Ok(ImpactRecord {
+        coordinates: coordinate_names(model),
+        body: spec.body.get_ref().clone(),
+        laws: records,
     })
+}
+
+/// The record's name of a contact mode.
+fn contact_mode(mode: ContactMode) -> ContactModeName {
+    match mode {
+        ContactMode::NoImpact => ContactModeName::NoImpact,
+        ContactMode::Frictionless => ContactModeName::Frictionless,
+        ContactMode::Stick => ContactModeName::Stick,
+        ContactMode::Slip => ContactModeName::Slip,
+        ContactMode::SlipThenStick => ContactModeName::SlipThenStick,
+        ContactMode::Reversed => ContactModeName::Reversed,
+    }
 }

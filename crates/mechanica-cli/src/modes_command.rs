@@ -6,11 +6,19 @@
 //! shift-invert Lanczos solver (memory O(nnz + n·k)); everything else is solved densely
 //! (all modes, or the k lowest). `--dense` forces the dense solver.
 
-use crate::report::{Quantity, Report, Step, timed_step};
+pub(crate) mod records;
+
+use crate::mechanism_run::records::SturmStatus;
+use crate::mode_record::ModeRecord;
+use crate::report::{Command, Record, Report, Step, timed_step};
 use mechanica::modal::faer::Mat;
 use mechanica::modal::{
-    ModeKind, PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparsePencil, SparseSolveOptions, Tuning,
+    PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparsePencil, SparseSolveOptions, Tuning,
     read_matrix_market, solve, solve_sparse,
+};
+use records::{
+    PencilAccuracyRecord, PencilFactorRecord, PencilModesRecord, PencilReadRecord, PencilRefineRecord, ResidualsName,
+    SolverName, SturmRecord,
 };
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -52,117 +60,39 @@ pub struct ModesArgs {
 /// The default of `--max-dense-order`.
 pub const DEFAULT_MAX_DENSE_ORDER: usize = 10_000;
 
-fn quantity(name: &str, values: Vec<f64>, unit: &str, accuracy: Option<String>) -> Quantity {
-    Quantity {
-        name: name.into(),
-        values,
-        unit: unit.into(),
-        accuracy,
-    }
+fn stage(analysis: &str, time: Duration, record: impl Into<Record>) -> Step {
+    Step::new(analysis, time.as_secs_f64(), record)
 }
 
-fn stage(analysis: &str, time: Duration, quantities: Vec<Quantity>) -> Step {
-    Step {
-        analysis: analysis.into(),
-        seconds: time.as_secs_f64(),
-        quantities,
-        notes: Vec::new(),
-    }
-}
-
-/// The classification code written to the report (0 oscillatory, 1 zero, 2 unstable, 3 infinite,
-/// 4 undecided: the interval ω² ± bound contains zero).
-fn kind_code(kind: ModeKind) -> f64 {
-    match kind {
-        ModeKind::Oscillatory { .. } => 0.0,
-        ModeKind::Zero => 1.0,
-        ModeKind::Unstable { .. } => 2.0,
-        ModeKind::Infinite => 3.0,
-        ModeKind::Undecided => 4.0,
-    }
-}
-
-const KIND_UNIT: &str =
-    "kind (0 oscillatory, 1 zero/rigid-body, 2 unstable, 3 infinite, 4 undecided: ω² ± bound contains 0)";
-
-/// The per-mode quantities shared by the dense and the sparse report.
-fn mode_quantities(modes: &[mechanica::modal::Mode], groups: &[mechanica::modal::ModeGroup]) -> Vec<Quantity> {
-    let bound = modes.iter().map(|m| m.error_bound).fold(0.0, f64::max);
-    let omega: Vec<f64> = modes
+/// The mode records of a solution, with the shapes when `x` is given (column k: mode k).
+fn mode_records(
+    modes: &[mechanica::modal::Mode],
+    groups: &[mechanica::modal::ModeGroup],
+    x: Option<&Mat<f64>>,
+) -> Vec<ModeRecord> {
+    modes
         .iter()
-        .map(|m| match m.kind {
-            ModeKind::Oscillatory { omega } => omega,
-            ModeKind::Infinite => f64::INFINITY,
-            _ => 0.0,
+        .enumerate()
+        .map(|(k, mode)| {
+            let shape = x
+                .filter(|x| k < x.ncols())
+                .map(|x| (0..x.nrows()).map(|i| x[(i, k)]).collect());
+            ModeRecord::new(mode, groups, shape)
         })
-        .collect();
-    let mut quantities = vec![
-        quantity(
-            "λ (8.89: det(λA + B) = 0)",
-            modes.iter().map(|m| m.lambda).collect(),
-            "1/s²",
-            None,
-        ),
-        quantity(
-            "ω² = −λ",
-            modes.iter().map(|m| m.omega_sq).collect(),
-            "rad²/s²",
-            Some(format!("max error bound {bound:.2e}")),
-        ),
-        quantity(
-            "error bound of ω²",
-            modes.iter().map(|m| m.error_bound).collect(),
-            "rad²/s²",
-            None,
-        ),
-        quantity(
-            "backward error η",
-            modes.iter().map(|m| m.backward_error.unwrap_or(f64::NAN)).collect(),
-            "",
-            None,
-        ),
-        quantity("ω (oscillatory modes)", omega.clone(), "rad/s", None),
-        quantity(
-            "frequency f = ω/2π",
-            omega.iter().map(|w| w / std::f64::consts::TAU).collect(),
-            "Hz",
-            None,
-        ),
-        quantity(
-            "growth rate (unstable modes)",
-            modes
-                .iter()
-                .map(|m| match m.kind {
-                    ModeKind::Unstable { growth_rate } => growth_rate,
-                    _ => 0.0,
-                })
-                .collect(),
-            "1/s",
-            None,
-        ),
-        quantity(
-            "classification",
-            modes.iter().map(|m| kind_code(m.kind)).collect(),
-            KIND_UNIT,
-            None,
-        ),
-        quantity(
-            "group multiplicity",
-            modes.iter().map(|m| groups[m.group].multiplicity as f64).collect(),
-            "",
-            None,
-        ),
-    ];
-    // Values only: no backward error was measured; the row is left out rather than printed as NaN.
-    quantities.retain(|q| !(q.name == "backward error η" && q.values.iter().all(|v| v.is_nan())));
-    quantities
+        .collect()
 }
 
-fn shapes(x: &Mat<f64>) -> Quantity {
-    let values = (0..x.ncols())
-        .flat_map(|j| (0..x.nrows()).map(move |i| x[(i, j)]))
-        .collect();
-    quantity("mode shapes (column-major, n per mode)", values, "", None)
+fn max_bound(modes: &[mechanica::modal::Mode]) -> f64 {
+    modes.iter().map(|m| m.error_bound).fold(0.0, f64::max)
+}
+
+/// The outcome of a Sturm check.
+fn sturm_status(consistent: Option<bool>) -> SturmStatus {
+    match consistent {
+        Some(true) => SturmStatus::Consistent,
+        Some(false) => SturmStatus::Inconsistent,
+        None => SturmStatus::NotRun,
+    }
 }
 
 fn read(path: &Path) -> Result<mechanica::modal::MatrixMarket, String> {
@@ -188,11 +118,11 @@ pub fn run(args: &ModesArgs) -> Result<Report, String> {
     } else {
         steps.extend(dense_steps(args, refinement, &a, &b)?);
     }
-    Ok(Report {
-        title: format!("modes of ({}, {})", args.mass.display(), args.stiffness.display()),
-        version: env!("CARGO_PKG_VERSION").into(),
+    Ok(Report::new(
+        Command::Modes,
+        format!("modes of ({}, {})", args.mass.display(), args.stiffness.display()),
         steps,
-    })
+    ))
 }
 
 /// The refinement policy named by `--refinement` (auto, off or always).
@@ -210,7 +140,7 @@ fn read_pencil(
     args: &ModesArgs,
 ) -> Result<(Step, mechanica::modal::MatrixMarket, mechanica::modal::MatrixMarket), String> {
     let mut files = None;
-    let read_step = timed_step("read Matrix Market files", || -> Result<Vec<Quantity>, String> {
+    let read_step = timed_step("read Matrix Market files", || -> Result<PencilReadRecord, String> {
         let (a, b) = (read(&args.mass)?, read(&args.stiffness)?);
         if a.nrows != a.ncols || b.nrows != b.ncols || a.nrows != b.nrows {
             return Err(format!(
@@ -219,17 +149,13 @@ fn read_pencil(
             ));
         }
         mechanica::modal::check_every_coordinate_used(a.nrows, &a.entries, &b.entries).map_err(|e| e.to_string())?;
-        let out = vec![
-            quantity("order n", vec![a.nrows as f64], "", None),
-            quantity(
-                "stored entries of A, B",
-                vec![a.entries.len() as f64, b.entries.len() as f64],
-                "",
-                None,
-            ),
-        ];
+        let record = PencilReadRecord {
+            order: a.nrows,
+            mass_entries: a.entries.len(),
+            stiffness_entries: b.entries.len(),
+        };
         files = Some((a, b));
-        Ok(out)
+        Ok(record)
     })?;
     let Some((a, b)) = files else {
         return Err("the Matrix Market files were not read".into());
@@ -256,43 +182,30 @@ fn sparse_steps(
     .map_err(|e| e.to_string())?;
     let r = &sol.report;
     let t = r.timings;
-    let mut steps = Vec::new();
-    steps.push(stage(
-        "factor B − σA (sparse Cholesky)",
-        t.factor,
-        vec![
-            quantity("shift σ", vec![r.shift], "rad²/s²", None),
-            quantity("stored entries of the factor", vec![r.factor_nnz as f64], "", None),
-        ],
-    ));
-    let mut quantities = mode_quantities(&sol.modes, &sol.groups);
-    quantities.push(quantity(
-        "max backward error, A-orthogonality error",
-        vec![r.max_backward_error, r.orthogonality_error],
-        "",
-        None,
-    ));
-    quantities.push(quantity(
-        "Sturm check: shift, count below, computed below",
-        vec![
-            r.inertia.map_or(f64::NAN, |c| c.count.shift),
-            r.inertia.map_or(f64::NAN, |c| c.count.below as f64),
-            r.computed_below as f64,
-        ],
-        "",
-        Some(if r.consistent { "consistent" } else { "INCONSISTENT" }.into()),
-    ));
-    if args.shapes {
-        quantities.push(shapes(&sol.vectors));
-    }
-    steps.push(stage("solve (shift-invert block Lanczos)", t.lanczos, quantities));
-    steps.push(stage(
-        "refine (Rayleigh–Ritz, double-double residuals)",
-        t.refine,
-        Vec::new(),
-    ));
-    steps.push(stage("Sturm check (inertia of B − τA)", t.inertia, Vec::new()));
-    Ok(steps)
+    let factor = PencilFactorRecord {
+        shift: Some(r.shift),
+        factor_entries: Some(r.factor_nnz),
+    };
+    let modes = PencilModesRecord {
+        solver: SolverName::SparseLanczos,
+        modes: mode_records(&sol.modes, &sol.groups, Some(&sol.vectors).filter(|_| args.shapes)),
+        max_bound: max_bound(&sol.modes),
+        max_backward_error: Some(r.max_backward_error),
+        orthogonality_error: Some(r.orthogonality_error),
+    };
+    let sturm = SturmRecord {
+        status: sturm_status(Some(r.consistent)),
+        shift: r.inertia.map(|c| c.count.shift),
+        count_below: r.inertia.map(|c| c.count.below),
+        computed_below: Some(r.computed_below),
+    };
+    let no_count = PencilRefineRecord { refined_modes: None };
+    Ok(vec![
+        stage("factor B − σA (sparse Cholesky)", t.factor, factor),
+        stage("solve (shift-invert block Lanczos)", t.lanczos, modes),
+        stage("refine (Rayleigh–Ritz, double-double residuals)", t.refine, no_count),
+        stage("Sturm check (inertia of B − τA)", t.inertia, sturm),
+    ])
 }
 
 /// The dense n × n matrix summing the triplets `t` (duplicates add up).
@@ -330,60 +243,52 @@ fn dense_steps(
     };
     let sol = solve(&problem, &options).map_err(|e| e.to_string())?;
     let t = sol.timings;
-    let mut steps = Vec::new();
-    steps.push(stage(
-        "factor (Cholesky of A, reduction C = L⁻¹BL⁻ᵀ)",
-        t.factor,
-        Vec::new(),
-    ));
-    let mut quantities = mode_quantities(&sol.modes, &sol.groups);
-    if let Some(x) = sol.vectors.as_ref().filter(|_| args.shapes) {
-        quantities.push(shapes(x));
-    }
-    steps.push(stage(
-        "solve (eigen-decomposition, back-transformation)",
-        t.eigen,
-        quantities,
-    ));
+    let factor = PencilFactorRecord {
+        shift: None,
+        factor_entries: None,
+    };
+    let modes = PencilModesRecord {
+        solver: SolverName::Dense,
+        modes: mode_records(&sol.modes, &sol.groups, sol.vectors.as_ref().filter(|_| args.shapes)),
+        max_bound: max_bound(&sol.modes),
+        max_backward_error: None,
+        orthogonality_error: None,
+    };
+    let mut steps = vec![
+        stage("factor (Cholesky of A, reduction C = L⁻¹BL⁻ᵀ)", t.factor, factor),
+        stage("solve (eigen-decomposition, back-transformation)", t.eigen, modes),
+    ];
     steps.extend(dense_accuracy_steps(&sol.accuracy, &t));
     Ok(steps)
 }
 
 /// The accuracy report, refinement and Sturm check steps of a dense solution.
 fn dense_accuracy_steps(acc: &mechanica::modal::AccuracyReport, t: &mechanica::modal::SolveTimings) -> [Step; 3] {
-    // Values only: no pair was formed, so there is no backward error to print (not a NaN).
-    let measured = match (acc.max_backward_error, acc.orthogonality_error) {
-        (Some(eta), Some(orthogonality)) => vec![quantity(
-            "max backward error, A-orthogonality error",
-            vec![eta, orthogonality],
-            "",
-            Some(format!("{:?} residuals", acc.residuals)),
-        )],
-        _ => Vec::new(),
+    let accuracy = PencilAccuracyRecord {
+        residuals: match acc.residuals {
+            Residuals::Sketched => ResidualsName::Sketched,
+            _ => ResidualsName::Exact,
+        },
+        max_backward_error: acc.max_backward_error,
+        orthogonality_error: acc.orthogonality_error,
     };
-    let accuracy = stage("accuracy report", t.accuracy, measured);
     let refined = acc.refinement_steps.iter().filter(|&&s| s > 0).count();
-    let refine = stage(
-        "refine (Newton, double-double residuals)",
-        t.refine,
-        vec![quantity("refined modes", vec![refined as f64], "", None)],
-    );
     let check = acc.inertia_check;
-    let sturm = stage(
-        "Sturm check (inertia of B − sA)",
-        t.inertia,
-        vec![quantity(
-            "shift, count below, computed below",
-            check.map_or(vec![], |c| {
-                vec![c.count.shift, c.count.below as f64, c.computed_below as f64]
-            }),
-            "",
-            Some(match check {
-                Some(c) if c.consistent => "consistent".into(),
-                Some(_) => "INCONSISTENT".into(),
-                None => "not run (no finite mode)".into(),
-            }),
-        )],
-    );
-    [accuracy, refine, sturm]
+    let sturm = SturmRecord {
+        status: sturm_status(check.map(|c| c.consistent)),
+        shift: check.map(|c| c.count.shift),
+        count_below: check.map(|c| c.count.below),
+        computed_below: check.map(|c| c.computed_below),
+    };
+    [
+        stage("accuracy report", t.accuracy, accuracy),
+        stage(
+            "refine (Newton, double-double residuals)",
+            t.refine,
+            PencilRefineRecord {
+                refined_modes: Some(refined),
+            },
+        ),
+        stage("Sturm check (inertia of B − sA)", t.inertia, sturm),
+    ]
 }

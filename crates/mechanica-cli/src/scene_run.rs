@@ -1,12 +1,15 @@
 //! Runs the analyses a scene asks for, and only those, timing each step.
 
-use crate::report::{Quantity, Report, Step, timed_step};
+pub(crate) mod records;
+
+use crate::report::{Command, Report, Step, timed_step};
 use crate::scene::{BodySpec, JointKind, JointSpec, Scene};
 use mechanica::kinematics::nalgebra::{Isometry3, Matrix3, UnitQuaternion, Vector3};
 use mechanica::kinematics::tree::{Joint, KinematicTree, TreeBuilder};
 use mechanica::mass::MassProperties;
 use mechanica::mass::mesh::MeshOptions;
 use mechanica::mass::primitives::{self, Amount};
+use records::{BodyRecord, BuildRecord, MassRecord, PlotsRecord};
 use std::path::Path;
 
 /// A scene turned into library objects: the tree, each body's mass properties in its own
@@ -29,19 +32,22 @@ pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report
     let mut model = None;
     steps.push(timed_step("build: bodies and kinematic tree", || {
         let built = build_model(scene, file)?;
-        let names = coordinate_names(&built);
-        let quantities = vec![
-            quantity("bodies", vec![built.bodies.len() as f64], "", None),
-            quantity("degrees of freedom", vec![built.tree.dof() as f64], "", None),
-            quantity(
-                &format!("q0, the start of every analysis, of {}", names.join(", ")),
-                built.q0.clone(),
-                "rad | m",
-                None,
-            ),
-        ];
+        let record = BuildRecord {
+            bodies: scene
+                .bodies
+                .iter()
+                .zip(&built.bodies)
+                .map(|(spec, props)| BodyRecord {
+                    name: spec.name.get_ref().clone(),
+                    mass: props.mass,
+                })
+                .collect(),
+            dof: built.tree.dof(),
+            coordinates: coordinate_names(&built),
+            q0: built.q0.clone(),
+        };
         model = Some(built);
-        Ok::<_, String>(quantities)
+        Ok::<_, String>(record)
     })?);
     let model = model.ok_or("internal: model not built")?;
     if scene.analyses.mass_properties {
@@ -53,34 +59,15 @@ pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report
     crate::dynamics_run::run(scene, &model, &mut steps)?;
     crate::simulate_run::run(scene, file, &model, &mut steps, &mut plots)?;
     for step in &steps {
-        crate::report::check_finite(step, |name| {
-            crate::mechanism_run::INFINITE_FOR_MASSLESS_MODES.contains(&name)
-        })
-        .map_err(|e| e.to_string())?;
+        crate::report::check_finite(step).map_err(|e| e.to_string())?;
     }
     if let Some(dir) = plot_dir {
+        let start = std::time::Instant::now();
         let written = plots.write_all(dir)?;
-        steps.push(crate::report::Step {
-            analysis: "plots".into(),
-            seconds: 0.0,
-            quantities: Vec::new(),
-            notes: written.iter().map(|p| format!("wrote {}", p.display())).collect(),
-        });
+        let files = written.iter().map(|p| p.display().to_string()).collect();
+        steps.push(Step::new("plots", start.elapsed().as_secs_f64(), PlotsRecord { files }));
     }
-    Ok(Report {
-        title: scene.title.clone(),
-        version: mechanica::version().into(),
-        steps,
-    })
-}
-
-pub(crate) fn quantity(name: &str, values: Vec<f64>, unit: &str, accuracy: Option<String>) -> Quantity {
-    Quantity {
-        name: name.into(),
-        values,
-        unit: unit.into(),
-        accuracy,
-    }
+    Ok(Report::new(Command::Run, scene.title.clone(), steps))
 }
 
 /// The mass properties of one body in its own frame, from the scene's description.
@@ -237,7 +224,7 @@ pub(crate) fn build_model(scene: &Scene, file: &Path) -> Result<Model, String> {
 
 /// Total mass properties in the world frame at q0, and the gravitational potential
 /// U = −m g·x₀ when the scene has gravity.
-fn mass_report(model: &Model, gravity: Option<Vector3<f64>>) -> Result<Vec<Quantity>, String> {
+fn mass_report(model: &Model, gravity: Option<Vector3<f64>>) -> Result<MassRecord, String> {
     let mut ws = model.tree.workspace();
     model
         .tree
@@ -252,39 +239,13 @@ fn mass_report(model: &Model, gravity: Option<Vector3<f64>>) -> Result<Vec<Quant
     }
     let total = MassProperties::sum(world.iter()).map_err(|e| e.to_string())?;
     let axes = total.principal_axes().map_err(|e| e.to_string())?;
-    if !axes.relative_residual.is_finite() {
-        return Err(crate::report::NonFiniteResult {
-            analysis: "mass properties at q0".into(),
-            quantity: "principal axes' relative residual".into(),
-            value: axes.relative_residual,
-        }
-        .to_string());
-    }
-    let mut quantities = vec![
-        quantity("total mass", vec![total.mass], "kg", None),
-        quantity(
-            "centre of mass (world)",
-            total.p_oc.iter().copied().collect(),
-            "m",
-            None,
-        ),
-        quantity(
-            "principal moments about the centre of mass (3.20)",
-            axes.moments.iter().copied().collect(),
-            "kg·m²",
-            Some(format!("relative residual {:.1e}", axes.relative_residual)),
-        ),
-    ];
-    if let Some(g) = gravity {
-        let potential = -total.mass * g.dot(&total.p_oc);
-        quantities.push(quantity(
-            "gravitational potential U = −m g·x₀",
-            vec![potential],
-            "J",
-            None,
-        ));
-    }
-    Ok(quantities)
+    Ok(MassRecord {
+        total_mass: total.mass,
+        centre_of_mass: total.p_oc.into(),
+        principal_moments: axes.moments.into(),
+        principal_relative_residual: axes.relative_residual,
+        gravitational_potential: gravity.map(|g| -total.mass * g.dot(&total.p_oc)),
+    })
 }
 
 /// One name per coordinate, in coordinate order: the joint's name, indexed within joints of
@@ -337,13 +298,14 @@ mod tests {
         let elbow = Vector3::new(-t1.sin(), 0.0, -t1.cos());
         let lower = elbow + Vector3::new(-0.5 * (t1 + t2).sin(), 0.0, -0.5 * (t1 + t2).cos());
         let expected = (upper + lower) / 2.0;
-        assert_eq!(q[0].values, vec![2.0]);
-        assert!((q[3].values[0] - 2.0 * 9.81 * expected.z).abs() < 1e-13);
+        assert_eq!(q.total_mass, 2.0);
+        let potential = q.gravitational_potential.expect("gravity");
+        assert!((potential - 2.0 * 9.81 * expected.z).abs() < 1e-13);
         for k in 0..3 {
             assert!(
-                (q[1].values[k] - expected[k]).abs() < 1e-15,
+                (q.centre_of_mass[k] - expected[k]).abs() < 1e-15,
                 "{:?} vs {expected:?}",
-                q[1].values
+                q.centre_of_mass
             );
         }
     }
@@ -353,7 +315,7 @@ mod tests {
         // Both rods on the z axis, centre of mass at z = -1: I = 2·mL²/12 + 2·m·(1/2)² = 2/3 about
         // x and y, and 0 about the rods' common axis.
         let q = mass_report(&pendulum_at([0.0, 0.0]), None).expect("report");
-        let moments = &q[2].values;
+        let moments = &q.principal_moments;
         assert!(
             moments[0].abs() < 1e-15
                 && (moments[1] - 2.0 / 3.0).abs() < 1e-15

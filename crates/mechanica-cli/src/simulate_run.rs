@@ -3,11 +3,15 @@
 //! estimate of its companion run (M.12)–(M.13) and the drift of the energy or Jacobi integral
 //! (M.1)–(M.2); the trajectory optionally written as CSV and JSON, and plotted with `--plot`.
 
+mod record;
+
 use crate::plots::{PlotData, SimulationSeries};
 use crate::report::{Step, timed_step};
 use crate::scene::{DEFAULT_SIMULATE_STEPS, Scene, SimulateSpec};
-use crate::scene_run::{Model, quantity};
+use crate::scene_run::Model;
 use mechanica::motion::{Forcing, Invariant, Method, MotionError, Options, Simulation, Trajectory};
+pub use record::SimulateRecord;
+use record::{InvariantName, MethodName, MonitorRecord};
 use std::path::Path;
 
 /// Runs the simulation when the scene asks for it.
@@ -42,15 +46,16 @@ pub fn run(
     );
     let mut step = timed_step(&title, || {
         let result = integrate(&simulation, model, spec)?;
-        let quantities = summary(&result, &names);
+        let record = summary(spec, &result, &names);
         trajectory = Some(result);
-        Ok::<_, String>(quantities)
+        Ok::<_, String>(record)
     })?;
     let trajectory = trajectory.ok_or("internal: trajectory missing")?;
-    step.notes.push(monitor_note(&trajectory));
     for (path, text) in outputs(spec, file, &trajectory, &names)? {
         std::fs::write(&path, text).map_err(|e| format!("analyses.simulate: {}: {e}", path.display()))?;
-        step.notes.push(format!("trajectory written to {}", path.display()));
+        if let crate::report::Record::Simulate(record) = &mut step.record {
+            record.files.push(path.display().to_string());
+        }
     }
     plots.simulation = Some(series(&trajectory, names));
     steps.push(step);
@@ -101,60 +106,51 @@ fn integrate(simulation: &Simulation, model: &Model, spec: &SimulateSpec) -> Res
     })
 }
 
-/// The final state with its estimated error, the largest estimate over the run and the costs.
-fn summary(trajectory: &Trajectory, names: &[String]) -> Vec<crate::report::Quantity> {
-    let Some(last) = trajectory.samples.last() else {
-        return Vec::new();
+/// The final state with its estimated error, the largest estimate over the run, the costs
+/// and the monitor of the conserved quantity.
+fn summary(spec: &SimulateSpec, trajectory: &Trajectory, names: &[String]) -> SimulateRecord {
+    let (method, step, rtol, atol) = match method_of(spec) {
+        Method::Rk4 { step } => (MethodName::Rk4, Some(step), None, None),
+        Method::StormerVerlet { step } => (MethodName::Verlet, Some(step), None, None),
+        Method::ImplicitMidpoint { step } => (MethodName::Midpoint, Some(step), None, None),
+        Method::DormandPrince { rtol, atol } => (MethodName::DormandPrince, None, Some(rtol), Some(atol)),
+        _ => (MethodName::DormandPrince, None, None, None),
     };
-    let (error_q, error_q_dot) = last.error.map_or((None, None), |e| {
-        (
-            Some(format!("estimated global error ≤ {:.1e} (∞-norm)", e.q)),
-            Some(format!("estimated global error ≤ {:.1e} (∞-norm)", e.q_dot)),
-        )
-    });
-    let mut out = vec![
-        quantity(
-            &format!("q(t_end) of {}", names.join(", ")),
-            last.q.clone(),
-            "rad | m",
-            error_q,
-        ),
-        quantity("q̇(t_end)", last.q_dot.clone(), "rad/s | m/s", error_q_dot),
-    ];
+    let last = trajectory.samples.last();
+    let error = last.and_then(|s| s.error);
     let worst = trajectory
         .samples
         .iter()
         .filter_map(|s| s.error)
         .fold((0.0f64, 0.0f64), |(a, b), e| (a.max(e.q), b.max(e.q_dot)));
-    if last.error.is_some() {
-        out.push(quantity(
-            "largest estimated error over the samples: q, q̇",
-            vec![worst.0, worst.1],
-            "rad | m, rad/s | m/s",
-            None,
-        ));
-    }
-    out.push(quantity(
-        "steps: main run, companion run",
-        vec![trajectory.steps as f64, trajectory.companion_steps as f64],
-        "",
-        None,
-    ));
-    out
-}
-
-/// The monitor of the conserved quantity in words.
-fn monitor_note(trajectory: &Trajectory) -> String {
     let m = &trajectory.monitors;
-    let what = match m.invariant {
-        Invariant::Energy => "energy T + U",
-        Invariant::JacobiIntegral => "Jacobi integral T₂ − T₀ + U",
-    };
-    format!(
-        "{what}: initial {:.6e} J; drift max {:.1e}, final {:.1e} of the energy scale {:.3e} J \
-         (conserved only without dampers and velocity-dependent forces)",
-        m.initial, m.max_drift, m.last_drift, m.scale
-    )
+    SimulateRecord {
+        method,
+        step,
+        rtol,
+        atol,
+        t_end: *spec.t_end.get_ref(),
+        coordinates: names.to_vec(),
+        q_end: last.map_or_else(Vec::new, |s| s.q.clone()),
+        q_dot_end: last.map_or_else(Vec::new, |s| s.q_dot.clone()),
+        error_q_end: error.map(|e| e.q),
+        error_q_dot_end: error.map(|e| e.q_dot),
+        max_error_q: error.map(|_| worst.0),
+        max_error_q_dot: error.map(|_| worst.1),
+        steps: trajectory.steps,
+        companion_steps: trajectory.companion_steps,
+        monitor: MonitorRecord {
+            invariant: match m.invariant {
+                Invariant::JacobiIntegral => InvariantName::JacobiIntegral,
+                _ => InvariantName::Energy,
+            },
+            initial: m.initial,
+            max_drift: m.max_drift,
+            last_drift: m.last_drift,
+            scale: m.scale,
+        },
+        files: Vec::new(),
+    }
 }
 
 /// The CSV and JSON files the scene asks for, with their contents.

@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 mod common;
-use common::{mechanica, values};
+use common::{mechanica, numbers, step, values};
 
 const G: f64 = 9.81;
 
@@ -160,7 +160,7 @@ fn a_parallelogram_four_bar_accelerates_as_its_closed_form() {
             "[analyses]\ndynamics = {}\n",
         );
         let json = run_json(&format!("fourbar{case}"), &scene);
-        let q_ddot = values(&json, "q̈ (constrained forward dynamics)");
+        let q_ddot = values(&json, "constrained_dynamics", "q_ddot");
         let alpha = linkage.angular_acceleration(theta);
         let scale = G / linkage.a + omega * omega;
         for (k, sign) in [1.0, -1.0, 1.0].iter().enumerate() {
@@ -171,7 +171,7 @@ fn a_parallelogram_four_bar_accelerates_as_its_closed_form() {
                 &format!("case {case} {linkage:?}: q̈[{k}]"),
             );
         }
-        let drift = values(&json, "drift ‖f(q)‖₂, ‖J q̇‖₂");
+        let drift = values(&json, "constrained_dynamics", "position_drift");
         assert!(drift[0] <= 1e-13 * linkage.d, "case {case}: ‖f‖ = {}", drift[0]);
     }
 }
@@ -193,7 +193,7 @@ fn a_start_off_the_loop_is_projected_onto_it() {
             &format!("projection{case}"),
             &linkage.scene(q0, [0.0; 3], "[analyses]\ndynamics = {}\n"),
         );
-        let q = values(&json, "q on the constraints");
+        let q = values(&json, "constraint_projection", "q");
         let FourBar { l, d, .. } = linkage;
         // Coupler end: crank tip + R_y(q0 + q1) (d, 0, 0); rocker tip: (d, 0, 0) + R_y(q2) (0, 0, −l).
         let coupler_angle = q[0] + q[1];
@@ -233,7 +233,7 @@ fn the_constrained_equilibrium_balances_the_spring_and_gravity() {
             &format!("equilibrium{case}"),
             &linkage.scene([0.1, -0.1, 0.1], [0.0; 3], &spring),
         );
-        let q = values(&json, "q at the constrained equilibrium");
+        let q = values(&json, "constrained_equilibrium", "q");
         let theta = 0.5 * (low + high);
         for (k_index, sign) in [1.0, -1.0, 1.0].iter().enumerate() {
             close(q[k_index], sign * theta, 1e-9, &format!("case {case}: q[{k_index}]"));
@@ -289,12 +289,14 @@ dynamics = {{}}
         let json = run_json(&format!("locked{case}"), &scene);
         let reach = l1 + l2;
         let alpha = -G * theta.sin() * (m1 * l1 + m2 * reach) / (m1 * l1 * l1 + m2 * reach * reach);
-        let q_ddot = values(&json, "q̈ (constrained forward dynamics)");
+        let q_ddot = values(&json, "constrained_dynamics", "q_ddot");
         let scale = G / l1.min(l2) + omega * omega;
         close(q_ddot[0], alpha, 1e-11 * scale, &format!("case {case}: θ̈"));
         close(q_ddot[1], 0.0, 1e-11 * scale, &format!("case {case}: elbow"));
         let torque = m2 * l2 * (reach * alpha + G * theta.sin());
-        let lock = values(&json, "reaction of \"constraint[0]\": generalized force");
+        let reaction = &step(&json, "constrained_dynamics")["reactions"][0];
+        assert_eq!(reaction["constraint"], "constraint[0]");
+        let lock = numbers(&reaction["generalized_force"]);
         let torque_scale = m2 * l2 * (reach * scale + G);
         close(
             lock[1],

@@ -3,7 +3,31 @@
 
 use std::path::PathBuf;
 mod common;
-use common::{mechanica, values};
+use common::{mechanica, numbers, step, values};
+
+/// The generalized force of the first load of the inverse dynamics whose name starts with `name`.
+fn load(json: &serde_json::Value, name: &str) -> Vec<f64> {
+    let loads = step(json, "inverse_dynamics")["loads"].as_array().expect("loads");
+    let load = loads
+        .iter()
+        .find(|l| l["name"].as_str().is_some_and(|n| n.starts_with(name)))
+        .unwrap_or_else(|| panic!("no load {name} in {loads:?}"));
+    numbers(&load["force"])
+}
+
+/// The force and moment of the reaction at `joint`, six numbers.
+fn reaction_at(json: &serde_json::Value, joint: &str) -> Vec<f64> {
+    let reactions = step(json, "inverse_dynamics")["reactions"]
+        .as_array()
+        .expect("reactions");
+    let reaction = reactions
+        .iter()
+        .find(|r| r["joint"] == joint)
+        .unwrap_or_else(|| panic!("no reaction at {joint} in {reactions:?}"));
+    let mut out = numbers(&reaction["force"]);
+    out.extend(numbers(&reaction["moment"]));
+    out
+}
 
 fn scene_file(name: &str, text: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mechanica-dynamics-{}", std::process::id()));
@@ -71,20 +95,20 @@ fn a_damped_pendulum_matches_its_closed_forms_in_every_frame() {
         let accel = (tau - m * G * l * s - c * rate) / (m * l * l);
         let scale = G / l + accel.abs();
         let world = run_json("pendulum_world", &pendulum(m, l, theta, rate, tau, c, "world"));
-        close(values(&world, "q̈ (forward dynamics)")[0], accel, 1e-13 * scale);
+        close(values(&world, "forward_dynamics", "q_ddot")[0], accel, 1e-13 * scale);
         close(
-            values(&world, "τ (inverse dynamics)")[0],
+            values(&world, "inverse_dynamics", "tau")[0],
             tau,
             1e-13 * m * G * l + 1e-15,
         );
         close(
-            values(&world, "g(q): gravity terms")[0],
+            values(&world, "inverse_dynamics", "gravity")[0],
             m * G * l * s,
             1e-13 * m * G * l,
         );
-        close(values(&world, "Q of joint damper")[0], -c * rate, 1e-15 * (1.0 + c));
+        close(load(&world, "joint damper")[0], -c * rate, 1e-15 * (1.0 + c));
         close(
-            values(&world, "dissipation function D")[0],
+            values(&world, "forward_dynamics", "dissipation")[0],
             0.5 * c * rate * rate,
             1e-15,
         );
@@ -92,14 +116,14 @@ fn a_damped_pendulum_matches_its_closed_forms_in_every_frame() {
         let ax = -l * co * accel + l * s * rate * rate;
         let az = l * s * accel + l * co * rate * rate;
         let force_scale = m * (G + l * (accel.abs() + rate * rate));
-        let reaction = values(&world, "reaction at joint \"hinge\"");
+        let reaction = reaction_at(&world, "hinge");
         close(reaction[0], m * ax, 1e-13 * force_scale);
         close(reaction[1], 0.0, 1e-13 * force_scale);
         close(reaction[2], m * (az + G), 1e-13 * force_scale);
         // The moment about the hinge along its axis is what the hinge applies: τ and the damper.
         close(reaction[4], tau - c * rate, 1e-12 * force_scale * l);
         let body = run_json("pendulum_body", &pendulum(m, l, theta, rate, tau, c, "body"));
-        let reaction = values(&body, "reaction at joint \"hinge\"");
+        let reaction = reaction_at(&body, "hinge");
         close(reaction[0], -m * (l * accel + G * s), 1e-13 * force_scale);
         close(reaction[2], m * (l * rate * rate + G * co), 1e-13 * force_scale);
     }
@@ -138,11 +162,11 @@ dynamics = {{ q_dot = [{v:?}], tau = [{tau:?}], q_ddot = [0.0] }}
         let d = q - x0;
         let along = if axial { d * d / (d * d + h * h) } else { 1.0 };
         let expected = (tau - c * v * along) / m;
-        close(values(&json, "q̈ (forward dynamics)")[0], expected, 1e-14);
+        close(values(&json, "forward_dynamics", "q_ddot")[0], expected, 1e-14);
         // At the given q̈ = 0 the inverse dynamics needs τ = −Q = c v (fraction along the line).
-        close(values(&json, "τ (inverse dynamics)")[0], c * v * along, 1e-14);
+        close(values(&json, "inverse_dynamics", "tau")[0], c * v * along, 1e-14);
         let dissipation = 0.5 * c * v * v * along;
-        close(values(&json, "dissipation function D")[0], dissipation, 1e-15);
+        close(values(&json, "forward_dynamics", "dissipation")[0], dissipation, 1e-15);
     }
 }
 
@@ -259,15 +283,23 @@ fn a_damped_oscillator_has_the_closed_form_damping_ratio_and_frequency() {
         let c = 2.0 * zeta * f64::sqrt(k * m);
         let scene = oscillator(m, k, c);
         let json = run_json("oscillator", &scene);
-        let (kind, prefix) = if zeta < 1.0 {
-            ("underdamped", "damped mode 1 (underdamped): ω_n, ω_d, ζ")
-        } else {
-            ("overdamped", "damped mode 1 (overdamped): ω_n, ω_d, ζ")
-        };
-        let f = values(&json, prefix);
+        let kind = if zeta < 1.0 { "underdamped" } else { "overdamped" };
+        let mode = &step(&json, "damped_modes")["modes"][0];
+        assert_eq!(mode["kind"], kind);
+        let f = [
+            &mode["natural_frequency"],
+            &mode["damped_frequency"],
+            &mode["damping_ratio"],
+        ]
+        .map(|v| numbers(v)[0]);
         close(f[0], omega_n, 1e-12 * omega_n);
         close(f[2], zeta, 1e-12 * (1.0 + zeta));
-        let s = values(&json, &format!("damped mode 1 ({kind}): s ="));
+        let s: Vec<f64> = mode["eigenvalues"]
+            .as_array()
+            .expect("eigenvalues")
+            .iter()
+            .flat_map(|e| numbers(&e["s"]))
+            .collect();
         assert_eq!(s.len(), 4, "two eigenvalues: {s:?}");
         if zeta < 1.0 {
             let omega_d = omega_n * f64::sqrt(1.0 - zeta * zeta);
@@ -283,7 +315,7 @@ fn a_damped_oscillator_has_the_closed_form_damping_ratio_and_frequency() {
             close(hi, slow, 1e-12 * fast.abs());
             assert_eq!(f[1], 0.0);
         }
-        close(values(&json, "‖grad U*(q0)‖")[0], 0.0, 0.0);
+        close(values(&json, "damped_modes", "gradient_norm")[0], 0.0, 0.0);
         let path = scene_file("oscillator_text", &scene);
         let (ok, text, err) = mechanica(&["run", path.to_str().expect("path")]);
         assert!(ok, "{err}");

@@ -64,20 +64,27 @@ fn mechanica(args: &[&str]) -> Output {
         .expect("run the mechanica binary")
 }
 
-/// The values of the quantity named `name` (first match) in the JSON report.
-fn values(report: &serde_json::Value, name: &str) -> Vec<f64> {
-    let steps = report["steps"].as_array().expect("steps");
-    let q = steps
-        .iter()
-        .flat_map(|s| s["quantities"].as_array().expect("quantities").iter())
-        .find(|q| q["name"].as_str() == Some(name))
-        .unwrap_or_else(|| panic!("no quantity {name:?} in {report}"));
-    q["values"]
+/// The step of the JSON report whose `analysis` is `analysis`.
+fn step<'a>(report: &'a serde_json::Value, analysis: &str) -> &'a serde_json::Value {
+    report["steps"]
         .as_array()
-        .expect("values")
+        .expect("steps")
         .iter()
-        .map(|v| v.as_f64().expect("number"))
-        .collect()
+        .find(|s| s["analysis"] == analysis)
+        .unwrap_or_else(|| panic!("no {analysis} step in {report}"))
+}
+
+/// The numbers of field `key` of the `analysis` step (nested arrays flattened by rows).
+fn values(report: &serde_json::Value, analysis: &str, key: &str) -> Vec<f64> {
+    fn flatten(value: &serde_json::Value, out: &mut Vec<f64>) {
+        match value {
+            serde_json::Value::Array(items) => items.iter().for_each(|v| flatten(v, out)),
+            other => out.push(other.as_f64().unwrap_or_else(|| panic!("not a number: {other}"))),
+        }
+    }
+    let mut out = Vec::new();
+    flatten(&step(report, analysis)[key], &mut out);
+    out
 }
 
 /// Runs `mechanica --json mass ARGS` and parses its report.
@@ -115,18 +122,23 @@ fn box_inertia(m: f64, [a, b, c]: [f64; 3]) -> [f64; 3] {
 }
 
 fn check_box_report(report: &serde_json::Value, mass: f64, origin: [f64; 3], size: [f64; 3], tol: f64) {
-    let m = values(report, "mass")[0];
+    let m = values(report, "mesh_mass_properties", "mass")[0];
     assert_close(m, mass, tol * mass, "mass");
     let volume = size[0] * size[1] * size[2];
-    assert_close(values(report, "volume")[0], volume, tol * volume, "volume");
-    let c = values(report, "centre of mass (file frame)");
+    assert_close(
+        values(report, "mesh_mass_properties", "measure")[0],
+        volume,
+        tol * volume,
+        "volume",
+    );
+    let c = values(report, "mesh_mass_properties", "centre_of_mass");
     for k in 0..3 {
         let expected = origin[k] + 0.5 * size[k];
         assert_close(c[k], expected, tol * expected.abs().max(size[k]), "centre of mass");
     }
     let diag = box_inertia(mass, size);
     let scale = diag.iter().copied().fold(0.0, f64::max);
-    let j = values(report, "inertia about centre of mass (rows of 3×3)");
+    let j = values(report, "mesh_mass_properties", "inertia");
     assert_eq!(j.len(), 9);
     for r in 0..3 {
         for col in 0..3 {
@@ -134,7 +146,8 @@ fn check_box_report(report: &serde_json::Value, mass: f64, origin: [f64; 3], siz
             assert_close(j[3 * r + col], expected, tol * scale, "central inertia");
         }
     }
-    let six = values(report, "inertia about c.o.m. ixx ixy ixz iyy iyz izz");
+    let urdf = &step(report, "mesh_mass_properties")["inertia_urdf"];
+    let six = ["ixx", "ixy", "ixz", "iyy", "iyz", "izz"].map(|k| urdf[k].as_f64().expect("number"));
     let expected_six = [diag[0], 0.0, 0.0, diag[1], 0.0, diag[2]];
     for k in 0..6 {
         assert_close(six[k], expected_six[k], tol * scale, "URDF inertia");
@@ -143,11 +156,11 @@ fn check_box_report(report: &serde_json::Value, mass: f64, origin: [f64; 3], siz
     // distinct sides, hence distinct moments).
     let mut sorted = diag;
     sorted.sort_by(f64::total_cmp);
-    let moments = values(report, "principal moments I1 ≤ I2 ≤ I3");
+    let moments = values(report, "mesh_mass_properties", "principal_moments");
     for k in 0..3 {
         assert_close(moments[k], sorted[k], tol * scale, "principal moment");
     }
-    let axes = values(report, "principal axes (axis 1, axis 2, axis 3; right-handed)");
+    let axes = values(report, "mesh_mass_properties", "principal_axes");
     assert_eq!(axes.len(), 9);
     for (k, &moment) in sorted.iter().enumerate() {
         let axis = diag
@@ -169,10 +182,10 @@ fn a_box_gives_the_closed_form_mass_centre_and_inertia() {
     // By density.
     let report = json_report(&[path, "--density", "500"]);
     check_box_report(&report, 500.0, origin, size, TOL);
-    assert_eq!(values(&report, "density"), vec![500.0]);
-    assert_eq!(values(&report, "boundary edges (used by one triangle)"), vec![0.0]);
-    assert_eq!(values(&report, "inside out, orientation flipped (1 = yes)"), vec![0.0]);
-    assert_eq!(values(&report, "degenerate triangles skipped"), vec![0.0]);
+    assert_eq!(values(&report, "mesh_mass_properties", "density"), vec![500.0]);
+    assert_eq!(values(&report, "mesh_diagnostics", "boundary_edges"), vec![0.0]);
+    assert_eq!(step(&report, "mesh_diagnostics")["flipped"], false);
+    assert_eq!(values(&report, "mesh_diagnostics", "degenerate_triangles"), vec![0.0]);
 
     // By mass, and the default density of water.
     check_box_report(&json_report(&[path, "--mass", "3.5"]), 3.5, origin, size, TOL);
@@ -180,7 +193,7 @@ fn a_box_gives_the_closed_form_mass_centre_and_inertia() {
 
     // Inertia about the file origin: Steiner from the centre, J_O = J_C + m(|c|² I − c cᵀ) (3.28).
     let report = json_report(&[path, "--mass", "2"]);
-    let j_o = values(&report, "inertia about file origin (rows of 3×3)");
+    let j_o = values(&report, "mesh_mass_properties", "inertia_about_origin");
     let c = [1.5, -1.0, 4.25];
     let diag = box_inertia(2.0, size);
     let c2: f64 = c.iter().map(|x| x * x).sum();
@@ -256,7 +269,7 @@ fn an_inside_out_box_is_flipped_and_reported() {
     write_ascii_stl(&file, &reversed);
     let report = json_report(&[file.to_str().expect("utf-8"), "--mass", "1"]);
     check_box_report(&report, 1.0, origin, size, TOL);
-    assert_eq!(values(&report, "inside out, orientation flipped (1 = yes)"), vec![1.0]);
+    assert_eq!(step(&report, "mesh_diagnostics")["flipped"], true);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -275,13 +288,11 @@ fn a_hairline_crack_is_welded_by_default_and_named_when_welding_is_off() {
 
     let report = json_report(&[path, "--density", "500"]);
     check_box_report(&report, 500.0, origin, size, TOL);
-    assert_eq!(values(&report, "vertices (after welding)"), vec![8.0]);
-    assert_eq!(values(&report, "vertices welded into another"), vec![1.0]);
-    assert_eq!(
-        values(&report, "weld tolerance (relative to bounding-box diagonal)"),
-        vec![1e-8]
-    );
-    let moved = values(&report, "largest vertex displacement by welding")[0];
+    assert_eq!(values(&report, "mesh_load", "vertices"), vec![8.0]);
+    assert_eq!(step(&report, "mesh_load")["weld"]["vertices_welded"], 1);
+    let weld = &step(&report, "mesh_load")["weld"];
+    assert_eq!(weld["relative_tolerance"], 1e-8);
+    let moved = weld["max_displacement"].as_f64().expect("number");
     assert!(moved > 0.0 && moved < 1e-19, "{moved}");
 
     let out = mechanica(&["mass", path, "--weld", "0"]);
@@ -312,11 +323,21 @@ fn an_open_mesh_is_rejected_with_its_boundary_edges_unless_shell() {
 
     // As a shell: five unit squares with surface density 2 kg/m².
     let report = json_report(&[path, "--shell", "--density", "2"]);
-    assert_close(values(&report, "surface area")[0], 5.0, TOL * 5.0, "area");
-    assert_close(values(&report, "mass")[0], 10.0, TOL * 10.0, "mass");
-    assert_eq!(values(&report, "boundary edges (used by one triangle)"), vec![4.0]);
+    assert_close(
+        values(&report, "mesh_mass_properties", "measure")[0],
+        5.0,
+        TOL * 5.0,
+        "area",
+    );
+    assert_close(
+        values(&report, "mesh_mass_properties", "mass")[0],
+        10.0,
+        TOL * 10.0,
+        "mass",
+    );
+    assert_eq!(values(&report, "mesh_diagnostics", "boundary_edges"), vec![4.0]);
     // Centre: the bottom face at z = 0 and four walls centred at z = 1/2, each of mass 2.
-    let c = values(&report, "centre of mass (file frame)");
+    let c = values(&report, "mesh_mass_properties", "centre_of_mass");
     assert_close(c[2], 0.4, TOL, "shell centre z");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -330,7 +351,7 @@ fn a_closed_cube_shell_has_the_closed_form_five_eighteenths_m_a_squared() {
     let a = 2.0;
     write_ascii_stl(&file, &box_triangles([-1.0, -1.0, -1.0], [a; 3]));
     let report = json_report(&[file.to_str().expect("utf-8"), "--shell", "--mass", "3"]);
-    let j = values(&report, "inertia about centre of mass (rows of 3×3)");
+    let j = values(&report, "mesh_mass_properties", "inertia");
     let expected = 5.0 / 18.0 * 3.0 * a * a;
     for k in 0..3 {
         assert_close(j[4 * k], expected, TOL * expected, "shell moment");

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 mod common;
-use common::{mechanica, values};
+use common::{mechanica, numbers, step};
 
 fn scratch() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mechanica-modes-{}", std::process::id()));
@@ -64,9 +64,9 @@ fn free_chain_dense_all_modes_match_the_closed_form() {
         "--stiffness",
         b.to_str().expect("utf-8 path"),
     ]);
-    let omega_sq = values(&json, "ω² = −λ");
-    let bounds = values(&json, "error bound of ω²");
-    let kinds = values(&json, "classification");
+    let modes = step(&json, "pencil_modes")["modes"].as_array().expect("modes");
+    let omega_sq: Vec<f64> = modes.iter().map(|m| numbers(&m["omega_sq"])[0]).collect();
+    let bounds: Vec<f64> = modes.iter().map(|m| numbers(&m["bound"])[0]).collect();
     assert_eq!(omega_sq.len(), n);
     for k in 0..n {
         let exact = 4.0 * (k as f64 * std::f64::consts::PI / (2.0 * n as f64)).sin().powi(2);
@@ -76,18 +76,18 @@ fn free_chain_dense_all_modes_match_the_closed_form() {
             omega_sq[k]
         );
     }
-    assert_eq!(kinds[0], 1.0, "the rigid-body mode is classified zero");
-    assert!(kinds[1..].iter().all(|&c| c == 0.0));
-    let check = values(&json, "shift, count below, computed below");
-    assert_eq!(check[1], check[2], "the Sturm count agrees");
+    assert_eq!(modes[0]["kind"], "zero", "the rigid-body mode is classified zero");
+    assert!(modes[1..].iter().all(|m| m["kind"] == "oscillatory"));
+    let check = step(&json, "sturm_check");
+    assert_eq!(check["status"], "consistent");
+    assert_eq!(check["count_below"], check["computed_below"], "the Sturm count agrees");
     // Every stage has a wall time.
-    let stages: Vec<&str> = json["steps"]
-        .as_array()
-        .expect("steps")
-        .iter()
-        .map(|s| s["analysis"].as_str().expect("name"))
-        .collect();
-    assert!(stages.iter().any(|s| s.starts_with("read")) && stages.iter().any(|s| s.starts_with("factor")));
+    for analysis in ["pencil_read", "pencil_factor", "pencil_modes", "sturm_check"] {
+        assert!(
+            step(&json, analysis)["seconds"].as_f64().is_some_and(|t| t >= 0.0),
+            "{analysis}"
+        );
+    }
 }
 
 /// A 25×25 grid Laplacian (n = 625 > the dense limit) with --lowest 4 goes through the sparse
@@ -121,21 +121,15 @@ fn grid_lowest_modes_use_the_sparse_solver() {
         "--lowest",
         "4",
     ]);
-    assert!(
-        json["steps"]
-            .as_array()
-            .expect("steps")
-            .iter()
-            .any(|s| s["analysis"].as_str().is_some_and(|a| a.contains("Lanczos")))
-    );
+    assert_eq!(step(&json, "pencil_modes")["solver"], "sparse_lanczos");
     let s = |p: f64| 4.0 * (p * std::f64::consts::PI / 52.0).sin().powi(2);
     let exact = [s(1.0) + s(1.0), s(1.0) + s(2.0), s(1.0) + s(2.0), s(2.0) + s(2.0)];
-    let omega_sq = values(&json, "ω² = −λ");
-    let bounds = values(&json, "error bound of ω²");
+    let modes = step(&json, "pencil_modes")["modes"].as_array().expect("modes");
     for k in 0..4 {
-        assert!((omega_sq[k] - exact[k]).abs() <= bounds[k], "mode {k}");
+        let (omega_sq, bound) = (numbers(&modes[k]["omega_sq"])[0], numbers(&modes[k]["bound"])[0]);
+        assert!((omega_sq - exact[k]).abs() <= bound, "mode {k}");
     }
-    assert_eq!(values(&json, "group multiplicity")[1], 2.0);
+    assert_eq!(modes[1]["multiplicity"], 2);
 }
 
 #[test]

@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 mod common;
-use common::{mechanica, values};
+use common::{mechanica, numbers, step, values};
 
 const G: f64 = 9.81;
 
@@ -86,11 +86,11 @@ fn a_pendulum_returns_after_one_period_within_the_estimate() {
         ] {
             let spec = format!("{{ t_end = {t:?}, interval = {:?}, {method} }}", t / 4.0);
             let json = run_json(&format!("period{case}"), &pendulum(l, theta0, &spec));
-            let q = values(&json, "q(t_end)")[0];
-            let q_dot = values(&json, "q̇(t_end)")[0];
+            let q = values(&json, "simulate", "q_end")[0];
+            let q_dot = values(&json, "simulate", "q_dot_end")[0];
             let report = json.to_string();
-            let estimate = estimate_of(&report, "q(t_end)");
-            let rate_estimate = estimate_of(&report, "q̇(t_end)");
+            let estimate = estimate_of(&report, "error_q_end");
+            let rate_estimate = estimate_of(&report, "error_q_dot_end");
             let error = (q - theta0).abs();
             let rate_error = q_dot.abs();
             assert!(
@@ -112,25 +112,10 @@ fn a_pendulum_returns_after_one_period_within_the_estimate() {
     assert!(honest * 10 >= total * 9, "{honest} of {total} estimates hold");
 }
 
-/// The estimate in the accuracy text of the quantity `name` ("estimated global error ≤ X").
-fn estimate_of(report: &str, name: &str) -> f64 {
+/// The simulation's estimated global error of `key` (`error_q_end` or `error_q_dot_end`).
+fn estimate_of(report: &str, key: &str) -> f64 {
     let json: serde_json::Value = serde_json::from_str(report).expect("json");
-    for step in json["steps"].as_array().expect("steps") {
-        for q in step["quantities"].as_array().expect("quantities") {
-            if q["name"].as_str().is_some_and(|n| n.starts_with(name)) {
-                let text = q["accuracy"].as_str().expect("accuracy");
-                let number = text
-                    .split('≤')
-                    .nth(1)
-                    .expect("≤")
-                    .split_whitespace()
-                    .next()
-                    .expect("number");
-                return number.parse().expect("estimate");
-            }
-        }
-    }
-    panic!("no {name}");
+    values(&json, "simulate", key)[0]
 }
 
 /// Störmer–Verlet keeps the energy of an undamped pendulum within a bounded band over many
@@ -146,13 +131,9 @@ fn verlet_keeps_the_energy_drift_bounded() {
     let (ok, out, err) = run("verlet", &pendulum(l, theta0, &spec));
     assert!(ok, "{err}");
     let json: serde_json::Value = serde_json::from_str(&out).expect("json");
-    let notes = json.to_string();
-    let drift: f64 = notes
-        .split("drift max ")
-        .nth(1)
-        .and_then(|s| s.split(',').next())
-        .and_then(|s| s.parse().ok())
-        .expect("drift in the notes");
+    let monitor = &step(&json, "simulate")["monitor"];
+    assert_eq!(monitor["invariant"], "energy");
+    let drift = numbers(&monitor["max_drift"])[0];
     // Verlet's energy error is O((ω h)²) and does not grow: here (ω h)² ≈ 1e-3.
     assert!(drift > 0.0 && drift < 5e-3, "drift {drift}");
 }
@@ -162,7 +143,7 @@ fn verlet_keeps_the_energy_drift_bounded() {
 fn trajectory_files_hold_every_sample() {
     let spec = "{ t_end = 1.0, interval = 0.1, tolerance = 1e-9, csv = \"pendulum.csv\", json = \"pendulum.json\" }";
     let json = run_json("files", &pendulum(0.8, 0.7, spec));
-    let q_end = values(&json, "q(t_end)")[0];
+    let q_end = values(&json, "simulate", "q_end")[0];
     let csv = std::fs::read_to_string(scratch().join("pendulum.csv")).expect("csv written");
     let mut lines = csv.lines();
     assert_eq!(lines.next(), Some("t,q:hinge,q_dot:hinge,energy,error_q,error_q_dot"));

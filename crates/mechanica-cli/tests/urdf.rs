@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 mod common;
-use common::{mechanica, values};
+use common::{mechanica, omega_sq, step, values};
 
 const G: f64 = 9.81;
 
@@ -89,7 +89,7 @@ fn rod_alone() -> f64 {
 
 fn lowest_omega_sq(out: &str) -> f64 {
     let json: serde_json::Value = serde_json::from_str(out).expect("JSON report");
-    values(&json, "ω²")[0]
+    omega_sq(&json)[0]
 }
 
 #[test]
@@ -108,7 +108,9 @@ fn a_usable_mesh_gives_the_link_its_mass_at_water_density() {
     assert!((got - exact).abs() <= 1e-10 * exact, "{got} vs {exact}");
     // The start of the analyses is printed, with the coordinate named after its URDF joint.
     let json: serde_json::Value = serde_json::from_str(&out).expect("JSON report");
-    assert_eq!(values(&json, "q0, the start of every analysis, of hinge"), vec![0.0]);
+    let build = step(&json, "build");
+    assert_eq!(build["coordinates"], serde_json::json!(["hinge"]));
+    assert_eq!(values(&json, "build", "q0"), vec![0.0]);
 }
 
 #[test]
@@ -159,10 +161,10 @@ fn allow_missing_mesh_makes_the_links_massless_with_a_warning_in_text_and_json()
         .as_array()
         .expect("steps")
         .iter()
-        .flat_map(|s| s["notes"].as_array().into_iter().flatten())
+        .flat_map(|s| s["warnings"].as_array().into_iter().flatten())
         .filter_map(|n| n.as_str())
-        .filter(|n| n.starts_with("warning:"))
         .collect();
+    assert!(notes.iter().all(|n| n.starts_with("warning:")), "{notes:?}");
     assert_eq!(notes.len(), meshes.len(), "{notes:?}");
     for (i, mesh) in meshes.iter().enumerate() {
         assert!(
@@ -178,4 +180,102 @@ fn allow_missing_mesh_makes_the_links_massless_with_a_warning_in_text_and_json()
         text.contains("warning: link \"tool0\"") && text.contains("massless"),
         "{text}"
     );
+}
+
+/// Two uniform rods (masses m₁, m₂, lengths l₁, l₂, hinges about y) hanging from a shoulder:
+/// a double compound pendulum.
+fn two_rods(m1: f64, l1: f64, m2: f64, l2: f64) -> String {
+    let link = |name: &str, m: f64, l: f64| {
+        let i = m * l * l / 12.0;
+        format!(
+            r#"  <link name="{name}">
+    <inertial>
+      <origin xyz="0 0 {:?}" rpy="0 0 0"/>
+      <mass value="{m:?}"/>
+      <inertia ixx="{i:?}" ixy="0" ixz="0" iyy="{i:?}" iyz="0" izz="1e-6"/>
+    </inertial>
+  </link>
+"#,
+            -0.5 * l
+        )
+    };
+    format!(
+        r#"<?xml version="1.0"?>
+<robot name="two_rods">
+  <link name="base"/>
+{}{}  <joint name="shoulder" type="continuous">
+    <parent link="base"/><child link="upper"/>
+    <origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="0 1 0"/>
+  </joint>
+  <joint name="elbow" type="continuous">
+    <parent link="upper"/><child link="lower"/>
+    <origin xyz="0 0 {:?}" rpy="0 0 0"/><axis xyz="0 1 0"/>
+  </joint>
+</robot>
+"#,
+        link("upper", m1, l1),
+        link("lower", m2, l2),
+        -l1
+    )
+}
+
+/// What a script reads from the JSON report (examples/read_report.py does the same): the
+/// first mode's frequency, and the name of the coordinate that moves most in it. Reference:
+/// in absolute angles φ the pendulum has M = [[m₁l₁²/3 + m₂l₁², m₂l₁l₂/2], [m₂l₁l₂/2, m₂l₂²/3]]
+/// and K = g diag(m₁l₁/2 + m₂l₁, m₂l₂/2); the joint angles are θ₁ = φ₁, θ₂ = φ₂ − φ₁.
+#[test]
+fn a_script_finds_the_first_frequency_and_the_coordinate_that_moves_most() {
+    let dir = scratch("script");
+    let cases = [
+        (1.0, 1.0, 1.0, 1.0),
+        (2.0, 0.5, 0.1, 1.5),
+        (0.3, 1.2, 4.0, 0.2),
+        (1.0, 0.8, 0.5, 2.0),
+    ];
+    let mut movers = std::collections::BTreeSet::new();
+    for (case, (m1, l1, m2, l2)) in cases.into_iter().enumerate() {
+        let urdf = dir.join(format!("rods{case}.urdf"));
+        std::fs::write(&urdf, two_rods(m1, l1, m2, l2)).expect("urdf");
+        let (ok, out, err) = mechanica(&["run", urdf.to_str().expect("path"), "--json"]);
+        assert!(ok, "{err}");
+        let report: serde_json::Value = serde_json::from_str(&out).expect("JSON report");
+        let modes = step(&report, "modes");
+        let first = &modes["modes"][0];
+        assert_eq!(first["kind"], "oscillatory");
+        let frequency = first["frequency_hz"].as_f64().expect("frequency");
+        let shape: Vec<f64> = first["shape"]
+            .as_array()
+            .expect("shape")
+            .iter()
+            .filter_map(|v| v.as_f64())
+            .collect();
+        let largest = (0..shape.len())
+            .max_by(|&a, &b| shape[a].abs().total_cmp(&shape[b].abs()))
+            .expect("entries");
+        let mover = modes["coordinates"][largest].as_str().expect("name");
+        // The closed form.
+        let (a11, a12, a22) = (
+            m1 * l1 * l1 / 3.0 + m2 * l1 * l1,
+            0.5 * m2 * l1 * l2,
+            m2 * l2 * l2 / 3.0,
+        );
+        let (k1, k2) = (G * (0.5 * m1 * l1 + m2 * l1), G * 0.5 * m2 * l2);
+        let (a, b, c) = (a11 * a22 - a12 * a12, -(k1 * a22 + k2 * a11), k1 * k2);
+        let w2 = (-b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a);
+        let exact = w2.sqrt() / std::f64::consts::TAU;
+        assert!(
+            (frequency - exact).abs() <= 1e-10 * exact,
+            "case {case}: {frequency} vs {exact}"
+        );
+        let phi = [a12 * w2, k1 - a11 * w2];
+        let theta = [phi[0], phi[1] - phi[0]];
+        let expected = if theta[0].abs() > theta[1].abs() {
+            "shoulder"
+        } else {
+            "elbow"
+        };
+        assert_eq!(mover, expected, "case {case}: θ ∝ {theta:?}, shape {shape:?}");
+        movers.insert(expected);
+    }
+    assert_eq!(movers.len(), 2, "the cases exercise both answers: {movers:?}");
 }

@@ -1,0 +1,122 @@
+//! The record of a simulation: the final state with its estimated global error, the costs and
+//! the monitor of the conserved quantity.
+
+use crate::report::text::{Precision, Text, bound, number};
+use serde::Serialize;
+
+/// The integrator (mechanica::motion::Method).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MethodName {
+    /// Classical Runge–Kutta, fixed step.
+    Rk4,
+    /// Störmer–Verlet, fixed step.
+    Verlet,
+    /// The implicit midpoint rule, fixed step.
+    Midpoint,
+    /// Dormand–Prince 5(4), adaptive.
+    DormandPrince,
+}
+
+/// The conserved quantity monitored (mechanica::motion::Invariant).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InvariantName {
+    /// T + U.
+    Energy,
+    /// T₂ − T₀ + U in a rotating frame.
+    JacobiIntegral,
+}
+
+/// The drift of the conserved quantity over the run (M.1)–(M.2).
+#[derive(Debug, Clone, Serialize)]
+pub struct MonitorRecord {
+    /// Which quantity.
+    pub invariant: InvariantName,
+    /// Its initial value, J.
+    pub initial: f64,
+    /// Largest |H(t) − H(0)| over the samples, relative to `scale`.
+    pub max_drift: f64,
+    /// |H(t_end) − H(0)| relative to `scale`.
+    pub last_drift: f64,
+    /// The energy scale, J.
+    pub scale: f64,
+}
+
+/// A simulation from (q0, qd0) to t_end.
+#[derive(Debug, Clone, Serialize)]
+pub struct SimulateRecord {
+    /// The integrator.
+    pub method: MethodName,
+    /// Its fixed step, s (fixed-step methods).
+    pub step: Option<f64>,
+    /// Relative and absolute tolerances (adaptive method).
+    pub rtol: Option<f64>,
+    /// Absolute tolerance (adaptive method).
+    pub atol: Option<f64>,
+    /// End time, s.
+    pub t_end: f64,
+    /// The coordinates' names.
+    pub coordinates: Vec<String>,
+    /// q(t_end), rad | m.
+    pub q_end: Vec<f64>,
+    /// q̇(t_end), rad/s | m/s.
+    pub q_dot_end: Vec<f64>,
+    /// Estimated global error of q(t_end), ∞-norm, with the companion run.
+    pub error_q_end: Option<f64>,
+    /// Estimated global error of q̇(t_end).
+    pub error_q_dot_end: Option<f64>,
+    /// Largest estimated error of q over the samples.
+    pub max_error_q: Option<f64>,
+    /// Largest estimated error of q̇ over the samples.
+    pub max_error_q_dot: Option<f64>,
+    /// Steps of the main run.
+    pub steps: usize,
+    /// Steps of the companion run (0 without it).
+    pub companion_steps: usize,
+    /// The conserved quantity's drift.
+    pub monitor: MonitorRecord,
+    /// Trajectory files written (CSV, JSON).
+    pub files: Vec<String>,
+}
+
+impl SimulateRecord {
+    pub(crate) fn write_text(&self, out: &mut Text) {
+        let names = &self.coordinates;
+        let precision = |e: Option<f64>| e.map_or(Precision::Exact, Precision::Absolute);
+        out.named("q(t_end)", names, &self.q_end, "rad | m", precision(self.error_q_end));
+        out.named(
+            "q̇(t_end)",
+            names,
+            &self.q_dot_end,
+            "rad/s | m/s",
+            precision(self.error_q_dot_end),
+        );
+        if let (Some(q), Some(q_dot)) = (self.max_error_q, self.max_error_q_dot) {
+            out.line(
+                "largest estimated error over the samples",
+                &format!("q {}, q̇ {}", bound(q), bound(q_dot)),
+            );
+        }
+        out.line(
+            "steps: main run, companion run",
+            &format!("{}, {}", self.steps, self.companion_steps),
+        );
+        let m = &self.monitor;
+        let what = match m.invariant {
+            InvariantName::Energy => "energy T + U",
+            InvariantName::JacobiIntegral => "Jacobi integral T₂ − T₀ + U",
+        };
+        out.note(&format!(
+            "{what}: initial {} J; drift max {}, final {} of the energy scale {} J \
+             (conserved only without dampers and velocity-dependent forces)",
+            number(m.initial, crate::report::text::MAX_DIGITS),
+            bound(m.max_drift),
+            bound(m.last_drift),
+            number(m.scale, 4)
+        ));
+        for file in &self.files {
+            out.note(&format!("trajectory written to {file}"));
+        }
+    }
+}
