@@ -1,7 +1,7 @@
 //! The linear and angular momentum of a whole mechanism (M.15)–(M.16), the first integrals
 //! that the monitors follow beside H and the cyclic momenta.
 //!
-//! Both are sums over the bodies of (3.4) and (3.6)–(3.7), with each body's centre velocity
+//! Both are sums over the bodies of (3.4) and (3.12) with (3.6), with each body's centre velocity
 //! and angular velocity from the tree's velocity recursion. They are taken in the mechanism's
 //! frame W with its base at rest: for a prescribed base motion or a rotating frame they are
 //! the momenta relative to that frame, which are not first integrals.
