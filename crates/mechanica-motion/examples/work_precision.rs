@@ -135,7 +135,8 @@ fn measure(p: &Problem, dynamics: &Dynamics, kind: &str, parameter: f64) -> Res<
         let start = Instant::now();
         let run = timed.run(q0, v0, p.t_end, p.t_end);
         let seconds = start.elapsed().as_secs_f64();
-        if run.is_err() {
+        if let Err(error) = run {
+            eprintln!("{} {kind} {parameter:e}: {error}", p.name);
             return Ok(format!(
                 "{},mechanica,{kind},{parameter:e},{seconds:e},0,,,,,failed\n",
                 p.name
