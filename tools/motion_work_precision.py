@@ -361,7 +361,7 @@ def write_svg(rows):
         parts.append(f'<text x="{20 + (i % 4) * 250}" y="{height + 25 + 18 * (i // 4)}" fill="{COLOURS[name]}">'
                      f'&#9679; {name}</text>')
     parts.append(f'<text x="20" y="{height + 75}" font-size="10">each series from the loosest tolerance or largest '
-                 f'step to the tightest; squares: diverged (clipped at 10) or below the floor</text>')
+                 f'step to the tightest; squares: error above 10 or diverged (drawn at 10), or error below the floor</text>')
     parts.append("</svg>\n")
     with open(SVG_OUT, "w") as fh:
         fh.write("\n".join(parts))
