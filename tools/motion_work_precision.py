@@ -248,7 +248,9 @@ def error_pair(state, reference, n):
 def collect(workdir):
     refs = references()
     rows = []
-    for r in run_mechanica(workdir):
+    mechanica = run_mechanica(workdir)
+    os.chdir(workdir)  # MuJoCo writes MUJOCO_LOG.TXT into the working directory on a divergence
+    for r in mechanica:
         p, ref = PROBLEMS[r["problem"]], refs[r["problem"]]["state"]
         n = len(p["mass"])
         row = dict(problem=r["problem"], solver="mechanica", method=r["method"], parameter=r["parameter"],
