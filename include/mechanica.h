@@ -1709,6 +1709,49 @@ typedef struct mech_motion_report_t {
 } mech_motion_report_t;
 #endif
 
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * One momentum vector of the whole mechanism over the states reported so far (world
+ * components of the mechanism's frame, its base at rest). Which components are conserved
+ * depends on the mechanism: see docs/theory.md (M.15)–(M.16).
+ */
+typedef struct mech_motion_momentum_drift_t {
+    /**
+     * The value at t = 0.
+     */
+    struct mech_vec3_t initial;
+    /**
+     * The value at the time reached.
+     */
+    struct mech_vec3_t last;
+    /**
+     * Componentwise max |x − x(0)| over every step and reported state.
+     */
+    struct mech_vec3_t max_drift;
+    /**
+     * The largest |x| over every step and reported state: the scale of the drift.
+     */
+    double scale;
+} mech_motion_momentum_drift_t;
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * The momentum monitors of a simulation: the linear momentum P = Σ mᵢ vᵢ (M.15), kg·m/s, and
+ * the angular momentum L about the origin of the mechanism's frame (M.16), kg·m²/s.
+ */
+typedef struct mech_motion_momentum_report_t {
+    /**
+     * The linear momentum P.
+     */
+    struct mech_motion_momentum_drift_t linear;
+    /**
+     * The angular momentum L about the origin.
+     */
+    struct mech_motion_momentum_drift_t angular;
+} mech_motion_momentum_report_t;
+#endif
+
 #if defined(MECH_FEATURE_URDF)
 /**
  * How the URDF readers treat links that are not physical as written. Start from
@@ -4950,6 +4993,18 @@ mech_status_t mech_simulation_advance(struct mech_simulation_t *simulation,
  */
 mech_status_t mech_simulation_report(const struct mech_simulation_t *simulation,
                                      struct mech_motion_report_t *report_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Writes the momentum monitors of the simulation (over every step since t = 0 up to the last
+ * successful advance) to `*report_out`.
+ *
+ * # Safety
+ * `simulation` must be a live handle and `report_out` writable.
+ */
+mech_status_t mech_simulation_momentum_report(const struct mech_simulation_t *simulation,
+                                              struct mech_motion_momentum_report_t *report_out);
 #endif
 
 #if defined(MECH_FEATURE_URDF)

@@ -58,6 +58,12 @@ pub enum MotionError {
     /// The dynamics could not be set up or evaluated at the initial state.
     #[error(transparent)]
     Dynamics(#[from] DynamicsError),
+    /// A quantity computed from a finite input overflowed f64.
+    #[error("the {what} is not finite")]
+    NonFiniteResult {
+        /// What overflowed.
+        what: &'static str,
+    },
     /// An input has the wrong length.
     #[error("{what}: expected length {expected}, got {got}")]
     WrongLength {

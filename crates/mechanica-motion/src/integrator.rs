@@ -86,9 +86,9 @@ impl Integrator {
             return Ok(());
         }
         let point = self.point();
-        let (energy, kinetic, p) = self.system.measure(&point.q, &point.q_dot)?;
+        let measurement = self.system.measure(&point.q, &point.q_dot)?;
         if let Some(tracker) = &mut self.tracker {
-            tracker.record(energy, kinetic, &p);
+            tracker.record(&measurement);
         }
         Ok(())
     }

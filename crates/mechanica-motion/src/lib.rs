@@ -12,7 +12,8 @@
 //! - Global error: a companion run at half the step (tolerances / 32) and the bound
 //!   e ≤ ‖y − y_c‖ / (1 − ρ) (M.12)–(M.13) ([`ErrorEstimate`]).
 //! - Monitors: drift of the energy or Jacobi integral (M.1)–(M.2), momenta of cyclic
-//!   coordinates ([`Monitors`]).
+//!   coordinates (9.3), and the linear and angular momentum of the whole mechanism
+//!   (M.15)–(M.16) ([`Monitors`], [`system_momentum`]).
 //! - Failures stop the run with [`MotionError::StepFailed`], carrying the time reached and
 //!   the last good state.
 
@@ -25,6 +26,7 @@ mod integrator;
 mod iteration;
 pub mod method;
 mod midpoint;
+pub mod momentum;
 pub mod monitors;
 mod rk4;
 pub mod simulation;
@@ -35,5 +37,6 @@ pub use error::{MotionError, StepFailure};
 pub use estimate::ErrorEstimate;
 pub use forcing::{ForceFunction, Forcing};
 pub use method::{MIN_RTOL, Method};
-pub use monitors::{CyclicMomentum, Invariant, Monitors};
+pub use momentum::{SystemMomentum, system_momentum};
+pub use monitors::{CyclicMomentum, Invariant, MomentumDrift, Monitors};
 pub use simulation::{DEFAULT_MAX_STEPS, MAX_SAMPLES, Options, Sample, Simulation, Stepper, Trajectory};

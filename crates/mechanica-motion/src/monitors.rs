@@ -1,5 +1,9 @@
-//! Monitors of a run: the drift of the conserved quantity H (M.1)–(M.2) and the momenta of
-//! coordinates the caller names cyclic.
+//! Monitors of a run: the drift of the conserved quantity H (M.1)–(M.2), the momenta of
+//! coordinates the caller names cyclic (9.3), and the linear and angular momentum of the whole
+//! mechanism (M.15)–(M.16).
+
+use crate::momentum::SystemMomentum;
+use nalgebra::Vector3;
 
 /// Which conserved quantity H = T₂ + U* − τ_c·q measures (M.1)–(M.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -23,6 +27,49 @@ pub struct CyclicMomentum {
     pub max_drift: f64,
 }
 
+/// A momentum vector of the whole mechanism over the run (world components). A component is a
+/// first integral only when the external forces have no resultant (P) or no moment about the
+/// origin of W (L) along it: a free-floating base (free joint at the root) with no gravity
+/// component along the axis for P, or with the axis parallel to gravity (or no gravity) for L;
+/// no springs or dampers to the world, no applied generalized forces on the root joint. A fixed
+/// base exerts reactions, so there only the components the joints cannot transmit are
+/// conserved (L along a root revolute axis parallel to gravity: the cyclic momentum of that
+/// joint). The monitor reports every component; which are conserved is the caller's knowledge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MomentumDrift {
+    /// The value at the start.
+    pub initial: Vector3<f64>,
+    /// The value at the last step or sample.
+    pub last: Vector3<f64>,
+    /// Componentwise max |x − x(0)| over the steps and samples.
+    pub max_drift: Vector3<f64>,
+    /// The largest |x| (Euclidean) over the steps and samples: the scale of the drift.
+    pub scale: f64,
+}
+
+impl MomentumDrift {
+    fn new(initial: Vector3<f64>) -> Self {
+        Self {
+            initial,
+            last: initial,
+            max_drift: Vector3::zeros(),
+            scale: initial.norm(),
+        }
+    }
+
+    fn record(&mut self, value: Vector3<f64>) {
+        self.last = value;
+        self.max_drift = self.max_drift.sup(&(value - self.initial).abs());
+        self.scale = self.scale.max(value.norm());
+    }
+
+    /// max |e·(x − x(0))| bounded by the componentwise drifts: Σ |e_i| max_drift_i, for the unit
+    /// axis e (exact when e is a coordinate axis).
+    pub fn drift_along(&self, axis: &Vector3<f64>) -> f64 {
+        axis.abs().dot(&self.max_drift)
+    }
+}
+
 /// The monitors of a run over every step of the main run and every sample. H is conserved only without dampers, without
 /// velocity-dependent potentials that do work, without a time-dependent base motion and with
 /// τ constant or zero; otherwise its change is the work of those forces, reported as drift.
@@ -41,6 +88,35 @@ pub struct Monitors {
     pub last_drift: f64,
     /// The momenta of the coordinates named cyclic.
     pub cyclic: Vec<CyclicMomentum>,
+    /// The linear momentum P of the whole mechanism (M.15), kg·m/s.
+    pub linear_momentum: MomentumDrift,
+    /// The angular momentum L of the whole mechanism about the origin of W (M.16), kg·m²/s.
+    pub angular_momentum: MomentumDrift,
+}
+
+/// What the monitors record at one state: H, T₂, the generalized momenta p = A q̇ and the
+/// momenta of the whole mechanism.
+#[derive(Debug, Clone)]
+pub(crate) struct Measurement {
+    pub energy: f64,
+    pub kinetic: f64,
+    pub p: Vec<f64>,
+    pub momentum: SystemMomentum,
+}
+
+impl Measurement {
+    /// Zero everywhere (no state measured).
+    pub(crate) fn nothing() -> Self {
+        Self {
+            energy: 0.0,
+            kinetic: 0.0,
+            p: Vec::new(),
+            momentum: SystemMomentum {
+                linear: Vector3::zeros(),
+                angular: Vector3::zeros(),
+            },
+        }
+    }
 }
 
 /// The running state of the monitors.
@@ -52,38 +128,44 @@ pub(crate) struct Tracker {
     max_change: f64,
     last_change: f64,
     cyclic: Vec<CyclicMomentum>,
+    linear: MomentumDrift,
+    angular: MomentumDrift,
 }
 
 impl Tracker {
-    /// Starts from H₀ and the initial momenta p of the cyclic coordinates.
-    pub(crate) fn new(invariant: Invariant, energy: f64, kinetic: f64, cyclic: &[usize], p: &[f64]) -> Self {
+    /// Starts from the initial measurement, following the momenta of the `cyclic` coordinates.
+    pub(crate) fn new(invariant: Invariant, start: &Measurement, cyclic: &[usize]) -> Self {
         Self {
             invariant,
-            initial: energy,
-            largest_kinetic: kinetic,
+            initial: start.energy,
+            largest_kinetic: start.kinetic,
             max_change: 0.0,
             last_change: 0.0,
             cyclic: cyclic
                 .iter()
                 .map(|&k| CyclicMomentum {
                     coordinate: k,
-                    initial: p[k],
-                    last: p[k],
+                    initial: start.p[k],
+                    last: start.p[k],
                     max_drift: 0.0,
                 })
                 .collect(),
+            linear: MomentumDrift::new(start.momentum.linear),
+            angular: MomentumDrift::new(start.momentum.angular),
         }
     }
 
-    /// Records a sample with H, T₂ and the momenta p.
-    pub(crate) fn record(&mut self, energy: f64, kinetic: f64, p: &[f64]) {
-        self.largest_kinetic = self.largest_kinetic.max(kinetic);
-        self.last_change = (energy - self.initial).abs();
+    /// Records the measurement of one step or sample.
+    pub(crate) fn record(&mut self, m: &Measurement) {
+        self.largest_kinetic = self.largest_kinetic.max(m.kinetic);
+        self.last_change = (m.energy - self.initial).abs();
         self.max_change = self.max_change.max(self.last_change);
         for c in &mut self.cyclic {
-            c.last = p[c.coordinate];
+            c.last = m.p[c.coordinate];
             c.max_drift = c.max_drift.max((c.last - c.initial).abs());
         }
+        self.linear.record(m.momentum.linear);
+        self.angular.record(m.momentum.angular);
     }
 
     /// The monitors so far.
@@ -96,6 +178,8 @@ impl Tracker {
             max_drift: self.max_change / scale,
             last_drift: self.last_change / scale,
             cyclic: self.cyclic.clone(),
+            linear_momentum: self.linear,
+            angular_momentum: self.angular,
         }
     }
 }

@@ -8,7 +8,7 @@ use crate::estimate::{ErrorEstimate, estimate};
 use crate::forcing::Forcing;
 use crate::integrator::Integrator;
 use crate::method::Method;
-use crate::monitors::{Invariant, Monitors, Tracker};
+use crate::monitors::{Invariant, Measurement, Monitors, Tracker};
 use crate::system::System;
 use mechanica_dynamics::Dynamics;
 
@@ -207,8 +207,9 @@ impl Stepper {
         main.system_mut()
             .acceleration(0.0, q0, q_dot0, &mut probe)
             .map_err(fail)?;
-        let (energy, kinetic, p) = main.system_mut().measure(q0, q_dot0).map_err(fail)?;
-        main.set_tracker(Tracker::new(invariant, energy, kinetic, &options.cyclic, &p));
+        let start = main.system_mut().measure(q0, q_dot0).map_err(fail)?;
+        let energy = start.energy;
+        main.set_tracker(Tracker::new(invariant, &start, &options.cyclic));
         let sample = Sample {
             t: 0.0,
             q: q0.to_vec(),
@@ -234,7 +235,7 @@ impl Stepper {
     pub fn monitors(&self) -> Monitors {
         // The tracker is set when the stepper starts; the fallback is never used.
         self.main.tracker().map_or_else(
-            || Tracker::new(Invariant::Energy, 0.0, 0.0, &[], &[]).monitors(),
+            || Tracker::new(Invariant::Energy, &Measurement::nothing(), &[]).monitors(),
             Tracker::monitors,
         )
     }
@@ -267,10 +268,11 @@ impl Stepper {
             None => None,
         };
         let measured = self.main.system_mut().measure(&point.q, &point.q_dot);
-        let (energy, kinetic, p) = measured.map_err(|c| failure(&self.main, c))?;
+        let measurement = measured.map_err(|c| failure(&self.main, c))?;
         if let Some(tracker) = self.main.tracker_mut() {
-            tracker.record(energy, kinetic, &p);
+            tracker.record(&measurement);
         }
+        let energy = measurement.energy;
         self.sample = Sample {
             t,
             q: reported.q,

@@ -4,7 +4,9 @@
 
 use crate::error::{StepFailure, check_finite};
 use crate::forcing::Forcing;
+use crate::monitors::Measurement;
 use mechanica_dynamics::{Dynamics, State};
+use mechanica_kinematics::tree::Workspace;
 use nalgebra::{DMatrix, DVector};
 
 /// A [`Dynamics`] with its applied forces and scratch storage for τ.
@@ -13,16 +15,20 @@ pub(crate) struct System {
     dynamics: Dynamics,
     forcing: Forcing,
     tau: Vec<f64>,
+    /// For the momenta of the whole mechanism (base at rest).
+    momentum_workspace: Workspace,
 }
 
 impl System {
     /// The system of `dynamics` driven by `forcing` (already validated).
     pub(crate) fn new(dynamics: Dynamics, forcing: Forcing) -> Self {
         let n = dynamics.dof();
+        let momentum_workspace = dynamics.tree().workspace();
         Self {
             dynamics,
             forcing,
             tau: vec![0.0; n],
+            momentum_workspace,
         }
     }
 
@@ -76,8 +82,9 @@ impl System {
         Ok(u + self.forcing.potential(q))
     }
 
-    /// H (M.1), T₂ and the generalized momenta p = A(q) q̇, from one mass matrix.
-    pub(crate) fn measure(&mut self, q: &[f64], q_dot: &[f64]) -> Result<(f64, f64, Vec<f64>), StepFailure> {
+    /// H (M.1), T₂ and the generalized momenta p = A(q) q̇ from one mass matrix, and the
+    /// momenta P, L of the whole mechanism (M.15)–(M.16), in the current charts.
+    pub(crate) fn measure(&mut self, q: &[f64], q_dot: &[f64]) -> Result<Measurement, StepFailure> {
         let a = self.mass_matrix(q)?;
         let v = DVector::from_column_slice(q_dot);
         let p = &a * &v;
@@ -86,6 +93,19 @@ impl System {
         if !energy.is_finite() {
             return Err(StepFailure::NonFinite { what: "energy" });
         }
-        Ok((energy, kinetic, p.as_slice().to_vec()))
+        let mechanism = self.dynamics.mechanism();
+        let momentum = crate::momentum::momentum_into(
+            mechanism.tree(),
+            mechanism.bodies(),
+            &mut self.momentum_workspace,
+            q,
+            q_dot,
+        )?;
+        Ok(Measurement {
+            energy,
+            kinetic,
+            p: p.as_slice().to_vec(),
+            momentum,
+        })
     }
 }

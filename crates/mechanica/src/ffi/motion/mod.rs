@@ -7,8 +7,11 @@ use super::c_enum::{c_enum, enum_value};
 use super::dynamics::mech_dynamics_t;
 use super::handle::Handle;
 use super::status::*;
+use super::types::mech_vec3_t;
 use super::validate::*;
-use mechanica_motion::{Forcing, Invariant, Method, MotionError, Options, Simulation, StepFailure, Stepper};
+use mechanica_motion::{
+    Forcing, Invariant, Method, MomentumDrift, MotionError, Options, Simulation, StepFailure, Stepper,
+};
 
 /// An integration method (int32_t).
 pub type mech_motion_method_t = i32;
@@ -97,6 +100,7 @@ impl From<MotionError> for FfiError {
             MotionError::Dynamics(e) => return FfiError::from(e.clone()),
             MotionError::WrongLength { .. } => MECH_STATUS_BAD_DIMENSION,
             MotionError::NonFiniteInput { .. } => MECH_STATUS_NON_FINITE,
+            MotionError::NonFiniteResult { .. } => MECH_STATUS_OUT_OF_RANGE,
             MotionError::StepFailed { cause, .. } => match cause {
                 StepFailure::Dynamics(e) => FfiError::from(e.clone()).status,
                 StepFailure::SingularMassMatrix => MECH_STATUS_SINGULAR,
@@ -302,6 +306,69 @@ pub unsafe extern "C" fn mech_simulation_report(
             report.max_energy_drift,
         ];
         finite_result(numbers.as_slice(), "simulation report")?;
+        // SAFETY: caller's contract.
+        unsafe { out.write(report) };
+        Ok(())
+    })
+}
+
+/// One momentum vector of the whole mechanism over the states reported so far (world
+/// components of the mechanism's frame, its base at rest). Which components are conserved
+/// depends on the mechanism: see docs/theory.md (M.15)–(M.16).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct mech_motion_momentum_drift_t {
+    /// The value at t = 0.
+    pub initial: mech_vec3_t,
+    /// The value at the time reached.
+    pub last: mech_vec3_t,
+    /// Componentwise max |x − x(0)| over every step and reported state.
+    pub max_drift: mech_vec3_t,
+    /// The largest |x| over every step and reported state: the scale of the drift.
+    pub scale: f64,
+}
+
+/// The momentum monitors of a simulation: the linear momentum P = Σ mᵢ vᵢ (M.15), kg·m/s, and
+/// the angular momentum L about the origin of the mechanism's frame (M.16), kg·m²/s.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct mech_motion_momentum_report_t {
+    /// The linear momentum P.
+    pub linear: mech_motion_momentum_drift_t,
+    /// The angular momentum L about the origin.
+    pub angular: mech_motion_momentum_drift_t,
+}
+
+impl From<&MomentumDrift> for mech_motion_momentum_drift_t {
+    fn from(d: &MomentumDrift) -> Self {
+        Self {
+            initial: d.initial.into(),
+            last: d.last.into(),
+            max_drift: d.max_drift.into(),
+            scale: d.scale,
+        }
+    }
+}
+
+/// Writes the momentum monitors of the simulation (over every step since t = 0 up to the last
+/// successful advance) to `*report_out`.
+///
+/// # Safety
+/// `simulation` must be a live handle and `report_out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_simulation_momentum_report(
+    simulation: *const mech_simulation_t,
+    report_out: *mut mech_motion_momentum_report_t,
+) -> mech_status_t {
+    boundary(|| {
+        let out = Out::new(report_out, "report_out")?;
+        // SAFETY: caller's contract.
+        let s = unsafe { mech_simulation_t::borrow(simulation, "simulation") }?;
+        let monitors = s.stepper.monitors();
+        let report = mech_motion_momentum_report_t {
+            linear: (&monitors.linear_momentum).into(),
+            angular: (&monitors.angular_momentum).into(),
+        };
         // SAFETY: caller's contract.
         unsafe { out.write(report) };
         Ok(())
