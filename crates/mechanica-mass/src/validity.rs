@@ -110,7 +110,7 @@ pub struct ValidityReport {
 
 /// The smallest violation [`check`] reports: eight spacings of the subnormal grid (2⁻¹⁰⁷⁴),
 /// the rounding that tensors of order 1e-320 cannot avoid.
-pub const SUBNORMAL_ALLOWANCE: f64 = 8.0 * 4.9406564584124654e-324;
+pub const SUBNORMAL_ALLOWANCE: f64 = f64::from_bits(8);
 
 /// Checks that `props` could be the mass properties of a real body and reports every problem
 /// found (not only the first) in [`MassError::InvalidInertia`]. Semidefinite tensors of rods,
