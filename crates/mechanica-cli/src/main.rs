@@ -54,6 +54,11 @@ struct RunArgs {
     /// Write SVG plots (spectrum, mode shapes, free response, impact energy) into this directory.
     #[arg(long, value_name = "DIR")]
     plot: Option<std::path::PathBuf>,
+    /// Evaluate at these coordinates instead of q0 (comma-separated, one per coordinate, in the
+    /// order the report prints q0): every analysis starts there, and the modes are those of the
+    /// linearisation at q, without an equilibrium search.
+    #[arg(long, value_name = "Q1,Q2,...", value_delimiter = ',', allow_negative_numbers = true)]
+    q: Option<Vec<f64>>,
 }
 
 impl Default for RunArgs {
@@ -65,6 +70,7 @@ impl Default for RunArgs {
             allow_missing_mesh: false,
             max_response_values: scene::SceneLimits::DEFAULT.max_response_values,
             plot: None,
+            q: None,
         }
     }
 }
@@ -88,7 +94,9 @@ enum Command {
 /// Runs a scene file, a URDF robot (by its extension) or the default scene.
 fn run(args: &RunArgs) -> Result<report::Report, String> {
     let plot = args.plot.as_deref();
+    let state = args.q.as_deref();
     match &args.scene {
+        None if state.is_some() => Err("--q needs a scene or URDF file: the default scene holds two mechanisms".into()),
         None => default_scene::run(plot),
         Some(path) if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) => {
             let options = urdf::UrdfOptions {
@@ -96,7 +104,7 @@ fn run(args: &RunArgs) -> Result<report::Report, String> {
                 allow_missing_mesh: args.allow_missing_mesh,
             };
             let (scene, notes) = urdf::load(path, options)?;
-            let mut report = scene_run::run(&scene, path, plot)?;
+            let mut report = scene_run::run_at(&scene, path, plot, state)?;
             if let Some(first) = report.steps.first_mut() {
                 let (warnings, remarks): (Vec<String>, Vec<String>) =
                     notes.into_iter().partition(|n| n.starts_with("warning:"));
@@ -110,7 +118,7 @@ fn run(args: &RunArgs) -> Result<report::Report, String> {
                 max_response_values: args.max_response_values,
             };
             let scene = scene::Scene::load_with(path, &limits).map_err(|e| e.to_string())?;
-            scene_run::run(&scene, path, plot)
+            scene_run::run_at(&scene, path, plot, state)
         }
     }
 }

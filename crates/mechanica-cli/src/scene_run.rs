@@ -28,10 +28,28 @@ pub(crate) struct Model {
 /// Runs `scene` (loaded from `file`) and returns its report; with `plot_dir`, also writes the
 /// SVG plots of what was computed there.
 pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report, String> {
+    run_at(scene, file, plot_dir, None)
+}
+
+/// [`run`], evaluated at the coordinates `state` instead of the scene's q0 when given: the
+/// equilibrium search is left out, so the modes are those of the linearisation at `state`.
+pub fn run_at(scene: &Scene, file: &Path, plot_dir: Option<&Path>, state: Option<&[f64]>) -> Result<Report, String> {
+    let mut at_state;
+    let scene = match state {
+        Some(_) => {
+            at_state = scene.clone();
+            at_state.analyses.equilibrium = None;
+            &at_state
+        }
+        None => scene,
+    };
     let mut steps: Vec<Step> = Vec::new();
     let mut model = None;
     steps.push(timed_step("build: bodies and kinematic tree", || {
-        let built = build_model(scene, file)?;
+        let mut built = build_model(scene, file)?;
+        if let Some(q) = state {
+            built.q0 = checked_state(q, &coordinate_names(&built))?;
+        }
         let record = BuildRecord {
             bodies: scene
                 .bodies
@@ -68,6 +86,22 @@ pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report
         steps.push(Step::new("plots", start.elapsed().as_secs_f64(), PlotsRecord { files }));
     }
     Ok(Report::new(Command::Run, scene.title.clone(), steps))
+}
+
+/// The coordinates given with `--q`, checked against the model's (named) coordinates.
+fn checked_state(q: &[f64], names: &[String]) -> Result<Vec<f64>, String> {
+    if q.len() != names.len() {
+        return Err(format!(
+            "--q has {} values; the model has {} coordinates ({})",
+            q.len(),
+            names.len(),
+            names.join(", ")
+        ));
+    }
+    if let Some(k) = q.iter().position(|v| !v.is_finite()) {
+        return Err(format!("--q: the value of {} is not finite: {}", names[k], q[k]));
+    }
+    Ok(q.to_vec())
 }
 
 /// The mass properties of one body in its own frame, from the scene's description.

@@ -279,3 +279,69 @@ fn a_script_finds_the_first_frequency_and_the_coordinate_that_moves_most() {
     }
     assert_eq!(movers.len(), 2, "the cases exercise both answers: {movers:?}");
 }
+
+/// `--q` evaluates at a given configuration without an equilibrium search: a uniform rod of
+/// mass m and length l hinged at its end, linearised at θ, has ω² = 3g cos θ / (2l) (U = −mg(l/2)
+/// cos θ, A = ml²/3), oscillatory below π/2 and unstable beyond; the report's q0 is the given q,
+/// and a wrong count of values is refused naming the coordinates.
+#[test]
+fn the_modes_at_a_given_configuration_match_the_linearised_rod() {
+    let dir = scratch("state");
+    let (m, l) = (0.7, 1.3);
+    let i = m * l * l / 12.0;
+    let urdf = dir.join("rod.urdf");
+    std::fs::write(
+        &urdf,
+        format!(
+            r#"<?xml version="1.0"?>
+<robot name="rod">
+  <link name="base"/>
+  <link name="rod">
+    <inertial>
+      <origin xyz="0 0 {:?}" rpy="0 0 0"/>
+      <mass value="{m:?}"/>
+      <inertia ixx="{i:?}" ixy="0" ixz="0" iyy="{i:?}" iyz="0" izz="1e-6"/>
+    </inertial>
+  </link>
+  <joint name="hinge" type="continuous">
+    <parent link="base"/><child link="rod"/>
+    <origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="0 1 0"/>
+  </joint>
+</robot>
+"#,
+            -0.5 * l
+        ),
+    )
+    .expect("urdf");
+    let path = urdf.to_str().expect("path");
+    for theta in [0.3, -1.1, 2.0, -2.9] {
+        let q = format!("{theta:?}");
+        let (ok, out, err) = mechanica(&["run", path, "--q", &q, "--json"]);
+        assert!(ok, "{err}");
+        let report: serde_json::Value = serde_json::from_str(&out).expect("JSON report");
+        assert_eq!(values(&report, "build", "q0"), vec![theta]);
+        assert!(
+            report["steps"]
+                .as_array()
+                .expect("steps")
+                .iter()
+                .all(|s| s["analysis"] != "equilibrium"),
+            "no equilibrium search with --q"
+        );
+        let want = 1.5 * G * f64::cos(theta) / l;
+        let got = omega_sq(&report)[0];
+        assert!(
+            (got - want).abs() <= 1e-10 * want.abs(),
+            "θ = {theta}: ω² {got} vs {want}"
+        );
+        let kind = &step(&report, "modes")["modes"][0]["kind"];
+        assert_eq!(kind, if want > 0.0 { "oscillatory" } else { "unstable" }, "θ = {theta}");
+    }
+    let (ok, _, err) = mechanica(&["run", path, "--q", "0.1,0.2"]);
+    assert!(
+        !ok && err.contains("--q has 2 values") && err.contains("hinge"),
+        "{err}"
+    );
+    let (ok, _, err) = mechanica(&["run", "--q", "0.1"]);
+    assert!(!ok && err.contains("--q needs a scene"), "{err}");
+}
