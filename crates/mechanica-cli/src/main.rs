@@ -17,6 +17,7 @@ mod scene;
 mod scene_run;
 mod simulate_run;
 mod simulation_plots;
+mod spectrum_plot;
 mod trajectory_file;
 mod urdf;
 

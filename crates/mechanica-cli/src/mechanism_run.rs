@@ -385,7 +385,11 @@ fn record_mode_plots(modes: &MechanismModes, plots: &mut PlotData) {
         .solution
         .modes
         .iter()
-        .map(|m| (m.omega_sq, matches!(m.kind, ModeKind::Oscillatory { .. })))
+        .map(|m| crate::spectrum_plot::SpectrumPoint {
+            omega_sq: m.omega_sq,
+            bound: m.error_bound,
+            kind: crate::mode_record::ModeKindName::of(m.kind).as_str().to_string(),
+        })
         .collect();
     if let Some(x) = &modes.solution.vectors {
         plots.shapes = (0..x.ncols().min(6))

@@ -21,6 +21,30 @@ pub enum ModeKindName {
     Undecided,
 }
 
+impl ModeKindName {
+    /// The class of `kind`.
+    pub fn of(kind: ModeKind) -> ModeKindName {
+        match kind {
+            ModeKind::Oscillatory { .. } => ModeKindName::Oscillatory,
+            ModeKind::Zero => ModeKindName::Zero,
+            ModeKind::Unstable { .. } => ModeKindName::Unstable,
+            ModeKind::Infinite => ModeKindName::Infinite,
+            ModeKind::Undecided => ModeKindName::Undecided,
+        }
+    }
+
+    /// The name the JSON report uses.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ModeKindName::Oscillatory => "oscillatory",
+            ModeKindName::Zero => "zero",
+            ModeKindName::Unstable => "unstable",
+            ModeKindName::Infinite => "infinite",
+            ModeKindName::Undecided => "undecided",
+        }
+    }
+}
+
 /// A body's motion in a mode, per unit modal amplitude (world components).
 #[derive(Debug, Clone, Serialize)]
 pub struct BodyMotion {

@@ -50,8 +50,8 @@ pub struct SimulationSeries {
 /// Everything the scene computed that can be plotted.
 #[derive(Debug, Clone, Default)]
 pub struct PlotData {
-    /// (ω², oscillatory?) per mode.
-    pub spectrum: Vec<(f64, bool)>,
+    /// Every mode with its bound and class.
+    pub spectrum: Vec<crate::spectrum_plot::SpectrumPoint>,
     /// The first mode shapes.
     pub shapes: Vec<ModeShape>,
     /// The free response.
@@ -115,24 +115,8 @@ impl PlotData {
         let mut written = Vec::new();
         if !self.spectrum.is_empty() {
             let path = dir.join("spectrum.svg");
-            let root = SVGBackend::new(&path, (800, 480)).into_drawing_area();
-            root.fill(&WHITE).map_err(failed)?;
-            let values: Vec<(f64, RGBColor)> = self
-                .spectrum
-                .iter()
-                .map(|&(w2, oscillatory)| {
-                    let f = w2.abs().sqrt() / std::f64::consts::TAU;
-                    if oscillatory { (f, BLUE) } else { (-f, RED) }
-                })
-                .collect();
-            bars(
-                &root,
-                "spectrum: f = ω/2π (red, negative: unstable or zero)",
-                "Hz",
-                &values,
-            )?;
-            root.present().map_err(failed)?;
-            written.push(path.clone());
+            crate::spectrum_plot::write(&self.spectrum, &path)?;
+            written.push(path);
         }
         if !self.shapes.is_empty() {
             let path = dir.join("mode_shapes.svg");
