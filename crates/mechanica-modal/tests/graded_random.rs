@@ -8,6 +8,9 @@
 //! exactly one zero mode); and, with `Refinement::Auto`, the five lowest non-rigid modes are
 //! right to 1e-8 relative.
 
+mod common;
+
+use common::triplets;
 use faer::Mat;
 use faer::sparse::Triplet;
 use mechanica_modal::testing::graded::{GradedFamily, Shape, SpringTree, spring_tree, tree_pencil_spectrum};
@@ -23,18 +26,6 @@ enum Use {
     ValuesOnly,
     Lowest(usize),
     Sparse(usize),
-}
-
-fn triplets(m: &Mat<f64>) -> Vec<Triplet<usize, usize, f64>> {
-    let mut t = Vec::new();
-    for j in 0..m.ncols() {
-        for i in 0..m.nrows() {
-            if m[(i, j)] != 0.0 {
-                t.push(Triplet::new(i, j, m[(i, j)]));
-            }
-        }
-    }
-    t
 }
 
 fn modes_of(system: &SpringTree, usage: Use) -> Vec<Mode> {

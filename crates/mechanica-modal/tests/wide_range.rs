@@ -8,8 +8,10 @@
 //! ω² < 0. A typed error is allowed (the pencil may be beyond what double precision resolves),
 //! a wrong number is not.
 
+mod common;
+
+use common::triplets;
 use faer::Mat;
-use faer::sparse::Triplet;
 use mechanica_modal::{
     ModalError, Mode, ModeKind, PencilProblem, Refinement, Selection, SolveOptions, SparsePencil, SparseSolveOptions,
     solve, solve_sparse,
@@ -57,18 +59,6 @@ enum Use {
     ValuesOnly,
     Lowest(usize),
     Sparse(usize),
-}
-
-fn triplets(m: &Mat<f64>) -> Vec<Triplet<usize, usize, f64>> {
-    let mut t = Vec::new();
-    for j in 0..m.ncols() {
-        for i in 0..m.nrows() {
-            if m[(i, j)] != 0.0 {
-                t.push(Triplet::new(i, j, m[(i, j)]));
-            }
-        }
-    }
-    t
 }
 
 /// The modes, or the typed refusal.
