@@ -172,7 +172,7 @@ impl Mechanism {
     }
 
     /// Forward kinematics at q with the base at rest (the rotating frame's own view).
-    fn positions(&self, q: &[f64]) -> Result<Workspace, MechanismError> {
+    pub(crate) fn positions(&self, q: &[f64]) -> Result<Workspace, MechanismError> {
         self.check_q(q)?;
         let mut ws = self.tree.workspace();
         self.tree.update_positions(&mut ws, q)?;
@@ -187,15 +187,19 @@ impl Mechanism {
         }
     }
 
+    /// Whether gravity or a rotating frame contributes to U*.
+    pub(crate) fn field_is_active(&self) -> bool {
+        self.gravity != Vector3::zeros() || self.rotation.is_some()
+    }
+
     /// U*(q) = U(q) − T₀(q) with its exact gradient and, when asked, its exact Hessian B(q) =
     /// ∂²U*/∂q∂q (8.85). Errors name the potential that failed.
     pub fn potential(&self, q: &[f64], with_hessian: bool) -> Result<PotentialSum, MechanismError> {
         let ws = self.positions(q)?;
         let config = Configuration::new(&self.tree, &ws, q, &self.bodies)?;
         let mut sum = PotentialSum::new(self.dof(), with_hessian);
-        let field = self.field();
-        if field.gravity != Vector3::zeros() || self.rotation.is_some() {
-            field.accumulate(&config, &mut sum)?;
+        if self.field_is_active() {
+            self.field().accumulate(&config, &mut sum)?;
         }
         for potential in &self.potentials {
             potential.accumulate(&config, &mut sum)?;

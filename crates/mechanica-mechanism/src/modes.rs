@@ -18,6 +18,7 @@
 //!   ‖(s²A + sG + B)x‖ / ((|s|²‖A‖ + |s|‖G‖ + ‖B‖)‖x‖), and its error bound. Gyroscopic
 //!   stabilisation (B indefinite, all Re s = 0 within their bounds) is reported as such.
 
+use crate::assembly_error::AssemblyError;
 use crate::{Mechanism, MechanismError};
 use faer::Mat;
 use faer::c64;
@@ -170,7 +171,8 @@ pub fn mechanism_modes_with_locks(
         ..*options
     };
     let mut solution = solve(&problem, &options)?;
-    propagate_assembly_error(&mut solution, &b);
+    let assembly = AssemblyError::of(mechanism, &q, &free)?;
+    propagate_assembly_error(&mut solution, &assembly);
     let stability = stability_of(&solution);
     let gradient_norm = free.iter().map(|&k| evaluation.gradient[k].powi(2)).sum::<f64>().sqrt();
     if let Some(x) = solution.vectors.take() {
@@ -203,27 +205,28 @@ pub fn mechanism_modes_with_locks(
     })
 }
 
-/// Relative size of the rounding error of an assembled B: ‖δB‖ ≤ 64·n·u·‖B‖_F (generous:
-/// each entry is a sum of O(n) products of rounded kinematic quantities).
-fn assembly_error(b: &Mat<f64>) -> f64 {
-    64.0 * b.nrows() as f64 * f64::EPSILON * b.norm_l2()
-}
-
 /// The modal solver certifies each ω² for the B it was given; B itself carries the rounding
-/// of its assembly. To first order a perturbation δB moves ω²_k by x_kᵀ δB x_k, so
-/// ‖δB‖·‖x_k‖² (x_k A-normalised) is added to every bound and the modes are reclassified with
-/// it: a ω² of 1e-29 from a B of size 40 is a zero mode, not an instability.
-fn propagate_assembly_error(solution: &mut ModalSolution, b: &Mat<f64>) {
-    let delta = assembly_error(b);
+/// of its assembly, bounded mode by mode in [`AssemblyError`], which is added to every bound,
+/// and the modes are reclassified with it: a ω² of 1e-29 from a B of size 40 is a zero mode,
+/// not an instability.
+fn propagate_assembly_error(solution: &mut ModalSolution, assembly: &AssemblyError) {
     let Some(x) = &solution.vectors else { return };
     for (k, mode) in solution.modes.iter_mut().enumerate() {
         if matches!(mode.kind, ModeKind::Infinite) {
             continue;
         }
-        let norm_sq: f64 = (0..x.nrows()).map(|r| x[(r, k)] * x[(r, k)]).sum();
-        mode.error_bound += delta * norm_sq;
-        // The assembly error is the model's own resolution: within the bound, a mode is zero.
-        mode.kind = mechanica_modal::classify(mode.omega_sq, mode.error_bound, mode.error_bound);
+        let shape = |r: usize| x[(r, k)];
+        let stiffness_share = assembly.stiffness_share(shape);
+        let sign_bound = mode.error_bound + stiffness_share;
+        // The assembly error is the model's own resolution: within B's share, a mode is zero.
+        // When the solve's own bound is what reaches zero, the size is unknown, not zero.
+        let kind = mechanica_modal::classify(mode.omega_sq, sign_bound, sign_bound);
+        let solve_limited = stiffness_share < mode.error_bound && mode.kind != ModeKind::Zero;
+        mode.kind = match kind {
+            ModeKind::Zero if solve_limited => ModeKind::Undecided,
+            other => other,
+        };
+        mode.error_bound = sign_bound + assembly.inertia_share(mode.omega_sq, shape);
         if let Some(bound) = solution.accuracy.error_bounds.get_mut(k) {
             *bound = mode.error_bound;
         }
