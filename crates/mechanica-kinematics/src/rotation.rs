@@ -391,7 +391,7 @@ pub fn orthonormalize_matrix(m: &Matrix3<f64>) -> Result<Orthonormalized, Kinema
             determinant,
         });
     };
-    let r = proper_polar_factor(u, &svd.singular_values, v_t);
+    let r = refine_polar_factor(proper_polar_factor(u, &svd.singular_values, v_t), &scaled);
     let orthogonality_error = (r.transpose() * r - Matrix3::identity()).norm();
     if !(orthogonality_error <= 64.0 * f64::EPSILON && r.determinant() > 0.0) {
         return Err(KinematicsError::NotARotation {
@@ -405,6 +405,27 @@ pub fn orthonormalize_matrix(m: &Matrix3<f64>) -> Result<Orthonormalized, Kinema
         rotation: Rotation3::from_matrix_unchecked(r),
         correction,
     })
+}
+
+/// Newton steps towards the rotation R with Rᵀm symmetric (the proper polar factor): with
+/// S = Rᵀm and its skew part [k]×, the rotation exp([ω]×) with (tr S·I − S) ω = 2k makes
+/// exp(−[ω]×) S symmetric to first order ([ω]× S + S [ω]× = [(tr S·I − S) ω]× for symmetric S).
+/// The matrix tr S·I − S has the eigenvalues σ_i + σ_j, so each step costs a 3 × 3 solve and
+/// brings R to the rounding level u κ that m's own rounding allows, which an SVD by iteration
+/// does not always reach. A step whose solve fails (m nearly singular) leaves R as it is.
+fn refine_polar_factor(mut r: Matrix3<f64>, m: &Matrix3<f64>) -> Matrix3<f64> {
+    for _ in 0..2 {
+        let s = r.transpose() * m;
+        // Twice the axial vector of S's skew part.
+        let k = Vector3::new(s[(2, 1)] - s[(1, 2)], s[(0, 2)] - s[(2, 0)], s[(1, 0)] - s[(0, 1)]);
+        let system = Matrix3::identity() * s.trace() - 0.5 * (s + s.transpose());
+        let Some(omega) = system.lu().solve(&k) else { break };
+        if !omega.iter().all(|w| w.is_finite()) || omega.norm() > 1e-3 {
+            break;
+        }
+        r *= Rotation3::from_scaled_axis(omega).matrix();
+    }
+    r
 }
 
 /// U Vᵀ with det +1: when rounding in a nearly singular m leaves det(U) det(Vᵀ) = −1 although

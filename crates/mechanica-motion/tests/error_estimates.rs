@@ -96,10 +96,13 @@ proptest! {
     }
 
     /// Random chains of 2–7 links with springs and dampers, random methods and steps, against
-    /// the tight reference.
+    /// the tight reference. A chain is honest when every sample's estimate covers its error;
+    /// misses come in whole chains, so chains are the unit counted. If 95 % of chains were
+    /// honest, 8 or more dishonest chains of 40 would occur with probability below 1e-3
+    /// (binomial tail), so that many fails the test; the measured rate is near 99 %.
     #[test]
-    fn random_chains_are_covered(seeds in prop::collection::vec(any::<u64>(), 16)) {
-        let (mut covered, mut total) = (0, 0);
+    fn random_chains_are_covered(seeds in prop::collection::vec(any::<u64>(), 40)) {
+        let (mut dishonest, mut chains) = (0, 0);
         for seed in seeds {
             let mut rng = Rng::new(seed);
             let links = 2 + rng.below(6);
@@ -123,9 +126,11 @@ proptest! {
                 let s = reference.samples.iter().find(|s| s.t == t).expect("same sample times");
                 (s.q.clone(), s.q_dot.clone())
             });
-            covered += a;
-            total += b;
+            chains += 1;
+            if a < b {
+                dishonest += 1;
+            }
         }
-        prop_assert!(covered as f64 >= 0.95 * total as f64, "covered {covered} of {total}");
+        prop_assert!(dishonest < 8, "{dishonest} of {chains} chains have an estimate below the error");
     }
 }
