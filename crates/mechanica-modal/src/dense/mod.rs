@@ -34,7 +34,7 @@ use crate::dense::definite::{select, solve_definite, solve_definite_owned};
 use crate::dense::finish::Finish;
 use crate::dense::idle_inputs::{EarlyInputs, IdleResults};
 use crate::dense::options::{check_interval, weakly_bounded};
-use crate::dense::reversed::{adopt_reversed_bottom, bottom_is_weak};
+use crate::dense::reversed::{adopt_reversed_bottom, reversed_bottom_of};
 use crate::dense::scaling::PencilScale;
 use crate::dense::solution::empty_solution;
 use crate::error::ModalError;
@@ -134,7 +134,12 @@ fn solve_in_range(problem: &PencilProblem, options: &SolveOptions) -> Result<Mod
                 |diag: &[f64], subdiag: &[f64]| certificate = idle_certificate::start(problem, diag, subdiag);
             let hook: Option<OnTridiagonal<'_>> = if idle_time { Some(&mut start_certificate) } else { None };
             let mut def = solve_definite_owned(l.as_ref(), b_copy, options.selection, want_vectors, par, hook)?;
-            if options.refinement != Refinement::Off && bottom_is_weak(&def.omega_sq) {
+            let clock = Instant::now();
+            let bottom = (options.refinement != Refinement::Off)
+                .then(|| reversed_bottom_of(&def.omega_sq, a, b, par))
+                .flatten();
+            def.timings.factor += clock.elapsed();
+            if let Some(bottom) = bottom {
                 if !want_vectors {
                     // The reversed modes are refined from their shapes, so the solve needs all of them.
                     let first_try = def.timings;
@@ -142,9 +147,7 @@ fn solve_in_range(problem: &PencilProblem, options: &SolveOptions) -> Result<Mod
                     def.timings.factor += first_try.factor;
                     def.timings.eigen += first_try.eigen;
                 }
-                let clock = Instant::now();
-                adopt_reversed_bottom(&mut def, a, b, l.as_ref(), par);
-                def.timings.factor += clock.elapsed();
+                adopt_reversed_bottom(&mut def, &bottom, l.as_ref());
             }
             let early = early_inputs.and_then(IdleTask::finished);
             let (norm_a, norm_b) = match &early {

@@ -44,9 +44,14 @@ pub(crate) fn reversed_bottom(
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
     forward_scale: f64,
+    reversal: Reversal,
     par: Par,
 ) -> Option<ReversedBottom> {
-    let (shift, r) = shifted_factor(a, b, par)?;
+    let attempts = match reversal {
+        Reversal::Shifted => SHIFT_ATTEMPTS,
+        Reversal::Unshifted => 0,
+    };
+    let (shift, r) = shifted_factor(a, b, attempts, par)?;
     let m = reduce(r.as_ref(), a, par);
     let (eigen, _) = symmetric_eigen_returning_input(m, true, par, None).ok()?;
     let z = eigen.vectors?;
@@ -78,8 +83,9 @@ pub(crate) fn reversed_bottom(
     })
 }
 
-/// The smallest shift tried for which B + sA has a Cholesky factor, with that factor.
-fn shifted_factor(a: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Option<(f64, Mat<f64>)> {
+/// The smallest shift tried (0, then up to `attempts` growing ones) for which B + sA has a
+/// Cholesky factor, with that factor.
+fn shifted_factor(a: MatRef<'_, f64>, b: MatRef<'_, f64>, attempts: usize, par: Par) -> Option<(f64, Mat<f64>)> {
     let n = a.nrows();
     let diagonal_ratio = (0..n)
         .map(|i| b[(i, i)].abs() / a[(i, i)])
@@ -87,7 +93,7 @@ fn shifted_factor(a: MatRef<'_, f64>, b: MatRef<'_, f64>, par: Par) -> Option<(f
         .fold(0.0, f64::max);
     let first_shift = 16.0 * n as f64 * f64::EPSILON * diagonal_ratio;
     let mut shift = 0.0;
-    for attempt in 0..=SHIFT_ATTEMPTS {
+    for attempt in 0..=attempts {
         if attempt == 1 {
             shift = first_shift;
         } else if attempt > 1 {
@@ -123,38 +129,58 @@ fn normalise_in_a(a: MatRef<'_, f64>, x: &mut Mat<f64>) {
 /// mixed beyond repair (random gradings).
 pub(crate) const REVERSAL_FROM: f64 = 1e-4;
 
-/// Whether the reduction's spectrum `omega_sq` has a mode whose relative error estimate
-/// u·n·max|ω²| / |ω²| exceeds [`REVERSAL_FROM`] while |ω²| is above the estimate itself (a mode
-/// visibly not zero but poorly resolved), or more modes within the estimate of zero than a free
-/// body has rigid-body modes ([`RIGID_BODY_MODES`]): the pencil is graded, and its bottom is worth
-/// the reversed solve. A free structure whose only small modes are its rigid-body ones is not.
-pub(crate) fn bottom_is_weak(omega_sq: &[f64]) -> bool {
+/// How the bottom of the reduction's spectrum calls for the reversed solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Reversal {
+    /// The pencil is graded: a mode whose relative error estimate u·n·max|ω²| / |ω²| exceeds
+    /// [`REVERSAL_FROM`] while |ω²| is above the estimate itself (visibly not zero but poorly
+    /// resolved), or more modes within the estimate of zero than a free body has rigid-body
+    /// modes ([`RIGID_BODY_MODES`]). Reversed with shifts as needed.
+    Shifted,
+    /// A few modes within the estimate of zero: the rigid-body modes of a free structure, or
+    /// soft modes buried under the stiff ones' rounding. Reversed only when B itself has a
+    /// Cholesky factor, which rules rigid-body modes out.
+    Unshifted,
+}
+
+/// Whether (and how) the reduction's spectrum `omega_sq` calls for the reversed solve.
+pub(crate) fn bottom_reversal(omega_sq: &[f64]) -> Option<Reversal> {
     let scale = omega_sq.iter().fold(0.0_f64, |m, w| m.max(w.abs()));
     let estimate = f64::EPSILON * omega_sq.len() as f64 * scale;
     let within_estimate = omega_sq.iter().filter(|w| w.abs() <= estimate).count();
     let poorly_resolved = omega_sq
         .iter()
         .any(|w| w.abs() > estimate && estimate > REVERSAL_FROM * w.abs());
-    poorly_resolved || within_estimate > RIGID_BODY_MODES
+    if poorly_resolved || within_estimate > RIGID_BODY_MODES {
+        Some(Reversal::Shifted)
+    } else if within_estimate > 0 {
+        Some(Reversal::Unshifted)
+    } else {
+        None
+    }
 }
 
 /// The rigid-body modes of one free body in space.
 const RIGID_BODY_MODES: usize = 6;
 
-/// Replaces the lowest modes of the reduction's spectrum `def` (values, selected shapes, and
-/// the reduced eigenvectors Y = LᵀX that refinement corrects through) by those of
-/// [`reversed_bottom`], where that gains. Returns whether anything was replaced.
-pub(crate) fn adopt_reversed_bottom(
-    def: &mut Definite,
+/// The reversed bottom of the reduction's spectrum `omega_sq`, when it calls for one
+/// ([`bottom_reversal`]) and the reversed solve succeeds.
+pub(crate) fn reversed_bottom_of(
+    omega_sq: &[f64],
     a: MatRef<'_, f64>,
     b: MatRef<'_, f64>,
-    l: MatRef<'_, f64>,
     par: Par,
-) -> bool {
+) -> Option<ReversedBottom> {
+    let reversal = bottom_reversal(omega_sq)?;
+    let scale = omega_sq.iter().fold(0.0_f64, |m, w| m.max(w.abs()));
+    reversed_bottom(a, b, scale, reversal, par)
+}
+
+/// Replaces the lowest modes of the reduction's spectrum `def` (values, selected shapes, and
+/// the reduced eigenvectors Y = LᵀX that refinement corrects through) by those of `bottom`
+/// ([`reversed_bottom_of`]), where that gains. Returns whether anything was replaced.
+pub(crate) fn adopt_reversed_bottom(def: &mut Definite, bottom: &ReversedBottom, l: MatRef<'_, f64>) -> bool {
     let scale = def.omega_sq.iter().fold(0.0_f64, |m, w| m.max(w.abs()));
-    let Some(bottom) = reversed_bottom(a, b, scale, par) else {
-        return false;
-    };
     let n = def.omega_sq.len();
     // Keep the spectrum ascending across the seam between the two sides.
     let mut m = bottom.omega_sq.len().min(n);
