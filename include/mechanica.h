@@ -3934,7 +3934,7 @@ mech_status_t mech_tree_body_acceleration(struct mech_tree_t *tree,
  * in which B has this pose. Written to `out`.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0 or a non-unit quaternion; MECH_STATUS_OUT_OF_RANGE when the result overflows.
+ * a mass ≤ 0, a tensor not symmetric within 1e-9·Σ|J_kk| or a non-unit quaternion; MECH_STATUS_OUT_OF_RANGE when the result overflows.
  *
  * # Safety
  * All pointers must be readable (inputs) or writable (`out`).
@@ -3955,7 +3955,7 @@ mech_status_t mech_mass_transform(const struct mech_mass_properties_t *propertie
  *
  * Errors: MECH_STATUS_BAD_DIMENSION for count = 0; MECH_STATUS_NULL_POINTER when only one of
  * `rotations` and `translations` is NULL; MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT
- * for a part with mass ≤ 0 (the message names it) or a non-unit quaternion;
+ * for a part with mass ≤ 0 or an asymmetric tensor (the message names it) or a non-unit quaternion;
  * MECH_STATUS_OUT_OF_RANGE when the total mass, centre or tensor overflows.
  *
  * # Safety
@@ -3974,7 +3974,7 @@ mech_status_t mech_mass_combine(const struct mech_mass_properties_t *parts,
  * The body `body` with the material `hole` (same frame) removed, written to `out`: the inverse
  * of mech_mass_combine.
  *
- * Errors: MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0 or a hole at
+ * Errors: MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0, an asymmetric tensor or a hole at
  * least as heavy as the body; MECH_STATUS_NOT_POSITIVE_DEFINITE or
  * MECH_STATUS_INVALID_ARGUMENT when the remainder is not a valid body (a hole that does not fit
  * inside); MECH_STATUS_OUT_OF_RANGE when the remainder overflows.
@@ -3994,7 +3994,7 @@ mech_status_t mech_mass_subtract(const struct mech_mass_properties_t *body,
  * 3.27–3.29), written to `inertia_out`.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when an entry of J_A overflows.
+ * a mass ≤ 0 or a tensor not symmetric within 1e-9·Σ|J_kk|; MECH_STATUS_OUT_OF_RANGE when an entry of J_A overflows.
  *
  * # Safety
  * `properties` and `point` must be readable and `inertia_out` writable.
@@ -4011,7 +4011,7 @@ mech_status_t mech_mass_inertia_about(const struct mech_mass_properties_t *prope
  * and 3.30, written to `moment_out`.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0 or a zero direction.
+ * a mass ≤ 0, a tensor not symmetric within 1e-9·Σ|J_kk| or a zero direction.
  *
  * # Safety
  * The inputs must be readable and `moment_out` writable.
@@ -4158,7 +4158,7 @@ mech_status_t mech_mass_mesh_welded(const double *vertices,
  * angular velocity `omega` (rad/s), both in that frame. Written to `angular_momentum_out`.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when the angular momentum overflows.
+ * a mass ≤ 0 or a tensor not symmetric within 1e-9·Σ|J_kk|; MECH_STATUS_OUT_OF_RANGE when the angular momentum overflows.
  *
  * # Safety
  * The inputs must be readable and `angular_momentum_out` writable.
@@ -4178,7 +4178,7 @@ mech_status_t mech_mass_angular_momentum(const struct mech_mass_properties_t *pr
  * of `properties`.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
- * a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when the energy or the momentum overflows.
+ * a mass ≤ 0 or a tensor not symmetric within 1e-9·Σ|J_kk|; MECH_STATUS_OUT_OF_RANGE when the energy or the momentum overflows.
  *
  * # Safety
  * The inputs must be readable, `energy_out` writable, `momentum_out` NULL or writable.

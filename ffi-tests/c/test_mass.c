@@ -178,7 +178,16 @@ static void combine_subtract_transform(void) {
     CHECK_STATUS(mech_mass_subtract(&cube, NULL, &s), MECH_STATUS_NULL_POINTER);
     CHECK_STATUS(mech_mass_transform(&b, &qbad[1], &tz, &s), MECH_STATUS_INVALID_ARGUMENT);
     CHECK_STATUS(mech_mass_transform(&b, &qz, NULL, &s), MECH_STATUS_NULL_POINTER);
+    /* An asymmetric tensor is refused, not silently replaced by its symmetric part; one
+       asymmetric within rounding of its trace is accepted. */
+    mech_mass_properties_t skew = b;
+    skew.inertia_about_com.m[1] += 1e-3;
+    CHECK_STATUS(mech_mass_transform(&skew, &qz, &tz, &s), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_mass_subtract(&skew, &far_hole, &s), MECH_STATUS_INVALID_ARGUMENT);
     CHECK(mech_untouched(&s, sizeof s));
+    mech_mass_properties_t nearly = b;
+    nearly.inertia_about_com.m[1] += 1e-14;
+    CHECK_STATUS(mech_mass_transform(&nearly, &qz, &tz, &s), MECH_STATUS_OK);
     CHECK_STATUS(mech_mass_transform(&b, &qz, &tz, NULL), MECH_STATUS_NULL_POINTER);
 }
 

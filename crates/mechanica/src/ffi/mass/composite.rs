@@ -13,7 +13,7 @@ use mechanica_mass::MassProperties;
 /// in which B has this pose. Written to `out`.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0 or a non-unit quaternion; MECH_STATUS_OUT_OF_RANGE when the result overflows.
+/// a mass ≤ 0, a tensor not symmetric within 1e-9·Σ|J_kk| or a non-unit quaternion; MECH_STATUS_OUT_OF_RANGE when the result overflows.
 ///
 /// # Safety
 /// All pointers must be readable (inputs) or writable (`out`).
@@ -46,7 +46,7 @@ pub unsafe extern "C" fn mech_mass_transform(
 ///
 /// Errors: MECH_STATUS_BAD_DIMENSION for count = 0; MECH_STATUS_NULL_POINTER when only one of
 /// `rotations` and `translations` is NULL; MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT
-/// for a part with mass ≤ 0 (the message names it) or a non-unit quaternion;
+/// for a part with mass ≤ 0 or an asymmetric tensor (the message names it) or a non-unit quaternion;
 /// MECH_STATUS_OUT_OF_RANGE when the total mass, centre or tensor overflows.
 ///
 /// # Safety
@@ -98,7 +98,7 @@ pub unsafe extern "C" fn mech_mass_combine(
 /// The body `body` with the material `hole` (same frame) removed, written to `out`: the inverse
 /// of mech_mass_combine.
 ///
-/// Errors: MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0 or a hole at
+/// Errors: MECH_STATUS_NON_FINITE; MECH_STATUS_INVALID_ARGUMENT for a mass ≤ 0, an asymmetric tensor or a hole at
 /// least as heavy as the body; MECH_STATUS_NOT_POSITIVE_DEFINITE or
 /// MECH_STATUS_INVALID_ARGUMENT when the remainder is not a valid body (a hole that does not fit
 /// inside); MECH_STATUS_OUT_OF_RANGE when the remainder overflows.

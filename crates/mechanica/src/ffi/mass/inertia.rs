@@ -13,7 +13,7 @@ use crate::ffi::validate::*;
 /// 3.27–3.29), written to `inertia_out`.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when an entry of J_A overflows.
+/// a mass ≤ 0 or a tensor not symmetric within 1e-9·Σ|J_kk|; MECH_STATUS_OUT_OF_RANGE when an entry of J_A overflows.
 ///
 /// # Safety
 /// `properties` and `point` must be readable and `inertia_out` writable.
@@ -40,7 +40,7 @@ pub unsafe extern "C" fn mech_mass_inertia_about(
 /// and 3.30, written to `moment_out`.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0 or a zero direction.
+/// a mass ≤ 0, a tensor not symmetric within 1e-9·Σ|J_kk| or a zero direction.
 ///
 /// # Safety
 /// The inputs must be readable and `moment_out` writable.

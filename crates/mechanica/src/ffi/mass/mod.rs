@@ -118,8 +118,9 @@ pub(crate) fn check_finite_properties(m: &mech_mass_properties_t, what: &str) ->
     finite(&m.inertia_about_com, &format!("{what}.inertia_about_com"))
 }
 
-/// Reads C mass properties for computation: every number finite and the mass positive (the
-/// tensor itself is not checked; see mech_mass_check).
+/// Reads C mass properties for computation: every number finite, the mass positive and the
+/// tensor symmetric within the validity tolerance |J_ij − J_ji| ≤ 1e-9·Σ|J_kk| (its other
+/// properties are not checked; see mech_mass_check).
 ///
 /// # Safety
 /// A non-NULL, aligned `ptr` must point to a readable mech_mass_properties_t.
@@ -133,7 +134,9 @@ unsafe fn read_properties(ptr: *const mech_mass_properties_t, what: &str) -> Res
             format!("{what}.mass must be positive, got {}", m.mass),
         ));
     }
-    Ok(raw_properties(&m))
+    let props = raw_properties(&m);
+    mechanica_mass::principal::require_symmetric(&props.inertia_c)?;
+    Ok(props)
 }
 
 /// A rigid motion from a unit quaternion (|‖q‖ − 1| ≤ 1e-12) and a translation.

@@ -13,7 +13,7 @@ use crate::ffi::validate::*;
 /// angular velocity `omega` (rad/s), both in that frame. Written to `angular_momentum_out`.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when the angular momentum overflows.
+/// a mass ≤ 0 or a tensor not symmetric within 1e-9·Σ|J_kk|; MECH_STATUS_OUT_OF_RANGE when the angular momentum overflows.
 ///
 /// # Safety
 /// The inputs must be readable and `angular_momentum_out` writable.
@@ -51,7 +51,7 @@ pub unsafe extern "C" fn mech_mass_angular_momentum(
 /// of `properties`.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT for
-/// a mass ≤ 0; MECH_STATUS_OUT_OF_RANGE when the energy or the momentum overflows.
+/// a mass ≤ 0 or a tensor not symmetric within 1e-9·Σ|J_kk|; MECH_STATUS_OUT_OF_RANGE when the energy or the momentum overflows.
 ///
 /// # Safety
 /// The inputs must be readable, `energy_out` writable, `momentum_out` NULL or writable.
