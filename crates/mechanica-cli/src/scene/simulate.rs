@@ -71,8 +71,8 @@ impl SimulateSpec {
 
 impl Validator<'_> {
     /// Ok when the simulation is well defined: positive finite times, a known method with
-    /// its parameters, τ of the scene's length, a bounded number of samples and steps, and no
-    /// constraints (the integrators do not enforce them).
+    /// its parameters, τ of the scene's length, a bounded number of samples and steps.
+    /// Constraints are kept by the integration (RATTLE, or projection after each step).
     pub(super) fn check_simulate(&self, spec: &SimulateSpec, dof: usize) -> Result<(), SceneError> {
         let at = |field: &str| format!("analyses.simulate.{field}");
         let positive = |value: &Spanned<f64>, field: &str| {
@@ -88,10 +88,6 @@ impl Validator<'_> {
             }
         };
         positive(&spec.t_end, "t_end")?;
-        if let Some(first) = self.scene.constraints.first() {
-            let message = "the integrators do not enforce [[constraint]] tables; remove them or the simulation";
-            return Err(self.error(Some(first.kind.span()), at("t_end"), message.into()));
-        }
         self.check_simulate_method(spec, &at)?;
         if let Some(interval) = &spec.interval {
             positive(interval, "interval")?;
