@@ -393,20 +393,34 @@ fn simulate_keeps_the_constraints_of_a_scene() {
             (format!("method = \"rattle\", step = {:?}", 2e-3 * period), 1e-4),
             ("method = \"dopri5\", tolerance = 1e-11".to_string(), 1e-7),
         ] {
-            let analysis = format!("[analyses]\nsimulate = {{ t_end = {period:?}, interval = {:?}, {method} }}\n", 0.5 * period);
+            let analysis = format!(
+                "[analyses]\nsimulate = {{ t_end = {period:?}, interval = {:?}, {method} }}\n",
+                0.5 * period
+            );
             let json = run_json(
                 &format!("simulate{case}"),
                 &linkage.scene([theta0, -theta0, theta0], [0.0; 3], &analysis),
             );
             let q = values(&json, "simulate", "q_end");
             for (k, sign) in [1.0, -1.0, 1.0].iter().enumerate() {
-                close(q[k], sign * theta0, tolerance * theta0, &format!("case {case} {method}: q[{k}]"));
+                close(
+                    q[k],
+                    sign * theta0,
+                    tolerance * theta0,
+                    &format!("case {case} {method}: q[{k}]"),
+                );
             }
             let drift = &step(&json, "simulate")["constraints"];
             let position = numbers(&drift["max_position_drift"])[0];
             let velocity = numbers(&drift["max_velocity_drift"])[0];
-            assert!(position <= 1e-13 * linkage.d, "case {case} {method}: ‖f‖ = {position:e}");
-            assert!(velocity <= 1e-13 * linkage.d * rate, "case {case} {method}: ‖J q̇‖ = {velocity:e}");
+            assert!(
+                position <= 1e-13 * linkage.d,
+                "case {case} {method}: ‖f‖ = {position:e}"
+            );
+            assert!(
+                velocity <= 1e-13 * linkage.d * rate,
+                "case {case} {method}: ‖J q̇‖ = {velocity:e}"
+            );
         }
     }
 }

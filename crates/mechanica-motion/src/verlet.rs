@@ -141,7 +141,13 @@ fn drift_residual(
 
 /// The Newton matrix ∂R/∂q₁ = I − (h/2) ∂(A(q₁)⁻¹p)/∂q₁ of the drift by forward differences
 /// (relative step √u), given A(q₁)⁻¹p.
-fn drift_matrix(system: &mut System, q1: &[f64], p: &[f64], v_end: &[f64], h: f64) -> Result<DMatrix<f64>, StepFailure> {
+fn drift_matrix(
+    system: &mut System,
+    q1: &[f64],
+    p: &[f64],
+    v_end: &[f64],
+    h: f64,
+) -> Result<DMatrix<f64>, StepFailure> {
     let n = q1.len();
     let reach = 0.5 * h * norm(v_end);
     let mut matrix = DMatrix::<f64>::identity(n, n);
@@ -161,7 +167,13 @@ fn drift_matrix(system: &mut System, q1: &[f64], p: &[f64], v_end: &[f64], h: f6
 /// explicit guess q₀ + h v₀, with the Newton matrix by differences re-formed whenever an
 /// iteration contracts by less than 4; it stops at rounding level ([`crate::iteration`]).
 /// With a constant A the matrix is I and one correction solves the drift.
-pub(crate) fn drift(system: &mut System, q0: &[f64], v_start: &[f64], p: &[f64], h: f64) -> Result<Vec<f64>, StepFailure> {
+pub(crate) fn drift(
+    system: &mut System,
+    q0: &[f64],
+    v_start: &[f64],
+    p: &[f64],
+    h: f64,
+) -> Result<Vec<f64>, StepFailure> {
     let mut q1: Vec<f64> = q0.iter().zip(v_start).map(|(x, v)| x + h * v).collect();
     let mut convergence = Convergence::new("Störmer–Verlet drift");
     let mut lu = None;
@@ -171,11 +183,14 @@ pub(crate) fn drift(system: &mut System, q0: &[f64], v_start: &[f64], p: &[f64],
         if lu.is_none() {
             lu = Some(drift_matrix(system, &q1, p, &v_end, h)?.lu());
         }
-        let correction = lu.as_ref().and_then(|f| f.solve(&residual)).ok_or(StepFailure::NotConverged {
-            what: "Störmer–Verlet drift (singular Newton matrix)",
-            iterations: 0,
-            correction: f64::INFINITY,
-        })?;
+        let correction = lu
+            .as_ref()
+            .and_then(|f| f.solve(&residual))
+            .ok_or(StepFailure::NotConverged {
+                what: "Störmer–Verlet drift (singular Newton matrix)",
+                iterations: 0,
+                correction: f64::INFINITY,
+            })?;
         q1.iter_mut().zip(correction.iter()).for_each(|(x, c)| *x -= c);
         let size = correction.amax();
         if convergence.done(size, norm(&q1).max(norm(q0)))? {

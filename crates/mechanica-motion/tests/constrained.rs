@@ -92,9 +92,14 @@ impl PendulumCase {
     /// The revolute pendulum's motion as the point's (y, z) at the samples of `run_times`,
     /// by Dormand–Prince at rtol 1e-12 without constraints.
     fn reference(&self, t_end: f64, interval: f64) -> Vec<Vec<f64>> {
-        let method = Method::DormandPrince { rtol: 1e-12, atol: 1e-14 };
+        let method = Method::DormandPrince {
+            rtol: 1e-12,
+            atol: 1e-14,
+        };
         let simulation = Simulation::new(pendulum(self.m, self.l, self.g), method, quiet()).expect("simulation");
-        let run = simulation.run(&[self.theta], &[self.rate], t_end, interval).expect("reference");
+        let run = simulation
+            .run(&[self.theta], &[self.rate], t_end, interval)
+            .expect("reference");
         run.samples
             .iter()
             .map(|s| point_state(self.l, s.q[0], s.q_dot[0]).0)
@@ -134,22 +139,45 @@ fn point_pendulum_follows_the_revolute_pendulum() {
         for (sample, r) in rattle.samples.iter().zip(&reference) {
             let estimate = sample.error.expect("estimate").q;
             let truth = distance(&sample.q, r);
-            assert!(truth <= estimate, "case {case} t = {}: error {truth:e} > estimate {estimate:e}", sample.t);
+            assert!(
+                truth <= estimate,
+                "case {case} t = {}: error {truth:e} > estimate {estimate:e}",
+                sample.t
+            );
         }
         let drift = rattle.monitors.constraints;
         let speed = p.rate.abs() * p.l + (2.0 * p.g * p.l * 2.0).sqrt();
-        assert!(drift.max_position <= 256.0 * U * p.l, "case {case}: ‖f‖ {:e}", drift.max_position);
-        assert!(drift.max_velocity <= 256.0 * U * speed, "case {case}: ‖J q̇‖ {:e}", drift.max_velocity);
+        assert!(
+            drift.max_position <= 256.0 * U * p.l,
+            "case {case}: ‖f‖ {:e}",
+            drift.max_position
+        );
+        assert!(
+            drift.max_velocity <= 256.0 * U * speed,
+            "case {case}: ‖J q̇‖ {:e}",
+            drift.max_velocity
+        );
         for method in [
             Method::Rk4 { step: h },
-            Method::DormandPrince { rtol: 1e-10, atol: 1e-12 * p.l },
+            Method::DormandPrince {
+                rtol: 1e-10,
+                atol: 1e-12 * p.l,
+            },
         ] {
             let run = p.run(method, quiet(), t_end, interval);
             let error = position_error(&run, &reference, p.l);
             assert!(error < 1e-6, "case {case} {method:?}: error {error:e}");
             let drift = run.monitors.constraints;
-            assert!(drift.max_position <= 256.0 * U * p.l, "case {case} {method:?}: ‖f‖ {:e}", drift.max_position);
-            assert!(drift.max_velocity <= 256.0 * U * speed, "case {case} {method:?}: ‖J q̇‖ {:e}", drift.max_velocity);
+            assert!(
+                drift.max_position <= 256.0 * U * p.l,
+                "case {case} {method:?}: ‖f‖ {:e}",
+                drift.max_position
+            );
+            assert!(
+                drift.max_velocity <= 256.0 * U * speed,
+                "case {case} {method:?}: ‖J q̇‖ {:e}",
+                drift.max_velocity
+            );
         }
     }
 }
@@ -165,13 +193,23 @@ fn rattle_is_second_order_on_the_point_pendulum() {
         let errors: Vec<f64> = [0.02, 0.01, 0.005, 0.0025]
             .iter()
             .map(|f| {
-                let run = p.run(Method::Rattle { step: f * p.period_scale() }, quiet(), t_end, t_end);
+                let run = p.run(
+                    Method::Rattle {
+                        step: f * p.period_scale(),
+                    },
+                    quiet(),
+                    t_end,
+                    t_end,
+                );
                 position_error(&run, &reference, p.l)
             })
             .collect();
         for pair in errors.windows(2) {
             let order = (pair[0] / pair[1]).log2();
-            assert!((1.8..=2.2).contains(&order), "case {case}: errors {errors:?}, order {order}");
+            assert!(
+                (1.8..=2.2).contains(&order),
+                "case {case}: errors {errors:?}, order {order}"
+            );
         }
     }
 }
@@ -303,7 +341,10 @@ impl FourBar {
 
 /// The four-bar's reference by Dormand–Prince at rtol 1e-12 with projection (M.19).
 fn four_bar_reference(bar: &FourBar, t_end: f64, interval: f64) -> Trajectory {
-    let method = Method::DormandPrince { rtol: 1e-12, atol: 1e-14 };
+    let method = Method::DormandPrince {
+        rtol: 1e-12,
+        atol: 1e-14,
+    };
     bar.run(method, quiet(), t_end, interval)
 }
 
@@ -334,11 +375,19 @@ fn rattle_keeps_random_four_bars_closed() {
             "case {case}: ‖f‖ {:e}",
             drift.max_position
         );
-        assert!(drift.max_velocity <= 1e3 * U * speed, "case {case}: ‖J q̇‖ {:e}", drift.max_velocity);
+        assert!(
+            drift.max_velocity <= 1e3 * U * speed,
+            "case {case}: ‖J q̇‖ {:e}",
+            drift.max_velocity
+        );
         for (sample, r) in run.samples.iter().zip(&reference.samples) {
             let estimate = sample.error.expect("estimate").q;
             let truth = distance(&sample.q, &r.q);
-            assert!(truth <= estimate, "case {case} t = {}: error {truth:e} > estimate {estimate:e}", sample.t);
+            assert!(
+                truth <= estimate,
+                "case {case} t = {}: error {truth:e} > estimate {estimate:e}",
+                sample.t
+            );
         }
         let reference_drift = reference.monitors.constraints;
         assert!(reference_drift.max_position <= 256.0 * U * bar.length_scale());
@@ -364,7 +413,10 @@ fn rattle_is_second_order_on_four_bars() {
             .collect();
         for pair in errors.windows(2) {
             let order = (pair[0] / pair[1]).log2();
-            assert!((1.8..=2.2).contains(&order), "case {case}: errors {errors:?}, order {order}");
+            assert!(
+                (1.8..=2.2).contains(&order),
+                "case {case}: errors {errors:?}, order {order}"
+            );
         }
     }
 }
@@ -404,8 +456,15 @@ fn rattle_energy_is_bounded_on_four_bars() {
         let drift = |s: &[mechanica_motion::Sample]| s.iter().fold(0.0f64, |m, x| m.max((x.energy - e0).abs())) / scale;
         let half = run.samples.len() / 2;
         let (first, second) = (drift(&run.samples[..half]), drift(&run.samples[half..]));
-        assert!(run.monitors.max_drift <= 0.05, "case {case}: max drift {:e}", run.monitors.max_drift);
-        assert!(second <= 2.0 * first, "case {case}: drift grows: {first:e} then {second:e}");
+        assert!(
+            run.monitors.max_drift <= 0.05,
+            "case {case}: max drift {:e}",
+            run.monitors.max_drift
+        );
+        assert!(
+            second <= 2.0 * first,
+            "case {case}: drift grows: {first:e} then {second:e}"
+        );
     }
 }
 
@@ -425,12 +484,12 @@ fn rattle_reports_a_constraint_it_cannot_meet() {
         .expect("simulation");
     match simulation.run(&q0, &v0, 50.0, 5.0) {
         Err(MotionError::StepFailed { cause, q, t, .. }) => {
-            assert!(
-                matches!(cause, StepFailure::ConstraintNotMet { .. }),
-                "cause {cause:?}"
-            );
+            assert!(matches!(cause, StepFailure::ConstraintNotMet { .. }), "cause {cause:?}");
             let radius = (q[0] * q[0] + q[1] * q[1]).sqrt();
-            assert!((radius - 1.0).abs() <= 1e-14, "last good state off the rod: {radius} at t = {t}");
+            assert!(
+                (radius - 1.0).abs() <= 1e-14,
+                "last good state off the rod: {radius} at t = {t}"
+            );
         }
         other => panic!("expected a failed step, got {other:?}"),
     }

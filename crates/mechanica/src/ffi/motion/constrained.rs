@@ -51,7 +51,9 @@ pub unsafe extern "C" fn mech_simulation_create_constrained(
 ) -> mech_status_t {
     boundary(|| {
         // SAFETY: caller's contract.
-        let model = unsafe { mech_dynamics_t::borrow(dynamics, "dynamics") }?.constrained().clone();
+        let model = unsafe { mech_dynamics_t::borrow(dynamics, "dynamics") }?
+            .constrained()
+            .clone();
         let initial: InitialValues = (q0, q_dot0, tau, n);
         // SAFETY: caller's contract.
         unsafe { start(model, options, initial, simulation_out) }
