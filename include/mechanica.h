@@ -1752,6 +1752,32 @@ typedef struct mech_motion_momentum_report_t {
 } mech_motion_momentum_report_t;
 #endif
 
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * The drift of a simulation's holonomic constraints over the states reached so far (M.20):
+ * ‖f(q)‖₂ (m, or mixed units when equations mix lengths and angles) and ‖J(q) q̇‖₂. All zero
+ * for a mechanism without constraints.
+ */
+typedef struct mech_motion_constraint_report_t {
+    /**
+     * max ‖f(q)‖₂ over every step and reported state.
+     */
+    double max_position_drift;
+    /**
+     * max ‖J(q) q̇‖₂ over every step and reported state.
+     */
+    double max_velocity_drift;
+    /**
+     * ‖f(q)‖₂ at the time reached.
+     */
+    double last_position_drift;
+    /**
+     * ‖J(q) q̇‖₂ at the time reached.
+     */
+    double last_velocity_drift;
+} mech_motion_constraint_report_t;
+#endif
+
 #if defined(MECH_FEATURE_URDF)
 /**
  * How the URDF readers treat links that are not physical as written. Start from
@@ -2618,6 +2644,14 @@ typedef struct mech_urdf_options_t {
  * The implicit midpoint rule with Newton's method, for stiff springs, fixed step `step`.
  */
 #define MECH_MOTION_IMPLICIT_MIDPOINT 3
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * RATTLE: Störmer–Verlet with the multipliers of holonomic constraints (M.17), symplectic,
+ * fixed step `step`; without constraints it is MECH_MOTION_STORMER_VERLET.
+ */
+#define MECH_MOTION_RATTLE 4
 #endif
 
 #if defined(MECH_FEATURE_MOTION)
@@ -5005,6 +5039,42 @@ mech_status_t mech_simulation_report(const struct mech_simulation_t *simulation,
  */
 mech_status_t mech_simulation_momentum_report(const struct mech_simulation_t *simulation,
                                               struct mech_motion_momentum_report_t *report_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Creates a simulation of a copy of `dynamics` that keeps its holonomic constraints (see the
+ * module docs; the arguments are those of mech_simulation_create). (`q0`, `q_dot0`) should
+ * satisfy the constraints; the first step moves the state onto them.
+ *
+ * Errors: those of mech_simulation_create; MECH_STATUS_INVALID_ARGUMENT for a coordinate
+ * constraint on a rotation vector of a spherical or free joint. A step whose constraints
+ * cannot be met (RATTLE's Newton iteration, or the projection, does not reach the rounding
+ * level of f) stops the integration with MECH_STATUS_NOT_CONVERGED at the last good state;
+ * dependent constraints give MECH_STATUS_SINGULAR.
+ *
+ * # Safety
+ * As mech_simulation_create.
+ */
+mech_status_t mech_simulation_create_constrained(const struct mech_dynamics_t *dynamics,
+                                                 const struct mech_motion_options_t *options,
+                                                 const double *q0,
+                                                 const double *q_dot0,
+                                                 const double *tau,
+                                                 size_t n,
+                                                 struct mech_simulation_t **simulation_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Writes the constraint drift of the simulation (over every step since t = 0 up to the last
+ * successful advance) to `*report_out`.
+ *
+ * # Safety
+ * `simulation` must be a live handle and `report_out` writable.
+ */
+mech_status_t mech_simulation_constraint_report(const struct mech_simulation_t *simulation,
+                                                struct mech_motion_constraint_report_t *report_out);
 #endif
 
 #if defined(MECH_FEATURE_URDF)

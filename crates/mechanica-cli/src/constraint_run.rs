@@ -66,7 +66,7 @@ pub fn run(
 }
 
 /// The scene's constraints on `dynamics`, named as in the scene.
-fn build(scene: &Scene, model: &Model, dynamics: Dynamics) -> Result<ConstrainedDynamics, String> {
+pub(crate) fn build(scene: &Scene, model: &Model, dynamics: Dynamics) -> Result<ConstrainedDynamics, String> {
     let mut constrained = ConstrainedDynamics::new(dynamics);
     for (i, spec) in scene.constraints.iter().enumerate() {
         let name = spec.name.clone().unwrap_or_else(|| format!("constraint[{i}]"));

@@ -86,8 +86,9 @@
 //! ```
 //!
 //! Constraints (`[[constraint]]`, kinds "points", "plane", "distance", "coordinate") are used by
-//! the dynamics analysis only: a scene with constraints that asks for the unconstrained
-//! equilibrium, modes, free response or impact is refused rather than answered without them.
+//! the dynamics analysis and kept by `simulate`: a scene with constraints that asks for the
+//! unconstrained equilibrium, modes, free response or impact is refused rather than answered
+//! without them.
 //!
 //! `inertia` lists the six independent entries (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) about the centre
 //! of mass, in the body frame. Unknown fields are errors, and so are coordinate counts that do

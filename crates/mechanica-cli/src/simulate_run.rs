@@ -2,6 +2,8 @@
 //! method of `mechanica-motion` (docs/theory.md, "Integration in time"), with the global error
 //! estimate of its companion run (M.12)–(M.13) and the drift of the energy or Jacobi integral
 //! (M.1)–(M.2); the trajectory optionally written as CSV and JSON, and plotted with `--plot`.
+//! A scene with `[[constraint]]` tables is simulated with its constraints kept (RATTLE (M.17),
+//! or projection after each step (M.19)), and the constraint drift (M.20) is reported.
 
 mod record;
 
@@ -11,7 +13,7 @@ use crate::scene::{DEFAULT_SIMULATE_STEPS, Scene, SimulateSpec};
 use crate::scene_run::Model;
 use mechanica::motion::{Forcing, Invariant, Method, MotionError, Options, Simulation, Trajectory};
 pub use record::SimulateRecord;
-use record::{InvariantName, MethodName, MonitorRecord};
+use record::{ConstraintRecord, InvariantName, MethodName, MonitorRecord};
 use std::path::Path;
 
 /// Runs the simulation when the scene asks for it.
@@ -36,17 +38,24 @@ pub fn run(
         ..Options::default()
     };
     let method = method_of(spec);
-    let simulation = Simulation::new(dynamics, method, options).map_err(|e| format!("analyses.simulate: {e}"))?;
+    let constrained = crate::constraint_run::build(scene, model, dynamics)?;
+    let simulation =
+        Simulation::constrained(constrained, method, options).map_err(|e| format!("analyses.simulate: {e}"))?;
     let names = crate::scene_run::coordinate_names(model);
     let mut trajectory = None;
+    let kept = if scene.constraints.is_empty() {
+        ""
+    } else {
+        ", constraints kept (M.17)–(M.19)"
+    };
     let title = format!(
-        "simulate: motion from (q0, qd0) to t = {} s by {} (M.3)–(M.11), error by a companion run (M.13)",
+        "simulate: motion from (q0, qd0) to t = {} s by {} (M.3)–(M.11){kept}, error by a companion run (M.13)",
         spec.t_end.get_ref(),
         describe(spec)
     );
     let mut step = timed_step(&title, || {
         let result = integrate(&simulation, model, spec)?;
-        let record = summary(spec, &result, &names);
+        let record = summary(spec, &result, &names, !scene.constraints.is_empty());
         trajectory = Some(result);
         Ok::<_, String>(record)
     })?;
@@ -69,6 +78,7 @@ fn method_of(spec: &SimulateSpec) -> Method {
         "rk4" => Method::Rk4 { step },
         "verlet" => Method::StormerVerlet { step },
         "midpoint" => Method::ImplicitMidpoint { step },
+        "rattle" => Method::Rattle { step },
         _ => {
             let rtol = spec.tolerance.as_ref().map_or(1e-8, |t| *t.get_ref());
             Method::DormandPrince {
@@ -85,6 +95,7 @@ fn describe(spec: &SimulateSpec) -> String {
         Method::Rk4 { step } => format!("RK4 with step {step} s"),
         Method::StormerVerlet { step } => format!("Störmer–Verlet with step {step} s"),
         Method::ImplicitMidpoint { step } => format!("the implicit midpoint rule with step {step} s"),
+        Method::Rattle { step } => format!("RATTLE with step {step} s"),
         Method::DormandPrince { rtol, atol } => format!("Dormand–Prince 5(4), rtol {rtol:e}, atol {atol:e}"),
         _ => "an integrator".into(),
     }
@@ -106,13 +117,14 @@ fn integrate(simulation: &Simulation, model: &Model, spec: &SimulateSpec) -> Res
     })
 }
 
-/// The final state with its estimated error, the largest estimate over the run, the costs
-/// and the monitor of the conserved quantity.
-fn summary(spec: &SimulateSpec, trajectory: &Trajectory, names: &[String]) -> SimulateRecord {
+/// The final state with its estimated error, the largest estimate over the run, the costs,
+/// the monitor of the conserved quantity and, for a `constrained` scene, the constraint drift.
+fn summary(spec: &SimulateSpec, trajectory: &Trajectory, names: &[String], constrained: bool) -> SimulateRecord {
     let (method, step, rtol, atol) = match method_of(spec) {
         Method::Rk4 { step } => (MethodName::Rk4, Some(step), None, None),
         Method::StormerVerlet { step } => (MethodName::Verlet, Some(step), None, None),
         Method::ImplicitMidpoint { step } => (MethodName::Midpoint, Some(step), None, None),
+        Method::Rattle { step } => (MethodName::Rattle, Some(step), None, None),
         Method::DormandPrince { rtol, atol } => (MethodName::DormandPrince, None, Some(rtol), Some(atol)),
         _ => (MethodName::DormandPrince, None, None, None),
     };
@@ -149,6 +161,10 @@ fn summary(spec: &SimulateSpec, trajectory: &Trajectory, names: &[String]) -> Si
             last_drift: m.last_drift,
             scale: m.scale,
         },
+        constraints: constrained.then_some(ConstraintRecord {
+            max_position_drift: m.constraints.max_position,
+            max_velocity_drift: m.constraints.max_velocity,
+        }),
         files: Vec::new(),
     }
 }

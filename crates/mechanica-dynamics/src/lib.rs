@@ -36,7 +36,8 @@ pub mod velocity_potential;
 
 pub use constraints::{
     Baumgarte, ConstrainedDynamics, ConstrainedEquilibrium, ConstrainedEquilibriumOptions, ConstrainedForward,
-    Constraint, ConstraintReaction, PositionProjection, ProjectionMetric, ProjectionOptions, VelocityProjection,
+    Constraint, ConstraintDrift, ConstraintReaction, PositionProjection, ProjectionMetric, ProjectionOptions,
+    VelocityProjection,
 };
 pub use damped_modes::DampedModes;
 pub use dissipation::Damper;

@@ -26,6 +26,11 @@ fn rotation_blocks(tree: &KinematicTree) -> Vec<(usize, usize)> {
         .collect()
 }
 
+/// True when coordinate `index` belongs to the rotation vector of a spherical or free joint.
+pub(crate) fn is_rotation_coordinate(tree: &KinematicTree, index: usize) -> bool {
+    rotation_blocks(tree).iter().any(|&(_, s)| (s..s + 3).contains(&index))
+}
+
 fn block(values: &[f64], s: usize) -> Vector3<f64> {
     Vector3::new(values[s], values[s + 1], values[s + 2])
 }

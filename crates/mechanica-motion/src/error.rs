@@ -37,6 +37,23 @@ pub enum StepFailure {
         /// The last correction, ∞-norm.
         correction: f64,
     },
+    /// RATTLE's simplified Newton iteration did not bring ‖f(q₁)‖₂ down to the rounding level
+    /// of f (M.17).
+    #[error(
+        "the constraints were not met after {iterations} Newton iterations (‖f‖₂ = {residual:e}, tolerance {tolerance:e})"
+    )]
+    ConstraintNotMet {
+        /// Newton iterations done.
+        iterations: usize,
+        /// ‖f(q₁)‖₂ at the last iterate.
+        residual: f64,
+        /// The tolerance: the rounding level of f at q₁.
+        tolerance: f64,
+    },
+    /// J A⁻¹ Jᵀ is not positive definite: the constraints' Jacobian J has dependent rows
+    /// (redundant constraints) at the start of a step.
+    #[error("the constraints' Jacobian has dependent rows (J A⁻¹ Jᵀ is singular)")]
+    SingularConstraints,
     /// The adaptive step size fell to the rounding level of t.
     #[error("the step size {step:e} fell below the rounding level of t")]
     StepSizeUnderflow {

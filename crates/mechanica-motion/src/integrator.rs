@@ -16,6 +16,8 @@ enum Engine {
     Rk4(Box<Rk4>, f64),
     Verlet(f64),
     Midpoint(f64),
+    /// The largest step and the multipliers of the last step (the next step's first guess).
+    Rattle(f64, Vec<f64>),
     Adaptive(Box<DormandPrince>),
 }
 
@@ -50,6 +52,7 @@ impl Integrator {
             Method::Rk4 { step } => Engine::Rk4(Box::new(Rk4::new(n)), step),
             Method::StormerVerlet { step } => Engine::Verlet(step),
             Method::ImplicitMidpoint { step } => Engine::Midpoint(step),
+            Method::Rattle { step } => Engine::Rattle(step, vec![0.0; system.constraints_equations()]),
             Method::DormandPrince { rtol, atol } => Engine::Adaptive(Box::new(DormandPrince::new(n, rtol, atol))),
         };
         let chart = ReportingChart::of(system.dynamics().tree());
@@ -146,7 +149,7 @@ impl Integrator {
     /// divide [t, target] into equal steps no longer than their step.
     pub(crate) fn advance_to(&mut self, target: f64, horizon: f64) -> Result<Point, StepFailure> {
         let largest = match self.engine {
-            Engine::Rk4(_, h) | Engine::Verlet(h) | Engine::Midpoint(h) => h,
+            Engine::Rk4(_, h) | Engine::Verlet(h) | Engine::Midpoint(h) | Engine::Rattle(h, _) => h,
             Engine::Adaptive(_) => return self.advance_adaptive(target, horizon),
         };
         let remaining = target - self.t;
@@ -159,17 +162,11 @@ impl Integrator {
         let n = self.y.len() / 2;
         for i in 0..count as usize {
             self.prepare_step()?;
-            let (q, v) = self.y.split_at_mut(n);
-            let mut q_new = q.to_vec();
-            let mut v_new = v.to_vec();
-            match &mut self.engine {
-                Engine::Rk4(rk4, _) => rk4.step(&mut self.system, self.t, &mut q_new, &mut v_new, h)?,
-                Engine::Verlet(_) => crate::verlet::step(&mut self.system, self.t, &mut q_new, &mut v_new, h)?,
-                Engine::Midpoint(_) => crate::midpoint::step(&mut self.system, self.t, &mut q_new, &mut v_new, h)?,
-                Engine::Adaptive(_) => {}
-            }
-            q.copy_from_slice(&q_new);
-            v.copy_from_slice(&v_new);
+            let mut q_new = self.y[..n].to_vec();
+            let mut v_new = self.y[n..].to_vec();
+            self.fixed_step(&mut q_new, &mut v_new, h)?;
+            self.y[..n].copy_from_slice(&q_new);
+            self.y[n..].copy_from_slice(&v_new);
             self.t = if i + 1 == count as usize {
                 target
             } else {
@@ -178,6 +175,20 @@ impl Integrator {
             self.monitor_step()?;
         }
         Ok(self.point())
+    }
+
+    /// One step of a fixed-step method from the state reached, into (q, q̇), followed by the
+    /// projection onto the constraints (M.19) for every method but RATTLE.
+    fn fixed_step(&mut self, q: &mut [f64], v: &mut [f64], h: f64) -> Result<(), StepFailure> {
+        let system = &mut self.system;
+        match &mut self.engine {
+            Engine::Rk4(rk4, _) => rk4.step(system, self.t, q, v, h)?,
+            Engine::Verlet(_) => crate::verlet::step(system, self.t, q, v, h)?,
+            Engine::Midpoint(_) => crate::midpoint::step(system, self.t, q, v, h)?,
+            Engine::Rattle(_, lambda) => return crate::rattle::step(system, self.t, (q, v), h, lambda),
+            Engine::Adaptive(_) => {}
+        }
+        crate::projection::project(system, q, v)
     }
 
     fn advance_adaptive(&mut self, target: f64, horizon: f64) -> Result<Point, StepFailure> {
@@ -189,6 +200,12 @@ impl Integrator {
             let mut y = self.y.clone();
             let mut t = self.t;
             dopri.step(&mut self.system, &mut t, &mut y, horizon.max(target))?;
+            if self.system.is_constrained() {
+                let n = y.len() / 2;
+                let (q, v) = y.split_at_mut(n);
+                crate::projection::project(&mut self.system, q, v)?;
+                dopri.invalidate();
+            }
             self.y = y;
             self.t = t;
             self.monitor_step()?;
@@ -202,6 +219,8 @@ impl Integrator {
         }
         crate::error::check_finite(&y, "interpolated state")?;
         let n = y.len() / 2;
+        let (q, v) = y.split_at_mut(n);
+        crate::projection::project(&mut self.system, q, v)?;
         Ok(Point {
             t: target,
             q: y[..n].to_vec(),

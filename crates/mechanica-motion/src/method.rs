@@ -3,7 +3,10 @@
 use crate::error::MotionError;
 
 /// How the equations of motion are integrated. Every method re-centres rotation-vector charts
-/// before each step ([`crate::chart`]).
+/// before each step ([`crate::chart`]). For a mechanism with holonomic constraints
+/// ([`crate::Simulation::constrained`]), [`Method::Rattle`] keeps them by multipliers (M.17);
+/// every other method integrates the index-1 equations (M.18) and projects each step's end
+/// point back onto f(q) = 0 and J q̇ = 0 (M.19).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Method {
@@ -33,6 +36,14 @@ pub enum Method {
         /// The largest step, s (> 0, finite).
         step: f64,
     },
+    /// RATTLE (M.17): Störmer–Verlet with the constraints' multipliers solved so that
+    /// f(q₁) = 0 to the rounding level of f and J(q₁) q̇₁ = 0, order 2, symplectic for
+    /// conservative constrained systems, with steps of at most `step` seconds. Without
+    /// constraints it is [`Method::StormerVerlet`].
+    Rattle {
+        /// The largest step, s (> 0, finite).
+        step: f64,
+    },
 }
 
 /// The smallest relative tolerance accepted by [`Method::DormandPrince`]: tighter than this
@@ -55,9 +66,10 @@ impl Method {
     /// Checks the parameters: steps and tolerances positive and finite, rtol ≥ [`MIN_RTOL`].
     pub fn validate(&self) -> Result<(), MotionError> {
         match *self {
-            Method::Rk4 { step } | Method::StormerVerlet { step } | Method::ImplicitMidpoint { step } => {
-                positive(step, "step")
-            }
+            Method::Rk4 { step }
+            | Method::StormerVerlet { step }
+            | Method::ImplicitMidpoint { step }
+            | Method::Rattle { step } => positive(step, "step"),
             Method::DormandPrince { rtol, atol } => {
                 positive(rtol, "rtol")?;
                 positive(atol, "atol")?;
@@ -78,7 +90,7 @@ impl Method {
         match self {
             Method::Rk4 { .. } => 4,
             Method::DormandPrince { .. } => 5,
-            Method::StormerVerlet { .. } | Method::ImplicitMidpoint { .. } => 2,
+            Method::StormerVerlet { .. } | Method::ImplicitMidpoint { .. } | Method::Rattle { .. } => 2,
         }
     }
 
@@ -89,6 +101,7 @@ impl Method {
             Method::Rk4 { step } => Method::Rk4 { step: step / 2.0 },
             Method::StormerVerlet { step } => Method::StormerVerlet { step: step / 2.0 },
             Method::ImplicitMidpoint { step } => Method::ImplicitMidpoint { step: step / 2.0 },
+            Method::Rattle { step } => Method::Rattle { step: step / 2.0 },
             Method::DormandPrince { rtol, atol } => Method::DormandPrince {
                 rtol: (rtol / 32.0).max(MIN_RTOL),
                 atol: atol / 32.0,

@@ -1,6 +1,6 @@
 //! Monitors of a run: the drift of the conserved quantity H (M.1)–(M.2), the momenta of
-//! coordinates the caller names cyclic (9.3), and the linear and angular momentum of the whole
-//! mechanism (M.15)–(M.16).
+//! coordinates the caller names cyclic (9.3), the linear and angular momentum of the whole
+//! mechanism (M.15)–(M.16), and the drift ‖f(q)‖₂, ‖J q̇‖₂ of holonomic constraints (M.20).
 
 use crate::momentum::SystemMomentum;
 use nalgebra::Vector3;
@@ -70,6 +70,30 @@ impl MomentumDrift {
     }
 }
 
+/// The drift of the holonomic constraints f(q) = 0 over a run (M.20): ‖f(q)‖₂ and ‖J(q) q̇‖₂
+/// (mixed units when the equations mix lengths and angles). Zero for a mechanism without
+/// constraints.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ConstraintMonitor {
+    /// max ‖f(q)‖₂ over the steps and samples.
+    pub max_position: f64,
+    /// max ‖J(q) q̇‖₂ over the steps and samples.
+    pub max_velocity: f64,
+    /// ‖f(q)‖₂ at the last step or sample.
+    pub last_position: f64,
+    /// ‖J(q) q̇‖₂ at the last step or sample.
+    pub last_velocity: f64,
+}
+
+impl ConstraintMonitor {
+    fn record(&mut self, (position, velocity): (f64, f64)) {
+        self.last_position = position;
+        self.last_velocity = velocity;
+        self.max_position = self.max_position.max(position);
+        self.max_velocity = self.max_velocity.max(velocity);
+    }
+}
+
 /// The monitors of a run over every step of the main run and every sample. H is conserved only without dampers, without
 /// velocity-dependent potentials that do work, without a time-dependent base motion and with
 /// τ constant or zero; otherwise its change is the work of those forces, reported as drift.
@@ -92,6 +116,8 @@ pub struct Monitors {
     pub linear_momentum: MomentumDrift,
     /// The angular momentum L of the whole mechanism about the origin of W (M.16), kg·m²/s.
     pub angular_momentum: MomentumDrift,
+    /// The drift of the holonomic constraints (M.20).
+    pub constraints: ConstraintMonitor,
 }
 
 /// What the monitors record at one state: H, T₂, the generalized momenta p = A q̇ and the
@@ -102,6 +128,8 @@ pub(crate) struct Measurement {
     pub kinetic: f64,
     pub p: Vec<f64>,
     pub momentum: SystemMomentum,
+    /// (‖f(q)‖₂, ‖J q̇‖₂), zero without constraints.
+    pub constraint_drift: (f64, f64),
 }
 
 impl Measurement {
@@ -115,6 +143,7 @@ impl Measurement {
                 linear: Vector3::zeros(),
                 angular: Vector3::zeros(),
             },
+            constraint_drift: (0.0, 0.0),
         }
     }
 }
@@ -130,6 +159,7 @@ pub(crate) struct Tracker {
     cyclic: Vec<CyclicMomentum>,
     linear: MomentumDrift,
     angular: MomentumDrift,
+    constraints: ConstraintMonitor,
 }
 
 impl Tracker {
@@ -152,6 +182,11 @@ impl Tracker {
                 .collect(),
             linear: MomentumDrift::new(start.momentum.linear),
             angular: MomentumDrift::new(start.momentum.angular),
+            constraints: {
+                let mut monitor = ConstraintMonitor::default();
+                monitor.record(start.constraint_drift);
+                monitor
+            },
         }
     }
 
@@ -166,6 +201,7 @@ impl Tracker {
         }
         self.linear.record(m.momentum.linear);
         self.angular.record(m.momentum.angular);
+        self.constraints.record(m.constraint_drift);
     }
 
     /// The monitors so far.
@@ -180,6 +216,7 @@ impl Tracker {
             cyclic: self.cyclic.clone(),
             linear_momentum: self.linear,
             angular_momentum: self.angular,
+            constraints: self.constraints,
         }
     }
 }

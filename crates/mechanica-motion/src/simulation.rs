@@ -10,7 +10,7 @@ use crate::integrator::Integrator;
 use crate::method::Method;
 use crate::monitors::{Invariant, Measurement, Monitors, Tracker};
 use crate::system::System;
-use mechanica_dynamics::Dynamics;
+use mechanica_dynamics::{ConstrainedDynamics, Constraint, Dynamics};
 
 /// The most samples a run records: (t_end / output_interval) + 1 must not exceed it.
 pub const MAX_SAMPLES: usize = 1_000_000;
@@ -70,10 +70,11 @@ pub struct Trajectory {
     pub companion_steps: usize,
 }
 
-/// A mechanism's dynamics with a method and options, ready to integrate.
+/// A mechanism's dynamics (with holonomic constraints or without) with a method and options,
+/// ready to integrate.
 #[derive(Debug, Clone)]
 pub struct Simulation {
-    dynamics: Dynamics,
+    dynamics: ConstrainedDynamics,
     method: Method,
     options: Options,
 }
@@ -81,7 +82,32 @@ pub struct Simulation {
 impl Simulation {
     /// Checks the method's parameters, a constant τ's length and the cyclic coordinates.
     pub fn new(dynamics: Dynamics, method: Method, options: Options) -> Result<Self, MotionError> {
+        Self::constrained(ConstrainedDynamics::new(dynamics), method, options)
+    }
+
+    /// A simulation of a mechanism with holonomic constraints f(q) = 0 (the constraints of
+    /// `dynamics`, with its dampers and loads). [`Method::Rattle`] keeps the constraints by
+    /// multipliers (M.17); the other methods integrate the index-1 equations (M.18) and
+    /// project onto f = 0 and J q̇ = 0 after every step (M.19). Either way the monitors report
+    /// the drift max ‖f(q)‖₂ and max ‖J q̇‖₂ (M.20). The initial state should satisfy the
+    /// constraints; the first step moves it onto them, and the monitors include its drift.
+    ///
+    /// Checks as [`Simulation::new`], and refuses a coordinate constraint on a rotation vector
+    /// of a spherical or free joint (its chart moves during the run, (M.14)).
+    pub fn constrained(dynamics: ConstrainedDynamics, method: Method, options: Options) -> Result<Self, MotionError> {
         method.validate()?;
+        let tree = dynamics.dynamics().tree();
+        for constraint in dynamics.constraints() {
+            if let Constraint::Coordinate { index, .. } = constraint
+                && crate::chart::is_rotation_coordinate(tree, *index)
+            {
+                return Err(MotionError::NoSuchCoordinate {
+                    what: "coordinate constraint on a rotation vector (charts move during a run)",
+                    index: *index,
+                    dof: tree.dof(),
+                });
+            }
+        }
         let n = dynamics.dof();
         options.forcing.validate(n)?;
         if let Some(&index) = options.cyclic.iter().find(|&&k| k >= n) {
@@ -192,7 +218,7 @@ impl Stepper {
         let companion = options
             .estimate_error
             .then(|| Integrator::new(system, simulation.method.companion(), q0, q_dot0, options.max_steps));
-        let invariant = match simulation.dynamics.mechanism().rotating_frame() {
+        let invariant = match simulation.dynamics.dynamics().mechanism().rotating_frame() {
             Some(_) => Invariant::JacobiIntegral,
             None => Invariant::Energy,
         };

@@ -16,6 +16,8 @@ pub enum MethodName {
     Midpoint,
     /// Dormand–Prince 5(4), adaptive.
     DormandPrince,
+    /// RATTLE (Störmer–Verlet with constraint multipliers), fixed step.
+    Rattle,
 }
 
 /// The conserved quantity monitored (mechanica::motion::Invariant).
@@ -41,6 +43,15 @@ pub struct MonitorRecord {
     pub last_drift: f64,
     /// The energy scale, J.
     pub scale: f64,
+}
+
+/// The drift of the scene's holonomic constraints over the run (M.20).
+#[derive(Debug, Clone, Serialize)]
+pub struct ConstraintRecord {
+    /// max ‖f(q)‖₂ over the steps and samples (m, or mixed units).
+    pub max_position_drift: f64,
+    /// max ‖J(q) q̇‖₂ over the steps and samples.
+    pub max_velocity_drift: f64,
 }
 
 /// A simulation from (q0, qd0) to t_end.
@@ -76,6 +87,9 @@ pub struct SimulateRecord {
     pub companion_steps: usize,
     /// The conserved quantity's drift.
     pub monitor: MonitorRecord,
+    /// The constraint drift, for a scene with constraints.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub constraints: Option<ConstraintRecord>,
     /// Trajectory files written (CSV, JSON).
     pub files: Vec<String>,
 }
@@ -115,6 +129,12 @@ impl SimulateRecord {
             bound(m.last_drift),
             number(m.scale, 4)
         ));
+        if let Some(c) = &self.constraints {
+            out.line(
+                "constraint drift: max ‖f(q)‖₂, max ‖J q̇‖₂",
+                &format!("{}, {}", bound(c.max_position_drift), bound(c.max_velocity_drift)),
+            );
+        }
         for file in &self.files {
             out.note(&format!("trajectory written to {file}"));
         }

@@ -22,9 +22,11 @@
 //! - [`ConstrainedDynamics::project_positions`] and
 //!   [`ConstrainedDynamics::project_velocities`] ([`projection`]): back onto f = 0 and
 //!   J q̇ = 0 for integrators.
+//! - [`ConstrainedDynamics::drift`] ([`drift`]): f(q), J q̇ and the rounding level of f.
 //! - [`ConstrainedDynamics::equilibrium`] ([`equilibrium`]): ∇U + Jᵀλ = 0, f = 0 (FM 4.83–4.86)
 //!   by Newton's method on (q, λ) with the exact Hessian of the Lagrangian.
 
+pub mod drift;
 pub mod equilibrium;
 mod evaluate;
 pub mod forward;
@@ -33,6 +35,7 @@ pub mod projection;
 pub mod reactions;
 pub mod schur;
 
+pub use drift::ConstraintDrift;
 pub use equilibrium::{ConstrainedEquilibrium, ConstrainedEquilibriumOptions};
 pub use forward::{Baumgarte, ConstrainedForward};
 pub use kinds::Constraint;

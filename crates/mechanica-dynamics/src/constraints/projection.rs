@@ -110,10 +110,7 @@ impl ConstrainedDynamics {
                     value: t,
                 });
             }
-            None => {
-                let scale = evaluated.value_scale.iter().fold(0.0f64, |m, s| m.max(*s));
-                64.0 * evaluated.equations() as f64 * f64::EPSILON * scale
-            }
+            None => super::drift::rounding_level(&evaluated),
         };
         let mut iterations = 0;
         loop {

@@ -67,6 +67,11 @@ impl mech_dynamics_t {
     pub(crate) fn dynamics(&self) -> &Dynamics {
         self.constrained.dynamics()
     }
+
+    /// The dynamics with its constraints (read by the motion module).
+    pub(crate) fn constrained(&self) -> &ConstrainedDynamics {
+        &self.constrained
+    }
 }
 
 /// Borrows the dynamics behind a handle for evaluating or changing it (NULL_POINTER,

@@ -1,6 +1,9 @@
 //! C entry points of the motion crate: a simulation handle created on a dynamics handle, with
 //! the method and its step or tolerances in mech_motion_options_t; advancing to a time into
 //! caller buffers (q, q̇); the report of the global error estimate (M.13) and the monitors.
+//! [`constrained`]: simulations that keep the holonomic constraints of the dynamics handle.
+
+mod constrained;
 
 use super::boundary::{FfiError, boundary};
 use super::c_enum::{c_enum, enum_value};
@@ -9,6 +12,7 @@ use super::handle::Handle;
 use super::status::*;
 use super::types::mech_vec3_t;
 use super::validate::*;
+use mechanica_dynamics::ConstrainedDynamics;
 use mechanica_motion::{
     Forcing, Invariant, Method, MomentumDrift, MotionError, Options, Simulation, StepFailure, Stepper,
 };
@@ -23,6 +27,9 @@ pub const MECH_MOTION_DORMAND_PRINCE: mech_motion_method_t = 1;
 pub const MECH_MOTION_STORMER_VERLET: mech_motion_method_t = 2;
 /// The implicit midpoint rule with Newton's method, for stiff springs, fixed step `step`.
 pub const MECH_MOTION_IMPLICIT_MIDPOINT: mech_motion_method_t = 3;
+/// RATTLE: Störmer–Verlet with the multipliers of holonomic constraints (M.17), symplectic,
+/// fixed step `step`; without constraints it is MECH_MOTION_STORMER_VERLET.
+pub const MECH_MOTION_RATTLE: mech_motion_method_t = 4;
 
 /// The quantity H that the energy monitor follows (int32_t).
 pub type mech_motion_invariant_t = i32;
@@ -37,6 +44,7 @@ enum MethodKind {
     DormandPrince,
     StormerVerlet,
     ImplicitMidpoint,
+    Rattle,
 }
 
 c_enum!(MethodKind,
@@ -44,6 +52,7 @@ c_enum!(MethodKind,
     MECH_MOTION_DORMAND_PRINCE => MethodKind::DormandPrince,
     MECH_MOTION_STORMER_VERLET => MethodKind::StormerVerlet,
     MECH_MOTION_IMPLICIT_MIDPOINT => MethodKind::ImplicitMidpoint,
+    MECH_MOTION_RATTLE => MethodKind::Rattle,
 );
 
 /// Options of a simulation. Start from mech_motion_options_default.
@@ -103,7 +112,7 @@ impl From<MotionError> for FfiError {
             MotionError::NonFiniteResult { .. } => MECH_STATUS_OUT_OF_RANGE,
             MotionError::StepFailed { cause, .. } => match cause {
                 StepFailure::Dynamics(e) => FfiError::from(e.clone()).status,
-                StepFailure::SingularMassMatrix => MECH_STATUS_SINGULAR,
+                StepFailure::SingularMassMatrix | StepFailure::SingularConstraints => MECH_STATUS_SINGULAR,
                 StepFailure::NonFinite { .. } | StepFailure::NonFiniteForce { .. } => MECH_STATUS_OUT_OF_RANGE,
                 _ => MECH_STATUS_NOT_CONVERGED,
             },
@@ -134,6 +143,7 @@ fn rust_options(o: &mech_motion_options_t, tau: Option<&[f64]>) -> Result<(Metho
         MethodKind::Rk4 => Method::Rk4 { step: o.step },
         MethodKind::StormerVerlet => Method::StormerVerlet { step: o.step },
         MethodKind::ImplicitMidpoint => Method::ImplicitMidpoint { step: o.step },
+        MethodKind::Rattle => Method::Rattle { step: o.step },
         MethodKind::DormandPrince => Method::DormandPrince {
             rtol: o.rtol,
             atol: o.atol,
@@ -178,29 +188,47 @@ pub unsafe extern "C" fn mech_simulation_create(
     simulation_out: *mut *mut mech_simulation_t,
 ) -> mech_status_t {
     boundary(|| {
-        let out = Out::new(simulation_out, "simulation_out")?;
         // SAFETY: caller's contract.
         let d = unsafe { mech_dynamics_t::borrow(dynamics, "dynamics") }?.dynamics();
-        let mut defaults = mech_motion_options_t::default_values();
-        if !options.is_null() {
-            // SAFETY: caller's contract.
-            defaults = unsafe { read(options, "options") }?;
-        }
+        let model = ConstrainedDynamics::new(d.clone());
         // SAFETY: caller's contract.
-        let (q0, q_dot0) = unsafe { (read_slice(q0, n, "q0")?, read_slice(q_dot0, n, "q_dot0")?) };
-        let tau = if tau.is_null() {
-            None
-        } else {
-            // SAFETY: caller's contract.
-            Some(unsafe { read_slice(tau, n, "tau") }?)
-        };
-        let (method, options) = rust_options(&defaults, tau)?;
-        let simulation = Simulation::new(d.clone(), method, options)?;
-        let stepper = simulation.start(q0, q_dot0)?;
-        // SAFETY: caller's contract.
-        unsafe { out.write(mech_simulation_t { stepper }.into_raw()) };
-        Ok(())
+        unsafe { start(model, options, (q0, q_dot0, tau, n), simulation_out) }
     })
+}
+
+/// The C inputs of a simulation's initial value problem: q₀, q̇₀, τ (may be NULL) and n.
+type InitialValues = (*const f64, *const f64, *const f64, usize);
+
+/// Starts a simulation of `model` with the C options and initial values and writes its handle.
+///
+/// # Safety
+/// As mech_simulation_create.
+unsafe fn start(
+    model: ConstrainedDynamics,
+    options: *const mech_motion_options_t,
+    (q0, q_dot0, tau, n): InitialValues,
+    simulation_out: *mut *mut mech_simulation_t,
+) -> Result<(), FfiError> {
+    let out = Out::new(simulation_out, "simulation_out")?;
+    let mut defaults = mech_motion_options_t::default_values();
+    if !options.is_null() {
+        // SAFETY: caller's contract.
+        defaults = unsafe { read(options, "options") }?;
+    }
+    // SAFETY: caller's contract.
+    let (q0, q_dot0) = unsafe { (read_slice(q0, n, "q0")?, read_slice(q_dot0, n, "q_dot0")?) };
+    let tau = if tau.is_null() {
+        None
+    } else {
+        // SAFETY: caller's contract.
+        Some(unsafe { read_slice(tau, n, "tau") }?)
+    };
+    let (method, options) = rust_options(&defaults, tau)?;
+    let simulation = Simulation::constrained(model, method, options)?;
+    let stepper = simulation.start(q0, q_dot0)?;
+    // SAFETY: caller's contract.
+    unsafe { out.write(mech_simulation_t { stepper }.into_raw()) };
+    Ok(())
 }
 
 impl mech_motion_options_t {
