@@ -17,8 +17,10 @@
 //! forward differences (m more half kicks and drifts). It starts from the previous step's λ
 //! and stops when
 //! ‖f(q₁)‖₂ is at most the rounding level of f at q₁ (64·m·u times the size of the terms of
-//! f, [`mechanica_dynamics::constraints::drift`]); after [`MAX_NEWTON_ITERATIONS`] it fails
-//! with [`StepFailure::ConstraintNotMet`].
+//! f, [`mechanica_dynamics::constraints::drift`]), or when it stalls below the rounding of
+//! q₁ = q₀ + h v itself, 64·m·u·max|J₀|·(max|q₀| + h·max|q̇₀|) (a coordinate held near zero,
+//! whose own terms are tiny); after [`MAX_NEWTON_ITERATIONS`] it fails with
+//! [`StepFailure::ConstraintNotMet`].
 //!
 //! **Velocities.** The last line is linear in μ: with p̃ = p_½ + (h/2) F(q₁, A(q₁)⁻¹p_½) and
 //! ṽ = A(q₁)⁻¹p̃, it gives q̇₁ = ṽ − A⁻¹Jᵀ(J A⁻¹ Jᵀ)⁻¹ J ṽ at q₁: the A-orthogonal
@@ -72,6 +74,10 @@ struct Landing {
     values: DVector<f64>,
     residual: f64,
     rounding_level: f64,
+    /// 64·m·u·max|J₀|·(max|q₀| + h·max|q̇₀|): how far f moves when q₁ = q₀ + h v is rounded,
+    /// the floor of ‖f‖ where the terms of f are themselves small (a coordinate held near zero).
+    /// From the step's start, so that a diverging λ cannot raise it.
+    landing_level: f64,
 }
 
 /// The half kick and drift for the multipliers `lambda`, and f at their end.
@@ -88,12 +94,16 @@ fn land(
     let q1 = drift(system, start.q, &v_start, &p_half, h)?;
     let zeros = vec![0.0; q1.len()];
     let drift_at = system.constraints_mut().drift(&q1, &zeros)?;
+    let amax = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let equations = drift_at.values.len() as f64;
+    let landing_level = 64.0 * equations * f64::EPSILON * multipliers.j0.amax() * (amax(start.q) + h * amax(start.v));
     Ok(Landing {
         q1,
         p_half,
         values: DVector::from_column_slice(&drift_at.values),
         residual: drift_at.position,
         rounding_level: drift_at.rounding_level,
+        landing_level,
     })
 }
 
@@ -131,8 +141,9 @@ fn positions(
 ) -> Result<(Vec<f64>, Vec<f64>), StepFailure> {
     let multipliers = Multipliers::at(system, start.q, start.factor)?;
     let mut differences: Option<nalgebra::LU<f64, Dyn, Dyn>> = None;
-    let mut at = land(system, (t, h), start, &multipliers, lambda)?;
-    let mut best = (lambda.to_vec(), at.residual);
+    let mut best = (lambda.to_vec(), f64::INFINITY);
+    let mut at = land(system, (t, h), start, &multipliers, lambda).map_err(|failure| diverged(failure, &best, 0.0))?;
+    best.1 = at.residual;
     let (mut previous, mut last_change) = (f64::INFINITY, 0.0f64);
     for _ in 0..MAX_NEWTON_ITERATIONS {
         if at.residual <= at.rounding_level {
@@ -144,13 +155,18 @@ fn positions(
         if at.residual < best.1 {
             best = (lambda.to_vec(), at.residual);
         }
+        if at.residual > 0.25 * previous && at.residual <= at.landing_level {
+            // Stalled at the rounding of q₁ itself.
+            return Ok((at.q1, at.p_half));
+        }
         if at.residual > 0.25 * previous {
             if at.residual > best.1 {
                 lambda.copy_from_slice(&best.0);
                 at = land(system, (t, h), start, &multipliers, lambda)?;
             }
             let size = lambda.iter().fold(last_change, |m, l| m.max(l.abs()));
-            let matrix = multiplier_matrix(system, (t, h), start, &multipliers, (lambda, &at), size)?;
+            let matrix = multiplier_matrix(system, (t, h), start, &multipliers, (lambda, &at), size)
+                .map_err(|failure| diverged(failure, &best, at.rounding_level))?;
             differences = Some(matrix.lu());
         }
         previous = at.residual;
@@ -160,9 +176,10 @@ fn positions(
         };
         last_change = change.amax();
         lambda.iter_mut().zip(change.iter()).for_each(|(l, c)| *l += c);
-        at = land(system, (t, h), start, &multipliers, lambda)?;
+        at = land(system, (t, h), start, &multipliers, lambda)
+            .map_err(|failure| diverged(failure, &best, at.rounding_level))?;
     }
-    if at.residual <= at.rounding_level {
+    if at.residual <= at.rounding_level.max(at.landing_level) {
         return Ok((at.q1, at.p_half));
     }
     Err(StepFailure::ConstraintNotMet {
@@ -170,6 +187,19 @@ fn positions(
         residual: at.residual,
         tolerance: at.rounding_level,
     })
+}
+
+/// A multiplier iterate far from the constraints can drive the dynamics out of range: that is
+/// the constraint not met (with the best residual reached), not an input out of range.
+fn diverged(failure: StepFailure, best: &(Vec<f64>, f64), tolerance: f64) -> StepFailure {
+    match failure {
+        StepFailure::Dynamics(_) | StepFailure::NonFinite { .. } => StepFailure::ConstraintNotMet {
+            iterations: MAX_NEWTON_ITERATIONS,
+            residual: best.1,
+            tolerance,
+        },
+        other => other,
+    }
 }
 
 /// One RATTLE step of size `h` from (t, q, q̇), in place; `lambda` (one entry per constraint
