@@ -165,7 +165,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     let bodies: Vec<String> = scene.bodies.iter().map(|b| b.name.get_ref().clone()).collect();
     let (step, modes) = modes_step(&mut mechanism, &q, &locked, spec, &names, &bodies)?;
     steps.push(step);
-    record_mode_plots(&modes, &mechanism, scene.gravity, plots);
+    record_mode_plots(&modes, &mechanism, &bodies, scene.gravity, plots);
     if let Some(response) = &analyses.response {
         steps.push(response_step(&modes, response.get_ref(), plots, &names)?);
     }
@@ -381,7 +381,13 @@ fn modes_record(m: &MechanismModes, names: &[String], locked: &[String], bodies:
 
 /// Puts the spectrum and the first six modes drawn on the mechanism into the plot data (the
 /// mechanism is the one the modes were computed with: its tree is re-centred at `modes.q`).
-fn record_mode_plots(modes: &MechanismModes, mechanism: &Mechanism, gravity: Option<[f64; 3]>, plots: &mut PlotData) {
+fn record_mode_plots(
+    modes: &MechanismModes,
+    mechanism: &Mechanism,
+    names: &[String],
+    gravity: Option<[f64; 3]>,
+    plots: &mut PlotData,
+) {
     let solution = &modes.solution;
     plots.spectrum = solution
         .modes
@@ -395,7 +401,7 @@ fn record_mode_plots(modes: &MechanismModes, mechanism: &Mechanism, gravity: Opt
     let Some(x) = &solution.vectors else { return };
     let (tree, bodies) = (mechanism.tree(), mechanism.bodies());
     // Without a skeleton (forward kinematics failing at q) there is nothing to draw on.
-    let Ok(skeleton) = crate::mode_shape::skeleton(tree, bodies, &modes.q, gravity) else {
+    let Ok(skeleton) = crate::mode_shape::skeleton(tree, bodies, names, &modes.q, gravity) else {
         return;
     };
     let figures = (0..x.ncols().min(solution.modes.len()).min(6))

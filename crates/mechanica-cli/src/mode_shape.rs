@@ -2,8 +2,9 @@
 //! the joint origins of revolute and spherical joints, and centres of mass) at the configuration
 //! q₀ of the modes, and displaced along each mode x_k to q₀ + s·x_k by exact forward
 //! kinematics. The amplitude s makes the largest linearised displacement of a drawn point
-//! [`DISPLACEMENT_FRACTION`] of the mechanism's extent, and no body turn by more than
-//! [`MAX_ROTATION`] rad, so the drawn shape stays close to the linear mode.
+//! [`DISPLACEMENT_FRACTION`] of the mechanism's extent, unless a body would then turn by more
+//! than [`MAX_ROTATION`] rad (a light link spinning about its own axis): s is then smaller, and
+//! the figure names that body.
 
 use crate::mode_record::{ModeKindName, ModeRecord};
 use crate::report::text::{bound, number};
@@ -14,8 +15,9 @@ use mechanica::mass::MassProperties;
 /// The largest displacement of a drawn point, as a fraction of the mechanism's extent.
 pub const DISPLACEMENT_FRACTION: f64 = 0.12;
 
-/// The largest rotation of a body in a drawn shape, rad.
-pub const MAX_ROTATION: f64 = 0.35;
+/// The largest rotation of a body in a drawn shape, rad: beyond it the exact pose no longer
+/// looks like the linear mode.
+pub const MAX_ROTATION: f64 = 0.5;
 
 /// Positions of the drawn points, world frame, m.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,6 +38,8 @@ impl Pose {
 /// The mechanism at rest: its tree structure and pose, and where "up" is.
 #[derive(Debug, Clone)]
 pub struct Skeleton {
+    /// Each body's name.
+    pub names: Vec<String>,
     /// Each body's parent body (`None`: hung from the ground).
     pub parents: Vec<Option<usize>>,
     /// Whether each body's joint has coordinates (a fixed joint has none).
@@ -66,6 +70,8 @@ pub struct ModeFigure {
     pub amplitude: f64,
     /// The largest distance a drawn point moved, m.
     pub largest: f64,
+    /// The body whose rotation limited s, when [`MAX_ROTATION`] did.
+    pub turned_most: Option<usize>,
     /// Why no displaced pose is drawn.
     pub note: Option<String>,
 }
@@ -95,10 +101,12 @@ fn pose_at(tree: &KinematicTree, bodies: &[MassProperties], q: &[f64]) -> Result
     Ok(pose)
 }
 
-/// The skeleton of `tree` with `bodies` at `q`; `gravity` sets the up direction.
+/// The skeleton of `tree` with `bodies` (named `names`) at `q`; `gravity` sets the up
+/// direction.
 pub fn skeleton(
     tree: &KinematicTree,
     bodies: &[MassProperties],
+    names: &[String],
     q: &[f64],
     gravity: Option<[f64; 3]>,
 ) -> Result<Skeleton, String> {
@@ -111,6 +119,7 @@ pub fn skeleton(
         .filter(|g| g.norm() > 0.0 && g.norm().is_finite())
         .map_or(Vector3::z(), |g| g.normalize());
     Ok(Skeleton {
+        names: names.to_vec(),
         parents: tree.parents().to_vec(),
         moving: (0..bodies.len()).map(|i| !tree.dof_range(i).is_empty()).collect(),
         base,
@@ -120,9 +129,14 @@ pub fn skeleton(
     })
 }
 
-/// The largest linearised displacement of a drawn point and the largest body rotation per unit
-/// amplitude of the mode `x`, from the point and angular Jacobians at `q`.
-fn linear_motion(tree: &KinematicTree, bodies: &[MassProperties], q: &[f64], x: &[f64]) -> Result<(f64, f64), String> {
+/// The largest linearised displacement of a drawn point, and the largest body rotation with
+/// that body, per unit amplitude of the mode `x`, from the point and angular Jacobians at `q`.
+fn linear_motion(
+    tree: &KinematicTree,
+    bodies: &[MassProperties],
+    q: &[f64],
+    x: &[f64],
+) -> Result<(f64, (f64, usize)), String> {
     let mut ws = tree.workspace();
     tree.update_positions(&mut ws, q).map_err(|e| e.to_string())?;
     let n = tree.dof();
@@ -131,7 +145,7 @@ fn linear_motion(tree: &KinematicTree, bodies: &[MassProperties], q: &[f64], x: 
         let v: Vector3<f64> = (0..n).map(|k| Vector3::new(j[3 * k], j[3 * k + 1], j[3 * k + 2]) * x[k]).sum();
         v.norm()
     };
-    let (mut displacement, mut rotation) = (0.0f64, 0.0f64);
+    let (mut displacement, mut rotation) = (0.0f64, (0.0f64, 0));
     for (i, body) in bodies.iter().enumerate() {
         let mut points = vec![Vector3::zeros()];
         if body.mass > 0.0 {
@@ -142,7 +156,10 @@ fn linear_motion(tree: &KinematicTree, bodies: &[MassProperties], q: &[f64], x: 
             displacement = displacement.max(times_x(&jacobian));
         }
         tree.angular_jacobian(&ws, i, &mut jacobian).map_err(|e| e.to_string())?;
-        rotation = rotation.max(times_x(&jacobian));
+        let turn = times_x(&jacobian);
+        if turn > rotation.0 {
+            rotation = (turn, i);
+        }
     }
     Ok((displacement, rotation))
 }
@@ -164,10 +181,12 @@ pub fn figure(
         displaced: None,
         amplitude: 0.0,
         largest: 0.0,
+        turned_most: None,
         note: None,
     };
     match displaced_pose(tree, bodies, q, skeleton, x) {
-        Ok((pose, s)) => {
+        Ok((pose, s, turned_most)) => {
+            figure.turned_most = turned_most;
             figure.largest = pose
                 .points()
                 .zip(skeleton.rest.points())
@@ -181,25 +200,32 @@ pub fn figure(
     figure
 }
 
-/// The pose at q + s·x and the amplitude s (see the module docs).
+/// The pose at q + s·x, the amplitude s (see the module docs) and the body whose rotation
+/// limited s, if one did.
 fn displaced_pose(
     tree: &KinematicTree,
     bodies: &[MassProperties],
     q: &[f64],
     skeleton: &Skeleton,
     x: &[f64],
-) -> Result<(Pose, f64), String> {
+) -> Result<(Pose, f64, Option<usize>), String> {
     if x.len() != q.len() || x.iter().any(|v| !v.is_finite()) {
         return Err("no finite shape vector for this mode".into());
     }
-    let (displacement, rotation) = linear_motion(tree, bodies, q, x)?;
+    let (displacement, (rotation, turning)) = linear_motion(tree, bodies, q, x)?;
     if !(displacement > 0.0) {
         return Err("this mode moves none of the drawn points".into());
     }
-    let s = (DISPLACEMENT_FRACTION * skeleton.extent / displacement).min(MAX_ROTATION / rotation);
+    let by_displacement = DISPLACEMENT_FRACTION * skeleton.extent / displacement;
+    let by_rotation = MAX_ROTATION / rotation;
+    let (s, turned_most) = if by_rotation < by_displacement {
+        (by_rotation, Some(turning))
+    } else {
+        (by_displacement, None)
+    };
     let moved: Vec<f64> = q.iter().zip(x).map(|(a, b)| a + s * b).collect();
     let pose = pose_at(tree, bodies, &moved).map_err(|e| format!("displaced shape: {e}"))?;
-    Ok((pose, s))
+    Ok((pose, s, turned_most))
 }
 
 /// The frequency |ω|/2π (Hz) of ω² and the ends of its interval from ω² ± bound.
@@ -236,6 +262,11 @@ fn interval_text(values: [f64; 3], unit: &str, name: &str) -> String {
     )
 }
 
+/// A small number with two significant digits (0 as "0").
+fn short(value: f64) -> String {
+    if value == 0.0 { "0".into() } else { bound(value) }
+}
+
 /// The two heading lines of mode `number`.
 pub fn heading(number: usize, record: &ModeRecord) -> [String; 2] {
     let mut first = format!("mode {number} · {}", record.kind.as_str());
@@ -250,11 +281,11 @@ pub fn heading(number: usize, record: &ModeRecord) -> [String; 2] {
             let gamma = record.growth_rate.unwrap_or(f64::NAN);
             interval_text([gamma, lo, hi], "1/s", "growth rate γ")
         }
-        ModeKindName::Zero => format!("rigid-body motion: ω² = {} ± {} rad²/s²", bound(w2), bound(record.bound)),
+        ModeKindName::Zero => format!("rigid-body motion: ω² = {} ± {} rad²/s²", short(w2), short(record.bound)),
         ModeKindName::Undecided => format!(
             "ω² = {} ± {} rad²/s²: the interval contains 0",
-            bound(w2),
-            bound(record.bound)
+            short(w2),
+            short(record.bound)
         ),
         ModeKindName::Infinite => "a massless direction: ω² = +∞".to_string(),
     };

@@ -1,5 +1,6 @@
 //! `mode_shapes.svg`: each mode drawn on the mechanism, a stick figure at rest (grey) and
-//! displaced along the mode (coloured by class): body origins (the joints) as open circles,
+//! displaced along the mode (coloured by class): body origins (the joints) as rings, smaller
+//! for fixed joints,
 //! links as lines from the parent's origin (the ground point for the root) to the body's
 //! origin, dashed arms from a body's origin to its centre of mass, drawn as a dot, and the
 //! ground marked by a hatched bar.
@@ -22,7 +23,7 @@ const HEADER: f64 = 56.0;
 const PANEL_W: f64 = 500.0;
 const PANEL_H: f64 = 440.0;
 const TITLE_H: f64 = 50.0;
-const CAPTION_H: f64 = 40.0;
+const CAPTION_H: f64 = 50.0;
 const MARGIN: f64 = 24.0;
 const REST: Color = Color(175, 175, 175);
 
@@ -132,12 +133,13 @@ fn draw_pose(svg: &mut Svg, skeleton: &Skeleton, pose: &Pose, frame: &Frame, col
             svg.line(&format!("{role}-arm"), frame.px(origin), frame.px(c), color, 1.0, true);
         }
     }
-    for (i, origin) in pose.origins.iter().enumerate() {
-        let r = if skeleton.moving[i] { 4.5 } else { 2.5 };
-        svg.circle(&format!("{role}-joint"), frame.px(origin), r, color, Some(Color(255, 255, 255)));
-    }
     for centre in pose.centres.iter().flatten() {
-        svg.circle(&format!("{role}-com"), frame.px(centre), 3.5, color, Some(color));
+        svg.circle(&format!("{role}-com"), frame.px(centre), 3.0, color, Some(color));
+    }
+    // Rings over the dots, so that a joint at a centre of mass shows both.
+    for (i, origin) in pose.origins.iter().enumerate() {
+        let r = if skeleton.moving[i] { 5.5 } else { 3.0 };
+        svg.circle(&format!("{role}-joint"), frame.px(origin), r, color, None);
     }
 }
 
@@ -198,11 +200,13 @@ fn draw_panel(svg: &mut Svg, shapes: &ModeShapes, figure: &ModeFigure, x: f64, y
         draw_pose(svg, skeleton, moved, &frame, color_of(figure.kind), "mode");
     }
     let bottom = y + PANEL_H - CAPTION_H;
-    draw_triad(svg, &view, (x + 30.0, bottom - 8.0));
+    draw_triad(svg, &view, (x + 36.0, bottom - 30.0));
     draw_scale_bar(svg, &frame, (x + PANEL_W - 16.0, bottom - 6.0));
-    for (k, line) in caption(skeleton, figure).iter().enumerate() {
-        let at = (x + 10.0, bottom + 14.0 + 15.0 * k as f64);
-        svg.text("caption", at, line, fitted_size(line, room, 11.0), Anchor::Start);
+    let lines = caption(skeleton, figure);
+    let size = lines.iter().map(|l| fitted_size(l, room, 11.0)).fold(11.0, f64::min);
+    for (k, line) in lines.iter().enumerate() {
+        let at = (x + 10.0, bottom + 13.0 + 14.0 * k as f64);
+        svg.text("caption", at, line, size, Anchor::Start);
     }
     svg.close_group();
 }
@@ -214,18 +218,23 @@ fn caption(skeleton: &Skeleton, figure: &ModeFigure) -> Vec<String> {
         let why = figure.note.as_deref().unwrap_or("no displaced shape");
         return vec![format!("rest pose only: {why}")];
     }
-    vec![
+    let mut lines = vec![
         format!(
-            "drawn at q₀ + s·x with s = {} (A-normalised x, exact kinematics): the largest",
+            "colour: the exact pose at q₀ + s·x with s = {} (x A-normalised)",
             n(figure.amplitude)
         ),
         format!(
-            "displacement is {} m, {} % of the mechanism's {} m extent",
+            "largest displacement {} m = {} % of the mechanism's {} m extent",
             n(figure.largest),
             n(100.0 * figure.largest / skeleton.extent),
             n(skeleton.extent)
         ),
-    ]
+    ];
+    if let Some(body) = figure.turned_most.and_then(|b| skeleton.names.get(b)) {
+        let limit = crate::mode_shape::MAX_ROTATION;
+        lines.push(format!("(s smaller: it keeps the turn of \"{body}\" to {limit} rad)"));
+    }
+    lines
 }
 
 /// The header: what the colours and marks mean.
@@ -235,10 +244,10 @@ fn draw_header(svg: &mut Svg) {
     let y = 44.0;
     let mut x = 14.0;
     let ink = Color(80, 80, 80);
-    svg.circle("legend", (x, y - 4.0), 4.5, ink, Some(Color(255, 255, 255)));
+    svg.circle("legend", (x, y - 4.0), 5.5, ink, None);
     svg.text("legend-label", (x + 10.0, y), "joint (body origin)", 12.0, Anchor::Start);
     x += 150.0;
-    svg.circle("legend", (x, y - 4.0), 3.5, ink, Some(ink));
+    svg.circle("legend", (x, y - 4.0), 3.0, ink, Some(ink));
     svg.text("legend-label", (x + 10.0, y), "centre of mass", 12.0, Anchor::Start);
     x += 130.0;
     draw_ground(svg, (x + 12.0, y - 6.0));
@@ -267,4 +276,78 @@ pub fn render(shapes: &ModeShapes) -> String {
 /// Writes [`render`] to `path`.
 pub fn write(shapes: &ModeShapes, path: &Path) -> Result<(), String> {
     std::fs::write(path, render(shapes)).map_err(|e| format!("plot {}: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A chain of bodies at `rest` (their origins and centres of mass the same points) hung from
+    /// the ground, displaced by `shift` per body index.
+    fn chain(rest: &[Vector3<f64>], shift: Vector3<f64>) -> (Skeleton, ModeFigure) {
+        let pose = |d: Vector3<f64>| Pose {
+            origins: rest.iter().enumerate().map(|(i, p)| p + d * i as f64).collect(),
+            centres: rest.iter().enumerate().map(|(i, p)| Some(p + d * i as f64)).collect(),
+        };
+        let skeleton = Skeleton {
+            names: (0..rest.len()).map(|i| format!("b{i}")).collect(),
+            parents: (0..rest.len()).map(|i| i.checked_sub(1)).collect(),
+            moving: vec![true; rest.len()],
+            base: Vector3::zeros(),
+            up: Vector3::z(),
+            rest: pose(Vector3::zeros()),
+            extent: 1.0,
+        };
+        let figure = ModeFigure {
+            number: 1,
+            kind: ModeKindName::Oscillatory,
+            heading: [String::new(), String::new()],
+            displaced: Some(pose(shift)),
+            amplitude: 1.0,
+            largest: shift.norm() * rest.len() as f64,
+            turned_most: None,
+            note: None,
+        };
+        (skeleton, figure)
+    }
+
+    fn along(v: &Vector3<f64>, axis: Vector3<f64>) -> bool {
+        (v.dot(&axis).abs() - 1.0).abs() < 1e-9
+    }
+
+    /// A chain hanging along −z and swinging along y is seen in the yz plane, up = z; a chain
+    /// zigzagging along x that bends vertically (a horizontal beam) nearly in the xz plane,
+    /// though its rest pose also spreads along y.
+    #[test]
+    fn the_view_shows_the_plane_of_the_motion_with_up_upwards() {
+        let hanging: Vec<Vector3<f64>> = (1..5).map(|i| Vector3::new(0.0, 0.0, -0.3 * i as f64)).collect();
+        let (skeleton, figure) = chain(&hanging, Vector3::new(0.0, 0.05, 0.0));
+        let view = view_of(&skeleton, &figure);
+        assert!(along(&view.up, Vector3::z()) && view.up.z > 0.0, "{view:?}");
+        assert!(along(&view.right, Vector3::y()), "{view:?}");
+        let beam: Vec<Vector3<f64>> = (1..6).map(|i| Vector3::new(0.4 * i as f64, 0.1 * (i % 2) as f64, 0.0)).collect();
+        let (skeleton, figure) = chain(&beam, Vector3::new(0.0, 0.0, -0.03));
+        let view = view_of(&skeleton, &figure);
+        assert!(along(&view.up, Vector3::z()) && view.up.z > 0.0, "{view:?}");
+        // The zigzag's x–y correlation tilts the least-spread direction slightly off y.
+        assert!(view.right.x.abs() > 0.999 && view.right.z == 0.0, "{view:?}");
+    }
+
+    /// Every drawn point lands inside the panel's box, whatever the scale of the mechanism.
+    #[test]
+    fn frames_fit_points_into_their_box() {
+        for scale in [1e-6, 1.0, 1e5] {
+            let points: Vec<Vector3<f64>> =
+                (0..7).map(|i| Vector3::new((i as f64).sin(), (i as f64).cos(), 0.1 * i as f64) * scale).collect();
+            let view = View {
+                right: Vector3::x(),
+                up: Vector3::z(),
+            };
+            let frame = Frame::fitted(view, &points, 10.0, 20.0, 300.0, 200.0);
+            for p in &points {
+                let (x, y) = frame.px(p);
+                assert!((10.0 - 1e-9..=310.0 + 1e-9).contains(&x) && (20.0 - 1e-9..=220.0 + 1e-9).contains(&y));
+            }
+        }
+    }
 }

@@ -237,8 +237,9 @@ mod tests {
         svg.text("t", (1.0, 2.0), "a < b & c", 12.0, Anchor::Start);
         let out = svg.finish();
         assert!(out.contains(">a &lt; b &amp; c</text>"), "{out}");
-        let size = fitted_size(&"x".repeat(100), 300.0, 14.0);
-        assert!(text_width(&"x".repeat(100), size) <= 300.0 + 1e-9 && size < 14.0);
+        let size = fitted_size(&"x".repeat(60), 300.0, 14.0);
+        assert!(text_width(&"x".repeat(60), size) <= 300.0 + 1e-9 && size < 14.0);
+        assert_eq!(fitted_size(&"x".repeat(100), 300.0, 14.0), 7.0, "no smaller than 7 px");
         assert_eq!(fitted_size("short", 300.0, 14.0), 14.0);
     }
 }
