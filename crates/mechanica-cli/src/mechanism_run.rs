@@ -442,7 +442,8 @@ fn response_step(
         let response =
             FreeResponse::new(&problem, &modes.solution, delta0, v0).map_err(|e| format!("analyses.response: {e}"))?;
         let duration = *spec.duration.get_ref();
-        let (series, end) = sample_response(&response, duration, *spec.samples.get_ref(), n)?;
+        let (mut series, end) = sample_response(&response, duration, *spec.samples.get_ref(), n)?;
+        series.names = names.to_vec();
         let fit = response.fit();
         let end_bound = response.error_bound(duration).map_err(|e| e.to_string())?;
         let record = ResponseRecord {
@@ -472,6 +473,7 @@ fn sample_response(
             .map_err(|_| format!("analyses.response.samples: cannot allocate {samples} samples"))
     };
     let mut series = ResponseSeries {
+        names: Vec::new(),
         times: Vec::new(),
         values: vec![Vec::new(); n],
     };

@@ -177,7 +177,7 @@ fn draw_scale_bar(svg: &mut Svg, frame: &Frame, right_end: (f64, f64)) {
     let left = (right_end.0 - pixels, right_end.1);
     svg.line("scale-bar", left, right_end, ink, 2.0, false);
     let label = format!("{} m", tick_label(length, length));
-    svg.text("scale-label", (right_end.0 - 0.5 * pixels, right_end.1 - 5.0), &label, 11.0, Anchor::Middle);
+    svg.text("scale-label", (right_end.0 - 0.5 * pixels, right_end.1 + 13.0), &label, 11.0, Anchor::Middle);
 }
 
 /// One panel at (`x`, `y`).
@@ -201,7 +201,7 @@ fn draw_panel(svg: &mut Svg, shapes: &ModeShapes, figure: &ModeFigure, x: f64, y
     }
     let bottom = y + PANEL_H - CAPTION_H;
     draw_triad(svg, &view, (x + 36.0, bottom - 30.0));
-    draw_scale_bar(svg, &frame, (x + PANEL_W - 16.0, bottom - 6.0));
+    draw_scale_bar(svg, &frame, (x + PANEL_W - 16.0, bottom - 16.0));
     let lines = caption(skeleton, figure);
     let size = lines.iter().map(|l| fitted_size(l, room, 11.0)).fold(11.0, f64::min);
     for (k, line) in lines.iter().enumerate() {

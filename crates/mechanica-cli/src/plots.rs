@@ -9,6 +9,8 @@ use std::path::{Path, PathBuf};
 /// Sampled free response: one series per coordinate.
 #[derive(Debug, Clone)]
 pub struct ResponseSeries {
+    /// The coordinates' names.
+    pub names: Vec<String>,
     /// Sample times, s.
     pub times: Vec<f64>,
     /// `values[k][i]` = δ_k(t_i).
@@ -102,7 +104,7 @@ impl PlotData {
             chart
                 .configure_mesh()
                 .x_desc("t (s)")
-                .y_desc("δ")
+                .y_desc("δ (rad | m)")
                 .draw()
                 .map_err(failed)?;
             for (k, series) in response.values.iter().enumerate() {
@@ -113,7 +115,7 @@ impl PlotData {
                         &color,
                     ))
                     .map_err(failed)?
-                    .label(format!("q{k}"))
+                    .label(response.names.get(k).cloned().unwrap_or_else(|| format!("q[{k}]")))
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], Palette99::pick(k)));
             }
             chart
