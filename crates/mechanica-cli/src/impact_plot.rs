@@ -24,16 +24,38 @@ fn y_of(t: f64, top: f64) -> f64 {
 
 /// The energy axis: ticks, grid lines and the axis title; returns the axis top (J).
 fn draw_axis(svg: &mut Svg, largest: f64) -> f64 {
-    let largest = if largest > 0.0 && largest.is_finite() { largest } else { 1.0 };
+    let largest = if largest > 0.0 && largest.is_finite() {
+        largest
+    } else {
+        1.0
+    };
     let (values, step) = ticks(0.0, 1.12 * largest, 5);
-    let top = values.last().copied().filter(|t| *t >= largest).unwrap_or(1.12 * largest).max(1.12 * largest);
+    let top = values
+        .last()
+        .copied()
+        .filter(|t| *t >= largest)
+        .unwrap_or(1.12 * largest)
+        .max(1.12 * largest);
     for v in &values {
         let y = y_of(*v, top);
         svg.line("grid", (LEFT, y), (WIDTH - RIGHT, y), Color(225, 225, 225), 1.0, false);
-        svg.text("tick-label", (LEFT - 8.0, y + 4.0), &tick_label(*v, step), 12.0, Anchor::End);
+        svg.text(
+            "tick-label",
+            (LEFT - 8.0, y + 4.0),
+            &tick_label(*v, step),
+            12.0,
+            Anchor::End,
+        );
     }
     svg.line("axis", (LEFT, TOP), (LEFT, HEIGHT - BOTTOM), INK, 1.0, false);
-    svg.line("axis", (LEFT, HEIGHT - BOTTOM), (WIDTH - RIGHT, HEIGHT - BOTTOM), INK, 1.0, false);
+    svg.line(
+        "axis",
+        (LEFT, HEIGHT - BOTTOM),
+        (WIDTH - RIGHT, HEIGHT - BOTTOM),
+        INK,
+        1.0,
+        false,
+    );
     let middle = 0.5 * (TOP + HEIGHT - BOTTOM);
     svg.vertical_text("axis-title", (22.0, middle), "kinetic energy T (J)", 13.0);
     svg.text(
@@ -65,13 +87,28 @@ fn draw_law(svg: &mut Svg, law: &(String, f64, f64), chosen: bool, x: f64, w: f6
     let base = HEIGHT - BOTTOM;
     let x_before = x + 0.5 * w - bar - 3.0;
     let x_after = x + 0.5 * w + 3.0;
-    svg.rect("bar-before", (x_before, y_of(before, top)), (x_before + bar, base), BEFORE);
+    svg.rect(
+        "bar-before",
+        (x_before, y_of(before, top)),
+        (x_before + bar, base),
+        BEFORE,
+    );
     let color = if after > before { GAIN } else { AFTER };
     svg.rect("bar-after", (x_after, y_of(after, top)), (x_after + bar, base), color);
     let change = change_label(before, after);
     let y = y_of(after.max(before), top) - 8.0;
-    svg.text("change-label", (x + 0.5 * w, y), &change, fitted_size(&change, w, 12.0), Anchor::Middle);
-    let label = if chosen { format!("{name} (the scene's law)") } else { name.to_string() };
+    svg.text(
+        "change-label",
+        (x + 0.5 * w, y),
+        &change,
+        fitted_size(&change, w, 12.0),
+        Anchor::Middle,
+    );
+    let label = if chosen {
+        format!("{name} (the scene's law)")
+    } else {
+        name.to_string()
+    };
     svg.text(
         "law-label",
         (x + 0.5 * w, base + 20.0),
@@ -103,7 +140,13 @@ pub fn render(balance: &EnergyBalance) -> String {
         "impact of body \"{}\" on the ground: kinetic energy before and after, per restitution law",
         balance.body
     );
-    svg.text("title", (12.0, 26.0), &title, fitted_size(&title, WIDTH - 24.0, 16.0), Anchor::Start);
+    svg.text(
+        "title",
+        (12.0, 26.0),
+        &title,
+        fitted_size(&title, WIDTH - 24.0, 16.0),
+        Anchor::Start,
+    );
     let largest = balance.laws.iter().flat_map(|l| [l.1, l.2]).fold(0.0, f64::max);
     let top = draw_axis(&mut svg, largest);
     let n = balance.laws.len().max(1) as f64;

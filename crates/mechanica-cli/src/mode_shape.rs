@@ -125,7 +125,11 @@ pub fn skeleton(
         base,
         up,
         rest,
-        extent: if extent > 0.0 && extent.is_finite() { extent } else { 1.0 },
+        extent: if extent > 0.0 && extent.is_finite() {
+            extent
+        } else {
+            1.0
+        },
     })
 }
 
@@ -142,7 +146,9 @@ fn linear_motion(
     let n = tree.dof();
     let mut jacobian = vec![0.0; 3 * n];
     let times_x = |j: &[f64]| -> f64 {
-        let v: Vector3<f64> = (0..n).map(|k| Vector3::new(j[3 * k], j[3 * k + 1], j[3 * k + 2]) * x[k]).sum();
+        let v: Vector3<f64> = (0..n)
+            .map(|k| Vector3::new(j[3 * k], j[3 * k + 1], j[3 * k + 2]) * x[k])
+            .sum();
         v.norm()
     };
     let (mut displacement, mut rotation) = (0.0f64, (0.0f64, 0));
@@ -152,10 +158,12 @@ fn linear_motion(
             points.push(body.p_oc);
         }
         for p in &points {
-            tree.point_jacobian(&ws, i, p, &mut jacobian).map_err(|e| e.to_string())?;
+            tree.point_jacobian(&ws, i, p, &mut jacobian)
+                .map_err(|e| e.to_string())?;
             displacement = displacement.max(times_x(&jacobian));
         }
-        tree.angular_jacobian(&ws, i, &mut jacobian).map_err(|e| e.to_string())?;
+        tree.angular_jacobian(&ws, i, &mut jacobian)
+            .map_err(|e| e.to_string())?;
         let turn = times_x(&jacobian);
         if turn > rotation.0 {
             rotation = (turn, i);
@@ -213,7 +221,7 @@ fn displaced_pose(
         return Err("no finite shape vector for this mode".into());
     }
     let (displacement, (rotation, turning)) = linear_motion(tree, bodies, q, x)?;
-    if !(displacement > 0.0) {
+    if displacement.is_nan() || displacement <= 0.0 {
         return Err("this mode moves none of the drawn points".into());
     }
     let by_displacement = DISPLACEMENT_FRACTION * skeleton.extent / displacement;
@@ -281,7 +289,11 @@ pub fn heading(number: usize, record: &ModeRecord) -> [String; 2] {
             let gamma = record.growth_rate.unwrap_or(f64::NAN);
             interval_text([gamma, lo, hi], "1/s", "growth rate γ")
         }
-        ModeKindName::Zero => format!("rigid-body motion: ω² = {} ± {} rad²/s²", short(w2), short(record.bound)),
+        ModeKindName::Zero => format!(
+            "rigid-body motion: ω² = {} ± {} rad²/s²",
+            short(w2),
+            short(record.bound)
+        ),
         ModeKindName::Undecided => format!(
             "ω² = {} ± {} rad²/s²: the interval contains 0",
             short(w2),

@@ -78,7 +78,10 @@ fn view_of(skeleton: &Skeleton, figure: &ModeFigure) -> View {
         eigen.eigenvectors.column(largest).into_owned()
     };
     let mut right = up.cross(&normal);
-    let dominant = right.iter().copied().fold(0.0f64, |a, v| if v.abs() > a.abs() { v } else { a });
+    let dominant = right
+        .iter()
+        .copied()
+        .fold(0.0f64, |a, v| if v.abs() > a.abs() { v } else { a });
     if dominant < 0.0 {
         right = -right;
     }
@@ -103,7 +106,11 @@ impl Frame {
         });
         let (dx, dy) = (hi.0 - lo.0, hi.1 - lo.1);
         let size = dx.max(dy);
-        let scale = if size > 0.0 { (w / dx.max(1e-9 * size)).min(h / dy.max(1e-9 * size)) } else { 1.0 };
+        let scale = if size > 0.0 {
+            (w / dx.max(1e-9 * size)).min(h / dy.max(1e-9 * size))
+        } else {
+            1.0
+        };
         Frame {
             view,
             scale,
@@ -126,7 +133,14 @@ fn draw_pose(svg: &mut Svg, skeleton: &Skeleton, pose: &Pose, frame: &Frame, col
     let width = if role == "rest" { 2.5 } else { 2.0 };
     for (i, origin) in pose.origins.iter().enumerate() {
         let from = skeleton.parents[i].map_or(&skeleton.base, |p| &pose.origins[p]);
-        svg.line(&format!("{role}-link"), frame.px(from), frame.px(origin), color, width, false);
+        svg.line(
+            &format!("{role}-link"),
+            frame.px(from),
+            frame.px(origin),
+            color,
+            width,
+            false,
+        );
     }
     for (origin, centre) in pose.origins.iter().zip(&pose.centres) {
         if let Some(c) = centre {
@@ -163,7 +177,13 @@ fn draw_triad(svg: &mut Svg, view: &View, at: (f64, f64)) {
         }
         let tip = (at.0 + 22.0 * a, at.1 - 22.0 * b);
         svg.line("axis", at, tip, ink, 1.2, false);
-        svg.text("axis-label", (tip.0 + 6.0 * a, tip.1 - 6.0 * b + 4.0), name, 11.0, Anchor::Middle);
+        svg.text(
+            "axis-label",
+            (tip.0 + 6.0 * a, tip.1 - 6.0 * b + 4.0),
+            name,
+            11.0,
+            Anchor::Middle,
+        );
     }
 }
 
@@ -177,7 +197,13 @@ fn draw_scale_bar(svg: &mut Svg, frame: &Frame, right_end: (f64, f64)) {
     let left = (right_end.0 - pixels, right_end.1);
     svg.line("scale-bar", left, right_end, ink, 2.0, false);
     let label = format!("{} m", tick_label(length, length));
-    svg.text("scale-label", (right_end.0 - 0.5 * pixels, right_end.1 + 13.0), &label, 11.0, Anchor::Middle);
+    svg.text(
+        "scale-label",
+        (right_end.0 - 0.5 * pixels, right_end.1 + 13.0),
+        &label,
+        11.0,
+        Anchor::Middle,
+    );
 }
 
 /// One panel at (`x`, `y`).
@@ -192,8 +218,20 @@ fn draw_panel(svg: &mut Svg, shapes: &ModeShapes, figure: &ModeFigure, x: f64, y
     svg.open_group("panel", &[("data-mode", &figure.number.to_string())]);
     let [first, second] = &figure.heading;
     let room = PANEL_W - 20.0;
-    svg.text("title", (x + 10.0, y + 20.0), first, fitted_size(first, room, 15.0), Anchor::Start);
-    svg.text("subtitle", (x + 10.0, y + 40.0), second, fitted_size(second, room, 12.0), Anchor::Start);
+    svg.text(
+        "title",
+        (x + 10.0, y + 20.0),
+        first,
+        fitted_size(first, room, 15.0),
+        Anchor::Start,
+    );
+    svg.text(
+        "subtitle",
+        (x + 10.0, y + 40.0),
+        second,
+        fitted_size(second, room, 12.0),
+        Anchor::Start,
+    );
     draw_ground(svg, frame.px(&skeleton.base));
     draw_pose(svg, skeleton, &skeleton.rest, &frame, REST, "rest");
     if let Some(moved) = &figure.displaced {
@@ -240,12 +278,24 @@ fn caption(skeleton: &Skeleton, figure: &ModeFigure) -> Vec<String> {
 /// The header: what the colours and marks mean.
 fn draw_header(svg: &mut Svg) {
     let title = "mode shapes: the mechanism at rest (grey) and displaced along each mode (coloured by class)";
-    svg.text("figure-title", (12.0, 22.0), title, fitted_size(title, WIDTH - 24.0, 16.0), Anchor::Start);
+    svg.text(
+        "figure-title",
+        (12.0, 22.0),
+        title,
+        fitted_size(title, WIDTH - 24.0, 16.0),
+        Anchor::Start,
+    );
     let y = 44.0;
     let mut x = 14.0;
     let ink = Color(80, 80, 80);
     svg.circle("legend", (x, y - 4.0), 5.5, ink, None);
-    svg.text("legend-label", (x + 10.0, y), "joint (body origin)", 12.0, Anchor::Start);
+    svg.text(
+        "legend-label",
+        (x + 10.0, y),
+        "joint (body origin)",
+        12.0,
+        Anchor::Start,
+    );
     x += 150.0;
     svg.circle("legend", (x, y - 4.0), 3.0, ink, Some(ink));
     svg.text("legend-label", (x + 10.0, y), "centre of mass", 12.0, Anchor::Start);
@@ -253,9 +303,18 @@ fn draw_header(svg: &mut Svg) {
     draw_ground(svg, (x + 12.0, y - 6.0));
     svg.text("legend-label", (x + 32.0, y), "ground", 12.0, Anchor::Start);
     x += 90.0;
-    for kind in [ModeKindName::Oscillatory, ModeKindName::Zero, ModeKindName::Unstable, ModeKindName::Undecided] {
+    for kind in [
+        ModeKindName::Oscillatory,
+        ModeKindName::Zero,
+        ModeKindName::Unstable,
+        ModeKindName::Undecided,
+    ] {
         svg.line("legend", (x, y - 4.0), (x + 18.0, y - 4.0), color_of(kind), 3.0, false);
-        let name = if kind == ModeKindName::Undecided { "undecided / infinite" } else { kind.as_str() };
+        let name = if kind == ModeKindName::Undecided {
+            "undecided / infinite"
+        } else {
+            kind.as_str()
+        };
         svg.text("legend-label", (x + 24.0, y), name, 12.0, Anchor::Start);
         x += 34.0 + crate::svg::text_width(name, 12.0);
     }
@@ -325,7 +384,9 @@ mod tests {
         let view = view_of(&skeleton, &figure);
         assert!(along(&view.up, Vector3::z()) && view.up.z > 0.0, "{view:?}");
         assert!(along(&view.right, Vector3::y()), "{view:?}");
-        let beam: Vec<Vector3<f64>> = (1..6).map(|i| Vector3::new(0.4 * i as f64, 0.1 * (i % 2) as f64, 0.0)).collect();
+        let beam: Vec<Vector3<f64>> = (1..6)
+            .map(|i| Vector3::new(0.4 * i as f64, 0.1 * (i % 2) as f64, 0.0))
+            .collect();
         let (skeleton, figure) = chain(&beam, Vector3::new(0.0, 0.0, -0.03));
         let view = view_of(&skeleton, &figure);
         assert!(along(&view.up, Vector3::z()) && view.up.z > 0.0, "{view:?}");
@@ -337,8 +398,9 @@ mod tests {
     #[test]
     fn frames_fit_points_into_their_box() {
         for scale in [1e-6, 1.0, 1e5] {
-            let points: Vec<Vector3<f64>> =
-                (0..7).map(|i| Vector3::new((i as f64).sin(), (i as f64).cos(), 0.1 * i as f64) * scale).collect();
+            let points: Vec<Vector3<f64>> = (0..7)
+                .map(|i| Vector3::new((i as f64).sin(), (i as f64).cos(), 0.1 * i as f64) * scale)
+                .collect();
             let view = View {
                 right: Vector3::x(),
                 up: Vector3::z(),

@@ -29,8 +29,13 @@ impl Element {
     }
 
     fn number(&self, key: &str) -> f64 {
-        let value = self.attributes.get(key).unwrap_or_else(|| panic!("{key} missing: {self:?}"));
-        value.parse().unwrap_or_else(|_| panic!("{key} = {value} is not a number"))
+        let value = self
+            .attributes
+            .get(key)
+            .unwrap_or_else(|| panic!("{key} missing: {self:?}"));
+        value
+            .parse()
+            .unwrap_or_else(|_| panic!("{key} = {value} is not a number"))
     }
 
     /// The element's centre (circle) or first point (line, text, rect).
@@ -99,7 +104,10 @@ impl Drawing {
         }
         let root = elements.first().expect("an svg element");
         assert_eq!(root.name, "svg");
-        let view: Vec<f64> = root.attributes["viewBox"].split(' ').map(|v| v.parse().expect("viewBox")).collect();
+        let view: Vec<f64> = root.attributes["viewBox"]
+            .split(' ')
+            .map(|v| v.parse().expect("viewBox"))
+            .collect();
         assert_eq!(view[..2], [0.0, 0.0]);
         Drawing {
             width: view[2],
@@ -184,8 +192,19 @@ modes = {{}}
 /// tip follows from the drawn elbow by exact kinematics, to the drawing's rounding.
 fn check_pendulum_panel(drawing: &Drawing, mode: usize, l: f64) {
     let panel = Some(mode);
-    let (sign, ratio) = if mode == 1 { (-1.0, 2f64.sqrt()) } else { (1.0, -(2f64.sqrt())) };
-    for class in ["rest-link", "mode-link", "rest-com", "mode-com", "rest-joint", "mode-joint"] {
+    let (sign, ratio) = if mode == 1 {
+        (-1.0, 2f64.sqrt())
+    } else {
+        (1.0, -(2f64.sqrt()))
+    };
+    for class in [
+        "rest-link",
+        "mode-link",
+        "rest-com",
+        "mode-com",
+        "rest-joint",
+        "mode-joint",
+    ] {
         assert_eq!(drawing.of_class(class, panel).len(), 2, "{class} in panel {mode}");
     }
     let rest = drawing.of_class("rest-com", panel);
@@ -193,7 +212,10 @@ fn check_pendulum_panel(drawing: &Drawing, mode: usize, l: f64) {
     let base = drawing.of_class("rest-link", panel)[0].at();
     let (elbow, tip) = (rest[0].at(), rest[1].at());
     let l_px = distance(elbow, base);
-    assert!(l_px > 20.0 && (distance(tip, elbow) - l_px).abs() < 0.02, "rest links {l_px}");
+    assert!(
+        l_px > 20.0 && (distance(tip, elbow) - l_px).abs() < 0.02,
+        "rest links {l_px}"
+    );
     let d = ((elbow.0 - base.0) / l_px, (elbow.1 - base.1) / l_px);
     let p = (-d.1, d.0);
     let u = (moved[0].at().0 - base.0, moved[0].at().1 - base.1);
@@ -214,7 +236,9 @@ fn check_pendulum_panel(drawing: &Drawing, mode: usize, l: f64) {
     assert!(title.contains(&format!("mode {mode} · oscillatory")), "{title}");
     let subtitle = drawing.texts("subtitle", panel).join(" ");
     let f = ((2.0 + sign * 2f64.sqrt()) * 9.81 / l).sqrt() / std::f64::consts::TAU;
-    let [_, lo, hi] = numbers_in(&subtitle)[..] else { panic!("{subtitle}") };
+    let [_, lo, hi] = numbers_in(&subtitle)[..] else {
+        panic!("{subtitle}")
+    };
     assert!(lo <= f && f <= hi, "{subtitle} does not contain the exact {f}");
     check_caption(drawing, mode, base, 2.0 * l, 2.0 * l_px);
 }
@@ -233,10 +257,21 @@ fn check_caption(drawing: &Drawing, mode: usize, base: (f64, f64), extent: f64, 
     let stated = numbers_in(&caption);
     let percent = stated.get(stated.len() - 2).copied().expect("percentage");
     let measured = 100.0 * largest / extent_px;
-    assert!((percent - measured).abs() < 0.01 * measured, "{caption}: measured {measured} %");
+    assert!(
+        (percent - measured).abs() < 0.01 * measured,
+        "{caption}: measured {measured} %"
+    );
     assert!((10.0..=15.0).contains(&percent), "{caption}");
-    assert!((stated[stated.len() - 1] - extent).abs() < 1e-3 * extent, "{caption} vs {extent}");
-    assert!(drawing.of_class("ground", panel).iter().any(|g| distance(g.at(), base) < 20.0));
+    assert!(
+        (stated[stated.len() - 1] - extent).abs() < 1e-3 * extent,
+        "{caption} vs {extent}"
+    );
+    assert!(
+        drawing
+            .of_class("ground", panel)
+            .iter()
+            .any(|g| distance(g.at(), base) < 20.0)
+    );
 }
 
 #[test]
@@ -260,7 +295,10 @@ fn double_pendulum_mode_shapes_follow_the_closed_form() {
             check_pendulum_panel(&drawing, mode, l);
         }
         let legend = drawing.texts("legend-label", None).join(" ");
-        assert!(legend.contains("centre of mass") && legend.contains("joint"), "{legend}");
+        assert!(
+            legend.contains("centre of mass") && legend.contains("joint"),
+            "{legend}"
+        );
     }
 }
 
@@ -282,10 +320,17 @@ fn impact_energy_bars_match_the_report() {
     let laws = step(&json, "impact")["laws"].as_array().expect("laws").clone();
     let drawing = Drawing::read(&plots.join("impact_energy.svg"));
     drawing.assert_inside();
-    let (before, after) = (drawing.of_class("bar-before", None), drawing.of_class("bar-after", None));
+    let (before, after) = (
+        drawing.of_class("bar-before", None),
+        drawing.of_class("bar-after", None),
+    );
     let (names, changes) = (drawing.texts("law-label", None), drawing.texts("change-label", None));
     assert_eq!(laws.len(), 3);
-    assert!([before.len(), after.len(), names.len(), changes.len()].iter().all(|&n| n == laws.len()));
+    assert!(
+        [before.len(), after.len(), names.len(), changes.len()]
+            .iter()
+            .all(|&n| n == laws.len())
+    );
     let ticks: Vec<(f64, f64)> = drawing
         .of_class("tick-label", None)
         .iter()
@@ -304,10 +349,17 @@ fn impact_energy_bars_match_the_report() {
         assert!((after[k].number("height") - per_joule * (t_before + change)).abs() < 0.05);
         let percent = numbers_in(&changes[k])[0];
         let exact = 100.0 * change / t_before;
-        assert!((percent - exact).abs() < 5e-3 * exact.abs(), "{} vs {exact}", changes[k]);
+        assert!(
+            (percent - exact).abs() < 5e-3 * exact.abs(),
+            "{} vs {exact}",
+            changes[k]
+        );
     }
     let titles = drawing.texts("axis-title", None).join(" ");
-    assert!(titles.contains("kinetic energy T (J)") && titles.contains("restitution law"), "{titles}");
+    assert!(
+        titles.contains("kinetic energy T (J)") && titles.contains("restitution law"),
+        "{titles}"
+    );
     let legend = drawing.texts("legend-label", None).join(" ");
     assert!(legend.contains("before") && legend.contains("after"), "{legend}");
 }
@@ -327,7 +379,12 @@ fn check_every_panel(drawing: &Drawing, bodies: usize, modes: usize) {
             moved == bodies || (moved == 0 && caption.starts_with("rest pose only")),
             "panel {mode}: {moved} displaced links, caption {caption}"
         );
-        assert!(drawing.texts("title", panel).join(" ").starts_with(&format!("mode {mode} · ")));
+        assert!(
+            drawing
+                .texts("title", panel)
+                .join(" ")
+                .starts_with(&format!("mode {mode} · "))
+        );
         assert_eq!(drawing.of_class("subtitle", panel).len(), 1);
     }
 }
@@ -369,8 +426,14 @@ stiffness = 3.0
     check_every_panel(&drawing, 3, 3);
     let titles = drawing.texts("title", None).join(" ");
     let subtitles = drawing.texts("subtitle", None).join(" ");
-    assert!(titles.contains("unstable") && subtitles.contains("growth rate γ"), "{titles} {subtitles}");
-    assert!(titles.contains("infinite") && subtitles.contains("massless"), "{titles} {subtitles}");
+    assert!(
+        titles.contains("unstable") && subtitles.contains("growth rate γ"),
+        "{titles} {subtitles}"
+    );
+    assert!(
+        titles.contains("infinite") && subtitles.contains("massless"),
+        "{titles} {subtitles}"
+    );
 }
 
 /// A spatial arm: a yaw joint about z, a pitch joint about y, a roll joint about x on links
