@@ -1,16 +1,16 @@
 //! `mode_shapes.svg`: each mode drawn on the mechanism, a stick figure at rest (grey) and
 //! displaced along the mode (coloured by class): body origins (the joints) as rings, smaller
-//! for fixed joints,
-//! links as lines from the parent's origin (the ground point for the root) to the body's
-//! origin, dashed arms from a body's origin to its centre of mass, drawn as a dot, and the
-//! ground marked by a hatched bar.
+//! for fixed joints; links as lines from the parent's origin (the ground point for the root)
+//! to the body's origin; dashed arms from a body's origin to its centre of mass, drawn as a
+//! dot; and the ground marked by a hatched bar.
 //!
 //! Each panel is an orthographic view chosen for its mode: the plane spanned by the two
 //! principal directions of the sum of the rest pose's spread about its mean and the second
-//! moment of the mode's displacements (each normalised by its trace), so that a planar mechanism is seen in its plane and a spatial one
-//! from where its motion shows most; one view per mode keeps six modes legible where three
-//! views each would not. The picture is turned so that "up" (against gravity) points up when
-//! it lies near the plane, and a triad shows the world axes.
+//! moment of the mode's displacements (each normalised by its trace), so that a planar
+//! mechanism is seen in its plane and a spatial one from where its motion shows most. One view
+//! per mode keeps six modes legible where three views each (front, side, top) would not. The
+//! picture is turned so that "up" (against gravity) points up when it lies near the plane, and
+//! a triad shows the world axes.
 
 use crate::mode_record::ModeKindName;
 use crate::mode_shape::{ModeFigure, ModeShapes, Pose, Skeleton};
@@ -98,7 +98,7 @@ struct Frame {
 }
 
 impl Frame {
-    /// Fits every point of `poses` and the base into the box at (`x`, `y`) of size `w` × `h`.
+    /// Fits `points` into the box at (`x`, `y`) of size `w` × `h`, one scale for both axes.
     fn fitted(view: View, points: &[Vector3<f64>], x: f64, y: f64, w: f64, h: f64) -> Frame {
         let projected = points.iter().map(|p| (p.dot(&view.right), p.dot(&view.up)));
         let (lo, hi) = projected.fold(((f64::MAX, f64::MAX), (f64::MIN, f64::MIN)), |(lo, hi), (a, b)| {

@@ -290,6 +290,7 @@ fn double_pendulum_mode_shapes_follow_the_closed_form() {
         assert!(ok, "{err}");
         let drawing = Drawing::read(&plots.join("mode_shapes.svg"));
         drawing.assert_inside();
+        assert_text_fits(&drawing, &["title", "subtitle", "caption"], 490.0);
         assert_eq!(drawing.of_class("panel", None).len(), 2);
         for mode in [1, 2] {
             check_pendulum_panel(&drawing, mode, l);
@@ -355,6 +356,7 @@ fn impact_energy_bars_match_the_report() {
             changes[k]
         );
     }
+    assert_text_fits(&drawing, &["title"], 780.0);
     let titles = drawing.texts("axis-title", None).join(" ");
     assert!(
         titles.contains("kinetic energy T (J)") && titles.contains("restitution law"),
@@ -386,6 +388,18 @@ fn check_every_panel(drawing: &Drawing, bodies: usize, modes: usize) {
                 .starts_with(&format!("mode {mode} · "))
         );
         assert_eq!(drawing.of_class("subtitle", panel).len(), 1);
+    }
+    assert_text_fits(drawing, &["title", "subtitle", "caption"], 490.0);
+}
+
+/// Every text of `classes` fits into `width` pixels at its font size, at 0.64 em a character
+/// (a DejaVu Sans digit; wider than most letters).
+fn assert_text_fits(drawing: &Drawing, classes: &[&str], width: f64) {
+    for class in classes {
+        for text in drawing.of_class(class, None) {
+            let needed = 0.64 * text.number("font-size") * text.text.chars().count() as f64;
+            assert!(needed <= width, "{class} too wide ({needed} px): {}", text.text);
+        }
     }
 }
 
