@@ -4,7 +4,7 @@
 pub(crate) mod records;
 
 use crate::mode_record::{BodyMotion, ModeRecord};
-use crate::plots::{EnergyBalance, ModeShape, PlotData, ResponseSeries};
+use crate::plots::{EnergyBalance, PlotData, ResponseSeries};
 use crate::report::{Step, timed_step};
 use crate::scene::Scene;
 use crate::scene_run::{Model, coordinate_names};
@@ -165,7 +165,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     let bodies: Vec<String> = scene.bodies.iter().map(|b| b.name.get_ref().clone()).collect();
     let (step, modes) = modes_step(&mut mechanism, &q, &locked, spec, &names, &bodies)?;
     steps.push(step);
-    record_mode_plots(&modes, plots);
+    record_mode_plots(&modes, &mechanism, &bodies, scene.gravity, plots);
     if let Some(response) = &analyses.response {
         steps.push(response_step(&modes, response.get_ref(), plots, &names)?);
     }
@@ -379,10 +379,17 @@ fn modes_record(m: &MechanismModes, names: &[String], locked: &[String], bodies:
     }
 }
 
-/// Puts the spectrum and the first six mode shapes into the plot data.
-fn record_mode_plots(modes: &MechanismModes, plots: &mut PlotData) {
-    plots.spectrum = modes
-        .solution
+/// Puts the spectrum and the first six modes drawn on the mechanism into the plot data (the
+/// mechanism is the one the modes were computed with: its tree is re-centred at `modes.q`).
+fn record_mode_plots(
+    modes: &MechanismModes,
+    mechanism: &Mechanism,
+    names: &[String],
+    gravity: Option<[f64; 3]>,
+    plots: &mut PlotData,
+) {
+    let solution = &modes.solution;
+    plots.spectrum = solution
         .modes
         .iter()
         .map(|m| crate::spectrum_plot::SpectrumPoint {
@@ -391,24 +398,23 @@ fn record_mode_plots(modes: &MechanismModes, plots: &mut PlotData) {
             kind: crate::mode_record::ModeKindName::of(m.kind).as_str().to_string(),
         })
         .collect();
-    if let Some(x) = &modes.solution.vectors {
-        plots.shapes = (0..x.ncols().min(6))
-            .map(|k| ModeShape {
-                label: mode_label(modes, k),
-                values: (0..x.nrows()).map(|r| x[(r, k)]).collect(),
-            })
-            .collect();
-    }
-}
-
-fn mode_label(modes: &MechanismModes, k: usize) -> String {
-    match modes.solution.modes[k].kind {
-        ModeKind::Oscillatory { omega } => format!("mode {} — {:.4} Hz", k + 1, omega / std::f64::consts::TAU),
-        ModeKind::Zero => format!("mode {} — zero", k + 1),
-        ModeKind::Unstable { growth_rate } => format!("mode {} — unstable, γ = {growth_rate:.4} 1/s", k + 1),
-        ModeKind::Infinite => format!("mode {} — infinite", k + 1),
-        ModeKind::Undecided => format!("mode {} — undecided (ω² ± bound contains 0)", k + 1),
-    }
+    let Some(x) = &solution.vectors else { return };
+    let (tree, bodies) = (mechanism.tree(), mechanism.bodies());
+    // Without a skeleton (forward kinematics failing at q) there is nothing to draw on.
+    let Ok(skeleton) = crate::mode_shape::skeleton(tree, bodies, names, &modes.q, gravity) else {
+        return;
+    };
+    let figures = (0..x.ncols().min(solution.modes.len()).min(6))
+        .map(|k| {
+            let shape: Vec<f64> = (0..x.nrows()).map(|r| x[(r, k)]).collect();
+            let record = ModeRecord::new(&solution.modes[k], &solution.groups, None);
+            crate::mode_shape::figure(tree, bodies, &modes.q, &skeleton, k + 1, &record, &shape)
+        })
+        .collect();
+    plots.shapes = Some(crate::mode_shape::ModeShapes {
+        skeleton,
+        modes: figures,
+    });
 }
 
 /// The free response δ(t) from the scene's initial disturbance, sampled `spec.samples` times
@@ -436,7 +442,8 @@ fn response_step(
         let response =
             FreeResponse::new(&problem, &modes.solution, delta0, v0).map_err(|e| format!("analyses.response: {e}"))?;
         let duration = *spec.duration.get_ref();
-        let (series, end) = sample_response(&response, duration, *spec.samples.get_ref(), n)?;
+        let (mut series, end) = sample_response(&response, duration, *spec.samples.get_ref(), n)?;
+        series.names = names.to_vec();
         let fit = response.fit();
         let end_bound = response.error_bound(duration).map_err(|e| e.to_string())?;
         let record = ResponseRecord {
@@ -466,6 +473,7 @@ fn sample_response(
             .map_err(|_| format!("analyses.response.samples: cannot allocate {samples} samples"))
     };
     let mut series = ResponseSeries {
+        names: Vec::new(),
         times: Vec::new(),
         values: vec![Vec::new(); n],
     };
@@ -506,7 +514,11 @@ fn impact_step(
         &format!("impact: body point on the ground, {chosen} law (7.115–7.117)"),
         || impact_record(scene, model, spec, chosen),
     )?;
-    let mut balance = EnergyBalance { laws: Vec::new() };
+    let mut balance = EnergyBalance {
+        body: spec.body.get_ref().clone(),
+        chosen: chosen.to_string(),
+        laws: Vec::new(),
+    };
     if let crate::report::Record::Impact(record) = &step.record {
         for law in &record.laws {
             let after = law.energy_before + law.energy_change;

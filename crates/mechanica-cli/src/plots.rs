@@ -1,22 +1,16 @@
-//! `--plot DIR`: SVG plots of what a scene computed — the spectrum, bar charts of the mode
-//! shapes, the free response over time, an impact's energy balance, and a simulation
-//! ([`crate::simulation_plots`]).
+//! `--plot DIR`: SVG plots of what a scene computed — the spectrum
+//! ([`crate::spectrum_plot`]), the mode shapes drawn on the mechanism
+//! ([`crate::mode_shape_plot`]), the free response over time, an impact's energy balance
+//! ([`crate::impact_plot`]), and a simulation ([`crate::simulation_plots`]).
 
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
-/// One mode shape for a bar chart.
-#[derive(Debug, Clone)]
-pub struct ModeShape {
-    /// Title, e.g. "mode 1 — 0.52 Hz".
-    pub label: String,
-    /// Entries per coordinate.
-    pub values: Vec<f64>,
-}
-
 /// Sampled free response: one series per coordinate.
 #[derive(Debug, Clone)]
 pub struct ResponseSeries {
+    /// The coordinates' names.
+    pub names: Vec<String>,
     /// Sample times, s.
     pub times: Vec<f64>,
     /// `values[k][i]` = δ_k(t_i).
@@ -26,7 +20,11 @@ pub struct ResponseSeries {
 /// Kinetic energy before and after an impact, per restitution law.
 #[derive(Debug, Clone)]
 pub struct EnergyBalance {
-    /// (law, T before, T after).
+    /// The body that strikes the ground.
+    pub body: String,
+    /// The scene's restitution law.
+    pub chosen: String,
+    /// (law, T before, T after), J.
     pub laws: Vec<(String, f64, f64)>,
 }
 
@@ -52,8 +50,8 @@ pub struct SimulationSeries {
 pub struct PlotData {
     /// Every mode with its bound and class.
     pub spectrum: Vec<crate::spectrum_plot::SpectrumPoint>,
-    /// The first mode shapes.
-    pub shapes: Vec<ModeShape>,
+    /// The first modes drawn on the mechanism.
+    pub shapes: Option<crate::mode_shape::ModeShapes>,
     /// The free response.
     pub response: Option<ResponseSeries>,
     /// The impact energy balance.
@@ -74,39 +72,6 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// A bar chart of `values` into `area`.
-fn bars(
-    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
-    title: &str,
-    y_label: &str,
-    values: &[(f64, RGBColor)],
-) -> Result<(), String> {
-    let (lo, hi) = range(values.iter().map(|v| v.0));
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 16))
-        .margin(8)
-        .x_label_area_size(28)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0f64..values.len() as f64, lo..hi)
-        .map_err(failed)?;
-    chart
-        .configure_mesh()
-        .y_desc(y_label)
-        .x_desc("index")
-        .draw()
-        .map_err(failed)?;
-    chart
-        .draw_series(
-            values
-                .iter()
-                .enumerate()
-                .filter(|(_, v)| v.0.is_finite())
-                .map(|(i, (v, color))| Rectangle::new([(i as f64 + 0.15, 0.0), (i as f64 + 0.85, *v)], color.filled())),
-        )
-        .map_err(failed)?;
-    Ok(())
-}
-
 impl PlotData {
     /// Writes the SVGs of whatever was computed into `dir` (created if needed); returns the
     /// files written.
@@ -118,18 +83,10 @@ impl PlotData {
             crate::spectrum_plot::write(&self.spectrum, &path)?;
             written.push(path);
         }
-        if !self.shapes.is_empty() {
+        if let Some(shapes) = &self.shapes {
             let path = dir.join("mode_shapes.svg");
-            let rows = self.shapes.len().div_ceil(2);
-            let root = SVGBackend::new(&path, (1000, 300 * rows as u32)).into_drawing_area();
-            root.fill(&WHITE).map_err(failed)?;
-            let areas = root.split_evenly((rows, 2));
-            for (shape, area) in self.shapes.iter().zip(&areas) {
-                let values: Vec<(f64, RGBColor)> = shape.values.iter().map(|&v| (v, BLUE)).collect();
-                bars(area, &shape.label, "q", &values)?;
-            }
-            root.present().map_err(failed)?;
-            written.push(path.clone());
+            crate::mode_shape_plot::write(shapes, &path)?;
+            written.push(path);
         }
         if let Some(response) = &self.response {
             let path = dir.join("response.svg");
@@ -147,7 +104,7 @@ impl PlotData {
             chart
                 .configure_mesh()
                 .x_desc("t (s)")
-                .y_desc("δ")
+                .y_desc("δ (rad | m)")
                 .draw()
                 .map_err(failed)?;
             for (k, series) in response.values.iter().enumerate() {
@@ -158,7 +115,7 @@ impl PlotData {
                         &color,
                     ))
                     .map_err(failed)?
-                    .label(format!("q{k}"))
+                    .label(response.names.get(k).cloned().unwrap_or_else(|| format!("q[{k}]")))
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], Palette99::pick(k)));
             }
             chart
@@ -171,25 +128,8 @@ impl PlotData {
         }
         if let Some(impact) = &self.impact {
             let path = dir.join("impact_energy.svg");
-            let root = SVGBackend::new(&path, (800, 480)).into_drawing_area();
-            root.fill(&WHITE).map_err(failed)?;
-            let mut values = Vec::new();
-            for (_, before, after) in &impact.laws {
-                values.push((*before, BLUE));
-                values.push((*after, if after > before { RED } else { GREEN }));
-            }
-            let names: Vec<&str> = impact.laws.iter().map(|l| l.0.as_str()).collect();
-            bars(
-                &root,
-                &format!(
-                    "impact: kinetic energy before (blue) / after, laws {}",
-                    names.join(", ")
-                ),
-                "J",
-                &values,
-            )?;
-            root.present().map_err(failed)?;
-            written.push(path.clone());
+            crate::impact_plot::write(impact, &path)?;
+            written.push(path);
         }
         if let Some(simulation) = &self.simulation {
             written.extend(crate::simulation_plots::write(simulation, dir)?);
