@@ -269,6 +269,33 @@ pub unsafe extern "C" fn mech_simulation_advance(
     })
 }
 
+/// Sets the most steps each run of the simulation may take, counted from t = 0 with the steps
+/// already taken: the main integration and, with `estimate_error`, its companion (the default
+/// is 100 000 000 each). An advance that needs more stops at the last good state with
+/// MECH_STATUS_NOT_CONVERGED (mech_last_error says "more than N steps"), so the limit bounds
+/// the work of every later mech_simulation_advance whatever its target time; raising it lets
+/// the integration go on from there.
+///
+/// Errors: MECH_STATUS_INVALID_ARGUMENT for `max_steps` = 0.
+///
+/// # Safety
+/// `simulation` must be a live handle not used by another thread during the call.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_simulation_set_max_steps(
+    simulation: *mut mech_simulation_t,
+    max_steps: u64,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let s = unsafe { mech_simulation_t::borrow_mut(simulation, "simulation") }?;
+        if max_steps == 0 {
+            return Err(FfiError::new(MECH_STATUS_INVALID_ARGUMENT, "max_steps must be ≥ 1, got 0"));
+        }
+        s.stepper.set_max_steps(usize::try_from(max_steps).unwrap_or(usize::MAX));
+        Ok(())
+    })
+}
+
 /// Writes the report of the last successful advance (or of the initial state) to
 /// `*report_out`: time, H, the global error estimates and the energy monitor.
 ///
