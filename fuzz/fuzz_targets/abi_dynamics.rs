@@ -132,12 +132,20 @@ fn add_constraint(d: &OwnedDynamics, loads: &mut Loads, input: &mut Input) {
             let (pa, pb) = (vec_or(input, 1.0), vec_or(input, 1.0));
             let count = input.below(5);
             let directions: Vec<mech_vec3_t> = (0..count.max(1)).map(|_| vec_or(input, 1.0)).collect();
-            let pointer = if input.u8() < 250 { directions.as_ptr() } else { std::ptr::null() };
+            let pointer = if input.u8() < 250 {
+                directions.as_ptr()
+            } else {
+                std::ptr::null()
+            };
             trace!("add_point_constraint({a}, {pa:?}, {b}, {pb:?}, {directions:?}, {count})");
             let status = unsafe {
                 mech_dynamics_add_point_constraint(d.handle, a, pa, b, pb, pointer, count.min(directions.len()), out)
             };
-            ("mech_dynamics_add_point_constraint", status, count.min(directions.len()))
+            (
+                "mech_dynamics_add_point_constraint",
+                status,
+                count.min(directions.len()),
+            )
         }
         1 => {
             let b = body(input);
@@ -253,12 +261,33 @@ fn forward(d: &OwnedDynamics, input: &mut Input) {
     let (h, bad) = handle_for(d, input, &mut storage);
     let mut q_ddot = sentinel_doubles(len);
     let mut report = Sentinel::<mech_forward_report_t>::new();
-    let report_ptr = if with_report { report.ptr() } else { std::ptr::null_mut() };
+    let report_ptr = if with_report {
+        report.ptr()
+    } else {
+        std::ptr::null_mut()
+    };
     trace!("forward(crba {crba}, q {q:?}, q̇ {q_dot:?}, τ {tau:?}, t {t:e}, n {len})");
-    let call = if crba { "mech_dynamics_forward_crba" } else { "mech_dynamics_forward" };
+    let call = if crba {
+        "mech_dynamics_forward_crba"
+    } else {
+        "mech_dynamics_forward"
+    };
     let status = unsafe {
-        let f = if crba { mech_dynamics_forward_crba } else { mech_dynamics_forward };
-        f(h, q.as_ptr(), q_dot.as_ptr(), tau.as_ptr(), t, len, q_ddot.as_mut_ptr(), report_ptr)
+        let f = if crba {
+            mech_dynamics_forward_crba
+        } else {
+            mech_dynamics_forward
+        };
+        f(
+            h,
+            q.as_ptr(),
+            q_dot.as_ptr(),
+            tau.as_ptr(),
+            t,
+            len,
+            q_ddot.as_mut_ptr(),
+            report_ptr,
+        )
     };
     let r = report.value;
     let mut written = q_ddot.clone();
@@ -329,19 +358,14 @@ fn inverse_and_reactions(d: &OwnedDynamics, input: &mut Input) {
     trace!("inverse(q {q:?}, q̇ {q_dot:?}, q̈ {q_ddot:?})");
     inverse(d, &q, &q_dot, &q_ddot, 0.0);
     let mut a = sentinel_doubles(n);
-    let status = unsafe {
-        mech_dynamics_aba(
-            d.handle,
-            q.as_ptr(),
-            q_dot.as_ptr(),
-            q_ddot.as_ptr(),
-            n,
-            a.as_mut_ptr(),
-        )
-    };
+    let status = unsafe { mech_dynamics_aba(d.handle, q.as_ptr(), q_dot.as_ptr(), q_ddot.as_ptr(), n, a.as_mut_ptr()) };
     check_call("mech_dynamics_aba", status, doubles_untouched(&a), &a);
     let frame = input.enum_i32(3);
-    let bodies = if input.u8() < 240 { d.bodies } else { input.below(d.bodies + 2) };
+    let bodies = if input.u8() < 240 {
+        d.bodies
+    } else {
+        input.below(d.bodies + 2)
+    };
     let mut wrenches = sentinel_doubles(6 * bodies);
     let status = unsafe {
         mech_dynamics_reactions(
@@ -362,7 +386,10 @@ fn inverse_and_reactions(d: &OwnedDynamics, input: &mut Input) {
         &wrenches,
     );
     if bodies != d.bodies || !(0..3).contains(&frame) {
-        assert_ne!(status, MECH_STATUS_OK, "mech_dynamics_reactions: accepted {bodies} bodies, frame {frame}");
+        assert_ne!(
+            status, MECH_STATUS_OK,
+            "mech_dynamics_reactions: accepted {bodies} bodies, frame {frame}"
+        );
     }
 }
 
@@ -394,7 +421,11 @@ fn forward_constrained(d: &OwnedDynamics, loads: &Loads, input: &mut Input) {
     let q = state_vector(input, n, 3.0);
     let q_dot = state_vector(input, n, 3.0);
     let tau = graded_vector(input, n);
-    let m = if input.u8() < 240 { loads.equations } else { input.below(loads.equations + 2) };
+    let m = if input.u8() < 240 {
+        loads.equations
+    } else {
+        input.below(loads.equations + 2)
+    };
     let mut q_ddot = sentinel_doubles(n);
     let mut multipliers = sentinel_doubles(m);
     let mut report = Sentinel::<mech_constrained_report_t>::new();
@@ -436,7 +467,17 @@ fn damped_modes(d: &OwnedDynamics, input: &mut Input) {
     let n = d.dof;
     let q0 = state_vector(input, n, 2.0);
     let mut count = Sentinel::<usize>::new();
-    let status = unsafe { mech_dynamics_damped_modes(d.handle, q0.as_ptr(), n, 0, std::ptr::null_mut(), count.ptr(), std::ptr::null_mut()) };
+    let status = unsafe {
+        mech_dynamics_damped_modes(
+            d.handle,
+            q0.as_ptr(),
+            n,
+            0,
+            std::ptr::null_mut(),
+            count.ptr(),
+            std::ptr::null_mut(),
+        )
+    };
     trace!("damped_modes(q0 {q0:?}): query status {status}");
     let untouched = count.untouched() || status == MECH_STATUS_BUFFER_TOO_SMALL;
     check_call("mech_dynamics_damped_modes (query)", status, untouched, &[]);
@@ -458,7 +499,15 @@ fn damped_modes(d: &OwnedDynamics, input: &mut Input) {
     let mut written = Sentinel::<usize>::new();
     let mut gradient = Sentinel::<f64>::new();
     let status = unsafe {
-        mech_dynamics_damped_modes(d.handle, q0.as_ptr(), n, capacity, modes.as_mut_ptr(), written.ptr(), gradient.ptr())
+        mech_dynamics_damped_modes(
+            d.handle,
+            q0.as_ptr(),
+            n,
+            capacity,
+            modes.as_mut_ptr(),
+            written.ptr(),
+            gradient.ptr(),
+        )
     };
     // The same call again: the count must be the one the query gave, whatever the capacity.
     if status == MECH_STATUS_BUFFER_TOO_SMALL || (status == MECH_STATUS_OK && capacity < needed) {
@@ -466,15 +515,29 @@ fn damped_modes(d: &OwnedDynamics, input: &mut Input) {
             written.value, needed,
             "damped modes: the count changed between calls (capacity {capacity}, status {status})"
         );
-        assert!(capacity < needed, "damped modes: BUFFER_TOO_SMALL for capacity {capacity} ≥ {needed}");
+        assert!(
+            capacity < needed,
+            "damped modes: BUFFER_TOO_SMALL for capacity {capacity} ≥ {needed}"
+        );
         return;
     }
     let mut numbers = vec![gradient.value];
     for m in &modes {
         numbers.extend([m.natural_frequency, m.damped_frequency, m.damping_ratio]);
-        numbers.extend(m.s_re.iter().chain(&m.s_im).chain(&m.error_bound).chain(&m.backward_error));
+        numbers.extend(
+            m.s_re
+                .iter()
+                .chain(&m.s_im)
+                .chain(&m.error_bound)
+                .chain(&m.backward_error),
+        );
     }
-    check_call("mech_dynamics_damped_modes", status, written.untouched() && gradient.untouched(), &numbers);
+    check_call(
+        "mech_dynamics_damped_modes",
+        status,
+        written.untouched() && gradient.untouched(),
+        &numbers,
+    );
     if status != MECH_STATUS_OK {
         return;
     }
@@ -500,12 +563,20 @@ fn damped_modes(d: &OwnedDynamics, input: &mut Input) {
 fn free_body(input: &mut Input) {
     let moments = if input.u8() < 230 {
         let base = graded(input, 10);
-        [base * (0.2 + input.fraction()), base * (0.2 + input.fraction()), base * (0.2 + input.fraction())]
+        [
+            base * (0.2 + input.fraction()),
+            base * (0.2 + input.fraction()),
+            base * (0.2 + input.fraction()),
+        ]
     } else {
         input.vec3_any()
     };
     let rotation = mech_mat3_t { m: input.mat3() };
-    let omega = if input.u8() < 230 { input.vec3_moderate(3.0) } else { input.vec3_any() };
+    let omega = if input.u8() < 230 {
+        input.vec3_moderate(3.0)
+    } else {
+        input.vec3_any()
+    };
     let start = mech_free_body_state_t {
         rotation,
         omega: v3(omega),
@@ -524,23 +595,53 @@ fn free_body(input: &mut Input) {
     }
     let method = input.enum_i32(5);
     let duration = any_or(input, 2.0);
-    let max_step = if input.u8() < 224 { duration.abs() / (1.0 + input.below(64) as f64) } else { input.any_f64() };
-    let tolerance = if input.u8() < 224 { 10f64.powi(-(input.below(8) as i32)) } else { input.any_f64() };
-    let spin = moments.iter().fold(0.0f64, |m, i| m.max(i.abs())) / moments.iter().fold(f64::INFINITY, |m, i| m.min(i.abs()));
+    let max_step = if input.u8() < 224 {
+        duration.abs() / (1.0 + input.below(64) as f64)
+    } else {
+        input.any_f64()
+    };
+    let tolerance = if input.u8() < 224 {
+        10f64.powi(-(input.below(8) as i32))
+    } else {
+        input.any_f64()
+    };
+    let spin =
+        moments.iter().fold(0.0f64, |m, i| m.max(i.abs())) / moments.iter().fold(f64::INFINITY, |m, i| m.min(i.abs()));
     let turns = omega.iter().map(|w| w.abs()).sum::<f64>() * duration.abs() * spin;
     let bounded = (duration.abs() / max_step.abs()) <= 64.0 && tolerance >= 1e-7 && turns <= 20.0;
-    if tolerance.is_finite() && tolerance > 0.0 && max_step.is_finite() && max_step > 0.0 && duration.is_finite() && duration > 0.0 && !bounded {
+    if tolerance.is_finite()
+        && tolerance > 0.0
+        && max_step.is_finite()
+        && max_step > 0.0
+        && duration.is_finite()
+        && duration > 0.0
+        && !bounded
+    {
         return; // a valid request whose work the harness does not bound
     }
     let mut out = Sentinel::<mech_free_body_state_t>::new();
     let mut report = Sentinel::<mech_free_body_report_t>::new();
     trace!("free_body_integrate({moments:?}, {start:?}, {duration:e}, {method}, {max_step:e}, {tolerance:e})");
     let status = unsafe {
-        mech_free_body_integrate(&inertia, &start, duration, method, max_step, tolerance, out.ptr(), report.ptr())
+        mech_free_body_integrate(
+            &inertia,
+            &start,
+            duration,
+            method,
+            max_step,
+            tolerance,
+            out.ptr(),
+            report.ptr(),
+        )
     };
     let mut written = doubles_of(&out.value).to_vec();
     written.extend([report.value.attitude_error, report.value.omega_error]);
-    check_call("mech_free_body_integrate", status, out.untouched() && report.untouched(), &written);
+    check_call(
+        "mech_free_body_integrate",
+        status,
+        out.untouched() && report.untouched(),
+        &written,
+    );
 }
 
 fn free_body_invariants(moments: [f64; 3], start: &mech_free_body_state_t, end: &mech_free_body_state_t) {
@@ -562,7 +663,10 @@ fn free_body_invariants(moments: [f64; 3], start: &mech_free_body_state_t, end: 
         return;
     }
     assert!((t1 - t0).abs() <= 1e-8 * t0, "free body: 2T went from {t0:e} to {t1:e}");
-    assert!((l1 - l0).abs() <= 1e-8 * l0, "free body: |L| went from {l0:e} to {l1:e}");
+    assert!(
+        (l1 - l0).abs() <= 1e-8 * l0,
+        "free body: |L| went from {l0:e} to {l1:e}"
+    );
 }
 
 fuzz_target!(|data: &[u8]| {

@@ -16,8 +16,7 @@
 use libfuzzer_sys::fuzz_target;
 use mechanica::ffi::*;
 use mechanica_fuzz::dynamics::{
-    OwnedDynamics, any_or, build_dynamics, check_call, decades, graded, graded_vector, misaligned, state_vector,
-    vec_or,
+    OwnedDynamics, any_or, build_dynamics, check_call, decades, graded, graded_vector, misaligned, state_vector, vec_or,
 };
 use mechanica_fuzz::oracle::{Sentinel, doubles_of, doubles_untouched, sentinel_doubles};
 use mechanica_fuzz::{Input, trace};
@@ -62,10 +61,18 @@ fn options(input: &mut Input) -> mech_motion_options_t {
             input.any_f64()
         }
     };
-    o.step = if input.u8() < 224 { (0.1 + input.fraction()) * decades(input, 4) } else { input.any_f64() };
+    o.step = if input.u8() < 224 {
+        (0.1 + input.fraction()) * decades(input, 4)
+    } else {
+        input.any_f64()
+    };
     o.rtol = tolerance(input);
     o.atol = tolerance(input);
-    o.estimate_error = if input.u8() < 248 { i32::from(input.bool()) } else { input.u64() as i32 };
+    o.estimate_error = if input.u8() < 248 {
+        i32::from(input.bool())
+    } else {
+        input.u64() as i32
+    };
     o
 }
 
@@ -83,22 +90,48 @@ fn create(d: &OwnedDynamics, input: &mut Input) -> Option<(OwnedSimulation, bool
     let tau_ptr = if input.bool() { tau.as_ptr() } else { std::ptr::null() };
     let o = options(input);
     let options_ptr: *const mech_motion_options_t = if input.u8() < 240 { &o } else { std::ptr::null() };
-    let estimate = if options_ptr.is_null() { true } else { o.estimate_error == 1 };
+    let estimate = if options_ptr.is_null() {
+        true
+    } else {
+        o.estimate_error == 1
+    };
     let mut storage = [0u64; 4];
     let (handle, bad) = match input.u8() {
         0..=249 => (d.handle.cast_const(), None),
         250..=252 => (std::ptr::null(), Some(MECH_STATUS_NULL_POINTER)),
-        _ => (misaligned::<mech_dynamics_t>(&mut storage).cast_const(), Some(MECH_STATUS_MISALIGNED_POINTER)),
+        _ => (
+            misaligned::<mech_dynamics_t>(&mut storage).cast_const(),
+            Some(MECH_STATUS_MISALIGNED_POINTER),
+        ),
     };
     let mut simulation = std::ptr::null_mut();
-    trace!("simulation_create(n {len}, q0 {q0:?}, q̇0 {q_dot0:?}, τ {:?}, options {o:?})", (!tau_ptr.is_null()).then_some(&tau));
-    let status = unsafe { mech_simulation_create(handle, options_ptr, q0.as_ptr(), q_dot0.as_ptr(), tau_ptr, len, &mut simulation) };
+    trace!(
+        "simulation_create(n {len}, q0 {q0:?}, q̇0 {q_dot0:?}, τ {:?}, options {o:?})",
+        (!tau_ptr.is_null()).then_some(&tau)
+    );
+    let status = unsafe {
+        mech_simulation_create(
+            handle,
+            options_ptr,
+            q0.as_ptr(),
+            q_dot0.as_ptr(),
+            tau_ptr,
+            len,
+            &mut simulation,
+        )
+    };
     check_call("mech_simulation_create", status, simulation.is_null(), &[]);
     if let Some(expected) = bad {
-        assert_eq!(status, expected, "mech_simulation_create: the status for a bad dynamics handle");
+        assert_eq!(
+            status, expected,
+            "mech_simulation_create: the status for a bad dynamics handle"
+        );
     }
     if len != n {
-        assert_ne!(status, MECH_STATUS_OK, "mech_simulation_create: accepted n = {len} for {n} coordinates");
+        assert_ne!(
+            status, MECH_STATUS_OK,
+            "mech_simulation_create: accepted n = {len} for {n} coordinates"
+        );
     }
     if status != MECH_STATUS_OK {
         return None;
@@ -111,11 +144,24 @@ fn reports(s: &OwnedSimulation, d: &OwnedDynamics, estimate: bool) -> Option<mec
     let mut report = Sentinel::<mech_motion_report_t>::new();
     let status = unsafe { mech_simulation_report(s.0, report.ptr()) };
     let r = report.value;
-    let numbers = [r.t, r.energy, r.error_q, r.error_q_dot, r.energy_scale, r.max_energy_drift, r.last_energy_drift];
+    let numbers = [
+        r.t,
+        r.energy,
+        r.error_q,
+        r.error_q_dot,
+        r.energy_scale,
+        r.max_energy_drift,
+        r.last_energy_drift,
+    ];
     check_call("mech_simulation_report", status, report.untouched(), &numbers);
     let mut momentum = Sentinel::<mech_motion_momentum_report_t>::new();
     let m_status = unsafe { mech_simulation_momentum_report(s.0, momentum.ptr()) };
-    check_call("mech_simulation_momentum_report", m_status, momentum.untouched(), doubles_of(&momentum.value));
+    check_call(
+        "mech_simulation_momentum_report",
+        m_status,
+        momentum.untouched(),
+        doubles_of(&momentum.value),
+    );
     if m_status == MECH_STATUS_OK {
         for drift in [momentum.value.linear, momentum.value.angular] {
             let max = drift.max_drift;
@@ -133,12 +179,26 @@ fn reports(s: &OwnedSimulation, d: &OwnedDynamics, estimate: bool) -> Option<mec
         "energy monitor out of order: {r:?}"
     );
     if estimate {
-        assert!(r.error_q >= 0.0 && r.error_q_dot >= 0.0, "error estimates missing: {r:?}");
+        assert!(
+            r.error_q >= 0.0 && r.error_q_dot >= 0.0,
+            "error estimates missing: {r:?}"
+        );
     } else {
-        assert!(r.error_q == -1.0 && r.error_q_dot == -1.0, "error estimates without a companion: {r:?}");
+        assert!(
+            r.error_q == -1.0 && r.error_q_dot == -1.0,
+            "error estimates without a companion: {r:?}"
+        );
     }
-    let expected = if d.rotating { MECH_MOTION_JACOBI_INTEGRAL } else { MECH_MOTION_ENERGY };
-    assert_eq!(r.invariant, expected, "the monitored invariant (rotating frame: {})", d.rotating);
+    let expected = if d.rotating {
+        MECH_MOTION_JACOBI_INTEGRAL
+    } else {
+        MECH_MOTION_ENERGY
+    };
+    assert_eq!(
+        r.invariant, expected,
+        "the monitored invariant (rotating frame: {})",
+        d.rotating
+    );
     assert!(r.steps <= MAX_STEPS, "{} steps above the limit {MAX_STEPS}", r.steps);
     Some(r)
 }
@@ -164,13 +224,20 @@ fn advance(s: &OwnedSimulation, d: &OwnedDynamics, estimate: bool, input: &mut I
     };
     let null_output = input.u8() >= 250 && len > 0;
     let (mut q, mut q_dot) = (sentinel_doubles(len), sentinel_doubles(len));
-    let q_ptr = if null_output { std::ptr::null_mut() } else { q.as_mut_ptr() };
+    let q_ptr = if null_output {
+        std::ptr::null_mut()
+    } else {
+        q.as_mut_ptr()
+    };
     trace!("advance({t:e}, n {len}, NULL q_out {null_output})");
     let status = unsafe { mech_simulation_advance(s.0, t, len, q_ptr, q_dot.as_mut_ptr()) };
     let written: Vec<f64> = q.iter().chain(&q_dot).copied().collect();
     check_call("mech_simulation_advance", status, doubles_untouched(&written), &written);
     if len != n || null_output || !(t >= reached) {
-        assert_ne!(status, MECH_STATUS_OK, "advance: accepted t {t:e} (reached {reached:e}), n {len}, NULL q {null_output}");
+        assert_ne!(
+            status, MECH_STATUS_OK,
+            "advance: accepted t {t:e} (reached {reached:e}), n {len}, NULL q {null_output}"
+        );
     }
     if status == MECH_STATUS_OK {
         let r = reports(s, d, estimate).map(|r| r.t);
@@ -184,7 +251,9 @@ fuzz_target!(|data: &[u8]| {
     let mut input = Input::new(data);
     let Some(d) = build_dynamics(&mut input) else { return };
     loads(&d, &mut input);
-    let Some((s, estimate)) = create(&d, &mut input) else { return };
+    let Some((s, estimate)) = create(&d, &mut input) else {
+        return;
+    };
     if input.u8() >= 248 {
         let status = unsafe { mech_simulation_set_max_steps(s.0, 0) };
         check_call("mech_simulation_set_max_steps(0)", status, true, &[]);
@@ -199,7 +268,11 @@ fuzz_target!(|data: &[u8]| {
     for _ in 0..1 + input.below(4) {
         advance(&s, &d, estimate, &mut input, reached);
         let Some(r) = reports(&s, &d, estimate) else { return };
-        assert!(r.t >= reached, "the report's time went back from {reached:e} to {:e}", r.t);
+        assert!(
+            r.t >= reached,
+            "the report's time went back from {reached:e} to {:e}",
+            r.t
+        );
         reached = r.t;
     }
 });

@@ -30,7 +30,10 @@ impl Drop for OwnedDynamics {
 pub fn check_call(call: &str, status: mech_status_t, untouched: bool, values: &[f64]) {
     check_status(call, status);
     if status == MECH_STATUS_OK {
-        assert!(finite(values), "{call}: MECH_STATUS_OK but wrote a non-finite value: {values:?}");
+        assert!(
+            finite(values),
+            "{call}: MECH_STATUS_OK but wrote a non-finite value: {values:?}"
+        );
     } else {
         assert!(untouched, "{call}: failed with status {status} but wrote an output");
         assert!(
@@ -125,7 +128,9 @@ fn mechanism_loads(mechanism: *mut mech_mechanism_t, tree: &OwnedTree, input: &m
                 let g = vec_or(input, 10.0);
                 crate::trace!("set_gravity({g:?})");
                 // SAFETY: the handle is live.
-                ("mech_mechanism_set_gravity", unsafe { mech_mechanism_set_gravity(mechanism, g) })
+                ("mech_mechanism_set_gravity", unsafe {
+                    mech_mechanism_set_gravity(mechanism, g)
+                })
             }
             1 => {
                 let axis = v3(input.unit_vec3());
@@ -169,7 +174,11 @@ fn mechanism_loads(mechanism: *mut mech_mechanism_t, tree: &OwnedTree, input: &m
 pub fn build_dynamics(input: &mut Input) -> Option<OwnedDynamics> {
     let tree = build_tree(input)?;
     let bodies: Vec<mech_mass_properties_t> = (0..tree.bodies).map(|_| graded_body(input)).collect();
-    crate::trace!("tree: {} bodies, {} coordinates; bodies {bodies:?}", tree.bodies, tree.dof);
+    crate::trace!(
+        "tree: {} bodies, {} coordinates; bodies {bodies:?}",
+        tree.bodies,
+        tree.dof
+    );
     let mut mechanism = std::ptr::null_mut();
     // SAFETY: the tree is live; `bodies` holds bodies.len() records.
     let status = unsafe { mech_mechanism_create(tree.handle, bodies.as_ptr(), bodies.len(), &mut mechanism) };

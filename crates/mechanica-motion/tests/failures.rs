@@ -158,7 +158,10 @@ fn a_step_limit_bounds_each_advance() {
     }
     let simulation = Simulation::new(
         pendulum(1.0, 1.0, 9.81),
-        Method::DormandPrince { rtol: 1e-10, atol: 1e-12 },
+        Method::DormandPrince {
+            rtol: 1e-10,
+            atol: 1e-12,
+        },
         Options::default(),
     )
     .expect("simulation");

@@ -289,9 +289,13 @@ pub unsafe extern "C" fn mech_simulation_set_max_steps(
         // SAFETY: caller's contract.
         let s = unsafe { mech_simulation_t::borrow_mut(simulation, "simulation") }?;
         if max_steps == 0 {
-            return Err(FfiError::new(MECH_STATUS_INVALID_ARGUMENT, "max_steps must be ≥ 1, got 0"));
+            return Err(FfiError::new(
+                MECH_STATUS_INVALID_ARGUMENT,
+                "max_steps must be ≥ 1, got 0",
+            ));
         }
-        s.stepper.set_max_steps(usize::try_from(max_steps).unwrap_or(usize::MAX));
+        s.stepper
+            .set_max_steps(usize::try_from(max_steps).unwrap_or(usize::MAX));
         Ok(())
     })
 }
