@@ -138,7 +138,9 @@ fn mechanism_loads(mechanism: *mut mech_mechanism_t, tree: &OwnedTree, input: &m
                 crate::trace!("set_rotating_frame({axis:?}, {rate:e})");
                 // SAFETY: the handle is live.
                 let status = unsafe { mech_mechanism_set_rotating_frame(mechanism, axis, rate) };
-                rotating |= status == MECH_STATUS_OK;
+                if status == MECH_STATUS_OK {
+                    rotating = rate != 0.0; // rate 0 removes the rotation
+                }
                 ("mech_mechanism_set_rotating_frame", status)
             }
             2 => {

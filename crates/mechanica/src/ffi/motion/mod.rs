@@ -303,6 +303,8 @@ pub unsafe extern "C" fn mech_simulation_set_max_steps(
 /// Writes the report of the last successful advance (or of the initial state) to
 /// `*report_out`: time, H, the global error estimates and the energy monitor.
 ///
+/// Errors: MECH_STATUS_OUT_OF_RANGE when one of its numbers overflowed (nothing is written).
+///
 /// # Safety
 /// `simulation` must be a live handle and `report_out` writable.
 #[unsafe(no_mangle)]
@@ -334,7 +336,9 @@ pub unsafe extern "C" fn mech_simulation_report(
             report.energy,
             report.error_q,
             report.error_q_dot,
+            report.energy_scale,
             report.max_energy_drift,
+            report.last_energy_drift,
         ];
         finite_result(numbers.as_slice(), "simulation report")?;
         // SAFETY: caller's contract.
@@ -384,6 +388,9 @@ impl From<&MomentumDrift> for mech_motion_momentum_drift_t {
 /// Writes the momentum monitors of the simulation (over every step since t = 0 up to the last
 /// successful advance) to `*report_out`.
 ///
+/// Errors: MECH_STATUS_OUT_OF_RANGE when a momentum or its drift overflowed (masses or
+/// velocities near the limits of double precision; nothing is written).
+///
 /// # Safety
 /// `simulation` must be a live handle and `report_out` writable.
 #[unsafe(no_mangle)]
@@ -400,8 +407,16 @@ pub unsafe extern "C" fn mech_simulation_momentum_report(
             linear: (&monitors.linear_momentum).into(),
             angular: (&monitors.angular_momentum).into(),
         };
+        let numbers = [report.linear, report.angular].map(momentum_numbers);
+        finite_result(numbers.as_flattened(), "momentum monitor")?;
         // SAFETY: caller's contract.
         unsafe { out.write(report) };
         Ok(())
     })
+}
+
+/// The ten numbers of one momentum monitor.
+fn momentum_numbers(d: mech_motion_momentum_drift_t) -> [f64; 10] {
+    let [a, b, c] = [d.initial, d.last, d.max_drift];
+    [a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.scale]
 }
