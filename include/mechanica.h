@@ -5006,6 +5006,8 @@ mech_status_t mech_simulation_set_max_steps(struct mech_simulation_t *simulation
  * Writes the report of the last successful advance (or of the initial state) to
  * `*report_out`: time, H, the global error estimates and the energy monitor.
  *
+ * Errors: MECH_STATUS_OUT_OF_RANGE when one of its numbers overflowed (nothing is written).
+ *
  * # Safety
  * `simulation` must be a live handle and `report_out` writable.
  */
@@ -5017,6 +5019,9 @@ mech_status_t mech_simulation_report(const struct mech_simulation_t *simulation,
 /**
  * Writes the momentum monitors of the simulation (over every step since t = 0 up to the last
  * successful advance) to `*report_out`.
+ *
+ * Errors: MECH_STATUS_OUT_OF_RANGE when a momentum or its drift overflowed (masses or
+ * velocities near the limits of double precision; nothing is written).
  *
  * # Safety
  * `simulation` must be a live handle and `report_out` writable.

@@ -277,3 +277,4 @@ proptest! {
         prop_assert!(close(spun, expected, 1e-12, omega * omega + g / l + centrifugal), "θ̈ = {spun} against {expected}");
     }
 }
+
