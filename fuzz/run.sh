@@ -13,7 +13,7 @@
 # (default fuzz/target), FUZZ_RSS_LIMIT_MB (default 2048), FUZZ_MAX_LEN (default 65536 bytes).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
-targets=(stl obj matrix_market scene urdf abi_kinematics abi_mass abi_impulse abi_modal abi_mechanism abi_urdf)
+targets=(stl obj matrix_market scene urdf abi_kinematics abi_mass abi_impulse abi_modal abi_mechanism abi_urdf abi_dynamics abi_motion)
 export CARGO_TARGET_DIR="${FUZZ_TARGET_DIR:-$here/target}"
 export CARGO_INCREMENTAL=0
 # Instrumentation is added by the wrapper, crate by crate; RUSTFLAGS would also reach build

@@ -5019,8 +5019,28 @@ mech_status_t mech_simulation_advance(struct mech_simulation_t *simulation,
 
 #if defined(MECH_FEATURE_MOTION)
 /**
+ * Sets the most steps each run of the simulation may take, counted from t = 0 with the steps
+ * already taken: the main integration and, with `estimate_error`, its companion (the default
+ * is 100 000 000 each). An advance that needs more stops at the last good state with
+ * MECH_STATUS_NOT_CONVERGED (mech_last_error says "more than N steps"), so the limit bounds
+ * the work of every later mech_simulation_advance whatever its target time; raising it lets
+ * the integration go on from there.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT for `max_steps` = 0.
+ *
+ * # Safety
+ * `simulation` must be a live handle not used by another thread during the call.
+ */
+mech_status_t mech_simulation_set_max_steps(struct mech_simulation_t *simulation,
+                                            uint64_t max_steps);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
  * Writes the report of the last successful advance (or of the initial state) to
  * `*report_out`: time, H, the global error estimates and the energy monitor.
+ *
+ * Errors: MECH_STATUS_OUT_OF_RANGE when one of its numbers overflowed (nothing is written).
  *
  * # Safety
  * `simulation` must be a live handle and `report_out` writable.
@@ -5033,6 +5053,9 @@ mech_status_t mech_simulation_report(const struct mech_simulation_t *simulation,
 /**
  * Writes the momentum monitors of the simulation (over every step since t = 0 up to the last
  * successful advance) to `*report_out`.
+ *
+ * Errors: MECH_STATUS_OUT_OF_RANGE when a momentum or its drift overflowed (masses or
+ * velocities near the limits of double precision; nothing is written).
  *
  * # Safety
  * `simulation` must be a live handle and `report_out` writable.

@@ -3,7 +3,8 @@
  * Dormand–Prince and by Störmer–Verlet, with the error estimate covering the true error; and
  * rejected options and arguments leaving the outputs untouched; the momentum monitors of a
  * free-floating two-body chain: P and L conserved without gravity, and under gravity the
- * momentum −m g t gained along it reported as drift while L along gravity stays conserved. */
+ * momentum −m g t gained along it reported as drift while L along gravity stays conserved; a
+ * step limit that stops an advance to 1e300 s after it, at the last good state, until raised. */
 #include "check.h"
 
 static const mech_vec3_t ZERO = {0.0, 0.0, 0.0};
@@ -113,6 +114,38 @@ static void rejected_arguments(mech_dynamics_t *d) {
     mech_simulation_destroy(NULL);
 }
 
+/* RK4 with step h reaches k·h in k steps: a limit of 40 refuses 1e300 s and 50·h (nothing
+ * written, the report still at t = 0 after 40 steps), and once raised to 50 reaches 50·h. */
+static void step_limit(mech_dynamics_t *d) {
+    const double q0 = 0.5, zero = 0.0, h = 0.01;
+    mech_motion_options_t options;
+    CHECK_STATUS(mech_motion_options_default(&options), MECH_STATUS_OK);
+    options.method = MECH_MOTION_RK4;
+    options.step = h;
+    options.estimate_error = 0;
+    mech_simulation_t *s = NULL;
+    CHECK_STATUS(mech_simulation_create(d, &options, &q0, &zero, NULL, 1, &s), MECH_STATUS_OK);
+    CHECK_STATUS(mech_simulation_set_max_steps(s, 0), MECH_STATUS_INVALID_ARGUMENT);
+    CHECK_STATUS(mech_simulation_set_max_steps(NULL, 40), MECH_STATUS_NULL_POINTER);
+    CHECK_STATUS(mech_simulation_set_max_steps(s, 40), MECH_STATUS_OK);
+    double q = 42.0, qd = 42.0;
+    CHECK_STATUS(mech_simulation_advance(s, 1e300, 1, &q, &qd), MECH_STATUS_NOT_CONVERGED);
+    CHECK_STATUS(mech_simulation_advance(s, 50 * h, 1, &q, &qd), MECH_STATUS_NOT_CONVERGED);
+    char message[256];
+    mech_last_error(message, sizeof message);
+    CHECK(strstr(message, "more than 40 steps") != NULL);
+    CHECK(q == 42.0 && qd == 42.0);
+    mech_motion_report_t report;
+    CHECK_STATUS(mech_simulation_report(s, &report), MECH_STATUS_OK);
+    CHECK(report.t == 0.0 && report.steps == 40);
+    CHECK_STATUS(mech_simulation_set_max_steps(s, 50), MECH_STATUS_OK);
+    CHECK_STATUS(mech_simulation_advance(s, 50 * h, 1, &q, &qd), MECH_STATUS_OK);
+    CHECK_STATUS(mech_simulation_report(s, &report), MECH_STATUS_OK);
+    CHECK(report.t == 50 * h && report.steps == 50);
+    CHECK(isfinite(q) && fabs(q) <= q0 && q != 42.0);
+    mech_simulation_destroy(s);
+}
+
 /* A free base (2 kg) carrying a link on a revolute joint about (1, 1, 0)/√2 at (0.4, 0, 0.1);
  * gravity g along −z. */
 static mech_dynamics_t *floating_pair(double g) {
@@ -192,6 +225,7 @@ int main(void) {
     period(d, MECH_MOTION_DORMAND_PRINCE, 1e-9);
     period(d, MECH_MOTION_STORMER_VERLET, 1e-5);
     rejected_arguments(d);
+    step_limit(d);
     momentum_monitors(0.0);
     momentum_monitors(9.81);
     mech_dynamics_destroy(d);

@@ -9,6 +9,7 @@
 
 #![allow(missing_docs)]
 
+pub mod dynamics;
 pub mod input;
 pub mod mesh_oracle;
 pub mod oracle;

@@ -110,8 +110,11 @@ impl DormandPrince {
         self.k1_valid = false;
     }
 
-    /// The weighted RMS norm ‖x / (atol + rtol·max(|a|, |b|))‖ of (M.5).
+    /// The weighted RMS norm ‖x / (atol + rtol·max(|a|, |b|))‖ of (M.5), 0 for empty vectors.
     fn weighted_norm(&self, x: &[f64], a: &[f64], b: &[f64]) -> f64 {
+        if x.is_empty() {
+            return 0.0; // no coordinates: no error
+        }
         let sum: f64 = (0..x.len())
             .map(|i| {
                 let scale = self.atol + self.rtol * a[i].abs().max(b[i].abs());
@@ -129,10 +132,12 @@ impl DormandPrince {
         for i in 0..y.len() {
             self.stage[i] = y[i] + h0 * self.k[0][i];
         }
+        // The slope buffer goes back before a failure is returned: a later step reuses it.
         let mut slope = std::mem::take(&mut self.next);
-        derivative(system, t + h0, &self.stage, &mut slope)?;
-        let diff: Vec<f64> = slope.iter().zip(&self.k[0]).map(|(a, b)| (a - b) / h0).collect();
+        let result = derivative(system, t + h0, &self.stage, &mut slope);
         self.next = slope;
+        result?;
+        let diff: Vec<f64> = self.next.iter().zip(&self.k[0]).map(|(a, b)| (a - b) / h0).collect();
         let d2 = self.weighted_norm(&diff, y, y);
         let largest = d1.max(d2);
         let h1 = if largest <= 1e-15 {

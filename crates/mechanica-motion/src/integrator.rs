@@ -96,6 +96,11 @@ impl Integrator {
         Ok(())
     }
 
+    /// Sets the most steps of the run, counted from t = 0 (the steps taken so far included).
+    pub(crate) fn set_max_steps(&mut self, max_steps: usize) {
+        self.max_steps = max_steps;
+    }
+
     /// Steps taken so far (accepted steps for the adaptive method).
     pub(crate) fn steps(&self) -> usize {
         self.steps

@@ -51,6 +51,9 @@ fn newton_matrix(
 /// One implicit-midpoint step of size `h` from (t, q, q̇), in place.
 pub(crate) fn step(system: &mut System, t: f64, q: &mut [f64], v: &mut [f64], h: f64) -> Result<(), StepFailure> {
     let n = q.len();
+    if n == 0 {
+        return Ok(()); // no coordinates: nothing moves (and no Newton matrix to factor)
+    }
     let tm = t + 0.5 * h;
     let mut accel = vec![0.0; n];
     system.acceleration(t, q, v, &mut accel)?;

@@ -271,6 +271,17 @@ impl Stepper {
         self.main.steps()
     }
 
+    /// Sets the most steps of each run (the main run and the companion), counted from t = 0
+    /// with the steps already taken, in place of [`Options::max_steps`]: an advance that
+    /// needs more fails with [`StepFailure::TooManySteps`] and leaves the stepper at its last
+    /// good state, so the limit bounds the work of every later advance whatever its target.
+    pub fn set_max_steps(&mut self, max_steps: usize) {
+        self.main.set_max_steps(max_steps);
+        if let Some(companion) = &mut self.companion {
+            companion.set_max_steps(max_steps);
+        }
+    }
+
     /// Integrates to `t` (finite, ≥ the time of the last sample) and records the sample there.
     /// A failed step gives [`MotionError::StepFailed`] with the last good state of the main
     /// run; the stepper then stays at that state (a later advance retries from it).

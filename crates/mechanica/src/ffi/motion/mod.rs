@@ -297,8 +297,41 @@ pub unsafe extern "C" fn mech_simulation_advance(
     })
 }
 
+/// Sets the most steps each run of the simulation may take, counted from t = 0 with the steps
+/// already taken: the main integration and, with `estimate_error`, its companion (the default
+/// is 100 000 000 each). An advance that needs more stops at the last good state with
+/// MECH_STATUS_NOT_CONVERGED (mech_last_error says "more than N steps"), so the limit bounds
+/// the work of every later mech_simulation_advance whatever its target time; raising it lets
+/// the integration go on from there.
+///
+/// Errors: MECH_STATUS_INVALID_ARGUMENT for `max_steps` = 0.
+///
+/// # Safety
+/// `simulation` must be a live handle not used by another thread during the call.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mech_simulation_set_max_steps(
+    simulation: *mut mech_simulation_t,
+    max_steps: u64,
+) -> mech_status_t {
+    boundary(|| {
+        // SAFETY: caller's contract.
+        let s = unsafe { mech_simulation_t::borrow_mut(simulation, "simulation") }?;
+        if max_steps == 0 {
+            return Err(FfiError::new(
+                MECH_STATUS_INVALID_ARGUMENT,
+                "max_steps must be ≥ 1, got 0",
+            ));
+        }
+        s.stepper
+            .set_max_steps(usize::try_from(max_steps).unwrap_or(usize::MAX));
+        Ok(())
+    })
+}
+
 /// Writes the report of the last successful advance (or of the initial state) to
 /// `*report_out`: time, H, the global error estimates and the energy monitor.
+///
+/// Errors: MECH_STATUS_OUT_OF_RANGE when one of its numbers overflowed (nothing is written).
 ///
 /// # Safety
 /// `simulation` must be a live handle and `report_out` writable.
@@ -331,7 +364,9 @@ pub unsafe extern "C" fn mech_simulation_report(
             report.energy,
             report.error_q,
             report.error_q_dot,
+            report.energy_scale,
             report.max_energy_drift,
+            report.last_energy_drift,
         ];
         finite_result(numbers.as_slice(), "simulation report")?;
         // SAFETY: caller's contract.
@@ -381,6 +416,9 @@ impl From<&MomentumDrift> for mech_motion_momentum_drift_t {
 /// Writes the momentum monitors of the simulation (over every step since t = 0 up to the last
 /// successful advance) to `*report_out`.
 ///
+/// Errors: MECH_STATUS_OUT_OF_RANGE when a momentum or its drift overflowed (masses or
+/// velocities near the limits of double precision; nothing is written).
+///
 /// # Safety
 /// `simulation` must be a live handle and `report_out` writable.
 #[unsafe(no_mangle)]
@@ -397,8 +435,16 @@ pub unsafe extern "C" fn mech_simulation_momentum_report(
             linear: (&monitors.linear_momentum).into(),
             angular: (&monitors.angular_momentum).into(),
         };
+        let numbers = [report.linear, report.angular].map(momentum_numbers);
+        finite_result(numbers.as_flattened(), "momentum monitor")?;
         // SAFETY: caller's contract.
         unsafe { out.write(report) };
         Ok(())
     })
+}
+
+/// The ten numbers of one momentum monitor.
+fn momentum_numbers(d: mech_motion_momentum_drift_t) -> [f64; 10] {
+    let [a, b, c] = [d.initial, d.last, d.max_drift];
+    [a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.scale]
 }
