@@ -184,7 +184,11 @@ impl Integrator {
 
     /// One step of a fixed-step method from the state reached, into (q, q̇), followed by the
     /// projection onto the constraints (M.19) for every method but RATTLE.
+    /// A system without coordinates has nothing to move (and no Newton matrix to factor).
     fn fixed_step(&mut self, q: &mut [f64], v: &mut [f64], h: f64) -> Result<(), StepFailure> {
+        if q.is_empty() {
+            return Ok(());
+        }
         let system = &mut self.system;
         match &mut self.engine {
             Engine::Rk4(rk4, _) => rk4.step(system, self.t, q, v, h)?,
