@@ -197,7 +197,7 @@ impl Dynamics {
     }
 
     /// True when a base motion is prescribed.
-    pub(crate) fn has_base_motion(&self) -> bool {
+    pub fn has_base_motion(&self) -> bool {
         self.base_motion.is_some()
     }
 

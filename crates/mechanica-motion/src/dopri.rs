@@ -194,7 +194,8 @@ impl DormandPrince {
         }
         let mut rejected = false;
         loop {
-            let h = self.h.min(limit - *t);
+            let to_limit = self.h >= limit - *t;
+            let h = if to_limit { limit - *t } else { self.h };
             if h.is_nan() || h <= 16.0 * f64::EPSILON * t.abs().max(f64::MIN_POSITIVE) {
                 return Err(StepFailure::StepSizeUnderflow { step: h });
             }
@@ -210,6 +211,9 @@ impl DormandPrince {
                 self.previous_error = error.max(1e-4);
                 let factor = if rejected { factor.max(1.0) } else { factor };
                 self.accept(t, y, h);
+                if to_limit {
+                    *t = limit; // t + (limit − t) may round below the limit
+                }
                 self.h = h / factor;
                 return Ok(());
             }

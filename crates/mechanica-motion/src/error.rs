@@ -1,6 +1,7 @@
 //! The error type of the motion crate.
 
 use mechanica_dynamics::DynamicsError;
+use mechanica_impulse::ImpulseError;
 use thiserror::Error;
 
 /// Why one integration step could not be completed.
@@ -66,6 +67,28 @@ pub enum StepFailure {
         /// The limit of [`crate::Options::max_steps`].
         limit: usize,
     },
+    /// A contact stays closed after its impact (its gap is ≤ 0 and closing again): resting or
+    /// sliding contact, or impacts accumulating in finite time (M.23). Neither is modelled.
+    #[error(
+        "contact {contact} stays closed (gap {gap:e} m, closing at {rate:e} m/s): sustained contact and accumulating impacts are not modelled"
+    )]
+    SustainedContact {
+        /// The contact's index.
+        contact: usize,
+        /// Its gap g, m.
+        gap: f64,
+        /// Its rate ġ, m/s.
+        rate: f64,
+    },
+    /// The run met more impacts than its limit.
+    #[error("more than {limit} impacts")]
+    TooManyImpacts {
+        /// The limit of [`crate::Options::max_impacts`].
+        limit: usize,
+    },
+    /// The impact at a located contact event could not be resolved.
+    #[error("the impact could not be resolved: {0}")]
+    Impact(Box<ImpulseError>),
 }
 
 /// Everything that can go wrong while integrating the equations of motion.
@@ -128,6 +151,14 @@ pub enum MotionError {
         requested: f64,
         /// The limit.
         limit: usize,
+    },
+    /// A unilateral contact is not valid for this mechanism.
+    #[error("contact {index}: {reason}")]
+    InvalidContact {
+        /// The contact's index.
+        index: usize,
+        /// What is wrong.
+        reason: String,
     },
     /// A step failed: the run stopped at `t` with the last good state.
     #[error("the integration stopped at t = {t}: {cause}")]

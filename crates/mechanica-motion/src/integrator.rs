@@ -107,6 +107,11 @@ impl Integrator {
     }
 
     /// The system with its current charts.
+    pub(crate) fn system(&self) -> &System {
+        &self.system
+    }
+
+    /// The system with its current charts, for evaluation.
     pub(crate) fn system_mut(&mut self) -> &mut System {
         &mut self.system
     }
@@ -153,33 +158,49 @@ impl Integrator {
     /// `target`) and gives the state at `target` in the current charts. Fixed-step methods
     /// divide [t, target] into equal steps no longer than their step.
     pub(crate) fn advance_to(&mut self, target: f64, horizon: f64) -> Result<Point, StepFailure> {
+        while self.t < target {
+            self.step_toward(target, horizon)?;
+        }
+        self.state_at(target)
+    }
+
+    /// The time reached by the last step (past the last target for the adaptive method, whose
+    /// steps run to the horizon).
+    pub(crate) fn time(&self) -> f64 {
+        self.t
+    }
+
+    /// Takes one step from the time reached towards `target` (> the time reached): for the
+    /// fixed-step methods the next of the equal steps no longer than their step that divide
+    /// [t, target], ending exactly at `target` on the last; for the adaptive method one
+    /// accepted step, which may pass `target` but not `horizon` ≥ `target`.
+    pub(crate) fn step_toward(&mut self, target: f64, horizon: f64) -> Result<(), StepFailure> {
         let largest = match self.engine {
             Engine::Rk4(_, h) | Engine::Verlet(h) | Engine::Midpoint(h) | Engine::Rattle(h, _) => h,
-            Engine::Adaptive(_) => return self.advance_adaptive(target, horizon),
+            Engine::Adaptive(_) => return self.adaptive_step(target, horizon),
         };
         let remaining = target - self.t;
-        if remaining <= 0.0 {
-            return Ok(self.point());
-        }
         let count = (remaining / largest * (1.0 - 1e-12)).ceil().max(1.0);
         let h = remaining / count;
-        let start = self.t;
         let n = self.y.len() / 2;
-        for i in 0..count as usize {
-            self.prepare_step()?;
-            let mut q_new = self.y[..n].to_vec();
-            let mut v_new = self.y[n..].to_vec();
-            self.fixed_step(&mut q_new, &mut v_new, h)?;
-            self.y[..n].copy_from_slice(&q_new);
-            self.y[n..].copy_from_slice(&v_new);
-            self.t = if i + 1 == count as usize {
-                target
-            } else {
-                start + (i + 1) as f64 * h
-            };
-            self.monitor_step()?;
+        self.prepare_step()?;
+        let mut q_new = self.y[..n].to_vec();
+        let mut v_new = self.y[n..].to_vec();
+        self.fixed_step(&mut q_new, &mut v_new, h)?;
+        self.y[..n].copy_from_slice(&q_new);
+        self.y[n..].copy_from_slice(&v_new);
+        self.t = if count <= 1.0 { target } else { self.t + h };
+        self.monitor_step()
+    }
+
+    /// Replaces the velocities of the state reached by `q_dot` (the same charts), as an impact
+    /// does; the adaptive method's first stage is recomputed.
+    pub(crate) fn jump_velocity(&mut self, q_dot: &[f64]) {
+        let n = self.y.len() / 2;
+        self.y[n..].copy_from_slice(q_dot);
+        if let Engine::Adaptive(dopri) = &mut self.engine {
+            dopri.invalidate();
         }
-        Ok(self.point())
     }
 
     /// One step of a fixed-step method from the state reached, into (q, q̇), followed by the
@@ -200,25 +221,30 @@ impl Integrator {
         crate::projection::project(system, q, v)
     }
 
-    fn advance_adaptive(&mut self, target: f64, horizon: f64) -> Result<Point, StepFailure> {
-        while self.t < target {
-            self.prepare_step()?;
-            let Engine::Adaptive(dopri) = &mut self.engine else {
-                break;
-            };
-            let mut y = self.y.clone();
-            let mut t = self.t;
-            dopri.step(&mut self.system, &mut t, &mut y, horizon.max(target))?;
-            if self.system.is_constrained() {
-                let n = y.len() / 2;
-                let (q, v) = y.split_at_mut(n);
-                crate::projection::project(&mut self.system, q, v)?;
-                dopri.invalidate();
-            }
-            self.y = y;
-            self.t = t;
-            self.monitor_step()?;
+    /// One accepted Dormand–Prince step not passing `horizon.max(target)`.
+    fn adaptive_step(&mut self, target: f64, horizon: f64) -> Result<(), StepFailure> {
+        self.prepare_step()?;
+        let Engine::Adaptive(dopri) = &mut self.engine else {
+            return Ok(());
+        };
+        let mut y = self.y.clone();
+        let mut t = self.t;
+        dopri.step(&mut self.system, &mut t, &mut y, horizon.max(target))?;
+        if self.system.is_constrained() {
+            let n = y.len() / 2;
+            let (q, v) = y.split_at_mut(n);
+            crate::projection::project(&mut self.system, q, v)?;
+            dopri.invalidate();
         }
+        self.y = y;
+        self.t = t;
+        self.monitor_step()
+    }
+
+    /// The state at `target`, in the current charts: the state reached when the last step
+    /// ended there, else (adaptive method, `target` inside the last step) its dense output
+    /// projected onto the constraints.
+    pub(crate) fn state_at(&mut self, target: f64) -> Result<Point, StepFailure> {
         if self.t == target {
             return Ok(self.point());
         }

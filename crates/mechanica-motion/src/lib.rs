@@ -14,10 +14,15 @@
 //! - Monitors: drift of the energy or Jacobi integral (M.1)–(M.2), momenta of cyclic
 //!   coordinates (9.3), and the linear and angular momentum of the whole mechanism
 //!   (M.15)–(M.16) ([`Monitors`], [`system_momentum`]).
+//! - Unilateral contacts ([`contacts`], (M.21)–(M.23)): [`Simulation::with_contacts`] locates
+//!   each closing of a gap, resolves the impact with `mechanica-impulse`, and reports every
+//!   impact's energy loss beside the integrator's drift over the free motion before it
+//!   ([`ImpactEvent`]).
 //! - Failures stop the run with [`MotionError::StepFailed`], carrying the time reached and
 //!   the last good state.
 
 pub mod chart;
+pub mod contacts;
 mod dopri;
 pub mod error;
 pub mod estimate;
@@ -35,6 +40,7 @@ pub mod simulation;
 mod system;
 mod verlet;
 
+pub use contacts::{ImpactEvent, UnilateralContact};
 pub use error::{MotionError, StepFailure};
 pub use estimate::ErrorEstimate;
 pub use forcing::{ForceFunction, Forcing};

@@ -19,11 +19,12 @@ pub enum Invariant {
 pub struct CyclicMomentum {
     /// The coordinate k.
     pub coordinate: usize,
-    /// p_k at the start.
+    /// p_k at the start (or just after the last impact of a run with contacts).
     pub initial: f64,
     /// p_k at the last step or sample.
     pub last: f64,
-    /// max |p_k − p_k(0)| over the steps and samples.
+    /// max |p_k − p_k(0)| over the steps and samples (with contacts, p_k(0) restarts after
+    /// each impact).
     pub max_drift: f64,
 }
 
@@ -37,11 +38,12 @@ pub struct CyclicMomentum {
 /// joint). The monitor reports every component; which are conserved is the caller's knowledge.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MomentumDrift {
-    /// The value at the start.
+    /// The value at the start (or just after the last impact of a run with contacts).
     pub initial: Vector3<f64>,
     /// The value at the last step or sample.
     pub last: Vector3<f64>,
-    /// Componentwise max |x − x(0)| over the steps and samples.
+    /// Componentwise max |x − x(0)| over the steps and samples (with contacts, x(0) restarts
+    /// after each impact).
     pub max_drift: Vector3<f64>,
     /// The largest |x| (Euclidean) over the steps and samples: the scale of the drift.
     pub scale: f64,
@@ -55,6 +57,10 @@ impl MomentumDrift {
             max_drift: Vector3::zeros(),
             scale: initial.norm(),
         }
+    }
+
+    fn rebase(&mut self, value: Vector3<f64>) {
+        self.initial = value;
     }
 
     fn record(&mut self, value: Vector3<f64>) {
@@ -106,7 +112,8 @@ pub struct Monitors {
     /// The energy scale, J: the largest kinetic energy T₂ over the steps and samples (at
     /// least the smallest positive f64).
     pub scale: f64,
-    /// max |H − H(0)| / scale over the steps and samples.
+    /// max |H − H(0)| / scale over the steps and samples. With contacts H(0) restarts just
+    /// after each impact (M.23): the impacts' own changes are in the impact events.
     pub max_drift: f64,
     /// |H − H(0)| / scale at the last step or sample.
     pub last_drift: f64,
@@ -153,6 +160,8 @@ impl Measurement {
 pub(crate) struct Tracker {
     invariant: Invariant,
     initial: f64,
+    /// H at the start of the current free segment (t = 0, or just after the last impact).
+    reference: f64,
     largest_kinetic: f64,
     max_change: f64,
     last_change: f64,
@@ -168,6 +177,7 @@ impl Tracker {
         Self {
             invariant,
             initial: start.energy,
+            reference: start.energy,
             largest_kinetic: start.kinetic,
             max_change: 0.0,
             last_change: 0.0,
@@ -193,7 +203,7 @@ impl Tracker {
     /// Records the measurement of one step or sample.
     pub(crate) fn record(&mut self, m: &Measurement) {
         self.largest_kinetic = self.largest_kinetic.max(m.kinetic);
-        self.last_change = (m.energy - self.initial).abs();
+        self.last_change = (m.energy - self.reference).abs();
         self.max_change = self.max_change.max(self.last_change);
         for c in &mut self.cyclic {
             c.last = m.p[c.coordinate];
@@ -202,6 +212,18 @@ impl Tracker {
         self.linear.record(m.momentum.linear);
         self.angular.record(m.momentum.angular);
         self.constraints.record(m.constraint_drift);
+    }
+
+    /// Restarts the drifts' references at the state just after an impact (M.23): the change of
+    /// H and of the momenta across an impact is the impact's, reported with it, not drift.
+    pub(crate) fn rebase(&mut self, m: &Measurement) {
+        self.reference = m.energy;
+        for c in &mut self.cyclic {
+            c.initial = m.p[c.coordinate];
+        }
+        self.linear.rebase(m.momentum.linear);
+        self.angular.rebase(m.momentum.angular);
+        self.record(m);
     }
 
     /// The monitors so far.

@@ -3,20 +3,27 @@
 //! and records samples at a fixed output interval with the monitors of [`crate::monitors`].
 //! [`Stepper`] is the same step by step (advance to a time, read the state).
 
+use crate::contacts::run::ContactRun;
+use crate::contacts::{ImpactEvent, UnilateralContact};
 use crate::error::{MotionError, StepFailure, check_vector};
 use crate::estimate::{ErrorEstimate, estimate};
 use crate::forcing::Forcing;
 use crate::integrator::Integrator;
+use crate::integrator::Point;
 use crate::method::Method;
 use crate::monitors::{Invariant, Measurement, Monitors, Tracker};
 use crate::system::System;
 use mechanica_dynamics::{ConstrainedDynamics, Constraint, Dynamics};
+use std::sync::Arc;
 
 /// The most samples a run records: (t_end / output_interval) + 1 must not exceed it.
 pub const MAX_SAMPLES: usize = 1_000_000;
 
 /// The default limit of steps per run (each of the main and the companion run).
 pub const DEFAULT_MAX_STEPS: usize = 100_000_000;
+
+/// The default limit of impacts per run (each of the main and the companion run).
+pub const DEFAULT_MAX_IMPACTS: usize = 100_000;
 
 /// Options of a simulation.
 #[derive(Debug, Clone)]
@@ -29,6 +36,9 @@ pub struct Options {
     pub estimate_error: bool,
     /// The most steps of each run; more fail with [`StepFailure::TooManySteps`].
     pub max_steps: usize,
+    /// The most impacts of each run with contacts; more fail with
+    /// [`StepFailure::TooManyImpacts`].
+    pub max_impacts: usize,
 }
 
 impl Default for Options {
@@ -38,6 +48,7 @@ impl Default for Options {
             cyclic: Vec::new(),
             estimate_error: true,
             max_steps: DEFAULT_MAX_STEPS,
+            max_impacts: DEFAULT_MAX_IMPACTS,
         }
     }
 }
@@ -68,6 +79,8 @@ pub struct Trajectory {
     pub steps: usize,
     /// Steps of the companion run (0 without it).
     pub companion_steps: usize,
+    /// The impacts of the main run, in time order (empty without contacts).
+    pub impacts: Vec<ImpactEvent>,
 }
 
 /// A mechanism's dynamics (with holonomic constraints or without) with a method and options,
@@ -77,6 +90,7 @@ pub struct Simulation {
     dynamics: ConstrainedDynamics,
     method: Method,
     options: Options,
+    contacts: Arc<[UnilateralContact]>,
 }
 
 impl Simulation {
@@ -121,7 +135,20 @@ impl Simulation {
             dynamics,
             method,
             options,
+            contacts: Arc::new([]),
         })
+    }
+
+    /// The same simulation with unilateral contacts (replacing any given before): every
+    /// closing of a gap is located and resolved as an impact ([`crate::contacts`],
+    /// (M.21)–(M.23)). Fails with [`MotionError::InvalidContact`] for a contact that names a
+    /// missing body, has a non-unit normal, a non-finite point or offset or an invalid law,
+    /// and for a mechanism with holonomic constraints, a rotating frame or a prescribed base
+    /// motion. Without contacts a run takes exactly the steps it takes without this call.
+    pub fn with_contacts(mut self, contacts: Vec<UnilateralContact>) -> Result<Self, MotionError> {
+        crate::contacts::validate(&contacts, &self.dynamics)?;
+        self.contacts = contacts.into();
+        Ok(self)
     }
 
     /// The method.
@@ -179,6 +206,7 @@ impl Simulation {
             monitors: stepper.monitors(),
             steps: stepper.main.steps(),
             companion_steps: stepper.companion.as_ref().map_or(0, |c| c.steps()),
+            impacts: stepper.impacts().to_vec(),
         })
     }
 }
@@ -200,6 +228,9 @@ fn positive(value: f64, what: &'static str) -> Result<(), MotionError> {
 pub struct Stepper {
     main: Integrator,
     companion: Option<Integrator>,
+    /// The contact states of the main and the companion run (when there are contacts).
+    main_contacts: Option<ContactRun>,
+    companion_contacts: Option<ContactRun>,
     ratio: f64,
     sample: Sample,
     /// Adaptive steps do not pass this time (the end of a run; the target of each advance
@@ -236,6 +267,20 @@ impl Stepper {
         let start = main.system_mut().measure(q0, q_dot0).map_err(fail)?;
         let energy = start.energy;
         main.set_tracker(Tracker::new(invariant, &start, &options.cyclic));
+        let contact_run = |run: &Integrator| -> Result<Option<ContactRun>, MotionError> {
+            if simulation.contacts.is_empty() {
+                return Ok(None);
+            }
+            let contacts = simulation.contacts.clone();
+            ContactRun::new(contacts, run, energy, options.max_impacts)
+                .map(Some)
+                .map_err(fail)
+        };
+        let main_contacts = contact_run(&main)?;
+        let companion_contacts = match &companion {
+            Some(c) => contact_run(c)?,
+            None => None,
+        };
         let sample = Sample {
             t: 0.0,
             q: q0.to_vec(),
@@ -246,6 +291,8 @@ impl Stepper {
         Ok(Self {
             main,
             companion,
+            main_contacts,
+            companion_contacts,
             ratio: simulation.method.companion_ratio(),
             sample,
             horizon: f64::INFINITY,
@@ -264,6 +311,11 @@ impl Stepper {
             || Tracker::new(Invariant::Energy, &Measurement::nothing(), &[]).monitors(),
             Tracker::monitors,
         )
+    }
+
+    /// The impacts of the main run so far, in time order (empty without contacts).
+    pub fn impacts(&self) -> &[ImpactEvent] {
+        self.main_contacts.as_ref().map_or(&[], ContactRun::events)
     }
 
     /// Steps of the main run so far.
@@ -294,11 +346,13 @@ impl Stepper {
             });
         }
         let horizon = if self.horizon.is_finite() { self.horizon } else { t };
-        let point = self.main.advance_to(t, horizon).map_err(|c| failure(&self.main, c))?;
+        let point = advance(&mut self.main, self.main_contacts.as_mut(), t, horizon);
+        let point = point.map_err(|c| failure(&self.main, c))?;
         let reported = self.main.report(&point).map_err(|c| failure(&self.main, c))?;
         let error = match &mut self.companion {
             Some(companion) => {
-                let other = companion.advance_to(t, horizon).map_err(|c| failure(&self.main, c))?;
+                let other = advance(companion, self.companion_contacts.as_mut(), t, horizon);
+                let other = other.map_err(|c| failure(&self.main, c))?;
                 let other = companion.report(&other).map_err(|c| failure(&self.main, c))?;
                 Some(estimate(&reported, &other, self.ratio, self.main.steps()))
             }
@@ -318,6 +372,20 @@ impl Stepper {
             error,
         };
         Ok(&self.sample)
+    }
+}
+
+/// `run` integrated to `t` (adaptive steps not passing `horizon`), through its contacts'
+/// impacts when it has contacts (whose steps then never pass `t`).
+fn advance(
+    run: &mut Integrator,
+    contacts: Option<&mut ContactRun>,
+    t: f64,
+    horizon: f64,
+) -> Result<Point, StepFailure> {
+    match contacts {
+        Some(contacts) => contacts.advance_to(run, t),
+        None => run.advance_to(t, horizon),
     }
 }
 
