@@ -1778,6 +1778,74 @@ typedef struct mech_motion_constraint_report_t {
 } mech_motion_constraint_report_t;
 #endif
 
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * A unilateral contact of a simulation: a body point against the plane n·x = offset of the
+ * environment (`contact.other_body` = −1), or against a point of another body. Its gap
+ * g = n·(x − x_other) − offset (m) must stay ≥ 0; `contact.normal` (world, unit) points from
+ * the plane or the other body into `contact.body`, and `contact.restitution`, `friction` and
+ * `law` give the impact law (one contact: that law; several at once: the simultaneous model).
+ */
+typedef struct mech_motion_contact_t {
+    /**
+     * The body points, normal and impact law.
+     */
+    struct mech_mechanism_contact_t contact;
+    /**
+     * The gap at which the contact closes, m.
+     */
+    double offset;
+} mech_motion_contact_t;
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * One impact of a simulation with contacts (world frame, SI units).
+ */
+typedef struct mech_motion_impact_t {
+    /**
+     * The time of the impact, s.
+     */
+    double t;
+    /**
+     * How many contacts took part (their indices: mech_simulation_impact_contacts).
+     */
+    size_t contact_count;
+    /**
+     * The smallest gap of those contacts at the impact, m: ≤ 0, the penetration left by
+     * locating the event to its tolerance.
+     */
+    double gap;
+    /**
+     * The largest approach speed −ġ of those contacts before the impact, m/s.
+     */
+    double approach_speed;
+    /**
+     * H just before the impact, J.
+     */
+    double energy_before;
+    /**
+     * H just after the impact, J.
+     */
+    double energy_after;
+    /**
+     * energy_before − energy_after, J (≥ 0 for a dissipative law).
+     */
+    double energy_lost;
+    /**
+     * H just before this impact minus H just after the previous one (or at t = 0), J: the
+     * integrator's drift over the free motion that ended here (or the work of dampers and
+     * applied forces there).
+     */
+    double segment_drift;
+    /**
+     * The impact's own error report: the single-contact process's impulse error (N·s) or the
+     * simultaneous model's complementarity residual (m/s).
+     */
+    double impulse_error;
+} mech_motion_impact_t;
+#endif
+
 #if defined(MECH_FEATURE_URDF)
 /**
  * How the URDF readers treat links that are not physical as written. Start from
@@ -5098,6 +5166,102 @@ mech_status_t mech_simulation_create_constrained(const struct mech_dynamics_t *d
  */
 mech_status_t mech_simulation_constraint_report(const struct mech_simulation_t *simulation,
                                                 struct mech_motion_constraint_report_t *report_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Creates a simulation of a copy of `dynamics` with the `contact_count` unilateral contacts
+ * `contacts` (the other arguments are those of mech_simulation_create). The initial state
+ * may touch a contact (gap ≤ 0) only if it opens from there.
+ *
+ * Errors: those of mech_simulation_create; MECH_STATUS_INVALID_ARGUMENT for a contact that
+ * names a missing body, has a normal that is not a unit vector (within 1e-9), a non-finite
+ * point or offset, or an invalid law, and for a dynamics with holonomic constraints, a
+ * rotating frame or a prescribed base motion. During mech_simulation_advance: a contact that
+ * stays closed after its impact (resting or sliding contact), impacts that accumulate
+ * faster than t can resolve, or more than 100 000 impacts stop the integration with
+ * MECH_STATUS_NOT_CONVERGED at the start of the step (mech_last_error says which).
+ *
+ * # Safety
+ * As mech_simulation_create; `contacts` must point to `contact_count` readable
+ * mech_motion_contact_t (it may be NULL when `contact_count` is 0).
+ */
+mech_status_t mech_simulation_create_with_contacts(const struct mech_dynamics_t *dynamics,
+                                                   const struct mech_motion_options_t *options,
+                                                   const struct mech_motion_contact_t *contacts,
+                                                   size_t contact_count,
+                                                   const double *q0,
+                                                   const double *q_dot0,
+                                                   const double *tau,
+                                                   size_t n,
+                                                   struct mech_simulation_t **simulation_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Writes the number of impacts so far (0 for a simulation without contacts) to `*count_out`.
+ *
+ * # Safety
+ * `simulation` must be a live handle and `count_out` writable.
+ */
+mech_status_t mech_simulation_impact_count(const struct mech_simulation_t *simulation,
+                                           size_t *count_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Writes impact `index` (0 ≤ index < mech_simulation_impact_count, in time order) to
+ * `*impact_out`.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT for an index past the count.
+ *
+ * # Safety
+ * `simulation` must be a live handle and `impact_out` writable.
+ */
+mech_status_t mech_simulation_impact(const struct mech_simulation_t *simulation,
+                                     size_t index,
+                                     struct mech_motion_impact_t *impact_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Writes, for impact `index`, the indices of the contacts that took part (into the array
+ * given at creation) to `contacts_out`, their impulses (world, N·s, on `contact.body`; the
+ * other body receives the opposite) to `impulses_out` and their modes (MECH_CONTACT_*) to
+ * `modes_out`, each `capacity` entries long; the number written is
+ * mech_motion_impact_t.contact_count. Any of the three may be NULL when not wanted.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT for an index past the count;
+ * MECH_STATUS_BAD_DIMENSION when `capacity` is below the contact count.
+ *
+ * # Safety
+ * `simulation` must be a live handle; the non-NULL outputs must point to `capacity`
+ * writable entries.
+ */
+mech_status_t mech_simulation_impact_contacts(const struct mech_simulation_t *simulation,
+                                              size_t index,
+                                              size_t capacity,
+                                              size_t *contacts_out,
+                                              struct mech_vec3_t *impulses_out,
+                                              mech_contact_mode_t *modes_out);
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/**
+ * Writes q̇ just before and just after impact `index` (n values each, the charts of
+ * mech_simulation_advance) to `q_dot_before_out` and `q_dot_after_out`.
+ *
+ * Errors: MECH_STATUS_INVALID_ARGUMENT for an index past the count;
+ * MECH_STATUS_BAD_DIMENSION when n is not the dof.
+ *
+ * # Safety
+ * `simulation` must be a live handle; both outputs must point to n writable doubles.
+ */
+mech_status_t mech_simulation_impact_velocities(const struct mech_simulation_t *simulation,
+                                                size_t index,
+                                                size_t n,
+                                                double *q_dot_before_out,
+                                                double *q_dot_after_out);
 #endif
 
 #if defined(MECH_FEATURE_URDF)

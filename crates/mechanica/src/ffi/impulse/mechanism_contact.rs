@@ -154,7 +154,7 @@ pub struct mech_mechanism_impact_t {
 }
 
 /// Reads and validates C contacts (the messages name the contact).
-fn contacts_from_c(raw: &[mech_mechanism_contact_t]) -> Result<Vec<MechanismContact>, FfiError> {
+pub(crate) fn contacts_from_c(raw: &[mech_mechanism_contact_t]) -> Result<Vec<MechanismContact>, FfiError> {
     let mut list = Vec::with_capacity(raw.len());
     for (i, c) in raw.iter().enumerate() {
         finite(&c.point, &format!("contacts[{i}].point"))?;

@@ -92,7 +92,7 @@ pub const MECH_CONTACT_SLIP_THEN_STICK: mech_contact_mode_t = 4;
 pub const MECH_CONTACT_REVERSED: mech_contact_mode_t = 5;
 
 /// The C value of a contact mode.
-fn mode_to_c(mode: ContactMode) -> mech_contact_mode_t {
+pub(crate) fn mode_to_c(mode: ContactMode) -> mech_contact_mode_t {
     match mode {
         ContactMode::NoImpact => MECH_CONTACT_NO_IMPACT,
         ContactMode::Frictionless => MECH_CONTACT_FRICTIONLESS,

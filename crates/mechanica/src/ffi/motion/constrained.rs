@@ -56,7 +56,7 @@ pub unsafe extern "C" fn mech_simulation_create_constrained(
             .clone();
         let initial: InitialValues = (q0, q_dot0, tau, n);
         // SAFETY: caller's contract.
-        unsafe { start(model, options, initial, simulation_out) }
+        unsafe { start(model, Vec::new(), options, initial, simulation_out) }
     })
 }
 

@@ -1,9 +1,11 @@
 //! C entry points of the motion crate: a simulation handle created on a dynamics handle, with
 //! the method and its step or tolerances in mech_motion_options_t; advancing to a time into
 //! caller buffers (q, q̇); the report of the global error estimate (M.13) and the monitors.
-//! [`constrained`]: simulations that keep the holonomic constraints of the dynamics handle.
+//! [`constrained`]: simulations that keep the holonomic constraints of the dynamics handle;
+//! [`contacts`]: simulations with unilateral contacts and their impacts.
 
 mod constrained;
+mod contacts;
 
 use super::boundary::{FfiError, boundary};
 use super::c_enum::{c_enum, enum_value};
@@ -15,6 +17,7 @@ use super::validate::*;
 use mechanica_dynamics::ConstrainedDynamics;
 use mechanica_motion::{
     Forcing, Invariant, Method, MomentumDrift, MotionError, Options, Simulation, StepFailure, Stepper,
+    UnilateralContact,
 };
 
 /// An integration method (int32_t).
@@ -112,6 +115,7 @@ impl From<MotionError> for FfiError {
             MotionError::NonFiniteResult { .. } => MECH_STATUS_OUT_OF_RANGE,
             MotionError::StepFailed { cause, .. } => match cause {
                 StepFailure::Dynamics(e) => FfiError::from(e.clone()).status,
+                StepFailure::Impact(e) => FfiError::from((**e).clone()).status,
                 StepFailure::SingularMassMatrix | StepFailure::SingularConstraints => MECH_STATUS_SINGULAR,
                 StepFailure::NonFinite { .. } | StepFailure::NonFiniteForce { .. } => MECH_STATUS_OUT_OF_RANGE,
                 _ => MECH_STATUS_NOT_CONVERGED,
@@ -192,19 +196,21 @@ pub unsafe extern "C" fn mech_simulation_create(
         let d = unsafe { mech_dynamics_t::borrow(dynamics, "dynamics") }?.dynamics();
         let model = ConstrainedDynamics::new(d.clone());
         // SAFETY: caller's contract.
-        unsafe { start(model, options, (q0, q_dot0, tau, n), simulation_out) }
+        unsafe { start(model, Vec::new(), options, (q0, q_dot0, tau, n), simulation_out) }
     })
 }
 
 /// The C inputs of a simulation's initial value problem: q₀, q̇₀, τ (may be NULL) and n.
 type InitialValues = (*const f64, *const f64, *const f64, usize);
 
-/// Starts a simulation of `model` with the C options and initial values and writes its handle.
+/// Starts a simulation of `model` with `contacts`, the C options and initial values, and
+/// writes its handle.
 ///
 /// # Safety
 /// As mech_simulation_create.
 unsafe fn start(
     model: ConstrainedDynamics,
+    contacts: Vec<UnilateralContact>,
     options: *const mech_motion_options_t,
     (q0, q_dot0, tau, n): InitialValues,
     simulation_out: *mut *mut mech_simulation_t,
@@ -224,7 +230,7 @@ unsafe fn start(
         Some(unsafe { read_slice(tau, n, "tau") }?)
     };
     let (method, options) = rust_options(&defaults, tau)?;
-    let simulation = Simulation::constrained(model, method, options)?;
+    let simulation = Simulation::constrained(model, method, options)?.with_contacts(contacts)?;
     let stepper = simulation.start(q0, q_dot0)?;
     // SAFETY: caller's contract.
     unsafe { out.write(mech_simulation_t { stepper }.into_raw()) };
