@@ -1821,6 +1821,10 @@ typedef struct mech_motion_impact_t {
      */
     double approach_speed;
     /**
+     * The kinetic energy ½ q̇ᵀA q̇ just before the impact, J (the scale of the loss).
+     */
+    double kinetic_energy_before;
+    /**
      * H just before the impact, J.
      */
     double energy_before;

@@ -90,6 +90,7 @@ static void check_bounces(mech_motion_method_t method) {
             CHECK_NEAR(impact.approach_speed, v, 1e-8 * v);
             CHECK_NEAR(impact.energy_lost, 0.5 * m * v * v * (1.0 - e * e), 1e-7 * m * v * v);
             CHECK_NEAR(impact.energy_before - impact.energy_after, impact.energy_lost, 1e-12 * m * v * v);
+            CHECK_NEAR(impact.kinetic_energy_before, 0.5 * m * v * v, 1e-8 * m * v * v);
             CHECK(fabs(impact.segment_drift) <= 1e-9 * m * g * h0);
             size_t which = 99;
             mech_vec3_t impulse = {0, 0, 0};

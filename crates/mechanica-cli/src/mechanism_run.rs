@@ -493,7 +493,7 @@ fn sample_response(
     Ok((series, out))
 }
 
-fn law_named(name: &str) -> RestitutionLaw {
+pub(crate) fn law_named(name: &str) -> RestitutionLaw {
     match name {
         "newton" => RestitutionLaw::Newton,
         "poisson" => RestitutionLaw::Poisson,
@@ -592,7 +592,7 @@ fn impact_record(
 }
 
 /// The record's name of a contact mode.
-fn contact_mode(mode: ContactMode) -> ContactModeName {
+pub(crate) fn contact_mode(mode: ContactMode) -> ContactModeName {
     match mode {
         ContactMode::NoImpact => ContactModeName::NoImpact,
         ContactMode::Frictionless => ContactModeName::Frictionless,

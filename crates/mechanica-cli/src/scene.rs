@@ -85,6 +85,9 @@
 //!                                      # and the damped modes are not computed
 //! ```
 //!
+//! Unilateral contacts (`[[contact]]`, see `scene/contacts.rs`) are kept by `simulate`: each
+//! impact is located, resolved with its restitution law and reported with its energy loss.
+//!
 //! Constraints (`[[constraint]]`, kinds "points", "plane", "distance", "coordinate") are used by
 //! the dynamics analysis and kept by `simulate`: a scene with constraints that asks for the
 //! unconstrained equilibrium, modes, free response or impact is refused rather than answered
@@ -98,10 +101,13 @@
 
 #[path = "scene/constraints.rs"]
 mod constraints;
+#[path = "scene/contacts.rs"]
+mod contacts;
 #[path = "scene/simulate.rs"]
 mod simulate;
 
 pub use constraints::ConstraintSpec;
+pub use contacts::ContactSpec;
 use serde::Deserialize;
 pub use simulate::{DEFAULT_SIMULATE_STEPS, SimulateSpec};
 use std::collections::HashMap;
@@ -143,6 +149,9 @@ pub struct Scene {
     /// Holonomic constraints closing loops or holding points (used by the dynamics).
     #[serde(default, rename = "constraint")]
     pub constraints: Vec<ConstraintSpec>,
+    /// Unilateral contacts kept by `simulate` (impacts during the motion).
+    #[serde(default, rename = "contact")]
+    pub contacts: Vec<ContactSpec>,
     /// The analyses requested; nothing else is computed.
     #[serde(default)]
     pub analyses: Analyses,
@@ -585,6 +594,7 @@ impl Scene {
         validator.check_joint_springs()?;
         validator.check_dampers()?;
         validator.check_constraints(&index_of)?;
+        validator.check_contacts(&index_of)?;
         validator.check_analyses()
     }
 }

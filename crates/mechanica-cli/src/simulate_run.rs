@@ -11,9 +11,13 @@ use crate::plots::{PlotData, SimulationSeries};
 use crate::report::{Step, timed_step};
 use crate::scene::{DEFAULT_SIMULATE_STEPS, Scene, SimulateSpec};
 use crate::scene_run::Model;
-use mechanica::motion::{Forcing, Invariant, Method, MotionError, Options, Simulation, Trajectory};
+use mechanica::impulse::{BodyPoint, ContactLaw, MechanismContact};
+use mechanica::kinematics::nalgebra::Vector3;
+use mechanica::motion::{
+    Forcing, ImpactEvent, Invariant, Method, MotionError, Options, Simulation, Trajectory, UnilateralContact,
+};
 pub use record::SimulateRecord;
-use record::{ConstraintRecord, InvariantName, MethodName, MonitorRecord};
+use record::{ConstraintRecord, ImpactEventRecord, InvariantName, MethodName, MonitorRecord};
 use std::path::Path;
 
 /// Runs the simulation when the scene asks for it.
@@ -39,14 +43,15 @@ pub fn run(
     };
     let method = method_of(spec);
     let constrained = crate::constraint_run::build(scene, model, dynamics)?;
-    let simulation =
-        Simulation::constrained(constrained, method, options).map_err(|e| format!("analyses.simulate: {e}"))?;
+    let simulation = Simulation::constrained(constrained, method, options)
+        .and_then(|s| s.with_contacts(contacts_of(scene)?))
+        .map_err(|e| format!("analyses.simulate: {e}"))?;
     let names = crate::scene_run::coordinate_names(model);
     let mut trajectory = None;
-    let kept = if scene.constraints.is_empty() {
-        ""
-    } else {
-        ", constraints kept (M.17)–(M.19)"
+    let kept = match (scene.constraints.is_empty(), scene.contacts.is_empty()) {
+        (false, _) => ", constraints kept (M.17)–(M.19)",
+        (true, false) => ", impacts at the contacts located and resolved (M.21)–(M.23)",
+        _ => "",
     };
     let title = format!(
         "simulate: motion from (q0, qd0) to t = {} s by {} (M.3)–(M.11){kept}, error by a companion run (M.13)",
@@ -55,7 +60,10 @@ pub fn run(
     );
     let mut step = timed_step(&title, || {
         let result = integrate(&simulation, model, spec)?;
-        let record = summary(spec, &result, &names, !scene.constraints.is_empty());
+        let mut record = summary(spec, &result, &names, !scene.constraints.is_empty());
+        if !scene.contacts.is_empty() {
+            record.impacts = Some(result.impacts.iter().map(|e| impact_record(scene, e)).collect());
+        }
         trajectory = Some(result);
         Ok::<_, String>(record)
     })?;
@@ -69,6 +77,73 @@ pub fn run(
     plots.simulation = Some(series(&trajectory, names));
     steps.push(step);
     Ok(())
+}
+
+/// The scene's contacts for the library (validated by the scene: bodies exist, numbers are
+/// finite, the normal is non-zero and is normalised here). Body indices are the scene's order.
+fn contacts_of(scene: &Scene) -> Result<Vec<UnilateralContact>, MotionError> {
+    let index = |name: &str| scene.bodies.iter().position(|b| b.name.get_ref() == name);
+    let mut contacts = Vec::with_capacity(scene.contacts.len());
+    for (i, spec) in scene.contacts.iter().enumerate() {
+        let invalid = |reason: String| MotionError::InvalidContact { index: i, reason };
+        let body = index(spec.body.get_ref()).ok_or_else(|| invalid("unknown body".into()))?;
+        let other = match &spec.other {
+            Some(name) => Some(BodyPoint {
+                body: index(name.get_ref()).ok_or_else(|| invalid("unknown other body".into()))?,
+                p_bq: Vector3::from(spec.other_point),
+            }),
+            None => None,
+        };
+        let law_kind = crate::mechanism_run::law_named(spec.law_name());
+        let law = ContactLaw::new(spec.restitution(), spec.friction(), law_kind).map_err(|e| invalid(e.to_string()))?;
+        let normal = Vector3::from(*spec.normal.get_ref());
+        contacts.push(UnilateralContact {
+            contact: MechanismContact {
+                point: BodyPoint {
+                    body,
+                    p_bq: Vector3::from(spec.point),
+                },
+                other,
+                normal_w: normal / normal.norm(),
+                law,
+            },
+            offset: spec.offset,
+        });
+    }
+    Ok(contacts)
+}
+
+/// The report's record of one impact, with the contacts named.
+fn impact_record(scene: &Scene, event: &ImpactEvent) -> ImpactEventRecord {
+    ImpactEventRecord {
+        t: event.t,
+        contacts: event
+            .contacts
+            .iter()
+            .map(|&i| {
+                scene
+                    .contacts
+                    .get(i)
+                    .map_or_else(|| format!("contact[{i}]"), |c| c.label(i))
+            })
+            .collect(),
+        impulses: event.impulses.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        modes: event
+            .modes
+            .iter()
+            .map(|m| crate::mechanism_run::contact_mode(*m))
+            .collect(),
+        gap: event.gap,
+        approach_speed: event.approach_speed,
+        kinetic_energy_before: event.kinetic_energy_before,
+        energy_before: event.energy_before,
+        energy_after: event.energy_after,
+        energy_lost: event.energy_lost(),
+        segment_drift: event.segment_drift,
+        impulse_error: event.impulse_error,
+        q_dot_before: event.q_dot_before.clone(),
+        q_dot_after: event.q_dot_after.clone(),
+    }
 }
 
 /// The library's method for the scene's name and parameters (validated by the scene).
@@ -165,6 +240,7 @@ fn summary(spec: &SimulateSpec, trajectory: &Trajectory, names: &[String], const
             max_position_drift: m.constraints.max_position,
             max_velocity_drift: m.constraints.max_velocity,
         }),
+        impacts: None,
         files: Vec::new(),
     }
 }
@@ -192,13 +268,23 @@ fn series(trajectory: &Trajectory, names: Vec<String>) -> SimulationSeries {
     let samples = &trajectory.samples;
     let initial = trajectory.monitors.initial;
     let scale = trajectory.monitors.scale;
+    // H(0) minus the losses of the impacts up to t: what H would be without integrator drift.
+    let booked = |t: f64| {
+        let lost: f64 = trajectory
+            .impacts
+            .iter()
+            .filter(|i| i.t <= t)
+            .map(ImpactEvent::energy_lost)
+            .sum();
+        initial - lost
+    };
     SimulationSeries {
         times: samples.iter().map(|s| s.t).collect(),
         coordinates: (0..names.len())
             .map(|k| samples.iter().map(|s| s.q[k]).collect())
             .collect(),
         names,
-        drift: samples.iter().map(|s| (s.energy - initial).abs() / scale).collect(),
+        drift: samples.iter().map(|s| (s.energy - booked(s.t)).abs() / scale).collect(),
         error_q: samples.iter().map(|s| s.error.map_or(f64::NAN, |e| e.q)).collect(),
         error_q_dot: samples.iter().map(|s| s.error.map_or(f64::NAN, |e| e.q_dot)).collect(),
     }

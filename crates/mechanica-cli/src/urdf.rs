@@ -61,6 +61,7 @@ pub fn load(path: &Path, options: UrdfOptions) -> Result<(Scene, Vec<String>), S
         joint_dampers: Vec::new(),
         dampers: Vec::new(),
         constraints: Vec::new(),
+        contacts: Vec::new(),
         analyses: Analyses {
             mass_properties: true,
             equilibrium: Some(EquilibriumSpec {

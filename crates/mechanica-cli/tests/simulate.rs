@@ -187,3 +187,101 @@ fn bad_simulation_options_are_refused_with_the_field_named() {
         assert!(!ok && err.contains(field), "{spec}: {err}");
     }
 }
+
+/// A point mass on a prismatic joint along z dropped from h₀ on a `[[contact]]` floor: the
+/// reported impacts against the closed form t_{k+1} = t_k + 2 e^k v₁/g, v_k = e^{k−1} v₁ and
+/// losses ½ m v_k² (1 − e²), for a family of masses, heights and restitutions, and the text
+/// report names the contact.
+#[test]
+fn bouncing_mass_on_a_contact_matches_the_closed_form() {
+    for (case, (m, h0, e)) in [
+        (0.3, 0.7, 0.5),
+        (12.0, 2.5, 0.8),
+        (1e-3, 0.05, 0.35),
+        (450.0, 9.0, 0.65),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let v1 = (2.0 * G * h0).sqrt();
+        let mut times = vec![v1 / G];
+        for k in 1..3 {
+            times.push(times[k - 1] + 2.0 * f64::powi(e, k as i32) * v1 / G);
+        }
+        let t_end = times[2] + f64::powi(e, 3) * v1 / G;
+        let scene = format!(
+            r#"title = "bouncing mass"
+gravity = [0.0, 0.0, -{G:?}]
+[[body]]
+name = "ball"
+primitive = {{ shape = "point", mass = {m:?} }}
+[[joint]]
+name = "drop"
+type = "prismatic"
+parent = "ground"
+child = "ball"
+axis = [0.0, 0.0, 1.0]
+q0 = [{h0:?}]
+[[contact]]
+name = "floor"
+body = "ball"
+normal = [0.0, 0.0, 2.0]
+restitution = {e:?}
+law = "newton"
+[analyses]
+simulate = {{ t_end = {t_end:?}, tolerance = 1e-11, atol = 1e-13, interval = {t_end:?} }}
+"#
+        );
+        let report = run_json(&format!("bounce-{case}"), &scene);
+        let record = step(&report, "simulate");
+        let impacts = record["impacts"].as_array().expect("impacts");
+        assert_eq!(impacts.len(), 3, "case {case}");
+        for (k, impact) in impacts.iter().enumerate() {
+            let v = f64::powi(e, k as i32) * v1;
+            let lost = 0.5 * m * v * v * (1.0 - e * e);
+            let at = format!("case {case} impact {k}");
+            let get = |key: &str| impact[key].as_f64().unwrap_or_else(|| panic!("{at}: {key}"));
+            assert!((get("t") - times[k]).abs() <= 1e-8 * times[k], "{at}: t {}", get("t"));
+            assert!(
+                (get("energy_lost") - lost).abs() <= 1e-7 * lost,
+                "{at}: lost {}",
+                get("energy_lost")
+            );
+            assert!((get("approach_speed") - v).abs() <= 1e-7 * v, "{at}");
+            assert_eq!(impact["contacts"][0], "floor", "{at}");
+            assert_eq!(impact["modes"][0], "frictionless", "{at}");
+        }
+        let q_end = numbers(&record["q_end"]);
+        let apex = f64::powi(f64::powi(e, 3) * v1, 2) / (2.0 * G);
+        assert!(
+            (q_end[0] - apex).abs() <= 1e-7 * h0,
+            "case {case}: {} vs {apex}",
+            q_end[0]
+        );
+    }
+    let (ok, out, err) = mechanica(&["run", "../../examples/scenes/striking_double_pendulum.toml"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("tip on wall") && out.contains("dissipated"), "{out}");
+}
+
+/// Contacts with a bad normal, restitution, law or body are refused with the field named.
+#[test]
+fn bad_contacts_are_located() {
+    let base = pendulum(1.0, 0.5, "{ t_end = 1.0 }");
+    for (field, table) in [
+        ("contact[0].normal", "body = \"bob\"\nnormal = [0.0, 0.0, 0.0]"),
+        (
+            "contact[0].restitution",
+            "body = \"bob\"\nnormal = [0.0, 0.0, 1.0]\nrestitution = 1.5",
+        ),
+        (
+            "contact[0].law",
+            "body = \"bob\"\nnormal = [0.0, 0.0, 1.0]\nlaw = \"hooke\"",
+        ),
+        ("contact[0].body", "body = \"nobody\"\nnormal = [0.0, 0.0, 1.0]"),
+    ] {
+        let scene = format!("{base}\n[[contact]]\n{table}\n");
+        let (ok, _, err) = run("bad-contact", &scene);
+        assert!(!ok && err.contains(field), "{field}: {err}");
+    }
+}

@@ -1,6 +1,7 @@
 //! The record of a simulation: the final state with its estimated global error, the costs and
 //! the monitor of the conserved quantity.
 
+use crate::mechanism_run::records::ContactModeName;
 use crate::report::text::{Precision, Text, bound, number};
 use serde::Serialize;
 
@@ -54,6 +55,41 @@ pub struct ConstraintRecord {
     pub max_velocity_drift: f64,
 }
 
+/// One impact during the motion (theory (M.23)).
+#[derive(Debug, Clone, Serialize)]
+pub struct ImpactEventRecord {
+    /// The time of the impact, s.
+    pub t: f64,
+    /// The contacts that took part, by name.
+    pub contacts: Vec<String>,
+    /// Their impulses, world, N·s (in the order of `contacts`).
+    pub impulses: Vec<[f64; 3]>,
+    /// Their modes at the end of the impact.
+    pub modes: Vec<ContactModeName>,
+    /// The smallest gap at the impact, m (≤ 0: the penetration left by locating the event).
+    pub gap: f64,
+    /// The largest approach speed, m/s.
+    pub approach_speed: f64,
+    /// The kinetic energy just before the impact, J.
+    pub kinetic_energy_before: f64,
+    /// H just before the impact, J.
+    pub energy_before: f64,
+    /// H just after the impact, J.
+    pub energy_after: f64,
+    /// energy_before − energy_after, J.
+    pub energy_lost: f64,
+    /// H just before this impact minus H just after the previous one (or at t = 0), J: the
+    /// integrator's drift over the free motion before it.
+    pub segment_drift: f64,
+    /// The impact's own error: the process's impulse error (N·s) or the simultaneous model's
+    /// residual (m/s).
+    pub impulse_error: f64,
+    /// q̇ just before, rad/s | m/s.
+    pub q_dot_before: Vec<f64>,
+    /// q̇ just after, rad/s | m/s.
+    pub q_dot_after: Vec<f64>,
+}
+
 /// A simulation from (q0, qd0) to t_end.
 #[derive(Debug, Clone, Serialize)]
 pub struct SimulateRecord {
@@ -90,6 +126,9 @@ pub struct SimulateRecord {
     /// The constraint drift, for a scene with constraints.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub constraints: Option<ConstraintRecord>,
+    /// The impacts, in time order, for a scene with contacts.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub impacts: Option<Vec<ImpactEventRecord>>,
     /// Trajectory files written (CSV, JSON).
     pub files: Vec<String>,
 }
@@ -135,8 +174,42 @@ impl SimulateRecord {
                 &format!("{}, {}", bound(c.max_position_drift), bound(c.max_velocity_drift)),
             );
         }
+        if let Some(impacts) = &self.impacts {
+            write_impacts(out, impacts);
+        }
         for file in &self.files {
             out.note(&format!("trajectory written to {file}"));
         }
     }
+}
+
+/// The impacts, one line each, and the energy books over the run.
+fn write_impacts(out: &mut Text, impacts: &[ImpactEventRecord]) {
+    out.line("impacts (M.23)", &impacts.len().to_string());
+    for (k, i) in impacts.iter().enumerate() {
+        let share = if i.kinetic_energy_before > 0.0 {
+            format!(
+                " ({} % of T⁻)",
+                number(100.0 * i.energy_lost / i.kinetic_energy_before, 3)
+            )
+        } else {
+            String::new()
+        };
+        out.line(
+            &format!("impact {k}: t = {} s, {}", number(i.t, 10), i.contacts.join(", ")),
+            &format!(
+                "approach {} m/s, energy lost {} J{share}, drift before it {} J",
+                number(i.approach_speed, 4),
+                number(i.energy_lost, 4),
+                bound(i.segment_drift)
+            ),
+        );
+    }
+    let lost: f64 = impacts.iter().map(|i| i.energy_lost).sum();
+    let drift: f64 = impacts.iter().map(|i| i.segment_drift.abs()).sum();
+    out.note(&format!(
+        "the impacts dissipated {} J in all; the integrator's drift between them adds up to at most {} J",
+        number(lost, 4),
+        bound(drift)
+    ));
 }

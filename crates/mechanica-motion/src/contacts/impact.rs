@@ -56,6 +56,7 @@ pub(crate) fn resolve(
         approach_speed: hitting.iter().map(|&i| -gaps[i].rate).fold(0.0, f64::max),
         impulses: impact.contacts.iter().map(|c| c.impulse_w).collect(),
         modes: impact.contacts.iter().map(|c| c.mode).collect(),
+        kinetic_energy_before: impact.energy_before,
         energy_before: before.energy,
         energy_after: after.energy,
         segment_drift: before.energy - segment_start,

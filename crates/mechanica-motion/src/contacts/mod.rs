@@ -57,6 +57,8 @@ pub struct ImpactEvent {
     pub impulses: Vec<Vector3<f64>>,
     /// The contact mode of each contact at the end of the impact.
     pub modes: Vec<ContactMode>,
+    /// The kinetic energy T⁻ = ½ q̇⁻ᵀ A q̇⁻ just before the impact (J): the scale of the loss.
+    pub kinetic_energy_before: f64,
     /// H just before the impact (J).
     pub energy_before: f64,
     /// H just after the impact (J); H⁺ − H⁻ = ΔT, the work of the impulses.

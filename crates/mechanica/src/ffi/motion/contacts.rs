@@ -41,6 +41,8 @@ pub struct mech_motion_impact_t {
     pub gap: f64,
     /// The largest approach speed −ġ of those contacts before the impact, m/s.
     pub approach_speed: f64,
+    /// The kinetic energy ½ q̇ᵀA q̇ just before the impact, J (the scale of the loss).
+    pub kinetic_energy_before: f64,
     /// H just before the impact, J.
     pub energy_before: f64,
     /// H just after the impact, J.
@@ -170,6 +172,7 @@ pub unsafe extern "C" fn mech_simulation_impact(
             contact_count: e.contacts.len(),
             gap: e.gap,
             approach_speed: e.approach_speed,
+            kinetic_energy_before: e.kinetic_energy_before,
             energy_before: e.energy_before,
             energy_after: e.energy_after,
             energy_lost: e.energy_lost(),
