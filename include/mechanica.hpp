@@ -5,7 +5,7 @@
  * Header-only; link the same library as for C (pkg-config `mechanica`, or the CMake target
  * `mechanica::mechanica`). Every failed C call throws mechanica::error, which carries the
  * ::mech_status_t and the text of mech_last_error(). Handles (tree, mechanism, modal_result,
- * dynamics) own their C handle, are movable and not copyable. Arrays are passed as
+ * dynamics, simulation) own their C handle, are movable and not copyable. Arrays are passed as
  * mechanica::const_span (std::span<const double> when the standard library has it, else a
  * pointer and a size); results come back as mechanica::matrix, column-major with data(),
  * rows() and cols(), so `Eigen::Map<const Eigen::MatrixXd>(m.data(), m.rows(), m.cols())` views
@@ -353,6 +353,79 @@ private:
         if (a.size() != b.size() || a.size() != c.size())
             throw error(MECH_STATUS_BAD_DIMENSION, "the three vectors must have the same length");
     }
+};
+#endif
+
+#if defined(MECH_FEATURE_MOTION)
+/** A simulation (mech_simulation_t): a copy of a dynamics integrated in time from an initial
+ * state, with its global error estimate, monitors and, with contacts, its impacts. */
+class simulation : public handle<mech_simulation_t, mech_simulation_destroy> {
+public:
+    /** The state (q, q̇) at a time. */
+    struct state {
+        std::vector<double> q, q_dot;
+    };
+    /** The default options (mech_motion_options_default). */
+    static mech_motion_options_t default_options() {
+        mech_motion_options_t options;
+        detail::check(mech_motion_options_default(&options));
+        return options;
+    }
+    /** A simulation of `d` without its constraints (mech_simulation_create). */
+    static simulation create(const dynamics &d, const mech_motion_options_t &options, const_span q0, const_span q_dot0) {
+        same_length(q0, q_dot0);
+        mech_simulation_t *raw = nullptr;
+        detail::check(mech_simulation_create(d.get(), &options, q0.data(), q_dot0.data(), nullptr, q0.size(), &raw));
+        return simulation(raw, q0.size());
+    }
+    /** A simulation that keeps the holonomic constraints of `d` (mech_simulation_create_constrained). */
+    static simulation constrained(const dynamics &d, const mech_motion_options_t &options, const_span q0,
+                                  const_span q_dot0) {
+        same_length(q0, q_dot0);
+        mech_simulation_t *raw = nullptr;
+        detail::check(
+            mech_simulation_create_constrained(d.get(), &options, q0.data(), q_dot0.data(), nullptr, q0.size(), &raw));
+        return simulation(raw, q0.size());
+    }
+    /** A simulation with unilateral contacts and their impacts (mech_simulation_create_with_contacts). */
+    static simulation with_contacts(const dynamics &d, const mech_motion_options_t &options,
+                                    const std::vector<mech_motion_contact_t> &contacts, const_span q0,
+                                    const_span q_dot0) {
+        same_length(q0, q_dot0);
+        mech_simulation_t *raw = nullptr;
+        detail::check(mech_simulation_create_with_contacts(d.get(), &options, contacts.data(), contacts.size(),
+                                                           q0.data(), q_dot0.data(), nullptr, q0.size(), &raw));
+        return simulation(raw, q0.size());
+    }
+    /** Integrates to `t` (mech_simulation_advance) and gives (q, q̇) there. */
+    state advance(double t) {
+        state s{std::vector<double>(n_), std::vector<double>(n_)};
+        detail::check(mech_simulation_advance(get(), t, n_, s.q.data(), s.q_dot.data()));
+        return s;
+    }
+    /** The error estimate and energy monitor at the time reached (mech_simulation_report). */
+    mech_motion_report_t report() const {
+        mech_motion_report_t r;
+        detail::check(mech_simulation_report(get(), &r));
+        return r;
+    }
+    /** The impacts so far, in time order (mech_simulation_impact). */
+    std::vector<mech_motion_impact_t> impacts() const {
+        std::size_t count = 0;
+        detail::check(mech_simulation_impact_count(get(), &count));
+        std::vector<mech_motion_impact_t> out(count);
+        for (std::size_t k = 0; k < count; ++k) detail::check(mech_simulation_impact(get(), k, &out[k]));
+        return out;
+    }
+    /** Number of coordinates. */
+    std::size_t dof() const noexcept { return n_; }
+
+private:
+    simulation(mech_simulation_t *raw, std::size_t n) : handle(raw), n_(n) {}
+    static void same_length(const_span a, const_span b) {
+        if (a.size() != b.size()) throw error(MECH_STATUS_BAD_DIMENSION, "q0 and q_dot0 must have the same length");
+    }
+    std::size_t n_ = 0;
 };
 #endif
 

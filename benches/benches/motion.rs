@@ -2,16 +2,19 @@
 //! and placements from a fixed seed, gravity, joint springs), each integrating 1 s of motion
 //! from the same state: RK4 and Störmer–Verlet at h = 1e-3 s, the implicit midpoint rule at
 //! h = 1e-3 s, Dormand–Prince at rtol = 1e-8; each without and with the companion run of the
-//! global error estimate.
+//! global error estimate. The group "contacts" runs the same chain with a unilateral contact
+//! at the last body that stays open (the cost of checking every step for events, theory
+//! (M.22)) beside the run without contacts.
 
 use criterion::Criterion;
+use mechanica::impulse::{BodyPoint, ContactLaw, MechanismContact, RestitutionLaw};
 use mechanica::kinematics::nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 use mechanica::kinematics::tree::{Joint, TreeBuilder};
 use mechanica::mass::MassProperties;
 use mechanica::mechanism::Mechanism;
 use mechanica::mechanism::potentials::JointSpring;
 use mechanica_dynamics::Dynamics;
-use mechanica_motion::{Method, Options, Simulation};
+use mechanica_motion::{Method, Options, Simulation, UnilateralContact};
 use std::hint::black_box;
 
 const LINKS: usize = 7;
@@ -96,5 +99,47 @@ fn main() {
         }
     }
     group.finish();
+    contacts(&mut criterion, &dynamics, &q0, &v0);
     criterion.final_summary();
+}
+
+/// The chain without contacts and with one open contact (a plane 100 m below the last body).
+fn contacts(criterion: &mut Criterion, dynamics: &Dynamics, q0: &[f64], v0: &[f64]) {
+    let far_floor = UnilateralContact {
+        contact: MechanismContact {
+            point: BodyPoint {
+                body: LINKS - 1,
+                p_bq: Vector3::zeros(),
+            },
+            other: None,
+            normal_w: Vector3::z(),
+            law: ContactLaw::new(0.5, 0.3, RestitutionLaw::Stronge).expect("law"),
+        },
+        offset: -100.0,
+    };
+    let mut group = criterion.benchmark_group("contacts 7-link chain, 1 s");
+    let methods = [
+        ("rk4 h=1e-3", Method::Rk4 { step: 1e-3 }),
+        (
+            "dopri rtol=1e-8",
+            Method::DormandPrince {
+                rtol: 1e-8,
+                atol: 1e-10,
+            },
+        ),
+    ];
+    for (name, method) in methods {
+        let options = Options {
+            estimate_error: false,
+            ..Options::default()
+        };
+        let plain = Simulation::new(dynamics.clone(), method, options).expect("simulation");
+        let checked = plain.clone().with_contacts(vec![far_floor]).expect("contacts");
+        for (label, simulation) in [("no contact", plain), ("open contact", checked)] {
+            group.bench_function(format!("{name}, {label}"), |b| {
+                b.iter(|| black_box(simulation.run(q0, v0, 1.0, 0.1).expect("run")))
+            });
+        }
+    }
+    group.finish();
 }
