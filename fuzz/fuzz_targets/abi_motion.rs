@@ -10,7 +10,10 @@
 //! - the report and the momentum monitors are finite whenever they are returned with
 //!   MECH_STATUS_OK, the drifts and scales non-negative, the error estimates −1 exactly when
 //!   the companion run is off, the invariant the Jacobi integral exactly with a rotating frame;
-//! - a failed advance leaves the report's time and the outputs where they were.
+//! - a failed advance leaves the report's time and the outputs where they were;
+//! - with unilateral contacts (random bodies, points, normals, offsets and laws, some invalid):
+//!   the impacts come in time order, at most one per step, each with
+//!   at least one contact and finite numbers, and the queries refuse indices past the count.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -105,20 +108,36 @@ fn create(d: &OwnedDynamics, input: &mut Input) -> Option<(OwnedSimulation, bool
         ),
     };
     let mut simulation = std::ptr::null_mut();
+    let contacts = (input.u8() < 96).then(|| contacts(d, input));
     trace!(
-        "simulation_create(n {len}, q0 {q0:?}, q̇0 {q_dot0:?}, τ {:?}, options {o:?})",
+        "simulation_create(n {len}, q0 {q0:?}, q̇0 {q_dot0:?}, τ {:?}, options {o:?}, contacts {contacts:?})",
         (!tau_ptr.is_null()).then_some(&tau)
     );
-    let status = unsafe {
-        mech_simulation_create(
-            handle,
-            options_ptr,
-            q0.as_ptr(),
-            q_dot0.as_ptr(),
-            tau_ptr,
-            len,
-            &mut simulation,
-        )
+    let status = match &contacts {
+        None => unsafe {
+            mech_simulation_create(
+                handle,
+                options_ptr,
+                q0.as_ptr(),
+                q_dot0.as_ptr(),
+                tau_ptr,
+                len,
+                &mut simulation,
+            )
+        },
+        Some(list) => unsafe {
+            mech_simulation_create_with_contacts(
+                handle,
+                options_ptr,
+                list.as_ptr(),
+                list.len(),
+                q0.as_ptr(),
+                q_dot0.as_ptr(),
+                tau_ptr,
+                len,
+                &mut simulation,
+            )
+        },
     };
     check_call("mech_simulation_create", status, simulation.is_null(), &[]);
     if let Some(expected) = bad {
@@ -137,6 +156,79 @@ fn create(d: &OwnedDynamics, input: &mut Input) -> Option<(OwnedSimulation, bool
         return None;
     }
     Some((OwnedSimulation(simulation), estimate))
+}
+
+/// Up to three contacts: mostly a body point against a plane with a unit normal, sometimes a
+/// point of another body, a missing body, a normal that is not a unit vector, or a restitution,
+/// friction, law or offset that is out of range.
+fn contacts(d: &OwnedDynamics, input: &mut Input) -> Vec<mech_motion_contact_t> {
+    (0..input.below(4))
+        .map(|_| {
+            let axis = vec_or(input, 1.0);
+            let length = (axis.x * axis.x + axis.y * axis.y + axis.z * axis.z).sqrt();
+            let normal = if input.u8() < 232 && length > 1e-3 && length.is_finite() {
+                mech_vec3_t {
+                    x: axis.x / length,
+                    y: axis.y / length,
+                    z: axis.z / length,
+                }
+            } else {
+                axis
+            };
+            let other_body = match input.u8() {
+                0..=199 => -1,
+                200..=249 => input.below(d.bodies + 1) as i64,
+                _ => -(input.below(3) as i64) - 2,
+            };
+            mech_motion_contact_t {
+                contact: mech_mechanism_contact_t {
+                    body: input.below(d.bodies + 1),
+                    point: vec_or(input, 1.0),
+                    other_body,
+                    other_point: vec_or(input, 1.0),
+                    normal,
+                    restitution: if input.u8() < 240 { input.fraction() } else { input.any_f64() },
+                    friction: if input.u8() < 240 { graded(input, 2) } else { input.any_f64() },
+                    law: input.enum_i32(2),
+                },
+                offset: any_or(input, 3.0),
+            }
+        })
+        .collect()
+}
+
+/// The impacts so far (including those of an advance that failed later on), checked against
+/// the steps taken.
+fn impacts(s: &OwnedSimulation, steps: u64) {
+    let mut count = usize::MAX;
+    let status = unsafe { mech_simulation_impact_count(s.0, &mut count) };
+    assert_eq!(status, MECH_STATUS_OK, "impact count");
+    assert!(count as u64 <= steps, "{count} impacts in {steps} steps");
+    let mut previous = 0.0;
+    for k in 0..count {
+        let mut impact = Sentinel::<mech_motion_impact_t>::new();
+        let status = unsafe { mech_simulation_impact(s.0, k, impact.ptr()) };
+        assert_eq!(status, MECH_STATUS_OK, "impact {k}");
+        let i = impact.value;
+        let numbers = [
+            i.t,
+            i.gap,
+            i.approach_speed,
+            i.kinetic_energy_before,
+            i.energy_before,
+            i.energy_after,
+            i.energy_lost,
+            i.segment_drift,
+            i.impulse_error,
+        ];
+        assert!(numbers.iter().all(|x| x.is_finite()), "impact {k}: {i:?}");
+        assert!(i.t >= previous, "impact {k} at {} before the previous one at {previous}", i.t);
+        assert!(i.contact_count >= 1 && i.approach_speed > 0.0, "impact {k}: {i:?}");
+        previous = i.t;
+    }
+    let mut beyond = Sentinel::<mech_motion_impact_t>::new();
+    let status = unsafe { mech_simulation_impact(s.0, count, beyond.ptr()) };
+    assert_eq!(status, MECH_STATUS_INVALID_ARGUMENT, "impact past the count");
 }
 
 /// The report and the momentum monitors, checked; the report is returned when it was.
@@ -274,5 +366,6 @@ fuzz_target!(|data: &[u8]| {
             r.t
         );
         reached = r.t;
+        impacts(&s, r.steps);
     }
 });

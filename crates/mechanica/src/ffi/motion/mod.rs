@@ -7,6 +7,9 @@
 mod constrained;
 mod contacts;
 
+pub use constrained::*;
+pub use contacts::*;
+
 use super::boundary::{FfiError, boundary};
 use super::c_enum::{c_enum, enum_value};
 use super::dynamics::mech_dynamics_t;
