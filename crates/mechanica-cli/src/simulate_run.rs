@@ -96,7 +96,10 @@ fn contacts_of(scene: &Scene) -> Result<Vec<UnilateralContact>, MotionError> {
         };
         let law_kind = crate::mechanism_run::law_named(spec.law_name());
         let law = ContactLaw::new(spec.restitution(), spec.friction(), law_kind).map_err(|e| invalid(e.to_string()))?;
+        // Scaled by its largest component first, so that neither 1e308 nor 1e-320 components
+        // overflow or underflow the length.
         let normal = Vector3::from(*spec.normal.get_ref());
+        let normal = normal / normal.amax();
         contacts.push(UnilateralContact {
             contact: MechanismContact {
                 point: BodyPoint {
