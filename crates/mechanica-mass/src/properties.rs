@@ -36,6 +36,14 @@ pub fn steiner_term(mass: f64, d: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 impl MassProperties {
+    /// No mass at all: the mass properties of a massless frame (mass 0, inertia 0, the centre of
+    /// mass at the origin by convention).
+    pub const ZERO: MassProperties = MassProperties {
+        mass: 0.0,
+        p_oc: Vector3::new(0.0, 0.0, 0.0),
+        inertia_c: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+    };
+
     /// Checked constructor: finite inputs, positive mass, and a physically valid central
     /// inertia (symmetric, positive semidefinite, triangle inequality; see
     /// [`crate::validity::check`] with the default tolerance).

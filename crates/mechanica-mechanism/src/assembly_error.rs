@@ -165,11 +165,7 @@ fn evaluate(
 
 /// The bodies with every mass property but body `b`'s set to zero.
 fn only_body(bodies: &[MassProperties], b: usize) -> Vec<MassProperties> {
-    let nothing = MassProperties {
-        mass: 0.0,
-        p_oc: nalgebra::Vector3::zeros(),
-        inertia_c: nalgebra::Matrix3::zeros(),
-    };
+    let nothing = MassProperties::ZERO;
     (0..bodies.len())
         .map(|i| if i == b { bodies[i] } else { nothing })
         .collect()

@@ -88,11 +88,7 @@ fn spring_mass_chain_built_as_a_mechanism_matches_the_matrix_closed_form() {
     }
     let tree = builder.build().expect("tree");
     let mut bodies = vec![MassProperties::point(1.0, Vector3::zeros()).expect("mass"); n + 1];
-    bodies[0] = MassProperties {
-        mass: 0.0,
-        p_oc: Vector3::zeros(),
-        inertia_c: nalgebra::Matrix3::zeros(),
-    };
+    bodies[0] = MassProperties::ZERO;
     let mut mechanism = Mechanism::new(tree, bodies).expect("mechanism");
     let ground = |x: f64| Anchor {
         body: None,
@@ -304,11 +300,7 @@ fn gyroscopic_coupling_shifts_frequencies_and_stabilises_a_potential_maximum() {
             Isometry3::identity(),
         );
         let tree = builder.build().expect("tree");
-        let massless = MassProperties {
-            mass: 0.0,
-            p_oc: Vector3::zeros(),
-            inertia_c: nalgebra::Matrix3::zeros(),
-        };
+        let massless = MassProperties::ZERO;
         let bodies = vec![massless, MassProperties::point(m, Vector3::zeros()).expect("mass")];
         let mut mechanism = Mechanism::new(tree, bodies).expect("mechanism");
         mechanism

@@ -30,11 +30,7 @@ fn point_pendulum(m: f64, l: f64, g: f64) -> ConstrainedDynamics {
     builder.add_body(None, Joint::Prismatic { axis: Vector3::y() }, Isometry3::identity());
     builder.add_body(Some(0), Joint::Prismatic { axis: Vector3::z() }, Isometry3::identity());
     let tree = builder.build().expect("tree");
-    let carriage = MassProperties {
-        mass: 0.0,
-        p_oc: Vector3::zeros(),
-        inertia_c: Matrix3::zeros(),
-    };
+    let carriage = MassProperties::ZERO;
     let bob = MassProperties::point(m, Vector3::zeros()).expect("bob");
     let mut mechanism = Mechanism::new(tree, vec![carriage, bob]).expect("mechanism");
     mechanism.set_gravity(Vector3::new(0.0, 0.0, -g)).expect("gravity");

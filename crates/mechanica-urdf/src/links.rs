@@ -14,11 +14,7 @@ pub const MESH_DENSITY: f64 = 1000.0;
 
 /// No mass anywhere: a frame.
 pub(crate) fn massless() -> MassProperties {
-    MassProperties {
-        mass: 0.0,
-        p_oc: Vector3::zeros(),
-        inertia_c: Matrix3::zeros(),
-    }
+    MassProperties::ZERO
 }
 
 /// What went wrong with the links, one line per link, in two groups.
