@@ -572,7 +572,10 @@ fn damped_modes(d: &OwnedDynamics, input: &mut Input) {
         )
     };
     assert_eq!(status, MECH_STATUS_OK, "damped modes: a repeated call failed");
-    assert_eq!(count_again.value, needed, "damped modes: the count changed between calls");
+    assert_eq!(
+        count_again.value, needed,
+        "damped modes: the count changed between calls"
+    );
     assert_eq!(
         gradient_again.value.to_bits(),
         gradient.value.to_bits(),

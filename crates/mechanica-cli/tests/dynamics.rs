@@ -344,7 +344,11 @@ impl Random {
 fn rayleigh_chain(m: &[f64], k: &[f64], damping: Option<(f64, f64)>) -> String {
     let mut text = String::from("title = \"proportionally damped chain\"\n");
     for (i, (mi, ki)) in m.iter().zip(k).enumerate() {
-        let parent = if i == 0 { "ground".to_string() } else { format!("m{}", i - 1) };
+        let parent = if i == 0 {
+            "ground".to_string()
+        } else {
+            format!("m{}", i - 1)
+        };
         text += &format!(
             "[[body]]\nname = \"m{i}\"\nprimitive = {{ shape = \"point\", mass = {mi:?} }}\n\
              [[joint]]\nname = \"j{i}\"\ntype = \"prismatic\"\nparent = \"{parent}\"\nchild = \"m{i}\"\n\
@@ -429,7 +433,10 @@ fn a_rayleigh_damped_chain_has_the_closed_form_modes() {
             .map(|mode| numbers(&mode["omega_sq"])[0])
             .collect();
         assert_eq!(again, omega_sq);
-        let damped = step(&json, "damped_modes")["modes"].as_array().expect("damped modes").clone();
+        let damped = step(&json, "damped_modes")["modes"]
+            .as_array()
+            .expect("damped modes")
+            .clone();
         assert_eq!(damped.len(), n, "one mode per undamped mode: {damped:?}");
         for (j, mode) in damped.iter().enumerate() {
             let (w, dw, z) = (omega[j], d_omega[j], zeta(omega[j], alpha, beta));
@@ -443,7 +450,10 @@ fn a_rayleigh_damped_chain_has_the_closed_form_modes() {
         }
         assert_eq!(damped[0]["kind"], "overdamped");
     }
-    assert!(underdamped >= 6 && overdamped >= 12, "{underdamped} underdamped, {overdamped} overdamped");
+    assert!(
+        underdamped >= 6 && overdamped >= 12,
+        "{underdamped} underdamped, {overdamped} overdamped"
+    );
 }
 
 /// The (s, bound, backward error) of a damped mode's eigenvalues.
@@ -481,16 +491,26 @@ fn check_rayleigh_mode(
         let (exact, rate) = roots[if swap { 1 - i } else { i }];
         let error = (s[0] - exact[0]).hypot(s[1] - exact[1]);
         let allowed = bound + rate * d_omega + 8.0 * f64::EPSILON * exact[0].hypot(exact[1]);
-        assert!(error <= allowed, "s = {s:?} vs {exact:?}: {error:e} > {allowed:e} (ζ = {zeta})");
+        assert!(
+            error <= allowed,
+            "s = {s:?} vs {exact:?}: {error:e} > {allowed:e} (ζ = {zeta})"
+        );
         // Informative bounds and a backward-stable solve (≤ 64 n u for n ≤ 5).
         assert!(*bound >= 0.0 && *bound < 1e-8 * omega * (1.0 + zeta), "bound {bound:e}");
-        assert!(*eta >= 0.0 && *eta < 64.0 * 5.0 * f64::EPSILON, "backward error {eta:e}");
+        assert!(
+            *eta >= 0.0 && *eta < 64.0 * 5.0 * f64::EPSILON,
+            "backward error {eta:e}"
+        );
         worst = worst.max(allowed);
     }
     // With e the largest error allowed above: |Δω_n| ≤ (1 + ζ) e (for real roots ½ Σ e/|s_i|
     // ω_n, and the slow root is ≥ ω/(2ζ)), |Δζ| ≤ (Σ e)/(2ω_n) + ζ |Δω_n|/ω_n.
     let natural = numbers(&mode["natural_frequency"])[0];
-    close(natural, omega, (1.0 + zeta) * worst + d_omega + 8.0 * f64::EPSILON * omega);
+    close(
+        natural,
+        omega,
+        (1.0 + zeta) * worst + d_omega + 8.0 * f64::EPSILON * omega,
+    );
     let zeta_tolerance = worst / omega * (1.0 + zeta * (1.0 + zeta)) + d_zeta + 8.0 * f64::EPSILON * (1.0 + zeta);
     close(numbers(&mode["damping_ratio"])[0], zeta, zeta_tolerance);
     let damped_frequency = numbers(&mode["damped_frequency"])[0];

@@ -183,7 +183,11 @@ fn identical_damped_mode_calls_agree_bit_for_bit_and_keep_the_charts() {
             point: rng.vector(2.0),
         };
         dynamics
-            .add_damper(Damper::Points { a, b, coefficient: 10f64.powf(rng.uniform(-2.0, 2.0)) })
+            .add_damper(Damper::Points {
+                a,
+                b,
+                coefficient: 10f64.powf(rng.uniform(-2.0, 2.0)),
+            })
             .expect("damper");
         let mass_before = dynamics.mass_matrix(&q0).expect("mass matrix");
         let first = dynamics.damped_modes(&q0, &QuadraticOptions::default());
@@ -199,5 +203,8 @@ fn identical_damped_mode_calls_agree_bit_for_bit_and_keep_the_charts() {
             (r1, r2) => panic!("seed {seed}: {:?} then {:?}", r1.map(|m| m.q), r2.map(|m| m.q)),
         }
     }
-    assert!(with_rotation_vectors >= 8, "only {with_rotation_vectors} trees with rotation vectors");
+    assert!(
+        with_rotation_vectors >= 8,
+        "only {with_rotation_vectors} trees with rotation vectors"
+    );
 }
