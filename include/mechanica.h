@@ -2990,11 +2990,14 @@ mech_status_t mech_dynamics_forward_constrained(struct mech_dynamics_t *dynamics
  * eigenproblems (damped and gyroscopic modes)"). Writes one mech_damped_mode_t per mode to
  * `modes_out`, by natural frequency ascending with infinite modes last, their number to
  * `*count_out`, and ‖grad U*(q₀)‖ to `*gradient_norm_out` (may be NULL): the linearization is
- * that of an equilibrium only when this is 0.
+ * that of an equilibrium only when this is 0. The rotation vectors of spherical and free joints
+ * are measured from the pose at q₀ for the linearization (their Hessian is exact only there);
+ * this re-centring is done on a copy, so the handle is not changed and identical calls give
+ * identical results, bit for bit.
  *
  * The number of modes is between n (all pairs) and 2n (all single roots). Call with
  * `capacity` = 2n to be sure it fits, or with `capacity` = 0 (`modes_out` may then be NULL) to
- * learn the count.
+ * learn the count, which a second call with the same arguments reproduces.
  *
  * Errors: MECH_STATUS_BAD_DIMENSION when n is not the dof; MECH_STATUS_NON_FINITE for a NaN or
  * infinite q0; MECH_STATUS_BUFFER_TOO_SMALL when `capacity` is below the number of modes, in

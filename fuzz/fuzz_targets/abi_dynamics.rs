@@ -11,7 +11,8 @@
 //!   reported only with η at its stated rounding level 16·(d + 4)·u;
 //! - mech_dynamics_rnea and mech_dynamics_inverse agree within the rounding estimate;
 //! - the mass matrix is symmetric; each added constraint adds its equations to the count;
-//! - damped modes follow the count protocol and number between n and 2n;
+//! - damped modes follow the count protocol, number between n and 2n, and a repeated call
+//!   gives the same records bit for bit;
 //! - the free body's exact motion keeps R orthonormal, its kinetic energy and |L|.
 #![no_main]
 
@@ -556,6 +557,48 @@ fn damped_modes(d: &OwnedDynamics, input: &mut Input) {
             "damped mode {i}: negative bound or frequency {m:?}"
         );
     }
+    // A third identical call: the handle carries nothing from one call to the next.
+    let mut again = vec![Sentinel::<mech_damped_mode_t>::new().value; capacity];
+    let (mut count_again, mut gradient_again) = (Sentinel::<usize>::new(), Sentinel::<f64>::new());
+    let status = unsafe {
+        mech_dynamics_damped_modes(
+            d.handle,
+            q0.as_ptr(),
+            n,
+            capacity,
+            again.as_mut_ptr(),
+            count_again.ptr(),
+            gradient_again.ptr(),
+        )
+    };
+    assert_eq!(status, MECH_STATUS_OK, "damped modes: a repeated call failed");
+    assert_eq!(
+        count_again.value, needed,
+        "damped modes: the count changed between calls"
+    );
+    assert_eq!(
+        gradient_again.value.to_bits(),
+        gradient.value.to_bits(),
+        "damped modes: the gradient norm changed between calls"
+    );
+    for (i, (m, r)) in modes.iter().zip(&again).enumerate() {
+        assert_eq!(record_bits(m), record_bits(r), "damped mode {i} changed between calls");
+    }
+}
+
+/// Every field of a damped-mode record as bits (the record has padding, which is not compared).
+fn record_bits(m: &mech_damped_mode_t) -> Vec<u64> {
+    let mut bits = vec![m.kind as u64, m.eigenvalue_count as u64];
+    bits.extend(
+        [m.natural_frequency, m.damped_frequency, m.damping_ratio]
+            .iter()
+            .chain(&m.s_re)
+            .chain(&m.s_im)
+            .chain(&m.error_bound)
+            .chain(&m.backward_error)
+            .map(|v| v.to_bits()),
+    );
+    bits
 }
 
 /// The torque-free body: the exact motion (R orthonormal, T and |L| kept) and the Lie-group

@@ -323,3 +323,200 @@ fn a_damped_oscillator_has_the_closed_form_damping_ratio_and_frequency() {
         assert!(text.contains("|Δs| ≤"), "{text}");
     }
 }
+
+/// A small deterministic generator for parameter families (xorshift64*).
+struct Random(u64);
+
+impl Random {
+    fn uniform(&mut self, low: f64, high: f64) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let bits = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
+        low + (high - low) * (bits as f64 / (1u64 << 53) as f64)
+    }
+}
+
+/// A chain of point masses `m` on prismatic joints along x with joint springs `k`; with
+/// `damping` = Some((α, β)) a damper α m_i from each mass to a ground point (full relative
+/// velocity: C = α A) and a joint damper β k_i on each joint (C = β B), and the dynamics
+/// analysis; the undamped modes in either case.
+fn rayleigh_chain(m: &[f64], k: &[f64], damping: Option<(f64, f64)>) -> String {
+    let mut text = String::from("title = \"proportionally damped chain\"\n");
+    for (i, (mi, ki)) in m.iter().zip(k).enumerate() {
+        let parent = if i == 0 {
+            "ground".to_string()
+        } else {
+            format!("m{}", i - 1)
+        };
+        text += &format!(
+            "[[body]]\nname = \"m{i}\"\nprimitive = {{ shape = \"point\", mass = {mi:?} }}\n\
+             [[joint]]\nname = \"j{i}\"\ntype = \"prismatic\"\nparent = \"{parent}\"\nchild = \"m{i}\"\n\
+             axis = [1.0, 0.0, 0.0]\norigin = [1.0, 0.0, 0.0]\nq0 = [0.0]\n\
+             [[joint_spring]]\njoint = \"j{i}\"\nstiffness = {ki:?}\n"
+        );
+        if let Some((alpha, beta)) = damping {
+            text += &format!(
+                "[[damper]]\na = \"m{i}\"\nb = \"ground\"\nb_point = [-10.0, 3.0, 0.0]\ndamping = {:?}\n\
+                 [[joint_damper]]\njoint = \"j{i}\"\ndamping = {:?}\n",
+                alpha * mi,
+                beta * ki
+            );
+        }
+    }
+    text += "[analyses]\nmodes = {}\n";
+    if damping.is_some() {
+        text += "dynamics = {}\n";
+    }
+    text
+}
+
+/// The closed-form roots of the undamped mode ω under C = αA + βB (2ζω = α + βω²): the pair
+/// −ζω ± iω√(1−ζ²), or the real roots −ζω ∓ ω√(ζ²−1) (fast first); with |ds/dω| of each, to
+/// carry the error of ω into the reference.
+fn rayleigh_roots(omega: f64, alpha: f64, beta: f64) -> [([f64; 2], f64); 2] {
+    let (p, dp) = (0.5 * (alpha + beta * omega * omega), beta * omega);
+    let zeta = p / omega;
+    if zeta < 1.0 {
+        let q = omega * (1.0 - zeta * zeta).sqrt();
+        let rate = dp.hypot((omega - p * dp).abs() / q);
+        [([-p, q], rate), ([-p, -q], rate)]
+    } else {
+        let r = omega * (zeta * zeta - 1.0).sqrt();
+        let fast = -(p + r);
+        let slow = omega * omega / fast;
+        let d_fast = dp + (p * dp - omega).abs() / r;
+        let d_slow = 2.0 * omega / fast.abs() + omega * omega * d_fast / (fast * fast);
+        [([fast, 0.0], d_fast), ([slow, 0.0], d_slow)]
+    }
+}
+
+/// Proportional (Rayleigh) damping C = αA + βB of a chain of 2 to 5 masses: each damped mode
+/// is the closed form of the undamped mode ω of the same scene (the `modes` step), within the
+/// reported bounds plus the closed form's own error from the bound on ω²; α, β are drawn so
+/// that the lowest mode is overdamped (ζ₁ in [1.5, 4)), and the family must show underdamped
+/// modes too. No mode is within 0.15 of critical damping, where only the bounds decide.
+#[test]
+fn a_rayleigh_damped_chain_has_the_closed_form_modes() {
+    let mut rng = Random(0x5DEE_CE66_D1CE_4E5B);
+    let (mut underdamped, mut overdamped) = (0, 0);
+    for trial in 0..12 {
+        let n = 2 + (trial % 4);
+        let m: Vec<f64> = (0..n).map(|_| 10f64.powf(rng.uniform(-1.5, 1.5))).collect();
+        let k: Vec<f64> = (0..n).map(|_| 10f64.powf(rng.uniform(0.0, 3.5))).collect();
+        let undamped = run_json("rayleigh_undamped", &rayleigh_chain(&m, &k, None));
+        let modes = step(&undamped, "modes")["modes"].as_array().expect("modes").clone();
+        assert_eq!(modes.len(), n);
+        let omega_sq: Vec<f64> = modes.iter().map(|mode| numbers(&mode["omega_sq"])[0]).collect();
+        let omega: Vec<f64> = omega_sq.iter().map(|w2| w2.sqrt()).collect();
+        // δω from the bound on ω² (δ√x ≈ δx/(2√x)), plus the rounding of the square root.
+        let d_omega: Vec<f64> = modes
+            .iter()
+            .zip(&omega)
+            .map(|(mode, w)| numbers(&mode["bound"])[0] / (2.0 * w) + f64::EPSILON * w)
+            .collect();
+        let zeta = |w: f64, alpha: f64, beta: f64| 0.5 * (alpha / w + beta * w);
+        let (alpha, beta) = (0..100)
+            .map(|_| {
+                let zeta_1 = rng.uniform(1.5, 4.0);
+                let beta = 10f64.powf(rng.uniform(-3.0, -0.5)) / omega[n - 1];
+                (2.0 * zeta_1 * omega[0] - beta * omega[0] * omega[0], beta)
+            })
+            .find(|&(alpha, beta)| alpha > 0.0 && omega.iter().all(|&w| (zeta(w, alpha, beta) - 1.0).abs() > 0.15))
+            .expect("a damping away from critical");
+        let json = run_json("rayleigh_damped", &rayleigh_chain(&m, &k, Some((alpha, beta))));
+        // The same mechanism: the undamped modes of the damped scene are those above.
+        let again: Vec<f64> = step(&json, "modes")["modes"]
+            .as_array()
+            .expect("modes")
+            .iter()
+            .map(|mode| numbers(&mode["omega_sq"])[0])
+            .collect();
+        assert_eq!(again, omega_sq);
+        let damped = step(&json, "damped_modes")["modes"]
+            .as_array()
+            .expect("damped modes")
+            .clone();
+        assert_eq!(damped.len(), n, "one mode per undamped mode: {damped:?}");
+        for (j, mode) in damped.iter().enumerate() {
+            let (w, dw, z) = (omega[j], d_omega[j], zeta(omega[j], alpha, beta));
+            let d_zeta = 0.5 * (beta - alpha / (w * w)).abs() * dw;
+            check_rayleigh_mode(mode, w, dw, (z, d_zeta), rayleigh_roots(w, alpha, beta));
+            if z < 1.0 {
+                underdamped += 1;
+            } else {
+                overdamped += 1;
+            }
+        }
+        assert_eq!(damped[0]["kind"], "overdamped");
+    }
+    assert!(
+        underdamped >= 6 && overdamped >= 12,
+        "{underdamped} underdamped, {overdamped} overdamped"
+    );
+}
+
+/// The (s, bound, backward error) of a damped mode's eigenvalues.
+fn eigenvalues_of(mode: &serde_json::Value) -> Vec<([f64; 2], f64, f64)> {
+    mode["eigenvalues"]
+        .as_array()
+        .expect("eigenvalues")
+        .iter()
+        .map(|e| {
+            let s = numbers(&e["s"]);
+            ([s[0], s[1]], numbers(&e["bound"])[0], numbers(&e["backward_error"])[0])
+        })
+        .collect()
+}
+
+/// One damped mode of the Rayleigh chain against its closed-form roots: the kind, each
+/// eigenvalue within its bound (plus the reference's error |ds/dω| δω and a few roundings), a
+/// backward error at rounding level, and ω_n, ω_d and ζ (whose reference moves by `d_zeta`
+/// with ω) within the bounds they inherit.
+fn check_rayleigh_mode(
+    mode: &serde_json::Value,
+    omega: f64,
+    d_omega: f64,
+    (zeta, d_zeta): (f64, f64),
+    roots: [([f64; 2], f64); 2],
+) {
+    let kind = if zeta < 1.0 { "underdamped" } else { "overdamped" };
+    assert_eq!(mode["kind"], kind, "ζ = {zeta}: {mode}");
+    let eigenvalues = eigenvalues_of(mode);
+    assert_eq!(eigenvalues.len(), 2, "{mode}");
+    // Real roots come in either order: match each to the nearer closed-form root.
+    let swap = zeta > 1.0 && (eigenvalues[0].0[0] - roots[0].0[0]).abs() > (eigenvalues[0].0[0] - roots[1].0[0]).abs();
+    let mut worst = 0f64;
+    for (i, (s, bound, eta)) in eigenvalues.iter().enumerate() {
+        let (exact, rate) = roots[if swap { 1 - i } else { i }];
+        let error = (s[0] - exact[0]).hypot(s[1] - exact[1]);
+        let allowed = bound + rate * d_omega + 8.0 * f64::EPSILON * exact[0].hypot(exact[1]);
+        assert!(
+            error <= allowed,
+            "s = {s:?} vs {exact:?}: {error:e} > {allowed:e} (ζ = {zeta})"
+        );
+        // Informative bounds and a backward-stable solve (≤ 64 n u for n ≤ 5).
+        assert!(*bound >= 0.0 && *bound < 1e-8 * omega * (1.0 + zeta), "bound {bound:e}");
+        assert!(
+            *eta >= 0.0 && *eta < 64.0 * 5.0 * f64::EPSILON,
+            "backward error {eta:e}"
+        );
+        worst = worst.max(allowed);
+    }
+    // With e the largest error allowed above: |Δω_n| ≤ (1 + ζ) e (for real roots ½ Σ e/|s_i|
+    // ω_n, and the slow root is ≥ ω/(2ζ)), |Δζ| ≤ (Σ e)/(2ω_n) + ζ |Δω_n|/ω_n.
+    let natural = numbers(&mode["natural_frequency"])[0];
+    close(
+        natural,
+        omega,
+        (1.0 + zeta) * worst + d_omega + 8.0 * f64::EPSILON * omega,
+    );
+    let zeta_tolerance = worst / omega * (1.0 + zeta * (1.0 + zeta)) + d_zeta + 8.0 * f64::EPSILON * (1.0 + zeta);
+    close(numbers(&mode["damping_ratio"])[0], zeta, zeta_tolerance);
+    let damped_frequency = numbers(&mode["damped_frequency"])[0];
+    if zeta < 1.0 {
+        close(damped_frequency, roots[0].0[1], worst + 8.0 * f64::EPSILON * omega);
+    } else {
+        assert_eq!(damped_frequency, 0.0);
+    }
+}

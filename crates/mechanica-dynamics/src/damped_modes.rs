@@ -19,7 +19,9 @@ use mechanica_modal::{QuadraticModes, QuadraticOptions, quadratic_modes};
 /// The damped modes of a mechanism about q₀.
 #[derive(Debug, Clone)]
 pub struct DampedModes {
-    /// The configuration (rotation vectors of spherical and free joints re-centred to φ = 0).
+    /// q₀ in charts re-centred at it: the rotation vectors of spherical and free joints are
+    /// zero, the other coordinates as given. The matrices and shapes are in these charts; the
+    /// dynamics the modes were asked of keeps its own.
     pub q: Vec<f64>,
     /// A(q₀).
     pub mass_matrix: Mat<f64>,
@@ -36,8 +38,11 @@ pub struct DampedModes {
 }
 
 impl Dynamics {
-    /// The damped and gyroscopic modes about `q0` (module docs). The mechanism's spherical and
-    /// free joints are re-centred at q₀ (poses unchanged), as the Hessian needs.
+    /// The damped and gyroscopic modes about `q0` (module docs). The Hessian needs the rotation
+    /// vectors of spherical and free joints at φ = 0, so with such joints the modes are those of
+    /// a copy of the dynamics whose charts are re-centred at q₀ (same poses, q₀'s rotation
+    /// vectors zeroed, [`DampedModes::q`]). `self` keeps its charts: q₀ names the same
+    /// configuration before and after the call, and identical calls give identical results.
     pub fn damped_modes(&mut self, q0: &[f64], options: &QuadraticOptions) -> Result<DampedModes, DynamicsError> {
         check_vector(q0, self.dof(), "q0")?;
         if !self.velocity_potentials.is_empty() {
@@ -55,7 +60,16 @@ impl Dynamics {
             });
         }
         let mut q = q0.to_vec();
-        self.mechanism.rebase(&mut q)?;
+        if self.mechanism.has_rotation_vectors() {
+            let mut recentred = self.clone();
+            recentred.mechanism.rebase(&mut q)?;
+            return recentred.linearized_modes(q, options);
+        }
+        self.linearized_modes(q, options)
+    }
+
+    /// The modes of the linearization about `q`, whose rotation vectors (if any) are zero.
+    fn linearized_modes(&mut self, q: Vec<f64>, options: &QuadraticOptions) -> Result<DampedModes, DynamicsError> {
         let potential = self.mechanism.potential(&q, true)?;
         let stiffness_matrix = potential.hessian.ok_or(DynamicsError::NonFiniteResult {
             what: "stiffness matrix",
