@@ -3118,8 +3118,10 @@ mech_status_t mech_dynamics_mass_matrix(struct mech_dynamics_t *dynamics,
  * a few ulps of the elliptic functions times the growth of the phase with t.
  *
  * Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_INVALID_ARGUMENT
- * for a moment ≤ 0 or an initial rotation that is not orthonormal with det +1 to 1e-12;
- * MECH_STATUS_OUT_OF_RANGE when the energy, the momentum or the phase overflow.
+ * for a moment ≤ 0, an initial rotation that is not orthonormal with det +1 to 1e-12, or a t
+ * so far that the motion's phase is lost (beyond 2⁵² quarter periods, where one ulp of the
+ * phase is a quarter period); MECH_STATUS_OUT_OF_RANGE when the energy or the momentum
+ * overflow.
  *
  * # Safety
  * `moments` and `initial` must be readable, `out` writable.

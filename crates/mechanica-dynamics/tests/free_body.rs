@@ -323,3 +323,40 @@ fn special_functions_and_rates_reject_bad_inputs() {
         Err(DynamicsError::NonFiniteInput { .. })
     ));
 }
+
+/// Far in time: up to 2⁵⁰ periods the state keeps the energy, the momentum and RᵀR = I (the
+/// phase carries the rounding of σt, the invariants do not); beyond 2⁵² quarter periods, where
+/// one ulp of σt is a quarter period, `state_at` refuses t instead of reducing a phase that is
+/// rounding noise (before, the reduction ran out of its range and ω grew by 1e22).
+#[test]
+fn far_times_keep_the_invariants_or_are_refused() {
+    let mut rng = Rng::new(16);
+    for case_index in 0..30 {
+        let case = random_case(&mut rng);
+        let solver = body(&case);
+        let period = solver.period().expect("a valid input");
+        let (t0, l0) = (solver.energy(), solver.angular_momentum());
+        for exponent in [20, 35, 45, 50] {
+            let t = period * 2f64.powi(exponent) * rng.uniform(0.5, 1.0);
+            let (r, w) = solver
+                .state_at(t)
+                .unwrap_or_else(|e| panic!("case {case_index}, t = {t:e}: {e}"));
+            let iw = case.moments.component_mul(&w);
+            assert!(
+                (0.5 * w.dot(&iw) - t0).abs() <= 1e-13 * t0,
+                "case {case_index}, t = {t:e}: T"
+            );
+            assert!(
+                (r * iw - l0).norm() <= 1e-12 * l0.norm(),
+                "case {case_index}, t = {t:e}: L"
+            );
+        }
+        for far in [period * 2f64.powi(56), 4.325195312500001e34, -1e300] {
+            let result = solver.state_at(far);
+            assert!(
+                matches!(result, Err(DynamicsError::OutOfRange { what: "time t", .. })),
+                "case {case_index}, t = {far:e}: {result:?}"
+            );
+        }
+    }
+}

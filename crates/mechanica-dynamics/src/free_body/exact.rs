@@ -147,9 +147,22 @@ impl TorqueFreeBody {
     }
 
     /// (R(t), ω(t)): the attitude (body → space) and the body-frame angular velocity at time t.
-    /// Errors: a non-finite t, or a t so large that σt overflows.
+    /// Errors: a non-finite t, or a t so far from 0 that the motion's phase is lost (the
+    /// argument σt of its elliptic functions beyond 2⁵² quarter periods, where one ulp of σt is
+    /// a quarter period; [`DynamicsError::OutOfRange`]).
     pub fn state_at(&self, t: f64) -> Result<(Rotation3<f64>, Vector3<f64>), DynamicsError> {
         check_input(&[t], "time t")?;
+        if let Motion::Polhode(polhode) = &self.motion {
+            let u = polhode.sigma.mul_add(t, polhode.u0);
+            polhode
+                .modulus
+                .check_argument(u)
+                .map_err(|_| DynamicsError::OutOfRange {
+                    what: "time t",
+                    requirement: "within 2⁵² quarter periods of the motion (beyond, its phase is lost)",
+                    value: t,
+                })?;
+        }
         let (rotation, omega) = match &self.motion {
             Motion::Steady => (self.r0 * Rotation3::from_scaled_axis(self.omega0 * t), self.omega0),
             Motion::Polhode(polhode) => {

@@ -14,12 +14,19 @@
 //!   descent and the ascent run in double-double (with sin and cos of the bottom argument by
 //!   their Taylor series) and the results are rounded to f64 once: measured against mpmath,
 //!   sn, cn and dn are within 1 ulp and am within 1 ulp (k from 0 to 1, |u| up to 1e4).
+//! - The quarter period is known to 106 bits, so the reduction is meaningful for |u| up to
+//!   [`MAX_QUARTER_PERIODS`]·K; beyond, the phase of u within its period would be rounding
+//!   noise, and [`EllipticModulus::jacobi`] and [`EllipticModulus::amplitude`] refuse u.
 //! - k = 0 gives sin, cos, 1 and k = 1 gives tanh, sech, sech exactly (DLMF 22.5.3, 22.5.4).
 //! - am(u) = mπ + atan2(sn u′, cn u′) for u = 2mK + u′, |u′| ≤ K (DLMF 22.16.1, 22.16.2).
 
 use super::double_double::{DoubleDouble, PI, sin_cos};
 use super::elliptic::EllipticModulus;
 use crate::error::{DynamicsError, check_input};
+
+/// The most quarter periods |u|/K an argument may span: 2⁵², where one ulp of u is a quarter
+/// period, so that the phase of u within its period is still determined by u.
+pub const MAX_QUARTER_PERIODS: f64 = 4_503_599_627_370_496.0;
 
 /// sn u, cn u and dn u at one argument.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,16 +40,32 @@ pub struct JacobiValues {
 }
 
 impl EllipticModulus {
-    /// sn, cn, dn at u; an error for a non-finite u.
+    /// sn, cn, dn at u; an error for a non-finite u or one beyond [`MAX_QUARTER_PERIODS`]
+    /// quarter periods.
     pub fn jacobi(&self, u: f64) -> Result<JacobiValues, DynamicsError> {
-        check_input(&[u], "argument u")?;
+        self.check_argument(u)?;
         Ok(self.jacobi_unchecked(u))
     }
 
-    /// am(u) (DLMF 22.16.1); an error for a non-finite u.
+    /// am(u) (DLMF 22.16.1); an error for a non-finite u or one beyond
+    /// [`MAX_QUARTER_PERIODS`] quarter periods.
     pub fn amplitude(&self, u: f64) -> Result<f64, DynamicsError> {
-        check_input(&[u], "argument u")?;
+        self.check_argument(u)?;
         Ok(self.amplitude_unchecked(u))
+    }
+
+    /// Ok when u is finite and within [`MAX_QUARTER_PERIODS`] quarter periods (any u for k = 1,
+    /// where nothing is periodic).
+    pub(crate) fn check_argument(&self, u: f64) -> Result<(), DynamicsError> {
+        check_input(&[u], "argument u")?;
+        match self.quarter_period_dd() {
+            Some(quarter) if (u / quarter.hi).abs() > MAX_QUARTER_PERIODS => Err(DynamicsError::OutOfRange {
+                what: "argument u",
+                requirement: "within 2⁵² quarter periods (beyond, its phase is rounding noise)",
+                value: u,
+            }),
+            _ => Ok(()),
+        }
     }
 
     pub(crate) fn jacobi_unchecked(&self, u: f64) -> JacobiValues {
