@@ -165,7 +165,7 @@ pub fn run(scene: &Scene, model: &Model, steps: &mut Vec<Step>, plots: &mut Plot
     let bodies: Vec<String> = scene.bodies.iter().map(|b| b.name.get_ref().clone()).collect();
     let (step, modes) = modes_step(&mut mechanism, &q, &locked, spec, &names, &bodies)?;
     steps.push(step);
-    record_mode_plots(&modes, &mechanism, &bodies, scene.gravity, plots);
+    record_mode_plots(&modes, &recentred(&mechanism, &q), &bodies, scene.gravity, plots);
     if let Some(response) = &analyses.response {
         steps.push(response_step(&modes, response.get_ref(), plots, &names)?);
     }
@@ -379,8 +379,19 @@ fn modes_record(m: &MechanismModes, names: &[String], locked: &[String], bodies:
     }
 }
 
+/// A copy of `mechanism` with its charts re-centred at `q`, as the modes at `q` were computed
+/// (`MechanismModes::q` names poses in these charts).
+fn recentred(mechanism: &Mechanism, q: &[f64]) -> Mechanism {
+    let mut copy = mechanism.clone();
+    if copy.has_rotation_vectors() {
+        // A failure leaves the copy as it was; the figures then fail to draw, nothing else.
+        let _ = copy.rebase(&mut q.to_vec());
+    }
+    copy
+}
+
 /// Puts the spectrum and the first six modes drawn on the mechanism into the plot data (the
-/// mechanism is the one the modes were computed with: its tree is re-centred at `modes.q`).
+/// mechanism in the charts the modes were computed in: re-centred at `modes.q`).
 fn record_mode_plots(
     modes: &MechanismModes,
     mechanism: &Mechanism,

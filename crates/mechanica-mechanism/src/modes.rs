@@ -74,7 +74,9 @@ pub struct GyroscopicModes {
 /// The modes of a mechanism at q₀.
 #[derive(Debug, Clone)]
 pub struct MechanismModes {
-    /// The configuration (after re-centring of spherical and free joints).
+    /// q₀ in charts re-centred at it: the rotation vectors of spherical and free joints are
+    /// zero, the other coordinates as given. The matrices and shapes are in these charts; the
+    /// mechanism the modes were asked of keeps its own.
     pub q: Vec<f64>,
     /// A(q₀).
     pub mass_matrix: Mat<f64>,
@@ -126,7 +128,11 @@ fn stability_of(solution: &ModalSolution) -> Stability {
 /// The stability and modes of `mechanism` about q₀ (normally an equilibrium from
 /// [`crate::find_equilibrium`]). `options` select the modes as in the modal crate; stability
 /// needs the unstable and zero modes, which are the lowest, so `Selection::Lowest(k)` suffices.
-/// Mode shapes are always computed (`options.vectors` is ignored).
+/// Mode shapes are always computed (`options.vectors` is ignored). The Hessian needs the
+/// rotation vectors of spherical and free joints at φ = 0, so with such joints the modes are
+/// those of a copy whose charts are re-centred at q₀ (same poses, [`MechanismModes::q`]);
+/// `mechanism` keeps its charts, so q₀ names the same configuration before and after the call
+/// and identical calls give identical results.
 pub fn mechanism_modes(
     mechanism: &mut Mechanism,
     q0: &[f64],
@@ -147,8 +153,20 @@ pub fn mechanism_modes_with_locks(
 ) -> Result<MechanismModes, MechanismError> {
     let mut q = q0.to_vec();
     if mechanism.has_rotation_vectors() {
-        mechanism.rebase(&mut q)?;
+        let mut recentred = mechanism.clone();
+        recentred.rebase(&mut q)?;
+        return modes_at(&mut recentred, q, locked, options);
     }
+    modes_at(mechanism, q, locked, options)
+}
+
+/// [`mechanism_modes_with_locks`] about `q`, whose rotation vectors (if any) are zero.
+fn modes_at(
+    mechanism: &mut Mechanism,
+    q: Vec<f64>,
+    locked: &[usize],
+    options: &SolveOptions,
+) -> Result<MechanismModes, MechanismError> {
     let n_all = mechanism.dof();
     if let Some(&k) = locked.iter().find(|&&k| k >= n_all) {
         return Err(MechanismError::NoSuchCoordinate {

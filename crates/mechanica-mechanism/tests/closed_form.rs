@@ -352,3 +352,62 @@ fn gyroscopic_coupling_shifts_frequencies_and_stabilises_a_potential_maximum() {
         }
     }
 }
+
+/// Modes of a mechanism with spherical joints at a state whose rotation vectors are not zero:
+/// a cylinder on a ball joint under a spring to a ground point (the spring makes every mode
+/// depend on the pose). Two identical calls give the same numbers bit for bit and leave the
+/// mechanism's charts as they were (A(q₀) and U(q₀) unchanged), for random poses; before, the
+/// first call re-centred the caller's mechanism, so the second read q₀ as another pose.
+#[test]
+fn repeated_mode_calls_with_rotation_vectors_agree_and_keep_the_charts() {
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut uniform = |lo: f64, hi: f64| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for case in 0..12 {
+        let mut builder = TreeBuilder::new();
+        builder.add_body(None, Joint::Spherical, Isometry3::identity());
+        let tree = builder.build().expect("tree");
+        let mut body = cylinder(0.05, 0.8, Amount::Mass(uniform(0.5, 5.0))).expect("cylinder");
+        body.p_oc = Vector3::new(0.0, 0.0, -0.4);
+        let mut mechanism = Mechanism::new(tree, vec![body]).expect("mechanism");
+        mechanism.set_gravity(Vector3::new(0.0, 0.0, -G)).expect("gravity");
+        let spring = PointSpring {
+            a: Anchor {
+                body: Some(0),
+                point: Vector3::new(0.03, 0.0, -0.8),
+            },
+            b: Anchor {
+                body: None,
+                point: Vector3::new(uniform(-0.5, 0.5), uniform(-0.5, 0.5), -1.2),
+            },
+            stiffness: uniform(5.0, 500.0),
+            rest_length: uniform(0.0, 0.3),
+        };
+        mechanism.add_potential(spring).expect("spring");
+        let q0 = [uniform(-1.5, 1.5), uniform(-1.5, 1.5), uniform(-1.5, 1.5)];
+        let a_before = mechanism.mass_matrix(&q0).expect("A");
+        let u_before = mechanism.potential(&q0, false).expect("U").value;
+        let first = mechanism_modes(&mut mechanism, &q0, &SolveOptions::default()).expect("modes");
+        let second = mechanism_modes(&mut mechanism, &q0, &SolveOptions::default()).expect("modes");
+        let bits = |m: &mechanica_mechanism::MechanismModes| -> Vec<u64> {
+            m.solution
+                .modes
+                .iter()
+                .flat_map(|mode| [mode.omega_sq.to_bits(), mode.error_bound.to_bits()])
+                .chain([m.gradient_norm.to_bits()])
+                .collect()
+        };
+        assert_eq!(bits(&first), bits(&second), "case {case}: the second call differs");
+        let a_after = mechanism.mass_matrix(&q0).expect("A");
+        assert_eq!(
+            a_before, a_after,
+            "case {case}: the call moved the charts (A(q₀) changed)"
+        );
+        let u_after = mechanism.potential(&q0, false).expect("U").value;
+        assert_eq!(u_before.to_bits(), u_after.to_bits(), "case {case}: U(q₀) changed");
+    }
+}
