@@ -4,11 +4,13 @@
 mod common;
 use common::mechanica;
 
-const RUN_OPTIONS: [&str; 4] = [
+const RUN_OPTIONS: [&str; 6] = [
     "--repair-inertia",
     "--allow-missing-mesh",
     "--max-response-values",
     "--plot",
+    "--q <Q1,Q2,...>",
+    "--matrices",
 ];
 
 #[test]
@@ -17,6 +19,9 @@ fn run_options_appear_in_run_help_only() {
     assert!(ok, "{err}");
     for option in RUN_OPTIONS {
         assert!(run.contains(option), "run --help lacks {option}:\n{run}");
+    }
+    for option in ["--density", "--shell", "--lowest", "--stiffness", "--shapes"] {
+        assert!(!run.contains(option), "run --help lists {option}:\n{run}");
     }
     for command in ["mass", "modes", "version"] {
         let (ok, help, err) = mechanica(&[command, "--help"]);
