@@ -22,7 +22,6 @@ mod simulate_run;
 mod simulation_plots;
 mod spectrum_plot;
 mod state_matrices;
-mod svg;
 mod trajectory_file;
 mod urdf;
 

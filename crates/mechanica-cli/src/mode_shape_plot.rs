@@ -14,8 +14,8 @@
 
 use crate::mode_record::ModeKindName;
 use crate::mode_shape::{ModeFigure, ModeShapes, Pose, Skeleton};
-use crate::svg::{Anchor, Color, Svg, fitted_size, tick_label, ticks};
 use mechanica::kinematics::nalgebra::{Matrix3, Vector3};
+use mechanica_svg::{Anchor, Color, Svg, fitted_size, tick_label, ticks};
 use std::path::Path;
 
 const WIDTH: f64 = 1000.0;
@@ -316,7 +316,7 @@ fn draw_header(svg: &mut Svg) {
             kind.as_str()
         };
         svg.text("legend-label", (x + 24.0, y), name, 12.0, Anchor::Start);
-        x += 34.0 + crate::svg::text_width(name, 12.0);
+        x += 34.0 + mechanica_svg::text_width(name, 12.0);
     }
 }
 
