@@ -13,6 +13,7 @@ mod mode_record;
 mod mode_shape;
 mod mode_shape_plot;
 mod modes_command;
+mod pencil_shape_plot;
 mod plots;
 mod progress;
 mod report;

@@ -262,8 +262,12 @@ fn caption(skeleton: &Skeleton, figure: &ModeFigure) -> Vec<String> {
             n(figure.amplitude)
         ),
         format!(
-            "largest displacement {} m = {} % of the mechanism's {} m extent",
+            "largest displacement {} m{} = {} % of the mechanism's {} m extent",
             n(figure.largest),
+            figure
+                .moved_most
+                .and_then(|b| skeleton.names.get(b))
+                .map_or(String::new(), |name| format!(", of \"{name}\",")),
             n(100.0 * figure.largest / skeleton.extent),
             n(skeleton.extent)
         ),
@@ -365,6 +369,7 @@ mod tests {
             amplitude: 1.0,
             largest: shift.norm() * rest.len() as f64,
             turned_most: None,
+            moved_most: None,
             note: None,
         };
         (skeleton, figure)

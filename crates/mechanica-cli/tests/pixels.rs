@@ -1,4 +1,4 @@
-//! Every picture `run --plot` writes, rendered to pixels (resvg, shapes only: text is not
+//! Every picture `run --plot` and `modes --plot` write, rendered to pixels (resvg, shapes only: text is not
 //! rasterised, its placement is checked in tests/plots.rs): it parses, renders at its declared
 //! size, and is neither blank nor flooded (between 0.2 % and 50 % of its pixels drawn without
 //! the text: a one-body mechanism's mode is a few strokes); the mechanism's stick figures of the mode shapes,
@@ -30,6 +30,26 @@ fn plotted(args: &[&str], dir: &Path) -> Vec<PathBuf> {
         .flat_map(|s| s["files"].as_array().expect("files").clone())
         .map(|f| PathBuf::from(f.as_str().expect("path")))
         .collect()
+}
+
+/// A fixed chain of n unit masses and unit springs as Matrix Market files (A, B) in `dir`.
+fn lumped_chain(dir: &Path, n: usize) -> (String, String) {
+    let write = |name: &str, entries: Vec<(usize, usize, f64)>| {
+        let mut text = format!(
+            "%%MatrixMarket matrix coordinate real symmetric\n{n} {n} {}\n",
+            entries.len()
+        );
+        for (i, j, v) in entries {
+            text.push_str(&format!("{} {} {v:?}\n", i + 1, j + 1));
+        }
+        let path = dir.join(name);
+        std::fs::write(&path, text).expect("matrix file");
+        path.to_str().expect("utf-8").to_string()
+    };
+    let mass = (0..n).map(|i| (i, i, 1.0)).collect();
+    let mut stiffness: Vec<_> = (0..n).map(|i| (i, i, 2.0)).collect();
+    stiffness.extend((1..n).map(|i| (i, i - 1, -1.0)));
+    (write("a.mtx", mass), write("b.mtx", stiffness))
 }
 
 /// The number in attribute `name` of the root `<svg>` tag.
@@ -70,6 +90,11 @@ fn every_plot_renders_at_its_size_and_is_drawn() {
     let chain = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/spring_pendulum_chain.toml");
     let mut files = plotted(&["run", chain.to_str().expect("utf-8")], &dir.join("chain"));
     files.extend(plotted(&["run"], &dir.join("default")));
+    let (a, b) = lumped_chain(&dir, 9);
+    files.extend(plotted(
+        &["modes", "--mass", &a, "--stiffness", &b],
+        &dir.join("pencil"),
+    ));
     let names: Vec<String> = files
         .iter()
         .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
