@@ -153,9 +153,12 @@ fn a_malformed_file_is_reported_with_its_line() {
     assert!(err.contains("bad_a.mtx") && err.contains("line 4"), "{err}");
 }
 
+/// What a test reads of one panel: points, index tick labels, caption, zero line.
+type ShapePanel = (Vec<(f64, f64)>, Vec<String>, String, f64);
+
 /// Per panel of `svg`: the `cx`/`cy` of every `<circle class="shape-point">`, the text of every
 /// index tick label, the caption, and the y of the zero line (the solid grid line).
-fn shape_panels(svg: &str) -> Vec<(Vec<(f64, f64)>, Vec<String>, String, f64)> {
+fn shape_panels(svg: &str) -> Vec<ShapePanel> {
     let attribute = |line: &str, name: &str| -> f64 {
         let key = format!(" {name}=\"");
         let start = line.find(&key).expect("attribute") + key.len();
