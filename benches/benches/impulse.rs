@@ -22,7 +22,8 @@ use mechanica::kinematics::nalgebra::{Isometry3, Matrix3, Rotation3, Vector3};
 use mechanica::kinematics::tree::{Joint, KinematicTree, TreeBuilder, Workspace};
 use mechanica::mass::MassProperties;
 use mechanica::mass::mechanism::TreeMass;
-use mechanica_benches::{Series, plot_error_vs_time, write_csv};
+use mechanica_benches::work_precision::{Panel, Series, WorkPoint, write_work_precision};
+use mechanica_benches::write_csv;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -131,25 +132,29 @@ fn swerve_series(_c: &mut Criterion) {
             format!("{:e}", result.contact.integration_error),
             result.contact.steps.to_string(),
         ]);
-        measured.push((seconds, error.max(1e-17)));
-        estimated.push((seconds, result.contact.integration_error));
+        let point = |error| WorkPoint {
+            order: tolerance,
+            seconds,
+            error,
+        };
+        measured.push(point(error));
+        estimated.push(point(result.contact.integration_error));
     }
     let header = ["tolerance", "seconds", "impulse_error", "reported_error", "steps"];
     match write_csv("impulse_swerve", &header, &rows) {
         Ok(path) => println!("wrote {}", path.display()),
         Err(e) => eprintln!("impulse_swerve.csv: {e}"),
     }
-    let series = [
-        Series {
-            label: "|P − P_ref| (N·s)".into(),
+    let panel = Panel {
+        title: "3-D swerving slip, tolerance 1e-2 to 1e-13".into(),
+        series: vec![Series {
+            label: "adaptive contact integration".into(),
             points: measured,
-        },
-        Series {
-            label: "reported error estimate".into(),
-            points: estimated,
-        },
-    ];
-    if let Err(e) = plot_error_vs_time("impulse_swerve", "3-D swerving slip: error vs run time", &series) {
+            bound: estimated,
+        }],
+    };
+    let title = "Impulse of a 3-D swerving slip: |P − P_ref| (N·s) and the reported estimate against run time";
+    if let Err(e) = write_work_precision("impulse_swerve", title, "impulse error (N·s)", &[panel]) {
         eprintln!("impulse_swerve.svg: {e}");
     }
 }

@@ -7,8 +7,10 @@
 //! n = 1000 and 2000 only; `rotated-plain` = mechanica all pairs with `Refinement::Off` against
 //! dsygvd on the rotated chain, only when named). Writes
 //! `target/reports/modal-<family>.csv`, `modal-<family>.svg` (max relative error of the lowest
-//! 10 ω² against run time, one series per method, one point per size) and
-//! `modal-<family>-backward.svg` (max backward error against run time), and prints the tables.
+//! 10 ω² against run time: one panel per problem family, one series per method joined in order
+//! of size, mechanica's reported bound dashed beside its error) and `modal-<family>-backward.svg`
+//! (max backward error against run time), and prints the tables
+//! ([`mechanica_benches::work_precision`]).
 //!
 //! - **OpenBLAS kernels.** Some OpenBLAS builds (Debian's 0.3.21 among them) do not recognise
 //!   recent Xeons and fall back to their `Prescott` (SSE3) kernels, several times slower; the
@@ -45,7 +47,8 @@ use mechanica_benches::modal::{
     from_col_major, from_nalgebra, from_triplets, lumped_fixed_chain, max_backward_error, max_eigenvalue_error,
     nalgebra_all_pairs, rotated_fixed_chain, to_col_major, to_nalgebra, to_triplets,
 };
-use mechanica_benches::{Series, lapack, median_seconds, plot_error_vs_time, write_csv};
+use mechanica_benches::work_precision::{Panel, Series, WorkPoint, write_work_precision};
+use mechanica_benches::{lapack, median_seconds, write_csv};
 use mechanica_modal::testing;
 use std::time::Duration;
 
@@ -61,6 +64,8 @@ type Triplets = Vec<Triplet<usize, usize, f64>>;
 /// One problem instance with its exact spectrum (at least the lowest [`LOWEST`] ω², ascending).
 struct Case {
     label: String,
+    /// The problem family (one panel of the diagrams): its sizes are joined in a series.
+    family: String,
     n: usize,
     /// Dense (A, B), when the dense methods apply.
     dense: Option<(Mat<f64>, Mat<f64>)>,
@@ -75,6 +80,7 @@ struct Case {
 struct Row {
     method: &'static str,
     case: String,
+    family: String,
     n: usize,
     seconds: f64,
     eig_error: f64,
@@ -175,6 +181,7 @@ fn run(method: Method, case: &Case) -> Option<Row> {
     let row = |seconds, omega: &[f64], backward, bound| Row {
         method: method.label(),
         case: case.label.clone(),
+        family: case.family.clone(),
         n: case.n,
         seconds,
         eig_error: max_eigenvalue_error(omega, &case.exact, LOWEST, case.scale),
@@ -290,6 +297,7 @@ fn chain_case(label: &str, n: usize, pencil: fn(usize) -> (Mat<f64>, Mat<f64>), 
     let sparse = Some((to_triplets(a.as_ref()), to_triplets(b.as_ref())));
     Case {
         label: format!("{label} n={n}"),
+        family: label.to_string(),
         n,
         dense: Some((a, b)),
         sparse,
@@ -331,6 +339,7 @@ fn graded_cases() -> Vec<Case> {
             ] {
                 cases.push(Case {
                     label,
+                    family: name.clone(),
                     n: a.nrows(),
                     sparse: Some((to_triplets(a.as_ref()), to_triplets(b.as_ref()))),
                     dense: Some((a, b)),
@@ -361,6 +370,7 @@ fn grid_case(side: usize) -> Case {
     // The largest ω² of the grid is below 8; only the scale of a zero mode uses it (none here).
     Case {
         label: format!("grid {side}x{side} n={n}"),
+        family: "grid".into(),
         n,
         dense,
         sparse: Some((ta, tb)),
@@ -385,6 +395,7 @@ fn dense_fixed_chain_case(kind: &str, (a, b): (Mat<f64>, Mat<f64>)) -> Case {
     let scale = exact.iter().copied().fold(0.0, f64::max);
     Case {
         label: format!("{kind} fixed chain n={n}"),
+        family: format!("{kind} fixed chain"),
         n,
         dense: Some((a, b)),
         sparse: None,
@@ -446,55 +457,70 @@ fn report(name: &str, title: &str, cases: &[Case], methods: &[Method]) -> Vec<Ro
     if let Err(e) = write_csv(&format!("modal-{name}"), &header, &csv) {
         println!("  cannot write csv: {e}");
     }
-    // Errors exactly 0 (possible for tiny cases) are lifted to u/2 so the point stays on the log axis.
-    let floor = |e: f64| e.max(f64::EPSILON / 2.0);
-    let series = |pick: &dyn Fn(&Row) -> Option<f64>| -> Vec<Series> {
-        let mut out: Vec<Series> = Vec::new();
-        for &m in methods {
-            let points: Vec<(f64, f64)> = rows
-                .iter()
-                .filter(|r| r.method == m.label())
-                .filter_map(|r| pick(r).map(|e| (r.seconds, floor(e))))
-                .collect();
-            if !points.is_empty() {
-                out.push(Series {
-                    label: m.label().into(),
-                    points,
-                });
-            }
-        }
-        out
-    };
-    let mut eig = series(&|r| Some(r.eig_error));
-    let bounds: Vec<(f64, f64)> = rows
-        .iter()
-        .filter(|r| r.method == Method::MechAll.label())
-        .filter_map(|r| r.bound.map(|b| (r.seconds, floor(b))))
-        .collect();
-    if !bounds.is_empty() {
-        eig.push(Series {
-            label: "bound reported by mechanica all pairs".into(),
-            points: bounds,
-        });
-    }
+    let eig = panels(&rows, methods, |r| Some(r.eig_error), |r| r.bound);
+    let backward = panels(&rows, methods, |r| r.backward, |_| None);
     let plots = [
         (
             format!("modal-{name}"),
-            format!("{title}: max rel. error of lowest 10 ω² vs time"),
+            format!("{title}: max relative error of the lowest 10 ω² against run time"),
+            "max relative error, lowest 10 ω²",
             eig,
         ),
         (
             format!("modal-{name}-backward"),
-            format!("{title}: max backward error vs time"),
-            series(&|r| r.backward),
+            format!("{title}: max backward error against run time"),
+            "max backward error",
+            backward,
         ),
     ];
-    for (file, caption, s) in plots {
-        if let Err(e) = plot_error_vs_time(&file, &caption, &s) {
+    for (file, caption, y_label, panels) in plots {
+        if let Err(e) = write_work_precision(&file, &caption, y_label, &panels) {
             println!("  cannot plot {file}: {e}");
         }
     }
     rows
+}
+
+/// One panel per problem family (in the order the rows were measured), one series per method
+/// with its points ordered by size: the error `pick`s, and the bound `bound` reports.
+fn panels(
+    rows: &[Row],
+    methods: &[Method],
+    pick: impl Fn(&Row) -> Option<f64>,
+    bound: impl Fn(&Row) -> Option<f64>,
+) -> Vec<Panel> {
+    let mut families: Vec<&str> = Vec::new();
+    for r in rows {
+        if !families.contains(&r.family.as_str()) {
+            families.push(&r.family);
+        }
+    }
+    let point = |r: &Row, error: f64| WorkPoint {
+        order: r.n as f64,
+        seconds: r.seconds,
+        error,
+    };
+    families
+        .into_iter()
+        .map(|family| {
+            let series = methods
+                .iter()
+                .map(|m| {
+                    let mine = || rows.iter().filter(|r| r.family == family && r.method == m.label());
+                    Series {
+                        label: m.label().into(),
+                        points: mine().filter_map(|r| pick(r).map(|e| point(r, e))).collect(),
+                        bound: mine().filter_map(|r| bound(r).map(|b| point(r, b))).collect(),
+                    }
+                })
+                .filter(|s| !s.points.is_empty())
+                .collect();
+            Panel {
+                title: family.to_string(),
+                series,
+            }
+        })
+        .collect()
 }
 
 /// Prints the dense comparison (ratios mechanica/LAPACK) from the rotated-chain rows.

@@ -4,7 +4,7 @@
 //! Newton's law) is drawn in red.
 
 use crate::plots::EnergyBalance;
-use crate::svg::{Anchor, Color, INK, Svg, fitted_size, text_width, tick_label, ticks};
+use mechanica_svg::{Anchor, Color, INK, Svg, fitted_size, text_width, tick_label, ticks};
 use std::path::Path;
 
 const WIDTH: f64 = 800.0;

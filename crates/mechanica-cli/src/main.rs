@@ -13,6 +13,7 @@ mod mode_record;
 mod mode_shape;
 mod mode_shape_plot;
 mod modes_command;
+mod pencil_shape_plot;
 mod plots;
 mod progress;
 mod report;
@@ -21,7 +22,7 @@ mod scene_run;
 mod simulate_run;
 mod simulation_plots;
 mod spectrum_plot;
-mod svg;
+mod state_matrices;
 mod trajectory_file;
 mod urdf;
 
@@ -62,8 +63,13 @@ struct RunArgs {
     /// Evaluate at these coordinates instead of q0 (comma-separated, one per coordinate, in the
     /// order the report prints q0): every analysis starts there, and the modes are those of the
     /// linearisation at q, without an equilibrium search.
-    #[arg(long, value_name = "Q1,Q2,...", value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_name = "Q1,Q2,...", value_delimiter = ',', allow_hyphen_values = true)]
     q: Option<Vec<f64>>,
+    /// Also report, at the start state (--q, or the scene's q0), the mass matrix A(q), the
+    /// potential U*(q), its gradient and its Hessian ∂²U*/∂q∂q, in full, over the named
+    /// coordinates.
+    #[arg(long)]
+    matrices: bool,
 }
 
 impl Default for RunArgs {
@@ -76,6 +82,7 @@ impl Default for RunArgs {
             max_response_values: scene::SceneLimits::DEFAULT.max_response_values,
             plot: None,
             q: None,
+            matrices: false,
         }
     }
 }
@@ -102,6 +109,9 @@ fn run(args: &RunArgs) -> Result<report::Report, String> {
     let state = args.q.as_deref();
     match &args.scene {
         None if state.is_some() => Err("--q needs a scene or URDF file: the default scene holds two mechanisms".into()),
+        None if args.matrices => {
+            Err("--matrices needs a scene or URDF file: the default scene holds two mechanisms".into())
+        }
         None => default_scene::run(plot),
         Some(path) if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("urdf")) => {
             let options = urdf::UrdfOptions {
@@ -109,7 +119,7 @@ fn run(args: &RunArgs) -> Result<report::Report, String> {
                 allow_missing_mesh: args.allow_missing_mesh,
             };
             let (scene, notes) = urdf::load(path, options)?;
-            let mut report = scene_run::run_at(&scene, path, plot, state)?;
+            let mut report = scene_run::run_at(&scene, path, plot, state, args.matrices)?;
             if let Some(first) = report.steps.first_mut() {
                 let (warnings, remarks): (Vec<String>, Vec<String>) =
                     notes.into_iter().partition(|n| n.starts_with("warning:"));
@@ -123,7 +133,7 @@ fn run(args: &RunArgs) -> Result<report::Report, String> {
                 max_response_values: args.max_response_values,
             };
             let scene = scene::Scene::load_with(path, &limits).map_err(|e| e.to_string())?;
-            scene_run::run_at(&scene, path, plot, state)
+            scene_run::run_at(&scene, path, plot, state, args.matrices)
         }
     }
 }

@@ -72,6 +72,8 @@ pub struct ModeFigure {
     pub largest: f64,
     /// The body whose rotation limited s, when [`MAX_ROTATION`] did.
     pub turned_most: Option<usize>,
+    /// The body whose origin or centre of mass moved [`ModeFigure::largest`].
+    pub moved_most: Option<usize>,
     /// Why no displaced pose is drawn.
     pub note: Option<String>,
 }
@@ -190,22 +192,41 @@ pub fn figure(
         amplitude: 0.0,
         largest: 0.0,
         turned_most: None,
+        moved_most: None,
         note: None,
     };
     match displaced_pose(tree, bodies, q, skeleton, x) {
         Ok((pose, s, turned_most)) => {
             figure.turned_most = turned_most;
-            figure.largest = pose
-                .points()
-                .zip(skeleton.rest.points())
-                .map(|(a, b)| (a - b).norm())
-                .fold(0.0, f64::max);
+            (figure.moved_most, figure.largest) = moved_most(&skeleton.rest, &pose);
             figure.amplitude = s;
             figure.displaced = Some(pose);
         }
         Err(why) => figure.note = Some(why),
     }
     figure
+}
+
+/// The body whose centre of mass (or origin) lies farthest from its place in `rest`, and that
+/// distance, m. Centres come first: a body's origin is its joint, which it shares with its
+/// parent, so a tie goes to the body whose mass is there.
+fn moved_most(rest: &Pose, moved: &Pose) -> (Option<usize>, f64) {
+    let origins = rest
+        .origins
+        .iter()
+        .zip(&moved.origins)
+        .map(|(a, b)| Some((a - b).norm()));
+    let centres = rest.centres.iter().zip(&moved.centres).map(|(a, b)| match (a, b) {
+        (Some(a), Some(b)) => Some((a - b).norm()),
+        _ => None,
+    });
+    let mut best = (None, 0.0);
+    for (body, distance) in centres.enumerate().chain(origins.enumerate()) {
+        if let Some(d) = distance.filter(|d| *d > best.1) {
+            best = (Some(body), d);
+        }
+    }
+    best
 }
 
 /// The pose at q + s·x, the amplitude s (see the module docs) and the body whose rotation

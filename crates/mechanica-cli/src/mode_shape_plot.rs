@@ -14,8 +14,8 @@
 
 use crate::mode_record::ModeKindName;
 use crate::mode_shape::{ModeFigure, ModeShapes, Pose, Skeleton};
-use crate::svg::{Anchor, Color, Svg, fitted_size, tick_label, ticks};
 use mechanica::kinematics::nalgebra::{Matrix3, Vector3};
+use mechanica_svg::{Anchor, Color, Svg, fitted_size, tick_label, ticks};
 use std::path::Path;
 
 const WIDTH: f64 = 1000.0;
@@ -262,8 +262,12 @@ fn caption(skeleton: &Skeleton, figure: &ModeFigure) -> Vec<String> {
             n(figure.amplitude)
         ),
         format!(
-            "largest displacement {} m = {} % of the mechanism's {} m extent",
+            "largest displacement {} m{} = {} % of the mechanism's {} m extent",
             n(figure.largest),
+            figure
+                .moved_most
+                .and_then(|b| skeleton.names.get(b))
+                .map_or(String::new(), |name| format!(", of \"{name}\",")),
             n(100.0 * figure.largest / skeleton.extent),
             n(skeleton.extent)
         ),
@@ -316,7 +320,7 @@ fn draw_header(svg: &mut Svg) {
             kind.as_str()
         };
         svg.text("legend-label", (x + 24.0, y), name, 12.0, Anchor::Start);
-        x += 34.0 + crate::svg::text_width(name, 12.0);
+        x += 34.0 + mechanica_svg::text_width(name, 12.0);
     }
 }
 
@@ -365,6 +369,7 @@ mod tests {
             amplitude: 1.0,
             largest: shift.norm() * rest.len() as f64,
             turned_most: None,
+            moved_most: None,
             note: None,
         };
         (skeleton, figure)

@@ -10,7 +10,9 @@ pub(crate) mod records;
 
 use crate::mechanism_run::records::SturmStatus;
 use crate::mode_record::ModeRecord;
+use crate::pencil_shape_plot::{MAX_MODES, PencilShape};
 use crate::report::{Command, Record, Report, Step, timed_step};
+use crate::scene_run::records::PlotsRecord;
 use mechanica::modal::faer::Mat;
 use mechanica::modal::{
     PencilProblem, Refinement, Residuals, Selection, SolveOptions, SparsePencil, SparseSolveOptions, Tuning,
@@ -55,6 +57,10 @@ pub struct ModesArgs {
     /// about 5.6 GB); above it the dense solver is refused with an error (use --lowest K).
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_DENSE_ORDER)]
     pub max_dense_order: usize,
+    /// Write the first six mode shapes, each as its displacement against the coordinate index,
+    /// to DIR/mode_shapes.svg.
+    #[arg(long, value_name = "DIR", conflicts_with = "values_only")]
+    pub plot: Option<PathBuf>,
 }
 
 /// The default of `--max-dense-order`.
@@ -82,6 +88,22 @@ fn mode_records(
         .collect()
 }
 
+/// The first modes with their shapes, for `--plot` (none without vectors).
+fn plotted_shapes(modes: &[mechanica::modal::Mode], x: Option<&Mat<f64>>) -> Vec<PencilShape> {
+    let Some(x) = x else { return Vec::new() };
+    modes
+        .iter()
+        .take(MAX_MODES.min(x.ncols()))
+        .enumerate()
+        .map(|(k, mode)| PencilShape {
+            number: k + 1,
+            omega_sq: Some(mode.omega_sq).filter(|w| w.is_finite()),
+            bound: mode.error_bound,
+            shape: (0..x.nrows()).map(|i| x[(i, k)]).collect(),
+        })
+        .collect()
+}
+
 fn max_bound(modes: &[mechanica::modal::Mode]) -> f64 {
     modes.iter().map(|m| m.error_bound).fold(0.0, f64::max)
 }
@@ -105,10 +127,11 @@ pub fn run(args: &ModesArgs) -> Result<Report, String> {
     let (read_step, a, b) = read_pencil(args)?;
     let n = a.nrows;
     let mut steps = vec![read_step];
+    let mut shapes = Vec::new();
     let sparse =
         matches!(args.lowest, Some(k) if n > Tuning::DEFAULT.dense_limit && k < n) && !args.dense && !args.values_only;
     if sparse {
-        steps.extend(sparse_steps(args, &a, &b)?);
+        steps.extend(sparse_steps(args, &a, &b, &mut shapes)?);
     } else if n > args.max_dense_order {
         return Err(format!(
             "order {n} is above the dense limit --max-dense-order {} (about seven n×n matrices of doubles, {:.1} GB): ask for --lowest K (sparse Lanczos), or raise the limit",
@@ -116,13 +139,26 @@ pub fn run(args: &ModesArgs) -> Result<Report, String> {
             7.0 * 8.0 * (n as f64) * (n as f64) / 1e9
         ));
     } else {
-        steps.extend(dense_steps(args, refinement, &a, &b)?);
+        steps.extend(dense_steps(args, refinement, &a, &b, &mut shapes)?);
+    }
+    if let Some(dir) = &args.plot {
+        steps.push(plot_step(dir, &shapes)?);
     }
     Ok(Report::new(
         Command::Modes,
         format!("modes of ({}, {})", args.mass.display(), args.stiffness.display()),
         steps,
     ))
+}
+
+/// Writes `mode_shapes.svg` into `dir` (created if needed) and reports the file.
+fn plot_step(dir: &Path, shapes: &[PencilShape]) -> Result<Step, String> {
+    let start = std::time::Instant::now();
+    std::fs::create_dir_all(dir).map_err(|e| format!("plot directory {}: {e}", dir.display()))?;
+    let path = dir.join("mode_shapes.svg");
+    crate::pencil_shape_plot::write(shapes, &path)?;
+    let files = vec![path.display().to_string()];
+    Ok(stage("plots", start.elapsed(), PlotsRecord { files }))
 }
 
 /// The refinement policy named by `--refinement` (auto, off or always).
@@ -169,6 +205,7 @@ fn sparse_steps(
     args: &ModesArgs,
     a: &mechanica::modal::MatrixMarket,
     b: &mechanica::modal::MatrixMarket,
+    shapes: &mut Vec<PencilShape>,
 ) -> Result<Vec<Step>, String> {
     let count = args.lowest.unwrap_or(0);
     let pencil = SparsePencil::from_triplets(a.nrows, &a.entries, &b.entries).map_err(|e| e.to_string())?;
@@ -180,6 +217,7 @@ fn sparse_steps(
         },
     )
     .map_err(|e| e.to_string())?;
+    *shapes = plotted_shapes(&sol.modes, Some(&sol.vectors));
     let r = &sol.report;
     let t = r.timings;
     let factor = PencilFactorRecord {
@@ -224,6 +262,7 @@ fn dense_steps(
     refinement: Refinement,
     a: &mechanica::modal::MatrixMarket,
     b: &mechanica::modal::MatrixMarket,
+    shapes: &mut Vec<PencilShape>,
 ) -> Result<Vec<Step>, String> {
     let n = a.nrows;
     let problem = PencilProblem::new(
@@ -242,6 +281,7 @@ fn dense_steps(
         },
     };
     let sol = solve(&problem, &options).map_err(|e| e.to_string())?;
+    *shapes = plotted_shapes(&sol.modes, sol.vectors.as_ref());
     let t = sol.timings;
     let factor = PencilFactorRecord {
         shift: None,

@@ -28,12 +28,20 @@ pub(crate) struct Model {
 /// Runs `scene` (loaded from `file`) and returns its report; with `plot_dir`, also writes the
 /// SVG plots of what was computed there.
 pub fn run(scene: &Scene, file: &Path, plot_dir: Option<&Path>) -> Result<Report, String> {
-    run_at(scene, file, plot_dir, None)
+    run_at(scene, file, plot_dir, None, false)
 }
 
 /// [`run`], evaluated at the coordinates `state` instead of the scene's q0 when given: the
 /// equilibrium search is left out, so the modes are those of the linearisation at `state`.
-pub fn run_at(scene: &Scene, file: &Path, plot_dir: Option<&Path>, state: Option<&[f64]>) -> Result<Report, String> {
+/// With `matrices`, a step reports A(q), U*(q), its gradient and Hessian at the start state
+/// ([`crate::state_matrices`]).
+pub fn run_at(
+    scene: &Scene,
+    file: &Path,
+    plot_dir: Option<&Path>,
+    state: Option<&[f64]>,
+    matrices: bool,
+) -> Result<Report, String> {
     let mut at_state;
     let scene = match state {
         Some(_) => {
@@ -71,6 +79,9 @@ pub fn run_at(scene: &Scene, file: &Path, plot_dir: Option<&Path>, state: Option
     if scene.analyses.mass_properties {
         let gravity = scene.gravity.map(Vector3::from);
         steps.push(timed_step("mass properties at q0", || mass_report(&model, gravity))?);
+    }
+    if matrices {
+        steps.push(crate::state_matrices::step(scene, &model)?);
     }
     let mut plots = crate::plots::PlotData::default();
     crate::mechanism_run::run(scene, &model, &mut steps, &mut plots)?;

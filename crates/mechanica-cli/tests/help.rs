@@ -4,11 +4,12 @@
 mod common;
 use common::mechanica;
 
-const RUN_OPTIONS: [&str; 4] = [
+const RUN_OPTIONS: [&str; 5] = [
     "--repair-inertia",
     "--allow-missing-mesh",
     "--max-response-values",
-    "--plot",
+    "--q <Q1,Q2,...>",
+    "--matrices",
 ];
 
 #[test]
@@ -17,6 +18,9 @@ fn run_options_appear_in_run_help_only() {
     assert!(ok, "{err}");
     for option in RUN_OPTIONS {
         assert!(run.contains(option), "run --help lacks {option}:\n{run}");
+    }
+    for option in ["--density", "--shell", "--lowest", "--stiffness", "--shapes"] {
+        assert!(!run.contains(option), "run --help lists {option}:\n{run}");
     }
     for command in ["mass", "modes", "version"] {
         let (ok, help, err) = mechanica(&[command, "--help"]);
@@ -27,10 +31,19 @@ fn run_options_appear_in_run_help_only() {
         assert!(help.contains("--json"), "{command} --help lacks --json:\n{help}");
     }
     let (ok, mass, _) = mechanica(&["mass", "--help"]);
-    assert!(ok && mass.contains("--density") && !mass.contains("--lowest"), "{mass}");
+    assert!(
+        ok && mass.contains("--density") && !mass.contains("--lowest") && !mass.contains("--plot"),
+        "{mass}"
+    );
     let (ok, modes, _) = mechanica(&["modes", "--help"]);
     assert!(
         ok && modes.contains("--lowest") && !modes.contains("--density"),
+        "{modes}"
+    );
+    // --plot is an option of run and of modes, each with its own meaning.
+    assert!(run.contains("--plot") && run.contains("free response"), "{run}");
+    assert!(
+        modes.contains("--plot") && modes.contains("coordinate index"),
         "{modes}"
     );
     // An option of another subcommand is refused, not ignored.

@@ -152,3 +152,117 @@ fn a_malformed_file_is_reported_with_its_line() {
     assert!(!ok);
     assert!(err.contains("bad_a.mtx") && err.contains("line 4"), "{err}");
 }
+
+/// What a test reads of one panel: points, index tick labels, caption, zero line.
+type ShapePanel = (Vec<(f64, f64)>, Vec<String>, String, f64);
+
+/// Per panel of `svg`: the `cx`/`cy` of every `<circle class="shape-point">`, the text of every
+/// index tick label, the caption, and the y of the zero line (the solid grid line).
+fn shape_panels(svg: &str) -> Vec<ShapePanel> {
+    let attribute = |line: &str, name: &str| -> f64 {
+        let key = format!(" {name}=\"");
+        let start = line.find(&key).expect("attribute") + key.len();
+        line[start..start + line[start..].find('"').expect("quoted")]
+            .parse()
+            .expect("a number")
+    };
+    let text = |line: &str| line[line.find('>').expect("tag") + 1..line.rfind("</").expect("end")].to_string();
+    let mut panels = Vec::new();
+    for line in svg.lines() {
+        if line.starts_with("<g class=\"panel\"") {
+            panels.push((Vec::new(), Vec::new(), String::new(), f64::NAN));
+        }
+        let Some((points, ticks, caption, zero)) = panels.last_mut() else {
+            continue;
+        };
+        if line.contains("class=\"shape-point\"") {
+            points.push((attribute(line, "cx"), attribute(line, "cy")));
+        } else if line.contains("class=\"tick-label\"") && line.contains("text-anchor=\"middle\"") {
+            ticks.push(text(line));
+        } else if line.contains("class=\"caption\"") {
+            *caption = text(line);
+        } else if line.contains("class=\"grid\"") && !line.contains("dasharray") {
+            *zero = attribute(line, "y1");
+        }
+    }
+    panels
+}
+
+/// `modes --plot` on a lumped fixed chain of n equal masses: one panel per mode (six), the
+/// displacement against the coordinate index on integer ticks 1 … n, and the k-th mode changes
+/// sign k − 1 times along the chain (the oscillation theorem of a Jacobi matrix), its largest
+/// |x_i| at the coordinate of the largest |sin(kπ i/(n + 1))|, which the caption names.
+#[test]
+fn lumped_chain_mode_shapes_are_drawn_against_the_coordinate_index() {
+    let dir = scratch().join("plot");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let n = 13;
+    let mass: Vec<_> = (0..n).map(|i| (i, i, 2.5)).collect();
+    let mut stiffness: Vec<_> = (0..n).map(|i| (i, i, 2.0 * 40.0)).collect();
+    stiffness.extend((1..n).map(|i| (i, i - 1, -40.0)));
+    let (a, b) = write_pencil(&dir, "chain", n, &mass, &stiffness);
+    let plots = dir.join("plots");
+    let args = [
+        "modes",
+        "--mass",
+        a.to_str().expect("utf-8"),
+        "--stiffness",
+        b.to_str().expect("utf-8"),
+        "--plot",
+        plots.to_str().expect("utf-8"),
+    ];
+    let json = run_json(&[&args[..], &["--json"]].concat());
+    let files = numbers_free_files(step(&json, "plots"));
+    assert_eq!(files, vec![plots.join("mode_shapes.svg").display().to_string()]);
+    let svg = std::fs::read_to_string(plots.join("mode_shapes.svg")).expect("svg");
+    let panels = shape_panels(&svg);
+    assert_eq!(panels.len(), 6);
+    for (k, (points, ticks, caption, zero)) in panels.iter().enumerate() {
+        let mode = k + 1;
+        assert_eq!(points.len(), n, "mode {mode}");
+        for tick in ticks {
+            let i: usize = tick
+                .parse()
+                .unwrap_or_else(|_| panic!("tick {tick:?} is not an integer"));
+            assert!((1..=n).contains(&i), "tick {i}");
+        }
+        assert!(ticks.first().map(String::as_str) == Some("1"), "{ticks:?}");
+        // Points are drawn left to right, one per coordinate; y is screen-down.
+        assert!(points.windows(2).all(|w| w[1].0 > w[0].0));
+        assert!(zero.is_finite(), "mode {mode}: no zero line");
+        let signs: Vec<bool> = points
+            .iter()
+            .filter(|p| (p.1 - zero).abs() > 0.02)
+            .map(|p| p.1 < *zero)
+            .collect();
+        let changes = signs.windows(2).filter(|w| w[0] != w[1]).count();
+        assert_eq!(changes, mode - 1, "mode {mode}: {points:?}");
+        let exact = |i: usize| {
+            (mode as f64 * std::f64::consts::PI * i as f64 / (n + 1) as f64)
+                .sin()
+                .abs()
+        };
+        let peak = (1..=n)
+            .max_by(|&i, &j| exact(i).total_cmp(&exact(j)))
+            .expect("a coordinate");
+        let ties = (1..=n)
+            .filter(|&i| (exact(i) - exact(peak)).abs() < 1e-9)
+            .collect::<Vec<_>>();
+        assert!(
+            ties.iter().any(|i| caption.contains(&format!("coordinate {i} "))),
+            "mode {mode}: {caption} (peak at {ties:?})"
+        );
+    }
+    let (ok, _, err) = mechanica(&[&args[..], &["--values-only"]].concat());
+    assert!(!ok && err.contains("--values-only"), "{err}");
+}
+
+/// The file names of a `plots` step.
+fn numbers_free_files(step: &serde_json::Value) -> Vec<String> {
+    step["files"]
+        .as_array()
+        .expect("files")
+        .iter()
+        .map(|f| f.as_str().expect("a path").to_string())
+        .collect()
+}

@@ -515,3 +515,59 @@ fn spatial_urdf_arm_is_drawn() {
     let axes = drawing.texts("axis-label", None);
     assert!(axes.iter().any(|a| a == "z"), "the world axes are shown: {axes:?}");
 }
+
+/// The caption names the body that moves most. A double pendulum of point masses m₁ (upper)
+/// and m₂ (lower) on links of length l, in absolute angles φ: A = l² [[m₁ + m₂, m₂], [m₂, m₂]],
+/// B = g l diag(m₁ + m₂, m₂). The upper mass moves l|φ₁|, the lower l|φ₁ + φ₂|: with a light
+/// upper mass its fast mode is concentrated there (a light middle body, like a wrist between
+/// heavy ones), which the caption must name, and the slow mode moves the lower mass most.
+#[test]
+fn the_caption_names_the_body_that_moves_most() {
+    let dir = scratch("moves-most");
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut uniform = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut named = std::collections::BTreeSet::new();
+    for case in 0..5 {
+        let (m1, m2, l) = (10f64.powf(-3.0 + 4.0 * uniform()), 1.0, 0.5 + uniform());
+        let scene = dir.join(format!("pendulum{case}.toml"));
+        let text = double_pendulum(1.0, l).replacen("mass = 1", &format!("mass = {m1:?}"), 1);
+        std::fs::write(&scene, text).expect("scene");
+        let plots = dir.join(format!("plots{case}"));
+        let (ok, _, err) = mechanica(&[
+            "run",
+            scene.to_str().expect("utf-8"),
+            "--plot",
+            plots.to_str().expect("utf-8"),
+        ]);
+        assert!(ok, "{err}");
+        let drawing = Drawing::read(&plots.join("mode_shapes.svg"));
+        // det(B − ω² A) = 0 per unit g/l: (m₁+m₂ − w(m₁+m₂))(m₂ − w m₂) − w² m₂² = 0.
+        let (a, b, c) = (m1 * m2, -2.0 * (m1 + m2) * m2, (m1 + m2) * m2);
+        let roots = [
+            (-b - (b * b - 4.0 * a * c).sqrt()) / (2.0 * a),
+            (-b + (b * b - 4.0 * a * c).sqrt()) / (2.0 * a),
+        ];
+        for (mode, w) in roots.into_iter().enumerate() {
+            // Second row of (B − w A) φ = 0: −w m₂ φ₁ + (m₂ − w m₂) φ₂ = 0.
+            let (phi1, phi2) = (1.0 - w, w);
+            let (upper, lower) = (phi1.abs(), (phi1 + phi2).abs());
+            if (upper / lower - 1.0).abs() < 0.2 {
+                continue;
+            }
+            let expected = if upper > lower { "upper" } else { "lower" };
+            let caption = drawing.texts("caption", Some(mode + 1)).join(" ");
+            assert!(
+                caption.contains(&format!("of \"{expected}\"")),
+                "case {case}, m₁ = {m1}, mode {}: {caption} (upper {upper}, lower {lower})",
+                mode + 1
+            );
+            named.insert(expected);
+        }
+    }
+    assert_eq!(named.len(), 2, "the cases exercise both answers: {named:?}");
+}

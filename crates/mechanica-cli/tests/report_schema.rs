@@ -69,6 +69,11 @@ fn every_report() -> Vec<(String, serde_json::Value)> {
         reports.push((name, report(&["run", scene.to_str().expect("utf-8")])));
     }
     reports.push(("default scene".into(), report(&[])));
+    let pendulum = path("examples/scenes/double_pendulum.toml");
+    reports.push((
+        format!("{pendulum} --q --matrices"),
+        report(&["run", &pendulum, "--q", "0.3,-1.2", "--matrices"]),
+    ));
     let panda = path("examples/cpp/panda_modes/panda.urdf");
     reports.push((panda.clone(), report(&["run", &panda])));
     reports.push(("URDF with massless links".into(), urdf_with_warnings()));
@@ -197,10 +202,18 @@ fn the_plots_step_validates_too() {
     assert_eq!(violations(&validator(), &json), Vec::<String>::new());
 }
 
+/// The index of the first `analysis` step of a report.
+fn step_index(report: &serde_json::Value, analysis: &str) -> usize {
+    let steps = report["steps"].as_array().expect("steps");
+    steps
+        .iter()
+        .position(|s| s["analysis"] == analysis)
+        .unwrap_or_else(|| panic!("no {analysis} step"))
+}
+
 /// The index of the modes step of a report.
 fn modes_step(report: &serde_json::Value) -> usize {
-    let steps = report["steps"].as_array().expect("steps");
-    steps.iter().position(|s| s["analysis"] == "modes").expect("modes step")
+    step_index(report, "modes")
 }
 
 /// One way to break a report, with what it breaks.
@@ -210,9 +223,9 @@ type Mutation = (&'static str, fn(&mut serde_json::Value));
 fn a_mutated_report_fails_validation() {
     let validator = validator();
     let chain = repo().join("examples/scenes/spring_pendulum_chain.toml");
-    let original = report(&["run", chain.to_str().expect("utf-8")]);
+    let original = report(&["run", chain.to_str().expect("utf-8"), "--matrices"]);
     assert!(violations(&validator, &original).is_empty());
-    let mutations: [Mutation; 9] = [
+    let mutations: [Mutation; 11] = [
         ("schema version 1", |r| r["schema_version"] = 1.into()),
         ("a string for ω²", |r| {
             let k = modes_step(r);
@@ -234,6 +247,14 @@ fn a_mutated_report_fails_validation() {
         }),
         ("an unknown analysis", |r| {
             r["steps"][0]["analysis"] = "astrology".into()
+        }),
+        ("a mass matrix flattened to one row", |r| {
+            let k = step_index(r, "state_matrices");
+            r["steps"][k]["mass_matrix"] = serde_json::json!([1.0, 0.0, 0.0, 1.0]);
+        }),
+        ("matrices without the Hessian", |r| {
+            let k = step_index(r, "state_matrices");
+            r["steps"][k].as_object_mut().expect("step").remove("hessian");
         }),
         ("a count that is not an integer", |r| r["steps"][0]["dof"] = 2.5.into()),
         ("a stability verdict in words", |r| {

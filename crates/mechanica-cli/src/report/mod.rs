@@ -127,6 +127,8 @@ records! {
     Build(scene::BuildRecord),
     /// Total mass properties of a scene at q0.
     MassProperties(scene::MassRecord),
+    /// A(q), U*(q), its gradient and Hessian at the start state (`run --matrices`).
+    StateMatrices(crate::state_matrices::StateMatricesRecord),
     /// The mechanism built from a scene (potentials, rotating frame).
     Mechanism(mechanism::MechanismRecord),
     /// An equilibrium search.

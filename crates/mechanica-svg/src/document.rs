@@ -1,7 +1,6 @@
-//! A minimal SVG writer for the pictures of `--plot` that are drawings rather than charts (the
-//! mode shapes on the mechanism, the impact energy bars): one element per line, each carrying
-//! a `class` naming what it shows, coordinates in pixels with two decimals; and the tick
-//! values of a linear axis.
+//! A minimal SVG writer for pictures that are drawings rather than charts: one element per
+//! line, each carrying a `class` naming what it shows, coordinates in pixels with two decimals;
+//! and the estimated width of sans-serif text.
 
 use std::fmt::Write as _;
 
@@ -50,13 +49,15 @@ pub fn text_width(text: &str, size: f64) -> f64 {
     0.64 * size * text.chars().count() as f64
 }
 
-/// The largest font size ≤ `size` (and ≥ 7 px) at which `text` fits into `width` pixels.
+/// The largest font size ≤ `size` in steps of 0.1 px (and ≥ 7 px) at which `text` fits into
+/// `width` pixels.
 pub fn fitted_size(text: &str, width: f64, size: f64) -> f64 {
     let needed = text_width(text, size);
     if needed <= width {
         size
     } else {
-        (size * width / needed).max(7.0)
+        // Rounded down to the 0.1 px the SVG text prints, so that the printed size still fits.
+        ((10.0 * size * width / needed).floor() / 10.0).max(7.0)
     }
 }
 
@@ -166,71 +167,9 @@ impl Svg {
     }
 }
 
-/// Tick values for a linear axis over [`lo`, `hi`]: multiples of a step 1, 2 or 5 × 10^k
-/// chosen for about `count` ticks, each the integer multiple k·step (so that its printed form
-/// is short), with the step.
-pub fn ticks(lo: f64, hi: f64, count: usize) -> (Vec<f64>, f64) {
-    if !(lo.is_finite() && hi.is_finite()) || hi <= lo {
-        return (vec![lo], 1.0);
-    }
-    let raw = (hi - lo) / count.max(1) as f64;
-    let decade = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .map(|m| m * decade)
-        .find(|s| *s >= raw)
-        .unwrap_or(10.0 * decade);
-    let first = (lo / step).ceil() as i64;
-    let last = (hi / step).floor() as i64;
-    ((first..=last).map(|k| k as f64 * step).collect(), step)
-}
-
-/// A tick value printed with no more digits than the step needs.
-pub fn tick_label(value: f64, step: f64) -> String {
-    if value == 0.0 {
-        return "0".into();
-    }
-    let digits = (value.abs().log10().floor() - step.log10().floor()) as usize + 1;
-    crate::report::text::number(value, digits.clamp(1, 6))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Ticks over random ranges (about six per range, so at most three significant digits
-    /// each): a 1-2-5 step, inside the range, printed without rounding noise.
-    #[test]
-    fn ticks_are_round_and_print_cleanly() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for _ in 0..2000 {
-            let scale = 10f64.powf(16.0 * uniform() - 8.0);
-            let lo = if uniform() < 0.5 { 0.0 } else { -scale * uniform() };
-            let hi = lo + scale * (0.1 + uniform());
-            let (values, step) = ticks(lo, hi, 6);
-            let mantissa = step / 10f64.powf(step.log10().floor());
-            assert!(
-                [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-9),
-                "step {step}"
-            );
-            assert!((2..=14).contains(&values.len()), "{lo} {hi}: {values:?}");
-            for v in &values {
-                assert!(*v >= lo - 1e-12 * scale && *v <= hi + 1e-12 * scale);
-                let label = tick_label(*v, step);
-                let mantissa = label.split('e').next().unwrap_or("").replace(['-', '.'], "");
-                let significant = mantissa.trim_start_matches('0').trim_end_matches('0');
-                assert!(significant.len() <= 3, "{label} ({v}, step {step})");
-                let back: f64 = label.parse().expect("a number");
-                assert!((back - v).abs() <= 1e-9 * step, "{label} vs {v}");
-            }
-        }
-    }
 
     #[test]
     fn text_is_escaped_and_fitted() {
