@@ -219,11 +219,20 @@ pub unsafe extern "C" fn mech_simulation_impact_contacts(
         }
         let impulses: Vec<mech_vec3_t> = e.impulses.iter().map(|p| (*p).into()).collect();
         let modes: Vec<mech_contact_mode_t> = e.modes.iter().map(|m| mode_to_c(*m)).collect();
+        let contacts = OutSlice::optional(contacts_out, count, "contacts_out")?;
+        let impulses_slice = OutSlice::optional(impulses_out, count, "impulses_out")?;
+        let modes_slice = OutSlice::optional(modes_out, count, "modes_out")?;
         // SAFETY: caller's contract.
         unsafe {
-            write_optional(contacts_out, &e.contacts, "contacts_out")?;
-            write_optional(impulses_out, &impulses, "impulses_out")?;
-            write_optional(modes_out, &modes, "modes_out")?;
+            if let Some(out) = contacts {
+                out.write(&e.contacts);
+            }
+            if let Some(out) = impulses_slice {
+                out.write(&impulses);
+            }
+            if let Some(out) = modes_slice {
+                out.write(&modes);
+            }
         }
         Ok(())
     })
@@ -265,18 +274,4 @@ pub unsafe extern "C" fn mech_simulation_impact_velocities(
         }
         Ok(())
     })
-}
-
-/// Writes `values` to `ptr` unless it is NULL.
-///
-/// # Safety
-/// A non-NULL `ptr` must point to `values.len()` writable entries.
-unsafe fn write_optional<T: Copy>(ptr: *mut T, values: &[T], what: &str) -> Result<(), FfiError> {
-    if ptr.is_null() || values.is_empty() {
-        return Ok(());
-    }
-    let out = OutSlice::new(ptr, values.len(), what)?;
-    // SAFETY: caller's contract.
-    unsafe { out.write(values) };
-    Ok(())
 }
