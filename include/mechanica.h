@@ -309,9 +309,10 @@ typedef struct mech_forward_report_t {
      */
     mech_forward_method_t method;
     /**
-     * ‖r‖∞ / max_k scale_k with r = τ − RNEA(q, q̇, q̈) the residual of the equations of motion
-     * at the computed q̈ and scale_k the magnitude of the terms summed into τ_k: the relative
-     * change of the forces that makes q̈ exact, up to the rounding of the check.
+     * ‖r‖∞ / max(max_k scale_k, λ) with r = τ − RNEA(q, q̇, q̈) the residual of the equations
+     * of motion at the computed q̈, scale_k the magnitude of the terms summed into τ_k and
+     * λ = DBL_MIN: the relative change of the forces that makes q̈ exact, up to the rounding of
+     * the check.
      */
     double backward_error;
     /**

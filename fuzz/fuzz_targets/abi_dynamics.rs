@@ -329,9 +329,10 @@ fn forward(d: &OwnedDynamics, input: &mut Input) {
 }
 
 /// ‖RNEA(q, q̇, q̈) − τ‖∞ ≤ η·S + 2·max ρ_k: the forward solve's backward error η is
-/// ‖r‖∞ / max_k(ρ_k / (16·(d + 4)·u) + |τ_k|), with r the residual of the library's own RNEA
-/// check at the same q̈; the scale S uses the smallest factor (d ≥ 1), so it bounds the
-/// library's from above, and 2·max ρ covers the rounding of this second evaluation.
+/// ‖r‖∞ / max(max_k(ρ_k / (16·(d + 4)·u) + |τ_k|), λ), with r the residual of the library's
+/// own RNEA check at the same q̈ and λ the smallest normal double; the scale S uses the
+/// smallest factor (d ≥ 1), so it bounds the library's from above, and 2·max ρ covers the
+/// rounding of this second evaluation.
 fn round_trip(d: &OwnedDynamics, [q, q_dot, tau]: [&[f64]; 3], t: f64, q_ddot: &[f64], eta: f64) {
     let Some((again, rho)) = inverse(d, q, q_dot, q_ddot, t) else {
         return;
@@ -340,7 +341,7 @@ fn round_trip(d: &OwnedDynamics, [q, q_dot, tau]: [&[f64]; 3], t: f64, q_ddot: &
         .iter()
         .zip(tau)
         .map(|(r, t)| r / FACTOR_MIN + t.abs())
-        .fold(0.0, f64::max);
+        .fold(f64::MIN_POSITIVE, f64::max);
     let rounding = rho.iter().fold(0.0, |m: f64, r| m.max(*r));
     let allowed = eta * scale * (1.0 + 1e-9) + 2.0 * rounding;
     let worst = again.iter().zip(tau).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);

@@ -109,7 +109,7 @@ mod simulate;
 pub use constraints::ConstraintSpec;
 pub use contacts::ContactSpec;
 use serde::Deserialize;
-pub use simulate::{DEFAULT_SIMULATE_STEPS, SimulateSpec};
+pub use simulate::SimulateSpec;
 use std::collections::HashMap;
 use std::fmt;
 use std::path::{Path, PathBuf};

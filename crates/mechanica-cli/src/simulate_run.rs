@@ -9,7 +9,7 @@ mod record;
 
 use crate::plots::{PlotData, SimulationSeries};
 use crate::report::{Step, timed_step};
-use crate::scene::{DEFAULT_SIMULATE_STEPS, Scene, SimulateSpec};
+use crate::scene::{Scene, SimulateSpec};
 use crate::scene_run::Model;
 use mechanica::impulse::{BodyPoint, ContactLaw, MechanismContact};
 use mechanica::kinematics::nalgebra::Vector3;
@@ -38,7 +38,7 @@ pub fn run(
             .as_ref()
             .map_or(Forcing::None, |tau| Forcing::Constant(tau.get_ref().clone())),
         estimate_error: spec.estimate_error.unwrap_or(true),
-        max_steps: spec.max_steps.as_ref().map_or(DEFAULT_SIMULATE_STEPS, |m| *m.get_ref()),
+        max_steps: spec.step_limit(),
         ..Options::default()
     };
     let method = method_of(spec);

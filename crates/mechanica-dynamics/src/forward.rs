@@ -50,8 +50,10 @@ pub struct ForwardDynamics {
     pub method: ForwardMethod,
     /// r = τ − RNEA(q, q̇, q̈): the residual of the equations of motion at the computed q̈.
     pub residual: Vec<f64>,
-    /// ‖r‖∞ / max_k(scale_k): the relative backward error, with scale_k the magnitude of the
-    /// terms that the inverse dynamics sums into τ_k (see `InverseDynamics::error_estimate`).
+    /// ‖r‖∞ / max(max_k scale_k, λ): the relative backward error, with scale_k the magnitude
+    /// of the terms that the inverse dynamics sums into τ_k (see
+    /// `InverseDynamics::error_estimate`) and λ = f64::MIN_POSITIVE, the smallest normal number
+    /// (below it the spacing of doubles is absolute).
     pub backward_error: f64,
     /// κ∞(A) = ‖A‖∞ ‖A⁻¹‖∞, when the mass matrix was formed (the CRBA route).
     pub condition: Option<f64>,
@@ -295,7 +297,8 @@ impl Dynamics {
             .map(|(e, t)| e / self.estimate_factor() + t.abs())
             .fold(0.0, f64::max);
         let norm = residual.iter().fold(0.0f64, |m, r| m.max(r.abs()));
-        let eta = if scale > 0.0 { norm / scale } else { 0.0 };
+        // Below the normal range the absolute spacing, not a relative one, limits every term.
+        let eta = norm / scale.max(f64::MIN_POSITIVE);
         let rounding = check_estimate.iter().fold(0.0f64, |m, e| m.max(*e));
         Ok((residual, eta, rounding))
     }

@@ -247,30 +247,32 @@ impl Dynamics {
         self.generalized_force_of(&weights)
     }
 
-    /// Per coordinate, the scale of τ_k's rounding: the power of the norms of everything the
-    /// transmitted wrench is summed from (a running-error estimate). Needs the accelerations of
-    /// the last `rnea_state` in the workspace and the loads in `self.loads`.
+    /// Per coordinate, the scale of τ_k's rounding: the products of the norms of everything the
+    /// transmitted wrench is summed from (a running-error estimate). The norms are 1-norms: they
+    /// bound the Euclidean ones and, unlike a sum of squares, neither underflow for forces near
+    /// 1e-300 nor overflow near 1e200. Needs the accelerations of the last `rnea_state` in the
+    /// workspace and the loads in `self.loads`.
     fn magnitudes(&self) -> Result<Vec<f64>, DynamicsError> {
         let tree = self.mechanism.tree();
-        let g = self.gravity().norm();
+        let g = self.gravity().lp_norm(1);
         let bodies = self.world.len();
         let (mut f_mag, mut m_mag) = (vec![0.0; bodies], vec![0.0; bodies]);
         for (i, body) in self.world.iter().enumerate() {
-            let w = self.ws.angular_velocity(i)?.norm();
-            let wd = self.ws.angular_acceleration(i)?.norm();
-            let a = self.ws.origin_acceleration(i)?.norm();
-            let c = body.c.norm();
-            f_mag[i] = body.mass * (a + (wd + w * w) * c + g) + self.loads[i].force.norm();
-            m_mag[i] = body.inertia_c.norm() * (wd + w * w) + c * f_mag[i] + self.loads[i].moment.norm();
+            let w = self.ws.angular_velocity(i)?.lp_norm(1);
+            let wd = self.ws.angular_acceleration(i)?.lp_norm(1);
+            let a = self.ws.origin_acceleration(i)?.lp_norm(1);
+            let c = body.c.lp_norm(1);
+            f_mag[i] = body.mass * (a + (wd + w * w) * c + g) + self.loads[i].force.lp_norm(1);
+            m_mag[i] = body.inertia_c.lp_norm(1) * (wd + w * w) + c * f_mag[i] + self.loads[i].moment.lp_norm(1);
         }
         let mut out = vec![0.0; self.dof()];
         for &i in tree.topological_order().iter().rev() {
             for k in tree.dof_range(i) {
                 let (w, v) = self.ws.motion_column(k)?;
-                out[k] = w.norm() * m_mag[i] + v.norm() * f_mag[i];
+                out[k] = w.lp_norm(1) * m_mag[i] + v.lp_norm(1) * f_mag[i];
             }
             if let Some(p) = tree.parent(i) {
-                let r = (self.ws.position(i)? - self.ws.position(p)?).norm();
+                let r = (self.ws.position(i)? - self.ws.position(p)?).lp_norm(1);
                 m_mag[p] += m_mag[i] + r * f_mag[i];
                 f_mag[p] += f_mag[i];
             }

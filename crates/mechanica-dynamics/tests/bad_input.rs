@@ -207,3 +207,54 @@ fn massless_coordinates_are_a_singular_mass_matrix() {
     );
     assert_eq!(out, [7.0; 2]);
 }
+
+/// Loads near the bottom of the range (a charge of 1e-312…1e-295 in a field of order 10 on
+/// bodies of 1e-3…1e3 kg): τ_k's rounding estimate is never below the rounding of τ_k itself (the
+/// sums of squares of the old Euclidean norms underflowed to an estimate of 0), and a forward
+/// solve whose q̈ underflows reports a nonzero backward error for its nonzero residual.
+#[test]
+fn tiny_loads_keep_their_rounding_estimate() {
+    let mut rng = Rng::new(41);
+    for case in 0..200 {
+        let bodies = 1 + rng.below(6);
+        let mut mechanism = random_mechanism(&mut rng, bodies, 6.0, case % 2 == 0);
+        mechanism.set_gravity(Vector3::zeros()).expect("gravity");
+        let mut dynamics = Dynamics::new(mechanism).expect("dynamics");
+        let field = Arc::new(UniformFields {
+            electric: rng.vector(100.0),
+            magnetic: rng.vector(1.0),
+        });
+        let charge = ChargedPoint {
+            body: rng.below(bodies),
+            point: rng.vector(1.0),
+            charge: 10f64.powf(rng.uniform(-312.0, -295.0)),
+            field,
+        };
+        dynamics.add_velocity_potential(charge).expect("charge");
+        let n = dynamics.dof();
+        let (q, zero) = (common::random_state(&mut rng, dynamics.mechanism()).0, vec![0.0; n]);
+        let state = State::new(&q, &zero);
+        let inverse = dynamics.inverse_dynamics(&state, &zero).expect("inverse dynamics");
+        for (k, (tau, estimate)) in inverse.tau.iter().zip(&inverse.error_estimate).enumerate() {
+            assert!(
+                *estimate >= f64::EPSILON / 2.0 * tau.abs(),
+                "case {case}: τ[{k}] = {tau:e} with rounding estimate {estimate:e}"
+            );
+        }
+        for result in [
+            dynamics.forward_dynamics(&state, &zero),
+            dynamics.forward_dynamics_crba(&state, &zero),
+        ] {
+            let forward = match result {
+                Ok(forward) => forward,
+                Err(DynamicsError::SingularMassMatrix { .. }) => continue,
+                Err(other) => panic!("case {case}: {other}"),
+            };
+            let residual = forward.residual.iter().fold(0.0f64, |m, r| m.max(r.abs()));
+            assert!(
+                residual == 0.0 || forward.backward_error > 0.0,
+                "case {case}: residual {residual:e} with backward error 0"
+            );
+        }
+    }
+}

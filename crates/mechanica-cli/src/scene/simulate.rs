@@ -56,6 +56,11 @@ pub struct SimulateSpec {
 }
 
 impl SimulateSpec {
+    /// The most steps of each run: `max_steps`, or [`DEFAULT_SIMULATE_STEPS`].
+    pub fn step_limit(&self) -> usize {
+        self.max_steps.as_ref().map_or(DEFAULT_SIMULATE_STEPS, |m| *m.get_ref())
+    }
+
     /// The method's name.
     pub fn method_name(&self) -> &str {
         self.method.as_ref().map_or("dopri5", |m| m.get_ref().as_str())
@@ -160,7 +165,7 @@ impl Validator<'_> {
             );
             return Err(self.error(Some(spec.t_end.span()), at("interval"), message));
         }
-        let max_steps = spec.max_steps.as_ref().map_or(DEFAULT_SIMULATE_STEPS, |m| *m.get_ref());
+        let max_steps = spec.step_limit();
         if let Some(step) = &spec.step
             && t_end / step.get_ref() > max_steps as f64
         {

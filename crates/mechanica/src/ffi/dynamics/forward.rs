@@ -24,9 +24,10 @@ pub const MECH_FORWARD_MASS_MATRIX: mech_forward_method_t = 1;
 pub struct mech_forward_report_t {
     /// The route that produced q̈ (a mech_forward_method_t).
     pub method: mech_forward_method_t,
-    /// ‖r‖∞ / max_k scale_k with r = τ − RNEA(q, q̇, q̈) the residual of the equations of motion
-    /// at the computed q̈ and scale_k the magnitude of the terms summed into τ_k: the relative
-    /// change of the forces that makes q̈ exact, up to the rounding of the check.
+    /// ‖r‖∞ / max(max_k scale_k, λ) with r = τ − RNEA(q, q̇, q̈) the residual of the equations
+    /// of motion at the computed q̈, scale_k the magnitude of the terms summed into τ_k and
+    /// λ = DBL_MIN: the relative change of the forces that makes q̈ exact, up to the rounding of
+    /// the check.
     pub backward_error: f64,
     /// κ∞(A) = ‖A‖∞ ‖A⁻¹‖∞ when the mass matrix was formed (MECH_FORWARD_MASS_MATRIX), else −1.
     pub condition: f64,
