@@ -340,6 +340,7 @@ impl Tree {
             )
         };
         check_status("mech_tree_add_body", status);
+        mechanica_fuzz::trace!("add_body(parent {parent}, joint {joint}) = {status}");
         if status == MECH_STATUS_OK {
             assert_eq!(body.value, self.bodies, "bodies are numbered in the order of the calls");
             self.bodies += 1;
@@ -380,6 +381,7 @@ impl Tree {
             .collect();
         let status = unsafe { mech_tree_set_state(self.handle, q.as_ptr(), q_dot.as_ptr(), n) };
         check_status("mech_tree_set_state", status);
+        mechanica_fuzz::trace!("set_state(q {q:?}, q̇ {q_dot:?}) = {status}");
         self.q_dot = (status == MECH_STATUS_OK).then_some(q_dot);
     }
 
@@ -394,6 +396,7 @@ impl Tree {
         };
         let status = unsafe { mech_tree_set_base(self.handle, &base) };
         check_status("mech_tree_set_base", status);
+        mechanica_fuzz::trace!("set_base({base:?}) = {status}");
         if status == MECH_STATUS_OK {
             self.base_moving = arr(&base.omega) != [0.0; 3] || arr(&base.velocity) != [0.0; 3];
             self.q_dot = None; // setting the base discards the state
@@ -509,7 +512,9 @@ fuzz_target!(|data: &[u8]| {
     let mut steps = 0;
     while !input.is_empty() && steps < 64 {
         steps += 1;
-        match input.u8() % 11 {
+        let op = input.u8() % 11;
+        mechanica_fuzz::trace!("op {op}");
+        match op {
             0 => euler_round_trip(&mut input),
             1 => quaternion_and_log_round_trips(&mut input),
             2 => axis_angle_and_orthonormalize(&mut input),

@@ -10,6 +10,8 @@ pub struct OwnedTree {
     pub handle: *mut mech_tree_t,
     pub bodies: usize,
     pub dof: usize,
+    /// The coordinates that are rotation vectors (of spherical and free joints).
+    pub rotation_coordinates: Vec<usize>,
 }
 
 impl Drop for OwnedTree {
@@ -38,7 +40,9 @@ pub fn build_tree(input: &mut Input) -> Option<OwnedTree> {
         handle,
         bodies: 0,
         dof: 0,
+        rotation_coordinates: Vec::new(),
     };
+    let mut offset = 0;
     let count = 1 + input.below(4);
     for i in 0..count {
         let parent = if i == 0 { -1 } else { input.below(i) as i64 };
@@ -59,6 +63,15 @@ pub fn build_tree(input: &mut Input) -> Option<OwnedTree> {
             return None;
         }
         tree.bodies += 1;
+        let (dof, rotation) = match joint {
+            MECH_JOINT_SPHERICAL => (3, 0..3),
+            MECH_JOINT_FREE => (6, 3..6),
+            MECH_JOINT_PLANAR => (3, 0..0),
+            MECH_JOINT_FIXED => (0, 0..0),
+            _ => (1, 0..0),
+        };
+        tree.rotation_coordinates.extend(rotation.map(|k| offset + k));
+        offset += dof;
     }
     // SAFETY: the handle is live.
     if unsafe { mech_tree_finalize(handle) } != MECH_STATUS_OK {
@@ -69,6 +82,7 @@ pub fn build_tree(input: &mut Input) -> Option<OwnedTree> {
     let status = unsafe { mech_tree_size(handle, &mut bodies, &mut dof) };
     assert_eq!(status, MECH_STATUS_OK);
     assert_eq!(bodies, tree.bodies);
+    assert_eq!(dof, offset, "the tree's dof differs from its joints'");
     tree.dof = dof;
     Some(tree)
 }

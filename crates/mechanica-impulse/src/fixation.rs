@@ -27,12 +27,18 @@ pub struct Fixation {
     pub residual: f64,
 }
 
+/// The largest speed left at a fixed point, relative to its speed before, that
+/// [`fix_point`] accepts.
+pub const FIXATION_RESIDUAL: f64 = 1e-8;
+
 /// Brings the body point at `p_wx` (world frame) to rest by a single impulse at that point
 /// (7.100–7.108). The result reports the velocity left at X as [`Fixation::residual`].
 ///
 /// Errors: a non-finite point, [`ImpulseError::ZeroInertiaAxisExcited`] for a point off a
 /// zero-inertia axis, and [`ImpulseError::Singular`] when W_X is singular and the
-/// pseudo-inverse leaves |v_X| > 1e-9·|v_X⁻| (X cannot be stopped by an impulse at X).
+/// pseudo-inverse leaves |v_X| > 1e-9·|v_X⁻| (X cannot be stopped by an impulse at X), or when
+/// the solve leaves |v_X| > [`FIXATION_RESIDUAL`]·|v_X⁻| (W_X too ill-conditioned, e.g. a
+/// point 1e100 m from a body of 1 m).
 pub fn fix_point(body: &RigidBody, p_wx: &Vector3<f64>) -> Result<Fixation, ImpulseError> {
     check_all_finite("fixed point", p_wx.iter())?;
     body.check_impulse_point("fixed point", p_wx)?;
@@ -69,6 +75,15 @@ pub fn fix_point(body: &RigidBody, p_wx: &Vector3<f64>) -> Result<Fixation, Impu
     let residual = (response.v_wc_after + response.w_w_after.cross(&(p_wx - body.p_wc()))).norm();
     let energy_change = 0.5 * impulse.dot(&v);
     check_result("energy change", [energy_change, residual].iter())?;
+    // ΔT = ½ S·(u⁻ + u⁺) exactly; the reported ½ S·u⁻ holds only while the point is at rest
+    // after. A point left moving at more than 1e-8 of its speed before (a mobility too
+    // ill-conditioned to solve, e.g. a point 1e100 m from a body of 1 m) is refused.
+    if residual > FIXATION_RESIDUAL * v.norm() {
+        return Err(ImpulseError::Singular {
+            what: "fixation: the point mobility is too ill-conditioned to bring the point to rest (speed left)",
+            value: residual,
+        });
+    }
     Ok(Fixation {
         impulse_w: impulse,
         v_wc_after: response.v_wc_after,
@@ -107,6 +122,56 @@ mod tests {
         // The impulse: S = m(V₀ − v₀) = m(ΩL/2 − v) ŷ = −m v/4 ŷ.
         assert!((fix.impulse_w - Vector3::new(0.0, -m * v / 4.0, 0.0)).norm() < 1e-13);
         assert!(fix.residual < 1e-14 * v);
+    }
+
+    /// Points 10^k m from a body of 1 m (k up to 150, random directions and velocities): either
+    /// the point is brought to rest and the energies T⁺ − T⁻ computed directly from the
+    /// velocities after match the reported ΔT (7.108) and never gain, or the solve is refused
+    /// (singular, or overflowing on its way); never a fixation that leaves the point moving and the body with more energy.
+    #[test]
+    fn far_points_are_fixed_with_the_energy_they_report_or_refused() {
+        let mut props = MassProperties::point(2.7, Vector3::new(0.9, 0.9, -0.4)).expect("ok");
+        props.inertia_c = Matrix3::new(2.1, 0.2, 0.8, 0.2, 3.1, -0.2, 0.8, -0.2, 2.5);
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let (mut fixed, mut refused) = (0, 0);
+        for case in 0..600 {
+            let k = (case % 150) as f64 + next();
+            let direction = Vector3::new(next(), next(), next()).normalize();
+            let v0 = Vector3::new(next(), next(), next()) * 10f64.powf(30.0 * (next() + 0.5));
+            let w0 = Vector3::new(next(), next(), next()) * 8.0;
+            let body = RigidBody::from_mass_properties(&props, v0, w0).expect("ok");
+            let x = props.p_oc + direction * 10f64.powf(k);
+            let energy = |v: &Vector3<f64>, w: &Vector3<f64>| {
+                0.5 * props.mass * v.norm_squared() + 0.5 * w.dot(&(props.inertia_c * w))
+            };
+            match fix_point(&body, &x) {
+                Ok(fix) => {
+                    fixed += 1;
+                    let (before, after) = (energy(&v0, &w0), energy(&fix.v_wc_after, &fix.w_w_after));
+                    assert!(
+                        after <= before * (1.0 + 1e-9),
+                        "case {case}: gained {:e} of {before:e}",
+                        after - before
+                    );
+                    let direct = after - before;
+                    assert!(
+                        (direct - fix.energy_change).abs() <= 1e-6 * before,
+                        "case {case} (10^{k:.1} m): ΔT {:e} reported, {direct:e} from the velocities",
+                        fix.energy_change
+                    );
+                }
+                // The ill-conditioned solve may also overflow on its way.
+                Err(ImpulseError::Singular { .. } | ImpulseError::NonFiniteResult { .. }) => refused += 1,
+                Err(other) => panic!("case {case}: {other}"),
+            }
+        }
+        assert!(fixed > 200 && refused > 0, "{fixed} fixed, {refused} refused");
     }
 
     #[test]

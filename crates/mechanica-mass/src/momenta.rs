@@ -5,6 +5,7 @@
 //! both expressed in W. Velocities are absolute and expressed in W.
 
 use crate::MassProperties;
+use mechanica_kinematics::scaling;
 use nalgebra::Vector3;
 
 impl MassProperties {
@@ -37,8 +38,17 @@ impl MassProperties {
     }
 
     /// The kinetic energy T = ½ m v₀·v₀ + ½ ω·J₀ ω (König, 3.37, 3.41).
+    /// Each term is formed on data scaled by powers of two and scaled back by an exponent-kept
+    /// product, so it under- or overflows only when its exact value does (a heavy body moving
+    /// at 1e-160 m/s has a normal T although |v|² underflows).
     pub fn kinetic_energy(&self, v_c: &Vector3<f64>, omega: &Vector3<f64>) -> f64 {
-        0.5 * self.mass * v_c.norm_squared() + 0.5 * omega.dot(&(self.inertia_c * omega))
+        let speed = scaling::norm(v_c);
+        let translational = scaling::product(&[0.5, self.mass, speed, speed]);
+        let w_scale = scaling::power_of_two_above(omega.amax());
+        let j_scale = scaling::power_of_two_above(self.inertia_c.amax());
+        let w = omega / w_scale;
+        let rotational = scaling::product(&[0.5, w.dot(&(self.inertia_c / j_scale * w)), j_scale, w_scale, w_scale]);
+        translational + rotational
     }
 
     /// The kinetic energy of a body turning with `omega` about the fixed point A at `p_oa`:

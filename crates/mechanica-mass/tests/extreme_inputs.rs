@@ -55,6 +55,32 @@ fn primitives() -> Vec<(&'static str, Primitive, Vec<f64>, i32)> {
 }
 
 proptest! {
+    /// T(2^a m, 2^b v, 2^c ω, 2^d J) = 2^(a+2b) ½ m v² + 2^(d+2c) ½ ωᵀJω for a body of order
+    /// one: the energy of a scaled body is the scaled energy (to a few ulps) whenever each
+    /// term is a normal number, although |v|², ω² or J ω may underflow or overflow on the way
+    /// (a 1e70 kg body at 1e-160 m/s has T = 1e-250, which a plain ½ m v·v returns as 0).
+    #[test]
+    fn kinetic_energy_is_homogeneous_over_the_range(
+        e_v in -1000i32..1000, b in -1000i32..1000, e_w in -1000i32..1000, c in -1000i32..1000,
+        v in proptest::array::uniform3(-1.0f64..1.0), w in proptest::array::uniform3(-1.0f64..1.0),
+        moments in proptest::array::uniform3(0.6f64..1.0), axis in proptest::array::uniform3(-3.0f64..3.0),
+    ) {
+        let (v, w) = (Vector3::from(v), Vector3::from(w));
+        let r = Rotation3::from_scaled_axis(Vector3::from(axis));
+        let j = r.matrix() * Matrix3::from_diagonal(&Vector3::from(moments)) * r.matrix().transpose();
+        let (t_v, t_w) = (0.5 * 0.7 * v.norm_squared(), 0.5 * w.dot(&(j * w)));
+        let scale = |x: f64, e: i32| x * pow2(e / 2) * pow2(e - e / 2);
+        let (a, d) = (e_v - 2 * b, e_w - 2 * c);
+        prop_assume!((-1020..=1020).contains(&a) && (-1020..=1020).contains(&d));
+        let (want_v, want_w) = (scale(t_v, e_v), scale(t_w, e_w));
+        let normal = |x: f64| x == 0.0 || (x.abs() >= f64::MIN_POSITIVE && x.is_finite());
+        prop_assume!(normal(want_v) && normal(want_w) && (want_v + want_w).is_finite());
+        let body = MassProperties::new(0.7 * pow2(a), Vector3::zeros(), j * pow2(d)).expect("valid body");
+        let got = body.kinetic_energy(&(v * pow2(b)), &(w * pow2(c)));
+        let want = want_v + want_w;
+        prop_assert!((got - want).abs() <= 1e-14 * want, "T = {:e}, want {:e}", got, want);
+    }
+
     /// Dimensions scaled by λ = 2^k and the mass by 2^j: the moments are exactly 2^(j+2k) times
     /// those of the unit body (up to the few roundings of the closed form), or a typed error
     /// naming the moment when that is not representable.

@@ -26,6 +26,10 @@ pub struct Workspace {
     q_dot: Vec<f64>,
     rotation: Vec<Matrix3<f64>>,
     position: Vec<Vector3<f64>>,
+    /// o_B − o_P (o_P the base origin for a root), formed from the placement and the joint's
+    /// own translation rather than as a difference of positions, so that lever arms stay exact
+    /// to rounding for bodies far from the world origin.
+    offset: Vec<Vector3<f64>>,
     omega: Vec<Vector3<f64>>,
     velocity: Vec<Vector3<f64>>,
     omega_dot: Vec<Vector3<f64>>,
@@ -46,6 +50,7 @@ impl Workspace {
             q_dot: vec![0.0; nv],
             rotation: vec![Matrix3::identity(); bodies],
             position: vec![z; bodies],
+            offset: vec![z; bodies],
             omega: vec![z; bodies],
             velocity: vec![z; bodies],
             omega_dot: vec![z; bodies],
@@ -279,7 +284,8 @@ impl KinematicTree {
                 Some(p) => (ws.rotation[p], ws.position[p]),
                 None => (base_r, base_p),
             };
-            let p_wj = p_wp + r_wp * self.p_pj[b];
+            let d_wj = r_wp * self.p_pj[b];
+            let p_wj = p_wp + d_wj;
             if let Joint::Revolute { .. } = self.joint[b] {
                 let s = self.dof_start[b];
                 let (sn, cs) = q[s].sin_cos();
@@ -287,19 +293,21 @@ impl KinematicTree {
                 let r_pb = self.r_pj[b] + k * sn + k2 * (1.0 - cs);
                 ws.rotation[b] = r_wp * r_pb;
                 ws.position[b] = p_wj;
+                ws.offset[b] = d_wj;
                 ws.col_w[s] = r_wp * a_p;
                 ws.col_v[s] = Vector3::zeros();
                 continue;
             }
             let r_wj = r_wp * self.r_pj[b];
             let s = self.dof_start[b];
-            let (r_wb, p_wb) = match self.joint[b] {
+            // The joint's translation t: o_B = o_J + t.
+            let (r_wb, t) = match self.joint[b] {
                 Joint::Revolute { .. } => continue, // handled above without forming R_WJ
                 Joint::Prismatic { axis } => {
                     let a = r_wj * axis;
                     ws.col_w[s] = Vector3::zeros();
                     ws.col_v[s] = a;
-                    (r_wj, p_wj + a * q[s])
+                    (r_wj, a * q[s])
                 }
                 Joint::Spherical => {
                     let phi = Vector3::new(q[s], q[s + 1], q[s + 2]);
@@ -309,7 +317,7 @@ impl KinematicTree {
                         ws.col_w[s + c] = jw.column(c).into_owned();
                         ws.col_v[s + c] = Vector3::zeros();
                     }
-                    (r, p_wj)
+                    (r, Vector3::zeros())
                 }
                 Joint::Free => {
                     let phi = Vector3::new(q[s + 3], q[s + 4], q[s + 5]);
@@ -321,7 +329,7 @@ impl KinematicTree {
                         ws.col_w[s + 3 + c] = jw.column(c).into_owned();
                         ws.col_v[s + 3 + c] = Vector3::zeros();
                     }
-                    (r, p_wj + r_wj * Vector3::new(q[s], q[s + 1], q[s + 2]))
+                    (r, r_wj * Vector3::new(q[s], q[s + 1], q[s + 2]))
                 }
                 Joint::Planar => {
                     let (sn, cs) = q[s + 2].sin_cos();
@@ -332,12 +340,13 @@ impl KinematicTree {
                     ws.col_v[s + 1] = r_wj.column(1).into_owned();
                     ws.col_w[s + 2] = r_wj.column(2).into_owned();
                     ws.col_v[s + 2] = Vector3::zeros();
-                    (r_wj * rz, p_wj + r_wj * Vector3::new(q[s], q[s + 1], 0.0))
+                    (r_wj * rz, r_wj * Vector3::new(q[s], q[s + 1], 0.0))
                 }
-                Joint::Fixed => (r_wj, p_wj),
+                Joint::Fixed => (r_wj, Vector3::zeros()),
             };
             ws.rotation[b] = r_wb;
-            ws.position[b] = p_wb;
+            ws.position[b] = p_wj + t;
+            ws.offset[b] = d_wj + t;
         }
         Workspace::check_stage(&ws.position, "body position")?;
         Workspace::check_stage(&ws.col_v, "motion column")?;
@@ -367,13 +376,13 @@ impl KinematicTree {
         ws.stage = Stage::Positions;
         ws.q_dot.copy_from_slice(q_dot);
         for &b in &self.order {
-            let (w_p, v_p, o_p) = match self.parent[b] {
-                Some(p) => (ws.omega[p], ws.velocity[p], ws.position[p]),
-                None => (ws.base.omega, ws.base.velocity, ws.base.position),
+            let (w_p, v_p) = match self.parent[b] {
+                Some(p) => (ws.omega[p], ws.velocity[p]),
+                None => (ws.base.omega, ws.base.velocity),
             };
             let range = self.dof_range(b);
             let mut w = w_p;
-            let mut v = v_p + w_p.cross(&(ws.position[b] - o_p));
+            let mut v = v_p + w_p.cross(&ws.offset[b]);
             for k in range.clone() {
                 w += ws.col_w[k] * q_dot[k];
                 v += ws.col_v[k] * q_dot[k];
@@ -433,24 +442,12 @@ impl KinematicTree {
         self.check_vector(q_ddot, "q_ddot")?;
         ws.stage = Stage::Velocities;
         for &b in &self.order {
-            let (wd_p, a_p, w_p, v_p, o_p) = match self.parent[b] {
-                Some(p) => (
-                    ws.omega_dot[p],
-                    ws.acceleration[p],
-                    ws.omega[p],
-                    ws.velocity[p],
-                    ws.position[p],
-                ),
-                None => (
-                    ws.base.omega_dot,
-                    ws.base.acceleration,
-                    ws.base.omega,
-                    ws.base.velocity,
-                    ws.base.position,
-                ),
+            let (wd_p, a_p, w_p, v_p) = match self.parent[b] {
+                Some(p) => (ws.omega_dot[p], ws.acceleration[p], ws.omega[p], ws.velocity[p]),
+                None => (ws.base.omega_dot, ws.base.acceleration, ws.base.omega, ws.base.velocity),
             };
             let mut wd = wd_p;
-            let mut a = a_p + wd_p.cross(&(ws.position[b] - o_p)) + w_p.cross(&(ws.velocity[b] - v_p));
+            let mut a = a_p + wd_p.cross(&ws.offset[b]) + w_p.cross(&(ws.velocity[b] - v_p));
             for k in self.dof_range(b) {
                 wd += ws.col_w_dot[k] * ws.q_dot[k] + ws.col_w[k] * q_ddot[k];
                 a += ws.col_v_dot[k] * ws.q_dot[k] + ws.col_v[k] * q_ddot[k];
@@ -489,27 +486,33 @@ impl KinematicTree {
         ws.check(Stage::Positions, body)?;
         self.check_jacobian_out(out, 3)?;
         check_finite_vec(p_bq, "body point")?;
-        let x = ws.rotation[body] * p_bq + ws.position[body];
-        self.fill_path_columns::<3>(body, out, |i, k| {
-            (ws.col_w[k].cross(&(x - ws.position[i])) + ws.col_v[k]).into()
+        let lever = ws.rotation[body] * p_bq;
+        self.fill_path_columns::<3>(ws, body, &lever, out, |k, r| {
+            (ws.col_w[k].cross(r) + ws.col_v[k]).into()
         });
         check_result(out.iter(), "point Jacobian")
     }
 
-    /// Zeroes `out` (W×dof, column-major) and writes column k = `column(i, k)` for every
-    /// coordinate k on the path from `body` to the root, i being the body that k moves.
+    /// Zeroes `out` (W×dof, column-major) and writes column k = `column(k, x − o_i)` for every
+    /// coordinate k on the path from `body` to the root, i being the body that k moves and x
+    /// the point at `lever` = x − o_body from the body's origin. The levers are summed from the
+    /// bodies' offsets, never formed as differences of world positions.
     fn fill_path_columns<const W: usize>(
         &self,
+        ws: &Workspace,
         body: usize,
+        lever: &Vector3<f64>,
         out: &mut [f64],
-        column: impl Fn(usize, usize) -> [f64; W],
+        column: impl Fn(usize, &Vector3<f64>) -> [f64; W],
     ) {
         out.fill(0.0);
+        let mut lever = *lever;
         let mut b = Some(body);
         while let Some(i) = b {
             for k in self.dof_range(i) {
-                out[W * k..W * k + W].copy_from_slice(&column(i, k));
+                out[W * k..W * k + W].copy_from_slice(&column(k, &lever));
             }
+            lever += ws.offset[i];
             b = self.parent[i];
         }
     }
@@ -519,7 +522,7 @@ impl KinematicTree {
         self.check_workspace(ws)?;
         ws.check(Stage::Positions, body)?;
         self.check_jacobian_out(out, 3)?;
-        self.fill_path_columns::<3>(body, out, |_, k| ws.col_w[k].into());
+        self.fill_path_columns::<3>(ws, body, &Vector3::zeros(), out, |k, _| ws.col_w[k].into());
         check_result(out.iter(), "angular Jacobian")
     }
 
@@ -536,10 +539,10 @@ impl KinematicTree {
         ws.check(Stage::Positions, body)?;
         self.check_jacobian_out(out, 6)?;
         check_finite_vec(p_bq, "body point")?;
-        let x = ws.rotation[body] * p_bq + ws.position[body];
-        self.fill_path_columns::<6>(body, out, |i, k| {
+        let lever = ws.rotation[body] * p_bq;
+        self.fill_path_columns::<6>(ws, body, &lever, out, |k, r| {
             let w = ws.col_w[k];
-            let v = w.cross(&(x - ws.position[i])) + ws.col_v[k];
+            let v = w.cross(r) + ws.col_v[k];
             [w.x, w.y, w.z, v.x, v.y, v.z]
         });
         check_result(out.iter(), "body Jacobian")
@@ -560,11 +563,11 @@ impl KinematicTree {
         self.check_jacobian_out(out, 3)?;
         check_finite_vec(p_bq, "body point")?;
         let rb = ws.rotation[body] * p_bq;
-        let x = rb + ws.position[body];
         let x_dot = ws.velocity[body] + ws.omega[body].cross(&rb);
-        self.fill_path_columns::<3>(body, out, |i, k| {
-            let (r, r_dot) = (x - ws.position[i], x_dot - ws.velocity[i]);
-            (ws.col_w_dot[k].cross(&r) + ws.col_w[k].cross(&r_dot) + ws.col_v_dot[k]).into()
+        let tree_body = &self.dof_body;
+        self.fill_path_columns::<3>(ws, body, &rb, out, |k, r| {
+            let r_dot = x_dot - ws.velocity[tree_body[k]];
+            (ws.col_w_dot[k].cross(r) + ws.col_w[k].cross(&r_dot) + ws.col_v_dot[k]).into()
         });
         check_result(out.iter(), "point Jacobian rate")
     }
@@ -575,7 +578,7 @@ impl KinematicTree {
         self.check_workspace(ws)?;
         ws.check(Stage::Velocities, body)?;
         self.check_jacobian_out(out, 3)?;
-        self.fill_path_columns::<3>(body, out, |_, k| ws.col_w_dot[k].into());
+        self.fill_path_columns::<3>(ws, body, &Vector3::zeros(), out, |k, _| ws.col_w_dot[k].into());
         check_result(out.iter(), "angular Jacobian rate")
     }
 
@@ -601,11 +604,11 @@ impl KinematicTree {
         let mut a = ws.base.acceleration;
         let mut prev = None;
         for &i in chain.iter().rev() {
-            let (w_p, v_p, o_p) = match prev {
-                Some(p) => (ws.omega[p], ws.velocity[p], ws.position[p]),
-                None => (ws.base.omega, ws.base.velocity, ws.base.position),
+            let (w_p, v_p) = match prev {
+                Some(p) => (ws.omega[p], ws.velocity[p]),
+                None => (ws.base.omega, ws.base.velocity),
             };
-            a += wd.cross(&(ws.position[i] - o_p)) + w_p.cross(&(ws.velocity[i] - v_p));
+            a += wd.cross(&ws.offset[i]) + w_p.cross(&(ws.velocity[i] - v_p));
             for k in self.dof_range(i) {
                 wd += ws.col_w_dot[k] * ws.q_dot[k];
                 a += ws.col_v_dot[k] * ws.q_dot[k];

@@ -223,7 +223,9 @@ pub struct mech_fixation_t {
 /// residual speed of the point (the accuracy of the solve) to `out`.
 ///
 /// Errors: as mech_impulse_apply, and MECH_STATUS_SINGULAR when the point cannot be stopped
-/// (e.g. a moving body of infinite mass).
+/// (e.g. a moving body of infinite mass) or the solve leaves it moving at more than 1e-8 of
+/// its speed before (a point mobility too ill-conditioned, e.g. a point 1e100 m from a body of
+/// 1 m).
 ///
 /// # Safety
 /// `body` and `point` must be readable, `out` writable.
