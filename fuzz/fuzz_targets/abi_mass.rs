@@ -185,7 +185,10 @@ fn combine_subtract(input: &mut Input) {
             doubles_of(&a.center_of_mass),
             tol * reach
         ),
-        "centre not restored"
+        "centre not restored: {:?} back as {:?} (tolerance {:e}; whole {sum:?}, part {hole:?})",
+        arr(&a.center_of_mass),
+        arr(&rest.center_of_mass),
+        tol * reach
     );
     assert!(
         close(&rest.inertia_about_com.m, &a.inertia_about_com.m, tol * j),

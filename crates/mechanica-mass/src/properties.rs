@@ -10,6 +10,7 @@
 use crate::MassError;
 use crate::error::{check_all_finite, check_finite, check_result};
 use crate::validity::{self, ValidityTolerance};
+use mechanica_kinematics::scaling;
 use nalgebra::{Isometry3, Matrix3, Vector3};
 
 /// Mass `mass`, centre of mass `p_OC` (from the frame origin O, expressed in that frame)
@@ -156,19 +157,22 @@ impl MassProperties {
         let Some(first) = parts.first() else {
             return Err(MassError::NonPositiveTotalMass(0.0));
         };
-        // Moments relative to the first part's centre keep the sum accurate far from the origin.
+        // Moments relative to the first part's centre keep the sum accurate far from the origin;
+        // the weights are the masses over a power of two, so that subnormal masses weigh with
+        // their full value.
         let origin = first.p_oc;
+        let weight = scaling::power_of_two_above(parts.iter().fold(0.0, |m: f64, p| m.max(p.mass.abs())));
         let mut mass = 0.0;
         let mut first_moment = Vector3::zeros();
         for p in &parts {
             mass += p.mass;
-            first_moment += p.mass * (p.p_oc - origin);
+            first_moment += (p.mass / weight) * (p.p_oc - origin);
         }
         check_result([mass].iter(), "total mass")?;
         if mass <= 0.0 {
             return Err(MassError::NonPositiveTotalMass(mass));
         }
-        let c_rel = first_moment / mass;
+        let c_rel = first_moment / (mass / weight);
         let mut inertia = Matrix3::zeros();
         for p in &parts {
             inertia += p.inertia_c + steiner_term(p.mass, &(p.p_oc - origin - c_rel));
@@ -210,7 +214,8 @@ impl MassProperties {
             return Err(MassError::NonPositiveTotalMass(mass));
         }
         let origin = self.p_oc;
-        let c_rel = -(hole.mass * (hole.p_oc - origin)) / mass;
+        let weight = scaling::power_of_two_above(self.mass.max(hole.mass));
+        let c_rel = -((hole.mass / weight) * (hole.p_oc - origin)) / (mass / weight);
         let inertia = self.inertia_c + steiner_term(self.mass, &(-c_rel))
             - hole.inertia_c
             - steiner_term(hole.mass, &(hole.p_oc - origin - c_rel));

@@ -55,6 +55,31 @@ fn primitives() -> Vec<(&'static str, Primitive, Vec<f64>, i32)> {
 }
 
 proptest! {
+    /// Parts whose masses are subnormal (k·2⁻¹⁰⁷⁴, k up to 1000) combine to the centre
+    /// Σ kᵢ cᵢ / Σ kᵢ, and subtracting a part gives the others' centre back, to rounding: the
+    /// weights are the masses over a power of two, so a mass of 5e-324 weighs 1, not 0 or 2.
+    #[test]
+    fn subnormal_masses_weigh_their_full_value(
+        counts in proptest::collection::vec(1u32..1000, 2..6),
+        centres in proptest::collection::vec(proptest::array::uniform3(-2.0f64..2.0), 6),
+    ) {
+        let tiny = f64::from_bits(1);
+        let parts: Vec<MassProperties> = counts
+            .iter()
+            .zip(&centres)
+            .map(|(k, c)| MassProperties::new(*k as f64 * tiny, Vector3::from(*c), Matrix3::identity()).expect("valid part"))
+            .collect();
+        let weighted = |parts: &[MassProperties]| {
+            let total: f64 = parts.iter().map(|p| p.mass / tiny).sum();
+            parts.iter().map(|p| p.p_oc * (p.mass / tiny)).sum::<Vector3<f64>>() / total
+        };
+        let sum = MassProperties::sum(&parts).expect("sum");
+        prop_assert!((sum.p_oc - weighted(&parts)).amax() <= 1e-14, "{} vs {}", sum.p_oc, weighted(&parts));
+        let rest = sum.subtract(&parts[0]).expect("rest");
+        let want = weighted(&parts[1..]);
+        prop_assert!((rest.p_oc - want).amax() <= 1e-11, "{} vs {}", rest.p_oc, want);
+    }
+
     /// T(2^a m, 2^b v, 2^c ω, 2^d J) = 2^(a+2b) ½ m v² + 2^(d+2c) ½ ωᵀJω for a body of order
     /// one: the energy of a scaled body is the scaled energy (to a few ulps) whenever each
     /// term is a normal number, although |v|², ω² or J ω may underflow or overflow on the way
