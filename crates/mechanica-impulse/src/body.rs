@@ -342,6 +342,14 @@ impl RigidBody {
         (w + w.transpose()) * 0.5
     }
 
+    /// For a free body of finite mass (not hinged): its inverse mass γ > 0 and inverse central
+    /// inertia W (the blocks of G = diag(γI, W)).
+    pub(crate) fn free_mobility(&self) -> Option<(f64, Matrix3<f64>)> {
+        let gamma = self.mobility[(0, 0)];
+        (self.mobility_factor.is_empty() && gamma > 0.0)
+            .then(|| (gamma, self.mobility.fixed_view::<3, 3>(3, 3).into_owned()))
+    }
+
     /// Fails if an impulse at `p_wp` could have a moment about a zero-inertia axis.
     pub(crate) fn check_impulse_point(&self, what: &'static str, p_wp: &Vector3<f64>) -> Result<(), ImpulseError> {
         if self.zero_inertia_count == 0 {

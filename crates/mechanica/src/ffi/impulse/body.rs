@@ -224,8 +224,8 @@ pub struct mech_fixation_t {
 ///
 /// Errors: as mech_impulse_apply, and MECH_STATUS_SINGULAR when the point cannot be stopped
 /// (e.g. a moving body of infinite mass) or the solve leaves it moving at more than 1e-8 of
-/// its speed before (a point mobility too ill-conditioned, e.g. a point 1e100 m from a body of
-/// 1 m).
+/// its speed before (a hinged body whose point mobility is too ill-conditioned; a free body is
+/// solved in the lever's frame and stays accurate for points any distance away).
 ///
 /// # Safety
 /// `body` and `point` must be readable, `out` writable.
