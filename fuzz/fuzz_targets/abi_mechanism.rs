@@ -211,7 +211,10 @@ fn modes(m: &Mechanism, tree: &OwnedTree, bodies: &[mech_mass_properties_t], q: 
             .iter()
             .chain(&bounds[..k])
             .all(|v| v.is_finite() || *v == f64::INFINITY),
-        "non-finite modes"
+        "non-finite modes: ω² {:?}, bounds {:?}, kinds {:?}",
+        &omega_sq[..k],
+        &bounds[..k],
+        &kinds[..k]
     );
     if m.rotating || k == 0 || kinds[..k].contains(&MECH_MODAL_KIND_INFINITE) {
         return;

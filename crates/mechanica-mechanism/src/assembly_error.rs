@@ -22,6 +22,7 @@
 use crate::configuration::Configuration;
 use crate::{Mechanism, MechanismError, Potential, PotentialSum};
 use faer::Mat;
+use mechanica_kinematics::scaling;
 use mechanica_mass::MassProperties;
 
 /// Beyond this many entries (bodies × n²), the field is taken as one contribution instead of
@@ -99,24 +100,29 @@ impl AssemblyError {
 fn share(terms: &[Contribution], x: impl Fn(usize) -> f64) -> f64 {
     terms
         .iter()
-        .map(|c| c.scale * c.support.iter().map(|&i| x(i) * x(i)).sum::<f64>())
+        .map(|c| {
+            let weight: f64 = c.support.iter().map(|&i| x(i) * x(i)).sum();
+            // A term the mode does not touch adds nothing, even when its norm overflowed.
+            if weight == 0.0 { 0.0 } else { c.scale * weight }
+        })
         .sum()
 }
 
 impl Contribution {
     /// γ‖B_c‖_F and the support of `h` restricted to `free`.
     fn of(h: &Mat<f64>, free: &[usize], gamma: f64) -> Self {
-        let mut norm_sq = 0.0;
+        let mut entries = Vec::new();
         let mut support = Vec::new();
         for (i, &r) in free.iter().enumerate() {
-            let row: f64 = free.iter().map(|&c| h[(r, c)] * h[(r, c)]).sum();
-            if row != 0.0 {
+            let row = free.iter().map(|&c| h[(r, c)]);
+            if row.clone().any(|v| v != 0.0) {
                 support.push(i);
-                norm_sq += row;
+                entries.extend(row);
             }
         }
+        // The Frobenius norm on scaled entries: their squares would overflow from 1e154.
         Contribution {
-            scale: gamma * norm_sq.sqrt(),
+            scale: gamma * scaling::norm_of(&entries),
             support,
         }
     }

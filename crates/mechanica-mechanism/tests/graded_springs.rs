@@ -128,6 +128,33 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Springs scaled by 2^k (k from 400 to 640, stiffnesses up to 1e205, whose squares
+    /// overflow): the modes are those of the unscaled chain times 2^k, within the two bounds,
+    /// and every bound is finite (the assembly error's Frobenius norms were formed from
+    /// squares and came out NaN).
+    #[test]
+    fn huge_stiffnesses_scale_the_modes_and_their_bounds(seed in any::<u64>(), n in 2usize..9, k in 400i32..640) {
+        let chain = random_chain(seed, n);
+        let scale = 2f64.powi(k);
+        let scaled = Chain {
+            masses: chain.masses.clone(),
+            lengths: chain.lengths.clone(),
+            stiffnesses: chain.stiffnesses.iter().map(|s| s * scale).collect(),
+        };
+        let unit = mechanism_modes(&mut mechanism(&chain), &vec![0.0; n], &SolveOptions::default()).expect("modes");
+        let big = mechanism_modes(&mut mechanism(&scaled), &vec![0.0; n], &SolveOptions::default()).expect("modes");
+        for (small, large) in unit.solution.modes.iter().zip(&big.solution.modes) {
+            prop_assert!(large.error_bound.is_finite() && large.omega_sq.is_finite(), "ω² = {} ± {}", large.omega_sq, large.error_bound);
+            let allowance = large.error_bound + small.error_bound * scale;
+            prop_assert!((large.omega_sq - small.omega_sq * scale).abs() <= allowance,
+                "ω² = {:e} against {:e} × 2^{}", large.omega_sq, small.omega_sq, k);
+        }
+    }
+}
+
 /// A chain whose two softest modes were buried under the stiff modes' rounding (|ω²| below
 /// u·n·max ω², few enough to pass for rigid-body modes): the solve must reverse the pencil,
 /// since B is positive definite, and find them, not call them zero.
