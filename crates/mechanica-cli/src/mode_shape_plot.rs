@@ -10,13 +10,16 @@
 //! mechanism is seen in its plane and a spatial one from where its motion shows most. One view
 //! per mode keeps six modes legible where three views each (front, side, top) would not. The
 //! picture is turned so that "up" (against gravity) points up when it lies near the plane, and
-//! a triad shows the world axes.
+//! a triad shows the world axes. A motion too small to see at the mechanism's scale gets a
+//! magnified detail, and a body whose turn limited the amplitude a mark ↻ (`detail`).
 
 use crate::mode_record::ModeKindName;
 use crate::mode_shape::{ModeFigure, ModeShapes, Pose, Skeleton};
 use mechanica::kinematics::nalgebra::{Matrix3, Vector3};
 use mechanica_svg::{Anchor, Color, Svg, fitted_size, tick_label, ticks};
 use std::path::Path;
+
+mod detail;
 
 const WIDTH: f64 = 1000.0;
 const HEADER: f64 = 56.0;
@@ -88,13 +91,15 @@ fn view_of(skeleton: &Skeleton, figure: &ModeFigure) -> View {
     View { right, up }
 }
 
-/// World points to pixels in a panel: the view, then a uniform scale and offset.
+/// World points to pixels in a panel: the view, then a uniform scale and offset; drawing is
+/// limited to `clip` (two corners) when set.
 #[derive(Debug, Clone, Copy)]
 struct Frame {
     view: View,
     scale: f64,
     origin: (f64, f64),
     centre: (f64, f64),
+    clip: Option<((f64, f64), (f64, f64))>,
 }
 
 impl Frame {
@@ -116,6 +121,7 @@ impl Frame {
             scale,
             origin: (0.5 * (lo.0 + hi.0), 0.5 * (lo.1 + hi.1)),
             centre: (x + 0.5 * w, y + 0.5 * h),
+            clip: None,
         }
     }
 
@@ -126,34 +132,66 @@ impl Frame {
             self.centre.1 - self.scale * (b - self.origin.1),
         )
     }
+
+    /// The pixel of `p` when it lies inside the clip box (always without one).
+    fn shown(&self, p: &Vector3<f64>) -> Option<(f64, f64)> {
+        let at = self.px(p);
+        match self.clip {
+            Some((lo, hi)) if !(lo.0..=hi.0).contains(&at.0) || !(lo.1..=hi.1).contains(&at.1) => None,
+            _ => Some(at),
+        }
+    }
+
+    /// The part of the segment from `a` to `b` inside the clip box (Liang–Barsky), in pixels.
+    fn segment(&self, a: &Vector3<f64>, b: &Vector3<f64>) -> Option<((f64, f64), (f64, f64))> {
+        let (p, q) = (self.px(a), self.px(b));
+        let Some((lo, hi)) = self.clip else {
+            return Some((p, q));
+        };
+        let (dx, dy) = (q.0 - p.0, q.1 - p.1);
+        let (mut enter, mut leave) = (0.0f64, 1.0f64);
+        for (step, room) in [(-dx, p.0 - lo.0), (dx, hi.0 - p.0), (-dy, p.1 - lo.1), (dy, hi.1 - p.1)] {
+            if step == 0.0 {
+                if room < 0.0 {
+                    return None;
+                }
+            } else if step < 0.0 {
+                enter = enter.max(room / step);
+            } else {
+                leave = leave.min(room / step);
+            }
+        }
+        let inside = (
+            (p.0 + enter * dx, p.1 + enter * dy),
+            (p.0 + leave * dx, p.1 + leave * dy),
+        );
+        (enter <= leave).then_some(inside)
+    }
 }
 
 /// Draws `pose` as a stick figure; classes are prefixed by `role` ("rest" or "mode").
 fn draw_pose(svg: &mut Svg, skeleton: &Skeleton, pose: &Pose, frame: &Frame, color: Color, role: &str) {
-    let width = if role == "rest" { 2.5 } else { 2.0 };
+    let width = if role.ends_with("rest") { 2.5 } else { 2.0 };
     for (i, origin) in pose.origins.iter().enumerate() {
         let from = skeleton.parents[i].map_or(&skeleton.base, |p| &pose.origins[p]);
-        svg.line(
-            &format!("{role}-link"),
-            frame.px(from),
-            frame.px(origin),
-            color,
-            width,
-            false,
-        );
-    }
-    for (origin, centre) in pose.origins.iter().zip(&pose.centres) {
-        if let Some(c) = centre {
-            svg.line(&format!("{role}-arm"), frame.px(origin), frame.px(c), color, 1.0, true);
+        if let Some((a, b)) = frame.segment(from, origin) {
+            svg.line(&format!("{role}-link"), a, b, color, width, false);
         }
     }
-    for centre in pose.centres.iter().flatten() {
-        svg.circle(&format!("{role}-com"), frame.px(centre), 3.0, color, Some(color));
+    for (origin, centre) in pose.origins.iter().zip(&pose.centres) {
+        if let Some((a, b)) = centre.and_then(|c| frame.segment(origin, &c)) {
+            svg.line(&format!("{role}-arm"), a, b, color, 1.0, true);
+        }
+    }
+    for at in pose.centres.iter().flatten().filter_map(|c| frame.shown(c)) {
+        svg.circle(&format!("{role}-com"), at, 3.0, color, Some(color));
     }
     // Rings over the dots, so that a joint at a centre of mass shows both.
     for (i, origin) in pose.origins.iter().enumerate() {
         let r = if skeleton.moving[i] { 5.5 } else { 3.0 };
-        svg.circle(&format!("{role}-joint"), frame.px(origin), r, color, None);
+        if let Some(at) = frame.shown(origin) {
+            svg.circle(&format!("{role}-joint"), at, r, color, None);
+        }
     }
 }
 
@@ -236,6 +274,7 @@ fn draw_panel(svg: &mut Svg, shapes: &ModeShapes, figure: &ModeFigure, x: f64, y
     draw_pose(svg, skeleton, &skeleton.rest, &frame, REST, "rest");
     if let Some(moved) = &figure.displaced {
         draw_pose(svg, skeleton, moved, &frame, color_of(figure.kind), "mode");
+        detail::draw(svg, skeleton, figure, moved, &frame, (x, y));
     }
     let bottom = y + PANEL_H - CAPTION_H;
     draw_triad(svg, &view, (x + 36.0, bottom - 30.0));
@@ -274,7 +313,9 @@ fn caption(skeleton: &Skeleton, figure: &ModeFigure) -> Vec<String> {
     ];
     if let Some(body) = figure.turned_most.and_then(|b| skeleton.names.get(b)) {
         let limit = crate::mode_shape::MAX_ROTATION;
-        lines.push(format!("(s smaller: it keeps the turn of \"{body}\" to {limit} rad)"));
+        lines.push(format!(
+            "(s smaller: it keeps the turn of \"{body}\", marked ↻, to {limit} rad)"
+        ));
     }
     lines
 }
