@@ -162,7 +162,8 @@ fn the_stick_figures_land_inside_the_canvas() {
     let dir = scratch("sticks");
     let chain = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/spring_pendulum_chain.toml");
     let arm = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/cpp/panda_modes/panda.urdf");
-    for (scene, name) in [(chain, "chain"), (arm, "panda")] {
+    let humanoid = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/g1_29dof.urdf");
+    for (scene, name) in [(chain, "chain"), (arm, "panda"), (humanoid, "g1")] {
         let files = plotted(&["run", scene.to_str().expect("utf-8")], &dir.join(name));
         let shapes = files
             .iter()
@@ -188,5 +189,67 @@ fn the_stick_figures_land_inside_the_canvas() {
             outside.len(),
             &outside[..outside.len().min(5)]
         );
+    }
+}
+
+/// The centres (cx, cy) of the circles of class `class` in `panel` (one panel's SVG text).
+fn circles(panel: &str, class: &str) -> Vec<(f64, f64)> {
+    let number = |tag: &str, name: &str| -> f64 {
+        let key = format!(" {name}=\"");
+        let start = tag.find(&key).expect("attribute") + key.len();
+        tag[start..].split('"').next().expect("value").parse().expect("number")
+    };
+    panel
+        .lines()
+        .filter(|l| l.starts_with("<circle") && l.contains(&format!("class=\"{class}\"")))
+        .map(|l| (number(l, "cx"), number(l, "cy")))
+        .collect()
+}
+
+/// The largest distance between matching circles of two classes, px.
+fn largest_motion(panel: &str, rest: &str, moved: &str) -> f64 {
+    circles(panel, rest)
+        .iter()
+        .zip(circles(panel, moved))
+        .map(|(a, b)| (a.0 - b.0).hypot(a.1 - b.1))
+        .fold(0.0, f64::max)
+}
+
+/// On a humanoid (Unitree G1, 29 joints: light hands on long arms) and an arm with a light
+/// wrist (Panda), every mode's motion can be seen: its stick figure moves some joint or centre
+/// of mass by 5 px or more, or the panel has a magnified detail in which the motion spans 20 px
+/// or more.
+#[test]
+fn every_mode_shape_shows_a_visible_motion() {
+    let dir = scratch("visible");
+    let arm = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/cpp/panda_modes/panda.urdf");
+    let humanoid = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/g1_29dof.urdf");
+    for (scene, name) in [(arm, "panda"), (humanoid, "g1")] {
+        let files = plotted(&["run", scene.to_str().expect("utf-8")], &dir.join(name));
+        let shapes = files
+            .iter()
+            .find(|f| f.ends_with("mode_shapes.svg"))
+            .expect("mode_shapes.svg");
+        let text = std::fs::read_to_string(shapes).expect("svg");
+        let panels: Vec<&str> = text.split("class=\"panel\"").skip(1).collect();
+        assert!(panels.len() >= 4, "{name}: {} panels", panels.len());
+        for (k, panel) in panels.iter().enumerate() {
+            if panel.contains("rest pose only") {
+                continue;
+            }
+            let main =
+                largest_motion(panel, "rest-joint", "mode-joint").max(largest_motion(panel, "rest-com", "mode-com"));
+            let detail = panel.split("class=\"detail\"").nth(1).map(|d| {
+                largest_motion(d, "detail-rest-com", "detail-mode-com").max(largest_motion(
+                    d,
+                    "detail-rest-joint",
+                    "detail-mode-joint",
+                ))
+            });
+            assert!(
+                main >= 5.0 || detail.is_some_and(|d| d >= 20.0),
+                "{name}, panel {k}: motion {main:.2} px, detail {detail:?}"
+            );
+        }
     }
 }
