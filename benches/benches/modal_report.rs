@@ -3,7 +3,7 @@
 //! nalgebra as peers in the same run.
 //!
 //! Run: `cargo bench -p mechanica-benches --bench modal_report [-- FAMILY...]` with FAMILY among
-//! `fixed free ring rotated lumped graded grid stages` (default: all; `stages-small` = the stages at
+//! `fixed free ring rotated lumped graded graded-random grid stages` (default: all; `stages-small` = the stages at
 //! n = 1000 and 2000 only; `rotated-plain` = mechanica all pairs with `Refinement::Off` against
 //! dsygvd on the rotated chain, only when named). Writes
 //! `target/reports/modal-<family>.csv`, `modal-<family>.svg` (max relative error of the lowest
@@ -31,7 +31,13 @@
 //!   the default auto refinement falls back to a solve with vectors when its a-priori bounds
 //!   promise fewer than 8 digits); `solve_sparse` (shift-invert block Lanczos, 10
 //!   lowest; n ≤ 400 falls back to dense); LAPACK `dsygvd` all pairs and values only; nalgebra
-//!   (Cholesky, two triangular solves, SymmetricEigen; n ≤ 1000 only, it is slow).
+//!   (Cholesky, two triangular solves, SymmetricEigen; n ≤ 1000 only, it is slow); SciPy
+//!   `eigh(B, A)` all pairs, timed in a Python process by tools/scipy_eigh_point.py (skipped
+//!   without python3 and SciPy; [`mechanica_benches::scipy`]).
+//! - **Random graded family** (`graded-random`): fixed spring chains and trees of 250, 500 and
+//!   1000 masses graded at random over 8 decades of mass and 12 of stiffness
+//!   ([`graded::spring_tree`]), against the lowest ω² of the stored pencil by double-double
+//!   bisection ([`graded::tree_pencil_lowest`]).
 //! - **Stages** (`stages`): the rotated chain at n = 1000, 2000, 4000 split into Cholesky,
 //!   reduction, eigensolver, back-transformation and (mechanica only) the accuracy report's
 //!   products and the Sturm count, against dpotrf, dsygst, dsyevd, dtrsm — where the time goes.
@@ -50,6 +56,7 @@ use mechanica_benches::modal::{
 use mechanica_benches::work_precision::{Panel, Series, WorkPoint, write_work_precision};
 use mechanica_benches::{lapack, median_seconds, write_csv};
 use mechanica_modal::testing;
+use mechanica_modal::testing::graded;
 use std::time::Duration;
 
 /// Modes whose eigenvalue error is reported.
@@ -101,6 +108,7 @@ enum Method {
     LapackAll,
     LapackValues,
     Nalgebra,
+    Scipy,
 }
 
 impl Method {
@@ -117,6 +125,7 @@ impl Method {
             Self::LapackAll => "LAPACK dsygvd all pairs",
             Self::LapackValues => "LAPACK dsygvd values only",
             Self::Nalgebra => "nalgebra all pairs",
+            Self::Scipy => "SciPy eigh all pairs",
         }
     }
 }
@@ -233,6 +242,13 @@ fn run(method: Method, case: &Case) -> Option<Row> {
             });
             Some(row(t, &eig.values, backward, None))
         }
+        Method::Scipy => {
+            let (a, b) = case.dense.as_ref()?;
+            match mechanica_benches::scipy::eigh(a.as_ref(), b.as_ref(), runs) {
+                Ok(point) => Some(row(point.seconds, &point.values, Some(point.backward), None)),
+                Err(e) => fail(&e),
+            }
+        }
         Method::Nalgebra => {
             let (a, b) = case.dense.as_ref()?;
             if case.n > NALGEBRA_MAX {
@@ -301,6 +317,30 @@ fn chain_case(label: &str, n: usize, pencil: fn(usize) -> (Mat<f64>, Mat<f64>), 
         n,
         dense: Some((a, b)),
         sparse,
+        exact,
+        scale,
+    }
+}
+
+/// Random graded spring chains and trees (`testing::graded`: masses 10^U(−8,0), stiffnesses
+/// 10^U(0,12), not monotone, randomly numbered, fixed to the ground) of order `n`, with the
+/// lowest ω² of their stored pencils by double-double bisection on inertia counts.
+fn graded_random_case(n: usize, shape: graded::Shape) -> Case {
+    let family = graded::GradedFamily::new(n, shape, true);
+    let system = graded::spring_tree(&family, 0x5eed + n as u64);
+    let exact = graded::tree_pencil_lowest(&system, LOWEST);
+    let scale = exact.last().copied().unwrap_or(1.0);
+    let name = if shape == graded::Shape::Chain {
+        "random graded chain"
+    } else {
+        "random graded tree"
+    };
+    Case {
+        label: format!("{name} n={n}"),
+        family: name.to_string(),
+        n,
+        sparse: Some((to_triplets(system.a.as_ref()), to_triplets(system.b.as_ref()))),
+        dense: Some((system.a, system.b)),
         exact,
         scale,
     }
@@ -838,6 +878,20 @@ fn main() {
             "graded",
             "Graded stiff chains, single and doubled (mpmath references)",
             &graded_cases(),
+            &methods,
+        );
+    }
+    if wanted("graded-random") {
+        // The certified low modes (default: Auto) against the plain reduction and the peers.
+        let cases: Vec<Case> = [250, 500, 1000]
+            .into_iter()
+            .flat_map(|n| [graded::Shape::Chain, graded::Shape::Tree].map(|shape| graded_random_case(n, shape)))
+            .collect();
+        let methods = [MechPlain, MechAll, MechValues, MechLowest, Sparse, LapackAll, Scipy];
+        report(
+            "graded-random",
+            "Random graded spring chains and trees (double-double references)",
+            &cases,
             &methods,
         );
     }

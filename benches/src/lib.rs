@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 
 pub mod lapack;
 pub mod modal;
+pub mod scipy;
 pub mod work_precision;
 
 /// Median wall time of `f` in seconds, and its last result. Runs `f` at least `min_runs` times
