@@ -500,7 +500,7 @@ impl Tree {
                 // Angular velocities below the normal range are rounded to the subnormal
                 // spacing 2⁻¹⁰⁷⁴ before they meet the lever arms, which the columns' sizes bound.
                 let reach: f64 = (0..self.dof).map(|k| jacobian[row + 3 * k].abs()).sum();
-                let noise = noise + 16.0 * f64::from_bits(1) * (1.0 + reach);
+                let noise = noise + 16.0 * f64::from_bits(1) * (1.0 + reach + lever);
                 assert!(
                     (sum - actual[row]).abs() <= 1e-10 * (scale + actual[row].abs()) + noise,
                     "kind {kind} row {row}: J q̇ = {sum}, the tree says {}; body {body}, point {point:?}, q̇ {q_dot:?}, J {jacobian:?}",

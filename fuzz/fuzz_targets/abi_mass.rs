@@ -95,11 +95,14 @@ fn transform_round_trip(input: &mut Input) {
     let r = rotation_of(q);
     let expected_com = mat_vec(&r, arr(&p.center_of_mass));
     let (_, c, j) = scale_of(&p);
-    let position_tol = 1e-14 * (c + norm1(&t));
+    // Plus the subnormal spacing that rotating a centre near 1e-310 rounds to.
+    let position_tol = 1e-14 * (c + norm1(&t)) + 16.0 * f64::from_bits(1);
     for k in 0..3 {
         assert!(
             (arr(&moved.center_of_mass)[k] - expected_com[k] - t[k]).abs() <= position_tol,
-            "moved centre"
+            "moved centre: {:?} vs R c + t = {:?} + {t:?} (tolerance {position_tol:e})",
+            arr(&moved.center_of_mass),
+            expected_com
         );
     }
     let jm = p.inertia_about_com.m;
@@ -414,10 +417,14 @@ fn primitive(input: &mut Input) {
     if amount_kind == MECH_AMOUNT_MASS {
         assert_eq!(m, amount, "a primitive given its mass has another mass");
     }
-    // The moments are formed on m/2^e (e the exponent of m) and scaled back at the end, so that
-    // a mass near the bottom of the normal range does not lose digits in 0.4·m or m/12 while
-    // the moment itself is a normal number.
-    let (m, exponent) = split_power_of_two(m);
+    // The moments are formed on m/2^e and dims/2^f (e the exponent of m, f of the largest
+    // dimension) and scaled back by 2^(e + 2f) at the end, so that neither 0.4·m nor d² leaves
+    // the normal range on the way while the moment itself is a normal number.
+    let (m, mass_exponent) = split_power_of_two(m);
+    let largest = dims.iter().fold(0.0f64, |a, d| a.max(d.abs()));
+    let (_, length_exponent) = split_power_of_two(largest);
+    let dims: Vec<f64> = dims.iter().map(|d| d / power_of_two(length_exponent)).collect();
+    let exponent = mass_exponent + 2 * length_exponent;
     let expected = match kind {
         MECH_PRIMITIVE_ROD => Some([m * dims[0] * dims[0] / 12.0, m * dims[0] * dims[0] / 12.0, 0.0]),
         MECH_PRIMITIVE_SPHERE => Some([0.4 * m * dims[0] * dims[0]; 3]),

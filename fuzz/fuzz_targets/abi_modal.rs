@@ -203,10 +203,11 @@ fn check_modes(p: &Pencil, s: &Solved) {
         }
         let residual = scaled_norm(&rows);
         let scale = (m.lambda.abs() * s.accuracy.norm_a + s.accuracy.norm_b) * x_norm;
-        // Plus the subnormal spacing the residual's products round to (pencils near 1e-310).
+        // Plus the subnormal spacing the residual's products round to (pencils near 1e-310),
+        // carried through the shape's entries.
         let allowed = 2.0 * m.backward_error * scale
             + 4.0 * n as f64 * f64::EPSILON * scale
-            + 4.0 * n as f64 * f64::from_bits(1);
+            + 4.0 * n as f64 * f64::from_bits(1) * (1.0 + x_norm) * (1.0 + s.accuracy.norm_a);
         assert!(
             residual <= allowed,
             "mode {k}: residual {residual} above η·scale = {allowed} (λ {}, η {}, kind {}); A = {:?}, B = {:?}",

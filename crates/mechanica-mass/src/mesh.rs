@@ -331,10 +331,11 @@ fn check_measure(
 fn properties_from_sums(sums: &Sums, r: &[f64; 3], amount: Amount) -> Result<MassProperties, MassError> {
     let measure = sums.v[0];
     let mass = amount.mass_for(measure)?;
-    let rho = mass / measure;
     let c = Vector3::new(sums.v[1], sums.v[2], sums.v[3]) / measure;
     let v = &sums.v;
-    let second = Matrix3::new(v[4], v[7], v[9], v[7], v[5], v[8], v[9], v[8], v[6]) * rho;
+    // The second moments per unit measure, then times the mass: the density mass/measure
+    // itself may underflow (a light body of large measure) where the moments do not.
+    let second = Matrix3::new(v[4], v[7], v[9], v[7], v[5], v[8], v[9], v[8], v[6]) / measure * mass;
     let central = second - mass * (c * c.transpose());
     let inertia = Matrix3::identity() * central.trace() - central;
     let properties = MassProperties {

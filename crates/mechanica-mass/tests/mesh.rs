@@ -23,6 +23,25 @@ fn box_inertia(m: f64, a: f64, b: f64, c: f64) -> Matrix3<f64> {
     ))
 }
 
+proptest! {
+    /// A cube of side 2^k (k up to 200, volume to 2^600) given a mass of 2^j (j down to −1070,
+    /// subnormal): I = m s²/6 whenever that is a normal number, though the density m/s³ may
+    /// underflow (it was formed first, and a light body of large volume got a zero tensor).
+    #[test]
+    fn a_light_cube_of_large_volume_keeps_its_moments(k in 0i32..200, j in -1070i32..0) {
+        let side = 2f64.powi(k);
+        let mass = 2f64.powi(j / 2) * 2f64.powi(j - j / 2);
+        let want = mass * side * side / 6.0;
+        prop_assume!(want >= f64::MIN_POSITIVE && want.is_finite());
+        let mesh = box_mesh([side, side, side], [0.0, 0.0, 0.0]);
+        let p = solid(&mesh, Amount::Mass(mass));
+        for axis in 0..3 {
+            let got = p.inertia_c[(axis, axis)];
+            prop_assert!((got - want).abs() <= 64.0 * EPS * want, "I = {:e}, want {:e}", got, want);
+        }
+    }
+}
+
 #[test]
 fn unit_cube_is_exact_at_the_origin_and_at_1e6() {
     for offset in [0.0, 1e6, -3.7e6] {
