@@ -116,7 +116,8 @@ fn points(input: &mut Input) {
     let tangential = |a: [f64; 3], b: [f64; 3]| norm(sub(sub(a, b), n.map(|c| c * dot(sub(a, b), n))));
     assert!(
         tangential(a1, v1) <= 1e-13 * (norm(v1) + norm(v2)),
-        "tangential velocity of point 1 changed"
+        "tangential velocity of point 1 changed by {:e}: m {m1}, {m2}, v {v1:?}, {v2:?} → {a1:?}, {a2:?}, n {n:?}, e {e}",
+        tangential(a1, v1)
     );
     let t = 0.5 * (m1 * dot(v1, v1) + m2 * dot(v2, v2));
     let direct = 0.5 * (m1 * (dot(a1, a1) - dot(v1, v1)) + m2 * (dot(a2, a2) - dot(v2, v2)));
