@@ -94,15 +94,6 @@ impl Dynamics {
         Ok(())
     }
 
-    /// The offset of body i's origin from its parent's (or the base's) origin.
-    fn offset_from_parent(&self, i: usize) -> Result<Vector3<f64>, DynamicsError> {
-        let o_p = match self.mechanism.tree().parent(i) {
-            Some(p) => self.ws.position(p)?,
-            None => self.ws.base().position,
-        };
-        Ok(self.ws.position(i)? - o_p)
-    }
-
     /// Leaves to root: U, D⁻¹ and u of every joint, condensing each subtree onto its parent.
     fn condense(&mut self, tau: &[f64]) -> Result<(), DynamicsError> {
         let order: Vec<usize> = self
@@ -159,7 +150,7 @@ impl Dynamics {
                     p_small -= ua * (d_inv[(a, b)] * ub.dot(&self.articulated.accel_bias[i]));
                 }
             }
-            let r = self.offset_from_parent(i)?;
+            let r = self.ws.parent_offset(i)?;
             self.articulated.inertia[p] += shifted_inertia(&i_small, &r);
             self.articulated.bias[p] += shifted_wrench(&p_small, &r);
         }
@@ -176,7 +167,7 @@ impl Dynamics {
                 Some(p) => self.articulated.acceleration[p],
                 None => base_accel,
             };
-            let r = self.offset_from_parent(i)?;
+            let r = self.ws.parent_offset(i)?;
             let mut accel = shifted_motion(&parent_accel, &r) + self.articulated.accel_bias[i];
             let range = self.mechanism.tree().dof_range(i);
             let (start, dim) = (range.start, range.len());

@@ -80,7 +80,7 @@ impl Dynamics {
                 tau[k] = wrenches[i].power(&w, &v);
             }
             if let Some(p) = tree.parent(i) {
-                let r = self.ws.position(i)? - self.ws.position(p)?;
+                let r = self.ws.parent_offset(i)?;
                 let moved = wrenches[i].shifted_by(&r);
                 wrenches[p] += moved;
             }
@@ -272,7 +272,7 @@ impl Dynamics {
                 out[k] = w.lp_norm(1) * m_mag[i] + v.lp_norm(1) * f_mag[i];
             }
             if let Some(p) = tree.parent(i) {
-                let r = (self.ws.position(i)? - self.ws.position(p)?).lp_norm(1);
+                let r = self.ws.parent_offset(i)?.lp_norm(1);
                 m_mag[p] += m_mag[i] + r * f_mag[i];
                 f_mag[p] += f_mag[i];
             }

@@ -97,12 +97,9 @@ fn free_body_fixation(body: &RigidBody, lever: &Vector3<f64>) -> Option<(Vector3
     let (v0, w0) = (body.v_wc(), body.w_w());
     let u_e = e.dot(&v0);
     let u_plane = Vector2::new(f1.dot(&v0) + length * w0.dot(&f2), f2.dot(&v0) - length * w0.dot(&f1));
-    let plane = Matrix2::new(
-        f2.dot(&(w * f2)),
-        -f1.dot(&(w * f2)),
-        -f1.dot(&(w * f2)),
-        f1.dot(&(w * f1)),
-    );
+    let (w_f1, w_f2) = (w * f1, w * f2);
+    let coupling = -f1.dot(&w_f2);
+    let plane = Matrix2::new(f2.dot(&w_f2), coupling, coupling, f1.dot(&w_f1));
     let block = plane + Matrix2::identity() * (gamma / length / length);
     let s_plane = -block.cholesky()?.solve(&(u_plane / length / length));
     let s_e = -u_e / gamma;

@@ -122,6 +122,14 @@ impl Workspace {
         Ok(self.position[body])
     }
 
+    /// o_B − o_P: `body`'s origin relative to its parent's (the base origin for a root), formed
+    /// from the placement and the joint's translation, so exact to rounding however far the
+    /// mechanism is from the world origin (a difference of world positions is not).
+    pub fn parent_offset(&self, body: usize) -> Result<Vector3<f64>, KinematicsError> {
+        self.check(Stage::Positions, body)?;
+        Ok(self.offset[body])
+    }
+
     /// World position x = R_WB p_BQ + p_WB of the body point with body coordinates `p_bq` (1.5).
     pub fn point_position(&self, body: usize, p_bq: &Vector3<f64>) -> Result<Vector3<f64>, KinematicsError> {
         self.check(Stage::Positions, body)?;
