@@ -24,6 +24,40 @@ fn norm1(a: &[f64]) -> f64 {
     a.iter().map(|x| x.abs()).sum()
 }
 
+/// x·2ᵉ, applied in steps that stay in range (exact unless the result is subnormal).
+fn scale_by_power_of_two(mut x: f64, mut exponent: i32) -> f64 {
+    while exponent != 0 {
+        let step = exponent.clamp(-1000, 1000);
+        x *= 2f64.powi(step);
+        exponent -= step;
+    }
+    x
+}
+
+/// The exponent e with 2ᵉ ≤ max|aᵢ| < 2ᵉ⁺¹ (0 for a zero or non-finite array).
+fn binary_exponent(a: &[f64]) -> i32 {
+    let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if largest == 0.0 || !largest.is_finite() {
+        return 0;
+    }
+    largest.log2().floor() as i32
+}
+
+fn diagonal(d: f64) -> [f64; 9] {
+    [d, 0.0, 0.0, 0.0, d, 0.0, 0.0, 0.0, d]
+}
+
+/// xᵀ M x with M and x first scaled by exact powers of two to order one, so that no
+/// intermediate product leaves the normal range; one rounding of the unscaled result remains.
+fn scaled_quadratic_form(m: &[f64; 9], x: [f64; 3]) -> f64 {
+    let (em, ex) = (binary_exponent(m), binary_exponent(&x));
+    let ms = m.map(|v| scale_by_power_of_two(v, -em));
+    let xs = x.map(|v| scale_by_power_of_two(v, -ex));
+    let mx = mat_vec(&ms, xs);
+    let form = xs[0] * mx[0] + xs[1] * mx[1] + xs[2] * mx[2];
+    scale_by_power_of_two(form, em + 2 * ex)
+}
+
 /// Calls `f` with a sentinel output and applies the output contract.
 fn call<T: Copy>(name: &str, f: impl FnOnce(*mut T) -> mech_status_t) -> Option<T>
 where
@@ -248,9 +282,11 @@ fn steiner_and_line(input: &mut Input) {
     let e = d_hat.map(|x| x / n);
     let je = mat_vec(&j_a.m, e);
     let want = e[0] * je[0] + e[1] * je[1] + e[2] * je[2];
+    // Below the normal range every product and sum rounds to the subnormal spacing 2⁻¹⁰⁷⁴.
+    let subnormal = 16.0 * f64::from_bits(1);
     assert!(
-        (moment - want).abs() <= 1e-13 * scale,
-        "moment about a line {moment} vs {want}; mass {}, centre {:?}, J {:?}, point {point:?}, direction {direction:?}",
+        (moment - want).abs() <= 1e-13 * scale + subnormal,
+        "moment about a line {moment:e} vs {want:e}; mass {:e}, centre {:?}, J {:?}, point {point:?}, direction {direction:?}",
         p.mass,
         c,
         p.inertia_about_com.m
@@ -317,15 +353,8 @@ fn energy_and_momentum(input: &mut Input) {
         energy.untouched() && momentum.untouched(),
         &written,
     );
-    let jw = mat_vec(&p.inertia_about_com.m, w);
     if status == MECH_STATUS_OK {
-        let terms = [
-            p.mass * v.iter().map(|x| x * x).sum::<f64>(),
-            w[0] * jw[0],
-            w[1] * jw[1],
-            w[2] * jw[2],
-        ];
-        let want = 0.5 * terms.iter().sum::<f64>();
+        let want = 0.5 * (scaled_quadratic_form(&diagonal(p.mass), v) + scaled_quadratic_form(&p.inertia_about_com.m, w));
         // (m·|v|)·|v|: a square |v|² alone may underflow where the energy does not.
         let scale = 0.5 * (p.mass * norm1(&v)) * norm1(&v) + (norm1(&p.inertia_about_com.m) * norm1(&w)) * norm1(&w);
         // Below the normal range every product and sum rounds to the subnormal spacing 2⁻¹⁰⁷⁴,
@@ -333,8 +362,10 @@ fn energy_and_momentum(input: &mut Input) {
         let subnormal = 16.0 * f64::from_bits(1);
         assert!(
             (energy.value - want).abs() <= 1e-14 * scale + subnormal,
-            "T = {} vs {want}",
-            energy.value
+            "T = {:e} vs {want:e}; mass {:e}, v {v:?}, ω {w:?}, J {:?}",
+            energy.value,
+            p.mass,
+            p.inertia_about_com.m
         );
         assert!(
             close(
@@ -354,6 +385,7 @@ fn energy_and_momentum(input: &mut Input) {
     let c = arr(&p.center_of_mass);
     let r = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
     let mv = v.map(|x| p.mass * x);
+    let jw = mat_vec(&p.inertia_about_com.m, w);
     let cross = [
         r[1] * mv[2] - r[2] * mv[1],
         r[2] * mv[0] - r[0] * mv[2],
