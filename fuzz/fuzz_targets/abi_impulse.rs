@@ -225,7 +225,13 @@ fn fix(input: &mut Input) {
         return;
     }
     let (v, w) = (arr(&out.value.velocity_after), arr(&out.value.angular_velocity_after));
-    mechanica_fuzz::trace!("fix_point(mass {}, J {:?}, {:?}, point {point:?}) → {:?}", b.mass, b.inertia, b.raw, out.value);
+    mechanica_fuzz::trace!(
+        "fix_point(mass {}, J {:?}, {:?}, point {point:?}) → {:?}",
+        b.mass,
+        b.inertia,
+        b.raw,
+        out.value
+    );
     let before = b.energy_before();
     let after = b.energy(v, w);
     if !(before + after).is_finite() || !b.energy_known {

@@ -218,7 +218,11 @@ fn euler_rates(input: &mut Input) {
     if status == MECH_STATUS_OK {
         let scale = back.iter().map(|c| c.abs()).sum::<f64>() + arr(&omega.value).iter().map(|c| c.abs()).sum::<f64>();
         let gap = distance(doubles_of(&omega.value), doubles_of(&again.value));
-        mechanica_fuzz::trace!("rates(sequence {sequence}, frame {frame}, angles {angles:?}, rates {rates:?}) → ω {:?} → {back:?} → {:?}", omega.value, again.value);
+        mechanica_fuzz::trace!(
+            "rates(sequence {sequence}, frame {frame}, angles {angles:?}, rates {rates:?}) → ω {:?} → {back:?} → {:?}",
+            omega.value,
+            again.value
+        );
         assert!(
             gap <= 1e-12 * scale + 1e-300,
             "ω → rates → ω is off by {gap:e} (scale {scale:e})"

@@ -229,7 +229,11 @@ fn combine_subtract(input: &mut Input) {
     );
     assert!(
         // Tensors at the subnormal spacing (bodies of subnormal mass) round by whole steps.
-        close(&rest.inertia_about_com.m, &a.inertia_about_com.m, tol * j + 16.0 * f64::from_bits(1)),
+        close(
+            &rest.inertia_about_com.m,
+            &a.inertia_about_com.m,
+            tol * j + 16.0 * f64::from_bits(1)
+        ),
         "tensor not restored: {:?} back as {:?} (tolerance {:e}; whole {sum:?}, part {hole:?}, first {a:?})",
         a.inertia_about_com.m,
         rest.inertia_about_com.m,
@@ -320,7 +324,11 @@ fn principal_axes(input: &mut Input) {
     // Moments within 1e-10 of the largest are merged into one repeated value (the documented
     // contract): the rebuilt tensor then differs by up to half their gap.
     let largest = i[0].abs().max(i[2].abs());
-    let merged = if i[0] == i[1] || i[1] == i[2] { 1e-10 * largest } else { 0.0 };
+    let merged = if i[0] == i[1] || i[1] == i[2] {
+        1e-10 * largest
+    } else {
+        0.0
+    };
     // A tensor at the subnormal spacing rebuilds to within a few of its steps.
     let subnormal = 16.0 * f64::from_bits(1);
     assert!(
@@ -354,7 +362,8 @@ fn energy_and_momentum(input: &mut Input) {
         &written,
     );
     if status == MECH_STATUS_OK {
-        let want = 0.5 * (scaled_quadratic_form(&diagonal(p.mass), v) + scaled_quadratic_form(&p.inertia_about_com.m, w));
+        let want =
+            0.5 * (scaled_quadratic_form(&diagonal(p.mass), v) + scaled_quadratic_form(&p.inertia_about_com.m, w));
         // (m·|v|)·|v|: a square |v|² alone may underflow where the energy does not.
         let scale = 0.5 * (p.mass * norm1(&v)) * norm1(&v) + (norm1(&p.inertia_about_com.m) * norm1(&w)) * norm1(&w);
         // Below the normal range every product and sum rounds to the subnormal spacing 2⁻¹⁰⁷⁴,
@@ -407,7 +416,7 @@ fn split_power_of_two(x: f64) -> (f64, i32) {
         return (x, 0);
     }
     let e = x.abs().log2().floor() as i32;
-    (x / power_of_two(e) , e)
+    (x / power_of_two(e), e)
 }
 
 /// 2^e, exact for −1074 ≤ e ≤ 1023 (formed from two halves, each in the normal range).
@@ -526,7 +535,8 @@ fn check_and_repair(input: &mut Input) {
     check_status("mech_mass_check", status);
     if status == MECH_STATUS_OK && repaired.value.mass > 0.0 {
         assert_eq!(
-            again.value.issues, 0,
+            again.value.issues,
+            0,
             "a repaired body still has issues {:#x}: moments {:?}, repaired J {:?} from J {:?}, tolerance {tolerance}",
             again.value.issues,
             doubles_of(&again.value.moments),
@@ -631,15 +641,26 @@ fn mesh(input: &mut Input) {
     let (mut area, mut perimeter) = (0.0, 0.0);
     for t in indices.chunks_exact(3) {
         let (a, b, c) = (corner(t[0] % 6), corner(t[1] % 6), corner(t[2] % 6));
-        let (u, v) = ([b[0] - a[0], b[1] - a[1], b[2] - a[2]], [c[0] - a[0], c[1] - a[1], c[2] - a[2]]);
-        let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+        let (u, v) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        );
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
         area += 0.5 * norm1(&n);
         perimeter += norm1(&u) + norm1(&v) + norm1(&[c[0] - b[0], c[1] - b[1], c[2] - b[2]]);
     }
     // A solid's volume moves by displacement × area, a shell's area by displacement × perimeter;
     // the displacement is the rounding of R v + t, some tens of ulps of `reach` per coordinate
     // (R itself is rounded): 1024 ulps bound it with room for the constants.
-    let lever = if earlier.model == MECH_MESH_SOLID { area } else { perimeter };
+    let lever = if earlier.model == MECH_MESH_SOLID {
+        area
+    } else {
+        perimeter
+    };
     let rho = 64.0 * bound + 1024.0 * f64::EPSILON * reach * lever / earlier.measure.abs().max(1e-300);
     if !(rho < 1e-3) {
         return;

@@ -187,8 +187,16 @@ fn contacts(d: &OwnedDynamics, input: &mut Input) -> Vec<mech_motion_contact_t> 
                     other_body,
                     other_point: vec_or(input, 1.0),
                     normal,
-                    restitution: if input.u8() < 240 { input.fraction() } else { input.any_f64() },
-                    friction: if input.u8() < 240 { graded(input, 2) } else { input.any_f64() },
+                    restitution: if input.u8() < 240 {
+                        input.fraction()
+                    } else {
+                        input.any_f64()
+                    },
+                    friction: if input.u8() < 240 {
+                        graded(input, 2)
+                    } else {
+                        input.any_f64()
+                    },
                     law: input.enum_i32(2),
                 },
                 offset: any_or(input, 3.0),
@@ -222,7 +230,11 @@ fn impacts(s: &OwnedSimulation, steps: u64) {
             i.impulse_error,
         ];
         assert!(numbers.iter().all(|x| x.is_finite()), "impact {k}: {i:?}");
-        assert!(i.t >= previous, "impact {k} at {} before the previous one at {previous}", i.t);
+        assert!(
+            i.t >= previous,
+            "impact {k} at {} before the previous one at {previous}",
+            i.t
+        );
         assert!(i.contact_count >= 1 && i.approach_speed > 0.0, "impact {k}: {i:?}");
         previous = i.t;
     }
