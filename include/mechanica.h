@@ -1449,11 +1449,11 @@ typedef struct mech_modal_mode_t {
  */
 typedef struct mech_modal_accuracy_t {
     /**
-     * ‖A‖_F.
+     * ‖A‖_F, or the largest double where the norm exceeds it (a pencil near 1e308).
      */
     double norm_a;
     /**
-     * ‖B‖_F.
+     * ‖B‖_F, or the largest double where the norm exceeds it.
      */
     double norm_b;
     /**
@@ -4765,7 +4765,8 @@ mech_status_t mech_modal_check_pencil(size_t n,
  * interval end; MECH_STATUS_NOT_POSITIVE_DEFINITE when A is indefinite; MECH_STATUS_SINGULAR
  * when det(λA + B) ≡ 0; MECH_STATUS_INVALID_ARGUMENT for an asymmetric matrix, a bad interval,
  * `vectors` not 0/1 or more modes than exist; MECH_STATUS_NOT_CONVERGED when the eigensolver
- * fails to converge.
+ * fails to converge; MECH_STATUS_OUT_OF_RANGE when an ω² or a bound exceeds the largest
+ * double.
  *
  * # Safety
  * `a` and `b` must each point to n·n readable doubles; `options` to a readable
@@ -4964,7 +4965,8 @@ mech_status_t mech_modal_result_accuracy(const struct mech_modal_result_t *resul
  * Errors: MECH_STATUS_BAD_DIMENSION for n = 0 or an index ≥ n; MECH_STATUS_NON_FINITE;
  * MECH_STATUS_INVALID_ARGUMENT for asymmetry, bad column pointers or count ∉ [1, n];
  * MECH_STATUS_NOT_POSITIVE_DEFINITE when no shift below the spectrum was found (A indefinite);
- * MECH_STATUS_NOT_CONVERGED (also when the reruns run out). Nothing is written on error.
+ * MECH_STATUS_NOT_CONVERGED (also when the reruns run out); MECH_STATUS_OUT_OF_RANGE when
+ * ‖A‖_F or ‖B‖_F exceeds the largest double. Nothing is written on error.
  *
  * # Safety
  * Each `*_col_ptr` must point to n + 1 readable size_t, each `*_row_idx` / `*_values` to

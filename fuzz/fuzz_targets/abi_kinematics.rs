@@ -489,7 +489,8 @@ impl Tree {
         // arms (placements, the point, prismatic offsets in q), not to the result.
         let lever = 1.0 + self.reach + point.x.abs() + point.y.abs() + point.z.abs();
         let rate: f64 = q_dot.iter().map(|v| v.abs()).sum();
-        let noise = 1e-12 * rate * lever;
+        // A point at ±1e308 makes the lever infinite; without velocities it adds nothing.
+        let noise = if rate == 0.0 { 0.0 } else { 1e-12 * rate * lever };
         for (kind, actual) in [(MECH_JACOBIAN_ANGULAR, omega), (MECH_JACOBIAN_POINT, velocity)] {
             let mut jacobian = vec![0.0; 3 * self.dof];
             let status =

@@ -319,7 +319,7 @@ fn principal_axes(input: &mut Input) {
     let r = axes.value.m;
     let rebuilt = rotate_tensor(&r, &[i[0], 0.0, 0.0, 0.0, i[1], 0.0, 0.0, 0.0, i[2]]);
     let j = p.inertia_about_com.m;
-    let sym: Vec<f64> = (0..9).map(|k| 0.5 * (j[k] + j[(k % 3) * 3 + k / 3])).collect();
+    let sym: Vec<f64> = (0..9).map(|k| 0.5 * j[k] + 0.5 * j[(k % 3) * 3 + k / 3]).collect();
     let scale = norm1(&j);
     // Moments within 1e-10 of the largest are merged into one repeated value (the documented
     // contract): the rebuilt tensor then differs by up to half their gap.

@@ -205,15 +205,23 @@ fn check_modes(p: &Pencil, s: &Solved) {
         let scale = (m.lambda.abs() * s.accuracy.norm_a + s.accuracy.norm_b) * x_norm;
         // Plus the subnormal spacing the residual's products round to (pencils near 1e-310),
         // carried through the shape's entries.
-        let allowed = 2.0 * m.backward_error * scale
+        // (η = 0 allows nothing, also where the scale overflows.)
+        let from_eta = if m.backward_error == 0.0 {
+            0.0
+        } else {
+            2.0 * m.backward_error * scale
+        };
+        let allowed = from_eta
             + 4.0 * n as f64 * f64::EPSILON * scale
             + 4.0 * n as f64 * f64::from_bits(1) * (1.0 + x_norm) * (1.0 + s.accuracy.norm_a);
         assert!(
             residual <= allowed,
-            "mode {k}: residual {residual} above η·scale = {allowed} (λ {}, η {}, kind {}); A = {:?}, B = {:?}",
+            "mode {k}: residual {residual:e} above η·scale = {allowed:e} (λ {:e}, η {:e}, kind {}, ‖A‖ {:e}, ‖B‖ {:e}, ‖x‖ {x_norm:e}); A = {:?}, B = {:?}",
             m.lambda,
             m.backward_error,
             m.kind,
+            s.accuracy.norm_a,
+            s.accuracy.norm_b,
             p.a,
             p.b
         );

@@ -81,7 +81,9 @@ pub fn rotation_from_matrix(r: &Matrix3<f64>) -> Result<Rotation3<f64>, Kinemati
     check_finite_mat(r, "rotation matrix entry")?;
     let orthogonality_error = (r.transpose() * r - Matrix3::identity()).norm();
     let determinant = r.determinant();
-    if orthogonality_error > ROTATION_TOLERANCE || determinant <= 0.0 {
+    // Written so that a NaN (RᵀR of entries near f64::MAX is ∞ − ∞) fails the check.
+    let is_rotation = orthogonality_error <= ROTATION_TOLERANCE && determinant > 0.0;
+    if !is_rotation {
         return Err(KinematicsError::NotARotation {
             orthogonality_error,
             determinant,

@@ -7,8 +7,9 @@ use mechanica_kinematics::nalgebra::{Isometry3, Matrix3, Rotation3, Unit, Vector
 use mechanica_kinematics::relative_motion::{RelativeMotion, decompose};
 use mechanica_kinematics::rigid_motion::RigidMotion;
 use mechanica_kinematics::rotation::{
-    QuaternionNorm, ROTATION_VECTOR_LIMIT, angular_velocity_from_rate, exp_map, orthonormalize_matrix, right_jacobian,
-    right_jacobian_rate, rotation_from_axis_angle, skew, unit_quaternion,
+    QuaternionNorm, ROTATION_VECTOR_LIMIT, angular_velocity_from_rate, exp_map, orthonormalize_matrix,
+    quaternion_from_matrix, right_jacobian, right_jacobian_rate, rotation_from_axis_angle, rotation_from_matrix, skew,
+    unit_quaternion,
 };
 use mechanica_kinematics::tree::{Joint, TreeBuilder};
 use proptest::prelude::*;
@@ -169,6 +170,19 @@ proptest! {
         let t = 2f64.powi(-1066);
         let tiny = unit_quaternion(w * t, x * t, y * t, z * t, QuaternionNorm::Normalize).expect("non-zero");
         prop_assert!((tiny.norm() - 1.0).abs() <= 4.0 * EPS);
+    }
+
+    /// A rotation scaled by s ≠ 1 (up to f64::MAX, where RᵀR − I is ∞ − ∞ = NaN) is not a
+    /// rotation; the rotation itself (s = 1) is accepted and gives back its unit quaternion.
+    #[test]
+    fn scaled_rotations_are_refused_at_every_scale(a in -3.0..3.0f64, b in -3.0..3.0f64, c in -3.0..3.0f64, exponent in 1.0..308.3f64, shrink in any::<bool>()) {
+        let r = Rotation3::from_scaled_axis(Vector3::new(a, b, c));
+        let s = if shrink { 10f64.powf(-exponent) } else { 10f64.powf(exponent).min(f64::MAX) };
+        let scaled = r.matrix() * s;
+        prop_assert!(rotation_from_matrix(&scaled).is_err(), "accepted {scaled:?}");
+        prop_assert!(quaternion_from_matrix(&scaled).is_err());
+        let q = quaternion_from_matrix(r.matrix()).expect("a rotation");
+        prop_assert!((q.to_rotation_matrix().matrix() - r.matrix()).norm() <= 8.0 * EPS);
     }
 
     /// ω from Ṙ = s [ω̂]× R for s up to 1e307: ω = s ω̂ to rounding.

@@ -167,3 +167,93 @@ fn every_bound_holds_on_pencils_spanning_eighty_decades() {
     );
     assert!(refused * 5 <= solved, "{refused} refusals against {solved} answers");
 }
+
+/// Pencils with entries up to f64::MAX, whose ‖B‖_F may exceed the largest double: the dense
+/// solve reports the norms finite (saturated at f64::MAX, as documented) with finite modes and
+/// bounds that hold; the sparse solve refuses a norm it cannot represent with `OutOfRange`.
+/// Exact ω²: B/top is the tridiagonal (−½, 1, −½) of order n, A diagonal, so ω² = top·μ with μ
+/// the eigenvalues of the small pencil, found by bisection on its Sturm sequence.
+#[test]
+fn pencils_at_the_top_of_the_range_report_finite_norms_and_true_modes() {
+    for n in [2usize, 3, 5, 9, 14] {
+        for (k, top) in [1e300, 1e307, f64::MAX / 2.0, f64::MAX].into_iter().enumerate() {
+            let b = Mat::from_fn(n, n, |i, j| match i.abs_diff(j) {
+                0 => top,
+                1 => -top / 2.0,
+                _ => 0.0,
+            });
+            let masses: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7 + k) % 5) as f64).collect();
+            let a = Mat::from_fn(n, n, |i, j| if i == j { masses[i] } else { 0.0 });
+            // ‖B‖_F = top·√(n + (n − 1)/2).
+            let norm_fits = top * (1.5 * n as f64 - 0.5).sqrt() <= f64::MAX;
+            let problem = PencilProblem::new(a.as_ref(), b.as_ref()).expect("symmetric");
+            match solve(&problem, &SolveOptions::default()) {
+                Ok(s) => {
+                    assert!(s.accuracy.norm_a.is_finite() && s.accuracy.norm_b.is_finite());
+                    let relative = (1.5 * n as f64 - 0.5).sqrt();
+                    if norm_fits {
+                        let ratio = s.accuracy.norm_b / top;
+                        assert!(
+                            (ratio - relative).abs() <= 1e-14 * relative,
+                            "n {n}, top {top:e}: ‖B‖_F/top {ratio}"
+                        );
+                    } else {
+                        assert_eq!(s.accuracy.norm_b, f64::MAX, "n {n}, top {top:e}");
+                    }
+                    for (i, mode) in s.modes.iter().enumerate() {
+                        let exact = top * tridiagonal_eigenvalue(&masses, i);
+                        assert!(mode.omega_sq.is_finite() && mode.error_bound.is_finite());
+                        assert!(
+                            (mode.omega_sq - exact).abs() <= mode.error_bound + 1e-13 * exact,
+                            "n {n}, top {top:e}, mode {i}: {} vs {exact:e} ± {:e}",
+                            mode.omega_sq,
+                            mode.error_bound
+                        );
+                    }
+                }
+                // ω² up to 2·top/min m may exceed the largest double.
+                Err(e @ ModalError::OutOfRange { .. }) => assert!(top > f64::MAX / 4.0, "n {n}, top {top:e}: {e}"),
+                Err(e) => panic!("n {n}, top {top:e}: {e}"),
+            }
+            let pencil = SparsePencil::from_triplets(n, &triplets(&a), &triplets(&b)).expect("valid");
+            let options = SparseSolveOptions {
+                count: 1,
+                ..SparseSolveOptions::default()
+            };
+            match solve_sparse(&pencil, &options) {
+                Ok(s) => assert!(
+                    s.modes
+                        .iter()
+                        .all(|m| m.omega_sq.is_finite() && m.error_bound.is_finite())
+                ),
+                Err(e @ ModalError::OutOfRange { .. }) => assert!(!norm_fits, "sparse, n {n}, top {top:e}: {e}"),
+                Err(e) => panic!("sparse, n {n}, top {top:e}: {e}"),
+            }
+        }
+    }
+}
+
+/// The i-th smallest μ (0-based) of det(T − μ M) = 0, T = tridiag(−½, 1, −½), M = diag(m), by
+/// bisection on the count of negative pivots of T − μM (Sylvester), to full precision.
+fn tridiagonal_eigenvalue(masses: &[f64], i: usize) -> f64 {
+    let below = |mu: f64| {
+        let mut count = 0;
+        let mut pivot = 1.0;
+        for (k, m) in masses.iter().enumerate() {
+            pivot = 1.0 - mu * m - if k == 0 { 0.0 } else { 0.25 / pivot };
+            if pivot == 0.0 {
+                pivot = -f64::EPSILON;
+            }
+            if pivot < 0.0 {
+                count += 1;
+            }
+        }
+        count
+    };
+    let (mut lo, mut hi) = (0.0, 2.0 / masses.iter().cloned().fold(f64::INFINITY, f64::min));
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if below(mid) > i { hi = mid } else { lo = mid }
+    }
+    0.5 * (lo + hi)
+}

@@ -296,7 +296,9 @@ fn check_state(r0: &Rotation3<f64>, omega0: &Vector3<f64>) -> Result<(), Dynamic
     check_input(r0.matrix().as_slice(), "initial attitude R(0)")?;
     check_input(omega0.as_slice(), "initial angular velocity ω(0)")?;
     let defect = (r0.matrix().transpose() * r0.matrix() - Matrix3::identity()).amax();
-    if defect > ROTATION_TOLERANCE || r0.matrix().determinant() <= 0.0 {
+    // Written so that a NaN (RᵀR of entries near f64::MAX is ∞ − ∞) fails the check.
+    let is_rotation = defect <= ROTATION_TOLERANCE && r0.matrix().determinant() > 0.0;
+    if !is_rotation {
         return Err(DynamicsError::OutOfRange {
             what: "orthonormality defect ‖RᵀR − I‖ of R(0) (det R(0) > 0)",
             requirement: "≤ 1e-12",

@@ -32,9 +32,9 @@ pub enum BoundKind {
 /// Accuracy of every number of a [`crate::ModalSolution`]; per-mode vectors are in mode order.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AccuracyReport {
-    /// ‖A‖_F.
+    /// ‖A‖_F, or the largest double where the norm exceeds it (a pencil near 1e308).
     pub norm_a: f64,
-    /// ‖B‖_F.
+    /// ‖B‖_F, or the largest double where the norm exceeds it.
     pub norm_b: f64,
     /// Backward error η of each pair (None for values only).
     pub backward_errors: Vec<Option<f64>>,

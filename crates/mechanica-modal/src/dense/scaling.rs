@@ -131,8 +131,10 @@ impl PencilScale {
             }
         }
         let report = &mut solution.accuracy;
-        report.norm_a = times_power_of_two(report.norm_a, self.mass);
-        report.norm_b = times_power_of_two(report.norm_b, self.stiffness);
+        // A norm beyond the largest double is reported as f64::MAX (documented on the field);
+        // the backward errors were formed on the scaled pencil and hold as they are.
+        report.norm_a = times_power_of_two(report.norm_a, self.mass).min(f64::MAX);
+        report.norm_b = times_power_of_two(report.norm_b, self.stiffness).min(f64::MAX);
         for (i, bound) in report.error_bounds.iter_mut().enumerate() {
             let omega_sq = solution.modes.get(i).map_or(0.0, |m| m.omega_sq);
             *bound = self.bound_to_stored(*bound, omega_sq);

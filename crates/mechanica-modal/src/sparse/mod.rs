@@ -122,6 +122,14 @@ fn solve_sparse_from(
     let (a, b) = (pencil.a(), pencil.b());
     let norm_a = frobenius(a);
     let norm_b = frobenius(b);
+    for (what, norm) in [("‖A‖_F", norm_a), ("‖B‖_F", norm_b)] {
+        if !norm.is_finite() {
+            return Err(ModalError::OutOfRange {
+                what: what.to_string(),
+                detail: "it exceeds the largest double; scale the pencil".to_string(),
+            });
+        }
+    }
     if n <= Tuning::DEFAULT.dense_limit {
         return dense_fallback(pencil, k, norm_a, norm_b);
     }

@@ -4,6 +4,7 @@
 //! duplicate entries.
 
 use crate::ModalError;
+use crate::linalg::norms::vector_norm;
 use crate::problem::SYMMETRY_ULPS;
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 
@@ -289,9 +290,10 @@ pub(crate) fn mul(m: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64]) 
     }
 }
 
-/// Frobenius norm of a sparse matrix.
+/// Frobenius norm of a sparse matrix: the norm of its stored values, scaled where their sum of
+/// squares would over- or underflow.
 pub(crate) fn frobenius(m: SparseColMatRef<'_, usize, f64>) -> f64 {
-    m.val().iter().map(|v| v * v).sum::<f64>().sqrt()
+    vector_norm(faer::ColRef::from_slice(m.val()))
 }
 
 /// |x|ᵀ |M| |x|: the scale of the rounding error of xᵀMx.

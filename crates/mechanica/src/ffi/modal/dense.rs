@@ -200,7 +200,8 @@ pub unsafe extern "C" fn mech_modal_check_pencil(n: usize, a: *const f64, b: *co
 /// interval end; MECH_STATUS_NOT_POSITIVE_DEFINITE when A is indefinite; MECH_STATUS_SINGULAR
 /// when det(λA + B) ≡ 0; MECH_STATUS_INVALID_ARGUMENT for an asymmetric matrix, a bad interval,
 /// `vectors` not 0/1 or more modes than exist; MECH_STATUS_NOT_CONVERGED when the eigensolver
-/// fails to converge.
+/// fails to converge; MECH_STATUS_OUT_OF_RANGE when an ω² or a bound exceeds the largest
+/// double.
 ///
 /// # Safety
 /// `a` and `b` must each point to n·n readable doubles; `options` to a readable

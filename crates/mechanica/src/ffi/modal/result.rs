@@ -12,9 +12,9 @@ use mechanica_modal::{Method, ModalSolution, PencilProblem};
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct mech_modal_accuracy_t {
-    /// ‖A‖_F.
+    /// ‖A‖_F, or the largest double where the norm exceeds it (a pencil near 1e308).
     pub norm_a: f64,
-    /// ‖B‖_F.
+    /// ‖B‖_F, or the largest double where the norm exceeds it.
     pub norm_b: f64,
     /// Largest backward error η of the pairs, or −1 for values only.
     pub max_backward_error: f64,

@@ -150,7 +150,8 @@ fn check_order(n: usize) -> Result<(), FfiError> {
 /// Errors: MECH_STATUS_BAD_DIMENSION for n = 0 or an index ≥ n; MECH_STATUS_NON_FINITE;
 /// MECH_STATUS_INVALID_ARGUMENT for asymmetry, bad column pointers or count ∉ [1, n];
 /// MECH_STATUS_NOT_POSITIVE_DEFINITE when no shift below the spectrum was found (A indefinite);
-/// MECH_STATUS_NOT_CONVERGED (also when the reruns run out). Nothing is written on error.
+/// MECH_STATUS_NOT_CONVERGED (also when the reruns run out); MECH_STATUS_OUT_OF_RANGE when
+/// ‖A‖_F or ‖B‖_F exceeds the largest double. Nothing is written on error.
 ///
 /// # Safety
 /// Each `*_col_ptr` must point to n + 1 readable size_t, each `*_row_idx` / `*_values` to
