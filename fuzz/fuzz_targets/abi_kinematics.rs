@@ -291,6 +291,11 @@ struct Tree {
     base_moving: bool,
     /// Σ |placement translation| of the bodies: the lever arms the velocities are built from.
     reach: f64,
+    /// Coordinates that are joint translations (prismatic; planar x, y; free position), in the
+    /// order of the bodies, and Σ |q_k| over them at the current state: lever arms too.
+    translations: Vec<usize>,
+    coordinates: usize,
+    translated: f64,
 }
 
 impl Drop for Tree {
@@ -312,6 +317,9 @@ impl Tree {
             q_dot: None,
             base_moving: false,
             reach: 0.0,
+            translations: Vec::new(),
+            coordinates: 0,
+            translated: 0.0,
         }
     }
 
@@ -350,6 +358,16 @@ impl Tree {
             assert_eq!(body.value, self.bodies, "bodies are numbered in the order of the calls");
             self.bodies += 1;
             self.reach += translation.x.abs() + translation.y.abs() + translation.z.abs();
+            let (dof, moved) = match joint {
+                MECH_JOINT_PRISMATIC => (1, 0..1),
+                MECH_JOINT_SPHERICAL => (3, 0..0),
+                MECH_JOINT_FREE => (6, 0..3),
+                MECH_JOINT_PLANAR => (3, 0..2),
+                MECH_JOINT_FIXED => (0, 0..0),
+                _ => (1, 0..0),
+            };
+            self.translations.extend(moved.map(|k| self.coordinates + k));
+            self.coordinates += dof;
         } else {
             assert!(body.untouched());
         }
@@ -388,6 +406,9 @@ impl Tree {
         check_status("mech_tree_set_state", status);
         mechanica_fuzz::trace!("set_state(q {q:?}, q̇ {q_dot:?}) = {status}");
         self.q_dot = (status == MECH_STATUS_OK).then_some(q_dot);
+        if status == MECH_STATUS_OK {
+            self.translated = self.translations.iter().map(|&k| q[k].abs()).sum();
+        }
     }
 
     fn set_base(&mut self, input: &mut Input) {
@@ -487,10 +508,17 @@ impl Tree {
         }
         // Rounding is relative to the terms the velocities are built from: q̇ times the lever
         // arms (placements, the point, prismatic offsets in q), not to the result.
-        let lever = 1.0 + self.reach + point.x.abs() + point.y.abs() + point.z.abs();
+        let lever = 1.0 + self.reach + self.translated + point.x.abs() + point.y.abs() + point.z.abs();
         let rate: f64 = q_dot.iter().map(|v| v.abs()).sum();
-        // A point at ±1e308 makes the lever infinite; without velocities it adds nothing.
-        let noise = if rate == 0.0 { 0.0 } else { 1e-12 * rate * lever };
+        // Without velocities the rounding is nil; with an infinite lever (a point or a reach
+        // at ±1e308) it is unbounded, and nothing is checked.
+        let noise = if rate == 0.0 {
+            0.0
+        } else if !lever.is_finite() {
+            f64::INFINITY
+        } else {
+            1e-12 * rate * lever
+        };
         for (kind, actual) in [(MECH_JACOBIAN_ANGULAR, omega), (MECH_JACOBIAN_POINT, velocity)] {
             let mut jacobian = vec![0.0; 3 * self.dof];
             let status =

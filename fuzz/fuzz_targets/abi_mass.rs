@@ -11,7 +11,10 @@ use libfuzzer_sys::fuzz_target;
 use mechanica::ffi::*;
 use mechanica_fuzz::Input;
 use mechanica_fuzz::input::{mat_vec, rotate_tensor, rotation_of};
-use mechanica_fuzz::oracle::{Sentinel, check_outputs, check_status, doubles_of, doubles_untouched, sentinel_doubles};
+use mechanica_fuzz::oracle::{
+    Sentinel, binary_exponent, check_outputs, check_status, doubles_of, doubles_untouched, sentinel_doubles,
+    times_power_of_two,
+};
 use mechanica_fuzz::tree::{body_properties, build_tree, v3};
 
 type Props = mech_mass_properties_t;
@@ -24,23 +27,15 @@ fn norm1(a: &[f64]) -> f64 {
     a.iter().map(|x| x.abs()).sum()
 }
 
-/// x·2ᵉ, applied in steps that stay in range (exact unless the result is subnormal).
-fn scale_by_power_of_two(mut x: f64, mut exponent: i32) -> f64 {
-    while exponent != 0 {
-        let step = exponent.clamp(-1000, 1000);
-        x *= 2f64.powi(step);
-        exponent -= step;
-    }
-    x
+/// The exponent e with 2ᵉ ≤ max|aᵢ| < 2ᵉ⁺¹ (0 for a zero or non-finite array).
+fn largest_exponent(a: &[f64]) -> i32 {
+    binary_exponent(a.iter().fold(0.0f64, |m, x| m.max(x.abs())))
 }
 
-/// The exponent e with 2ᵉ ≤ max|aᵢ| < 2ᵉ⁺¹ (0 for a zero or non-finite array).
-fn binary_exponent(a: &[f64]) -> i32 {
-    let largest = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    if largest == 0.0 || !largest.is_finite() {
-        return 0;
-    }
-    largest.log2().floor() as i32
+/// a·b, but 0 when either is 0: a zero inertia times an overflowing ω² contributes nothing
+/// to a tolerance (0·∞ would make it NaN).
+fn weighted(a: f64, b: f64) -> f64 {
+    if a == 0.0 || b == 0.0 { 0.0 } else { a * b }
 }
 
 fn diagonal(d: f64) -> [f64; 9] {
@@ -50,12 +45,12 @@ fn diagonal(d: f64) -> [f64; 9] {
 /// xᵀ M x with M and x first scaled by exact powers of two to order one, so that no
 /// intermediate product leaves the normal range; one rounding of the unscaled result remains.
 fn scaled_quadratic_form(m: &[f64; 9], x: [f64; 3]) -> f64 {
-    let (em, ex) = (binary_exponent(m), binary_exponent(&x));
-    let ms = m.map(|v| scale_by_power_of_two(v, -em));
-    let xs = x.map(|v| scale_by_power_of_two(v, -ex));
+    let (em, ex) = (largest_exponent(m), largest_exponent(&x));
+    let ms = m.map(|v| times_power_of_two(v, -em));
+    let xs = x.map(|v| times_power_of_two(v, -ex));
     let mx = mat_vec(&ms, xs);
     let form = xs[0] * mx[0] + xs[1] * mx[1] + xs[2] * mx[2];
-    scale_by_power_of_two(form, em + 2 * ex)
+    times_power_of_two(form, em + 2 * ex)
 }
 
 /// Calls `f` with a sentinel output and applies the output contract.
@@ -365,7 +360,8 @@ fn energy_and_momentum(input: &mut Input) {
         let want =
             0.5 * (scaled_quadratic_form(&diagonal(p.mass), v) + scaled_quadratic_form(&p.inertia_about_com.m, w));
         // (m·|v|)·|v|: a square |v|² alone may underflow where the energy does not.
-        let scale = 0.5 * (p.mass * norm1(&v)) * norm1(&v) + (norm1(&p.inertia_about_com.m) * norm1(&w)) * norm1(&w);
+        let scale = 0.5 * weighted(weighted(p.mass, norm1(&v)), norm1(&v))
+            + weighted(weighted(norm1(&p.inertia_about_com.m), norm1(&w)), norm1(&w));
         // Below the normal range every product and sum rounds to the subnormal spacing 2⁻¹⁰⁷⁴,
         // an absolute error that no relative tolerance covers.
         let subnormal = 16.0 * f64::from_bits(1);
@@ -401,7 +397,7 @@ fn energy_and_momentum(input: &mut Input) {
         r[0] * mv[1] - r[1] * mv[0],
     ];
     let want = [jw[0] + cross[0], jw[1] + cross[1], jw[2] + cross[2]];
-    let scale = norm1(&p.inertia_about_com.m) * norm1(&w) + norm1(&r) * norm1(&mv);
+    let scale = weighted(norm1(&p.inertia_about_com.m), norm1(&w)) + weighted(norm1(&r), norm1(&mv));
     assert!(
         close(doubles_of(&d), &want, 1e-14 * scale),
         "D_A = {:?} vs {want:?}",
@@ -409,13 +405,13 @@ fn energy_and_momentum(input: &mut Input) {
     );
 }
 
-/// x = s·2^e with 1/2 ≤ |s| < 4 (a rounded log₂ may miss by one), for finite nonzero x; (x, 0)
+/// x = s·2^e with 1 ≤ |s| < 2, for finite nonzero x; (x, 0)
 /// otherwise.
 fn split_power_of_two(x: f64) -> (f64, i32) {
     if x == 0.0 || !x.is_finite() {
         return (x, 0);
     }
-    let e = x.abs().log2().floor() as i32;
+    let e = binary_exponent(x);
     (x / power_of_two(e), e)
 }
 
@@ -423,12 +419,6 @@ fn split_power_of_two(x: f64) -> (f64, i32) {
 fn power_of_two(e: i32) -> f64 {
     let half = e / 2;
     2f64.powi(half) * 2f64.powi(e - half)
-}
-
-/// x·2^e in two steps, so that only the final product may round.
-fn times_power_of_two(x: f64, e: i32) -> f64 {
-    let half = e / 2;
-    x * 2f64.powi(half) * 2f64.powi(e - half)
 }
 
 /// Primitives: the contract for any arguments, the textbook moments for four shapes.
@@ -493,7 +483,7 @@ fn primitive(input: &mut Input) {
         let scale = norm1(&want) + 16.0 * f64::from_bits(1);
         assert!(
             close(&diag, &want, 1e-14 * scale),
-            "primitive {kind}: {diag:?} vs {want:?}"
+            "primitive {kind}: {diag:?} vs {want:?}; mass {m:e}·2^{mass_exponent}, dims {dims:?}·2^{length_exponent}"
         );
         assert!(
             close(&[j[1], j[2], j[3], j[5], j[6], j[7]], &[0.0; 6], 1e-14 * scale),

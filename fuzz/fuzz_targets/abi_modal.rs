@@ -11,7 +11,9 @@
 
 use libfuzzer_sys::fuzz_target;
 use mechanica::ffi::*;
-use mechanica_fuzz::oracle::{Sentinel, check_status, doubles_untouched, sentinel_doubles};
+use mechanica_fuzz::oracle::{
+    Sentinel, binary_exponent, check_status, doubles_untouched, sentinel_doubles, times_power_of_two,
+};
 use mechanica_fuzz::{Input, trace};
 
 const MAX_ORDER: usize = 8;
@@ -191,32 +193,42 @@ fn check_modes(p: &Pencil, s: &Solved) {
         }
         let x = &s.vectors[k * n..(k + 1) * n];
         let x_norm = scaled_norm(x);
-        let mut rows = Vec::with_capacity(n);
+        // Everything in units of 2ᵉ ≈ |λ|‖A‖ + ‖B‖ (exact powers of two), so that neither the
+        // residual nor its scale overflows for pencils and eigenvalues near f64::MAX.
+        let (a_norm, b_norm) = (s.accuracy.norm_a, s.accuracy.norm_b);
+        let (e_l, e_a, e_b) = (
+            binary_exponent(m.lambda),
+            binary_exponent(a_norm),
+            binary_exponent(b_norm),
+        );
+        let e = (e_l + e_a).max(e_b);
+        let lambda_unit = times_power_of_two(m.lambda, -e_l);
+        let mass_term = |a_ij: f64| times_power_of_two(lambda_unit * times_power_of_two(a_ij, -e_a), e_l + e_a - e);
         // The solver decomposes the symmetric parts (entries symmetric within its tolerance are
         // accepted): the residual is theirs.
         let sym = |m: &[f64], i: usize, j: usize| 0.5 * m[i + n * j] + 0.5 * m[j + n * i];
-        for i in 0..n {
-            let r: f64 = (0..n)
-                .map(|j| (m.lambda * sym(&p.a, i, j) + sym(&p.b, i, j)) * x[j])
-                .sum();
-            rows.push(r);
-        }
+        let rows: Vec<f64> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| (mass_term(sym(&p.a, i, j)) + times_power_of_two(sym(&p.b, i, j), -e)) * x[j])
+                    .sum()
+            })
+            .collect();
         let residual = scaled_norm(&rows);
-        let scale = (m.lambda.abs() * s.accuracy.norm_a + s.accuracy.norm_b) * x_norm;
-        // Plus the subnormal spacing the residual's products round to (pencils near 1e-310),
-        // carried through the shape's entries.
-        // (η = 0 allows nothing, also where the scale overflows.)
+        let scale = (mass_term(a_norm).abs() + times_power_of_two(b_norm, -e)) * x_norm;
+        // (η = 0 allows nothing.)
         let from_eta = if m.backward_error == 0.0 {
             0.0
         } else {
             2.0 * m.backward_error * scale
         };
-        let allowed = from_eta
-            + 4.0 * n as f64 * f64::EPSILON * scale
-            + 4.0 * n as f64 * f64::from_bits(1) * (1.0 + x_norm) * (1.0 + s.accuracy.norm_a);
+        // Plus the subnormal spacing the residual's products round to (pencils near 1e-310),
+        // carried through the shape's entries.
+        let subnormal = times_power_of_two(4.0 * n as f64 * f64::from_bits(1) * (1.0 + x_norm) * (1.0 + a_norm), -e);
+        let allowed = from_eta + 4.0 * n as f64 * f64::EPSILON * scale + subnormal;
         assert!(
             residual <= allowed,
-            "mode {k}: residual {residual:e} above η·scale = {allowed:e} (λ {:e}, η {:e}, kind {}, ‖A‖ {:e}, ‖B‖ {:e}, ‖x‖ {x_norm:e}); A = {:?}, B = {:?}",
+            "mode {k}: residual {residual:e} above η·scale = {allowed:e} (units of 2^{e}; λ {:e}, η {:e}, kind {}, ‖A‖ {:e}, ‖B‖ {:e}, ‖x‖ {x_norm:e}); A = {:?}, B = {:?}",
             m.lambda,
             m.backward_error,
             m.kind,
@@ -236,6 +248,44 @@ fn scaled_norm(v: &[f64]) -> f64 {
         return largest;
     }
     largest * v.iter().map(|x| (x / largest).powi(2)).sum::<f64>().sqrt()
+}
+
+/// ‖A⁻¹‖_F (≥ ‖A⁻¹‖₂) by Gauss–Jordan elimination with partial pivoting, or None for a
+/// matrix singular to working precision or an inverse beyond the double range.
+fn inverse_norm(a: &[f64], n: usize) -> Option<f64> {
+    let mut m: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            (0..2 * n)
+                .map(|j| {
+                    if j < n {
+                        a[i + n * j]
+                    } else {
+                        f64::from(u8::from(j - n == i))
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    for col in 0..n {
+        let pivot = (col..n).max_by(|&x, &y| m[x][col].abs().total_cmp(&m[y][col].abs()))?;
+        if m[pivot][col] == 0.0 || !m[pivot][col].is_finite() {
+            return None;
+        }
+        m.swap(col, pivot);
+        let head = m[col].clone();
+        for (row, line) in m.iter_mut().enumerate() {
+            if row != col {
+                let factor = line[col] / head[col];
+                line.iter_mut().zip(&head).for_each(|(x, h)| *x -= factor * h);
+            }
+        }
+    }
+    let inverse: Vec<f64> = (0..n)
+        .flat_map(|i| (n..2 * n).map(move |j| (i, j)))
+        .map(|(i, j)| m[i][j] / m[i][i])
+        .collect();
+    let norm = scaled_norm(&inverse);
+    norm.is_finite().then_some(norm)
 }
 
 fn finite_omega(s: &Solved) -> Vec<(f64, f64)> {
@@ -290,6 +340,14 @@ fn dense(input: &mut Input) {
         return;
     }
     let shift = 0.5 * (lo + hi);
+    trace!("spectrum (ω², bound) {spectrum:?}, shift {shift:e}");
+    // The count is exact for B − sA up to its rounding: it resolves only modes farther from the
+    // shift than about n·u·(‖B‖ + |s|‖A‖)·‖A⁻¹‖ (the documented contract).
+    let Some(inverse) = inverse_norm(&p.a, p.n) else { return };
+    let resolution = 8.0 * p.n as f64 * f64::EPSILON * (scaled_norm(&p.b) + shift.abs() * scaled_norm(&p.a)) * inverse;
+    if shift - lo <= resolution || hi - shift <= resolution {
+        return;
+    }
     let mut below = Sentinel::<usize>::new();
     let status = unsafe { mech_modal_count_below(p.n, p.a.as_ptr(), p.b.as_ptr(), shift, below.ptr()) };
     check_status("mech_modal_count_below", status);

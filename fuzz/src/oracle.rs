@@ -97,3 +97,30 @@ pub fn doubles_of<T: Copy>(value: &T) -> &[f64] {
     // SAFETY: the callers pass structs made only of f64 fields (repr(C), no padding).
     unsafe { std::slice::from_raw_parts((value as *const T).cast::<f64>(), std::mem::size_of::<T>() / 8) }
 }
+
+/// The e with 2ᵉ ≤ |x| < 2ᵉ⁺¹ (0 for zero or a non-finite x).
+pub fn binary_exponent(x: f64) -> i32 {
+    if x == 0.0 || !x.is_finite() {
+        return 0;
+    }
+    // log2 rounds up to 1024 next to f64::MAX (and may be off by one next to any power of two).
+    let mut e = (x.abs().log2().floor() as i32).min(1023);
+    while times_power_of_two(1.0, e) > x.abs() {
+        e -= 1;
+    }
+    while times_power_of_two(1.0, e + 1) <= x.abs() {
+        e += 1;
+    }
+    e
+}
+
+/// x·2^e in steps of at most 2^±1000 (any e): exact unless the result is subnormal, where only
+/// the last step rounds.
+pub fn times_power_of_two(mut x: f64, mut e: i32) -> f64 {
+    while e != 0 {
+        let step = e.clamp(-1000, 1000);
+        x *= 2f64.powi(step);
+        e -= step;
+    }
+    x
+}

@@ -6,6 +6,7 @@
 //! eigenvalues of B − sA equals the number of modes with ω² < s. The negative eigenvalues are
 //! counted on the block-diagonal factor of a Bunch–Kaufman LBLᵀ factorization (faer).
 
+use crate::linalg::powers_of_two::{exponent, times_power_of_two};
 use crate::{ModalError, PencilProblem};
 use faer::{Mat, Side};
 
@@ -23,21 +24,44 @@ pub struct InertiaCount {
 }
 
 /// Counts the modes with ω² below `shift` (ω² = −λ, λ of det(λA + B) = 0), certified by the
-/// inertia of an LBLᵀ factorization of B − shift·A. Exact for the factorized matrix; the count
-/// can be off only for modes within about n·u·(‖B‖ + |s|‖A‖)‖A⁻¹‖ of the shift.
+/// inertia of an LBLᵀ factorization of B − shift·A, scaled by a power of two (any finite pencil
+/// and shift). Exact for the factorized matrix; the count can be off only for modes within about
+/// n·u·(‖B‖ + |s|‖A‖)‖A⁻¹‖ of the shift.
 pub fn count_below(problem: &PencilProblem, shift: f64) -> Result<InertiaCount, ModalError> {
     if !shift.is_finite() {
         return Err(ModalError::BadShift(shift));
     }
-    let (a, b) = (problem.a(), problem.b());
-    let n = problem.dim();
-    let k = Mat::from_fn(n, n, |i, j| b[(i, j)] - shift * a[(i, j)]);
-    let (below, zero, above) = inertia_of(&k);
+    let (below, zero, above) = inertia_of(&scaled_shifted(problem, shift));
     Ok(InertiaCount {
         shift,
         below,
         zero,
         above,
+    })
+}
+
+/// (B − sA)·2⁻ᵉ with 2ᵉ near the largest of max|b_ij| and |s|·max|a_ij|: a positive multiple,
+/// so of the same inertia, whose entries and factorization neither over- nor underflow for
+/// pencils and shifts anywhere in the double range (B − sA itself overflows for |s|·a_ij beyond
+/// f64::MAX, and the pivots' products for entries beyond 1e154). The scalings are exact but for
+/// entries pushed below the normal range, which are then below u times the largest.
+fn scaled_shifted(problem: &PencilProblem, shift: f64) -> Mat<f64> {
+    let (a, b) = (problem.a(), problem.b());
+    let n = problem.dim();
+    let largest = |m: faer::MatRef<'_, f64>| {
+        (0..n)
+            .flat_map(|j| (0..n).map(move |i| m[(i, j)].abs()))
+            .fold(0.0, f64::max)
+    };
+    let exponent_of = |x: f64| if x == 0.0 { None } else { Some(exponent(x)) };
+    let (e_b, e_a, e_s) = (exponent_of(largest(b)), exponent_of(largest(a)), exponent_of(shift));
+    let e_sa = e_a.zip(e_s).map(|(x, y)| x + y);
+    let e = e_b.max(e_sa).unwrap_or(0);
+    let (e_a, e_s) = (e_a.unwrap_or(0), e_s.unwrap_or(0));
+    let unit_shift = times_power_of_two(shift, -e_s);
+    Mat::from_fn(n, n, |i, j| {
+        let sa = times_power_of_two(unit_shift * times_power_of_two(a[(i, j)], -e_a), e_a + e_s - e);
+        times_power_of_two(b[(i, j)], -e) - sa
     })
 }
 
@@ -92,9 +116,14 @@ pub(crate) fn inertia_of(k: &Mat<f64>) -> (usize, usize, usize) {
     let mut i = 0;
     while i < n {
         if i + 1 < n && s[i] != 0.0 {
-            // 2×2 block [d_i s_i; s_i d_{i+1}]: eigenvalue signs from determinant and trace.
-            let det = d[i] * d[i + 1] - s[i] * s[i];
-            let trace = d[i] + d[i + 1];
+            // 2×2 block [d_i s_i; s_i d_{i+1}]: eigenvalue signs from determinant and trace,
+            // on the block divided by a power of two near its largest entry (no over- or
+            // underflow of the products).
+            let top = d[i].abs().max(d[i + 1].abs()).max(s[i].abs());
+            let e = if top > 0.0 && top.is_finite() { exponent(top) } else { 0 };
+            let [d0, d1, s0] = [d[i], d[i + 1], s[i]].map(|x| times_power_of_two(x, -e));
+            let det = d0 * d1 - s0 * s0;
+            let trace = d0 + d1;
             if det < 0.0 {
                 neg += 1;
                 pos += 1;
@@ -148,5 +177,49 @@ mod tests {
             assert_eq!(c.below + c.zero + c.above, n);
         }
         assert!(matches!(count_below(&p, f64::NAN), Err(ModalError::BadShift(_))));
+    }
+
+    /// Blocks [[c, 2c], [2c, c]] (eigenvalues 3c and −c; Bunch–Kaufman takes them as 2×2
+    /// pivots) with c from 1e-300 to 1e300 and A = I: one mode below each shift in (−c, 3c).
+    /// The block's determinant c² − 4c² was ∞ − ∞ above 1e154 and 0 − 0 below 1e-162, and the
+    /// block was counted as a zero eigenvalue.
+    #[test]
+    fn two_by_two_pivots_keep_their_signs_across_the_double_range() {
+        for p in (-300..=300).step_by(25) {
+            let c = 10f64.powi(p);
+            let b = Mat::from_fn(2, 2, |i, j| if i == j { c } else { 2.0 * c });
+            let a = Mat::<f64>::identity(2, 2);
+            let problem = PencilProblem::new(a.as_ref(), b.as_ref()).expect("valid pencil");
+            for (s, expected) in [(-2.0, 0), (-0.5, 1), (0.0, 1), (2.5, 1), (4.0, 2)] {
+                let count = count_below(&problem, s * c).expect("finite shift");
+                assert_eq!((count.below, count.zero), (expected, 0), "c = 1e{p}, shift {s}·c");
+            }
+        }
+    }
+
+    /// The same chain with B scaled by 10^p and A by 10^q anywhere in the double range (ω² and
+    /// the shifts by 10^(p−q)): the counts are those of the closed form.
+    #[test]
+    fn counts_hold_across_the_double_range() {
+        let n = 12;
+        let (a, b) = testing::fixed_chain(n);
+        let exact = testing::fixed_chain_omega_sq(n);
+        for p in [-300, -160, -20, 0, 40, 155, 300] {
+            for q in [-300, -150, 0, 150, 300] {
+                if p - q > 300 || q - p > 300 {
+                    continue;
+                }
+                let (sb, sa) = (10f64.powi(p), 10f64.powi(q));
+                let scaled_b = Mat::from_fn(n, n, |i, j| b[(i, j)] * sb);
+                let scaled_a = Mat::from_fn(n, n, |i, j| a[(i, j)] * sa);
+                let problem = PencilProblem::new(scaled_a.as_ref(), scaled_b.as_ref()).expect("valid pencil");
+                for s in [-1.0, 0.05, 0.3, 1.7, 2.0, 3.99, 5.0] {
+                    let expected = exact.iter().filter(|&&w| w < s).count();
+                    let count = count_below(&problem, s * (sb / sa)).expect("finite shift");
+                    assert_eq!(count.below, expected, "B·1e{p}, A·1e{q}, shift {s}");
+                    assert_eq!(count.below + count.zero + count.above, n);
+                }
+            }
+        }
     }
 }

@@ -1,6 +1,7 @@
 //! Dense linear-algebra kernels of the modal solvers, below every solver and certificate: the
 //! Cholesky factorization, the reduction C = L⁻¹BL⁻ᵀ and the back-transformation ([`reduce`]),
-//! the symmetric eigensolver with its tridiagonal stages ([`eigen`]), and one-pass norms.
+//! the symmetric eigensolver with its tridiagonal stages ([`eigen`]), one-pass norms and exact
+//! scaling by powers of two.
 //!
 //! They form their own layer, not part of the dense solver, because the certificates (the
 //! bottom-of-spectrum Cholesky, the a-priori bound's ‖A⁻¹‖) and the refinement (corrections
@@ -9,4 +10,5 @@
 
 pub mod eigen;
 pub(crate) mod norms;
+pub(crate) mod powers_of_two;
 pub mod reduce;

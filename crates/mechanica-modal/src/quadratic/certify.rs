@@ -13,8 +13,8 @@
 use super::linearize::Eigenpair;
 use super::scaling::ScaledProblem;
 use super::{QuadraticBoundKind, QuadraticEigenvalue};
-use crate::dense::scaling::times_power_of_two;
 use crate::error::ModalError;
+use crate::linalg::powers_of_two::times_power_of_two;
 use faer::{Mat, c64};
 
 /// An eigenpair of the scaled problem with its certificate, the bound in stored units.

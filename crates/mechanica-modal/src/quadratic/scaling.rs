@@ -6,9 +6,9 @@
 //! for both problems, so everything is certified on the scaled problem and only s and its
 //! absolute bound are multiplied back by γ.
 
-use crate::dense::scaling::{exponent, times_power_of_two};
 use crate::error::ModalError;
 use crate::linalg::norms::frobenius_norm;
+use crate::linalg::powers_of_two::{exponent, times_power_of_two};
 use faer::{Mat, MatRef};
 
 /// The scaled problem P̃(s̃) = s̃²Ã + s̃C̃ + B̃ and its scales.

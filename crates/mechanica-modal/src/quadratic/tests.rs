@@ -5,7 +5,7 @@
 
 use super::*;
 use crate::dd::Dd;
-use crate::dense::scaling::{exponent, times_power_of_two};
+use crate::linalg::powers_of_two::{exponent, times_power_of_two};
 use crate::testing::graded::{GradedFamily, Shape, SplitMix, spring_tree, tree_pencil_spectrum};
 
 const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;

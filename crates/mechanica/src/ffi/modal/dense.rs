@@ -261,7 +261,10 @@ pub extern "C" fn mech_modal_release_scratch() {
 
 /// Writes to `*below` the number of modes with ω² < `shift` (rad²/s²), certified by the inertia
 /// of an LBLᵀ factorization of B − shift·A (Sylvester's law; A must be positive definite for the
-/// count to equal the number of modes). The n×n matrices are column-major.
+/// count to equal the number of modes), formed on the pencil scaled by a power of two so that
+/// any finite pencil and shift work. The count is exact for B − shift·A up to its rounding: it
+/// can be off only for modes within about n·u·(‖B‖ + |shift|·‖A‖)·‖A⁻¹‖ of the shift. The n×n
+/// matrices are column-major.
 ///
 /// Errors: as mech_modal_check_pencil, and MECH_STATUS_NON_FINITE for a NaN or infinite shift.
 ///
