@@ -7,10 +7,12 @@
 #   fuzz/run.sh ci SECONDS       # CI: replay every committed corpus, then SECONDS per target
 #                                # from seed 1 (deterministic: a slower machine runs a prefix)
 #
-# The corpus grows in fuzz/corpus/TARGET (the committed seeds plus what the run finds; commit
-# only small, interesting additions); crashes are written to fuzz/artifacts/TARGET/. Each run
-# uses one process (-jobs/-workers may be passed for more). Environment: FUZZ_TARGET_DIR
-# (default fuzz/target), FUZZ_RSS_LIMIT_MB (default 2048), FUZZ_MAX_LEN (default 65536 bytes).
+# New inputs go to a scratch corpus, $FUZZ_TARGET_DIR/corpus/TARGET, read together with the
+# committed seeds in fuzz/corpus/TARGET (FUZZ_GROW_CORPUS=1 grows the committed directory
+# instead; commit only small, interesting additions); crashes are written to
+# fuzz/artifacts/TARGET/. Each run uses one process (-jobs/-workers may be passed for more).
+# Environment: FUZZ_TARGET_DIR (default fuzz/target), FUZZ_RSS_LIMIT_MB (default 2048),
+# FUZZ_MAX_LEN (default 65536 bytes), FUZZ_MAX_MAGNITUDE (default: the whole double range).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 targets=(stl obj matrix_market scene urdf abi_kinematics abi_mass abi_impulse abi_modal abi_mechanism abi_urdf abi_dynamics abi_motion)
@@ -99,7 +101,7 @@ case "${1:-}" in
         exit 0
         ;;
     "" | -h | --help)
-        sed -n '2,14p' "$0"
+        sed -n '2,16p' "$0"
         exit 2
         ;;
 esac

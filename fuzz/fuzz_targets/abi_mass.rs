@@ -258,7 +258,7 @@ fn steiner_and_line(input: &mut Input) {
             expected[row + 3 * col] += p.mass * (if row == col { d2 } else { 0.0 } - d[row] * d[col]);
         }
     }
-    let scale = norm1(&p.inertia_about_com.m) + 3.0 * p.mass.abs() * norm1(&d).powi(2);
+    let scale = norm1(&p.inertia_about_com.m) + 3.0 * weighted(weighted(p.mass.abs(), norm1(&d)), norm1(&d));
     assert!(
         close(&j_a.m, &expected, 1e-14 * scale),
         "Steiner: {:?} vs {expected:?}",

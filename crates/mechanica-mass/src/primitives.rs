@@ -190,7 +190,8 @@ pub fn hemisphere(radius: f64, amount: Amount) -> Result<MassProperties, MassErr
     let m = amount.mass_for_product(&[2.0 / 3.0 * PI, r, r, r])?;
     let ixx = moment(m, r, 83.0 / 320.0);
     Ok(MassProperties {
-        p_oc: Vector3::new(0.0, 0.0, 3.0 * r / 8.0),
+        // r·(3/8), not 3r/8: 3r overflows for r above f64::MAX/3.
+        p_oc: Vector3::new(0.0, 0.0, r * 0.375),
         ..centred(m, [ixx, ixx, moment(m, r, 0.4)], "hemisphere moment of inertia")?
     })
 }
