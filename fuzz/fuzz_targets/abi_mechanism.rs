@@ -197,6 +197,7 @@ fn modes(m: &Mechanism, tree: &OwnedTree, bodies: &[mech_mass_properties_t], q: 
         )
     };
     check_status("mech_mechanism_modes", status);
+    trace!("modes(q {q:?}, count {count}) = {status}");
     if status != MECH_STATUS_OK {
         assert!(
             doubles_untouched(&omega_sq) && found.untouched() && stability.untouched(),

@@ -92,18 +92,28 @@ impl AssemblyError {
 
     /// A's share, |ω²| Σ_b γ‖A_b‖_F ‖x|S_b‖²: relative to ω², it never changes its sign.
     pub(crate) fn inertia_share(&self, omega_sq: f64, x: impl Fn(usize) -> f64) -> f64 {
+        if omega_sq == 0.0 {
+            return 0.0;
+        }
         omega_sq.abs() * share(&self.inertia, x)
     }
 }
 
-/// Σ_c scale_c ‖x|S_c‖².
+/// Σ_c scale_c ‖x|S_c‖², each term formed as (scale_c·t)·t·Σ(x_i/t)² with t = max |x_i| on
+/// S_c, so that shapes of light bodies (entries near 1e158 for a mass of 1e-316) neither
+/// overflow the squares nor turn a zero scale into 0·∞ = NaN.
 fn share(terms: &[Contribution], x: impl Fn(usize) -> f64) -> f64 {
     terms
         .iter()
         .map(|c| {
-            let weight: f64 = c.support.iter().map(|&i| x(i) * x(i)).sum();
-            // A term the mode does not touch adds nothing, even when its norm overflowed.
-            if weight == 0.0 { 0.0 } else { c.scale * weight }
+            let top = c.support.iter().fold(0.0_f64, |m, &i| m.max(x(i).abs()));
+            // A term the mode does not touch, or whose entries are all zero, adds nothing,
+            // even when the other factor overflowed.
+            if top == 0.0 || c.scale == 0.0 {
+                return 0.0;
+            }
+            let relative: f64 = c.support.iter().map(|&i| (x(i) / top).powi(2)).sum();
+            c.scale * top * top * relative
         })
         .sum()
 }

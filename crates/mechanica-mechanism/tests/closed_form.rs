@@ -411,3 +411,55 @@ fn repeated_mode_calls_with_rotation_vectors_agree_and_keep_the_charts() {
         assert_eq!(u_before.to_bits(), u_after.to_bits(), "case {case}: U(q₀) changed");
     }
 }
+
+/// Two sliders on separate branches of a fixed root (A = diag(m₁, m₂) exactly), the first
+/// one light down to subnormal masses, with joint springs k₁, k₂: ω² = kᵢ/mᵢ. Every bound is
+/// finite (or +∞) and holds; a light body's shape entries near 1e158 made the assembly
+/// error 0·∞ = NaN.
+#[test]
+fn light_sliders_have_true_finite_bounds() {
+    for m1 in [5e-324, 4.843403e-317, 1e-310, 1e-300, 1e-200, 1e-3] {
+        for k1 in [0.0, 1e-310, 1e-300, 1e-290] {
+            let mut builder = TreeBuilder::new();
+            let root = builder.add_body(None, Joint::Fixed, Isometry3::translation(-0.3, -0.3, -0.3));
+            for (axis, at) in [(Vector3::x(), 0.2), (Vector3::y(), -0.7)] {
+                builder.add_body(
+                    Some(root),
+                    Joint::Prismatic { axis },
+                    Isometry3::translation(at, 0.1, 0.0),
+                );
+            }
+            let bodies = vec![
+                MassProperties::point(4.8, Vector3::zeros()).expect("root"),
+                MassProperties::point(m1, Vector3::zeros()).expect("light slider"),
+                MassProperties::point(0.01, Vector3::zeros()).expect("slider"),
+            ];
+            let mut mechanism = Mechanism::new(builder.build().expect("tree"), bodies).expect("mechanism");
+            for (coordinate, stiffness) in [(0, k1), (1, 3.0)] {
+                if stiffness > 0.0 {
+                    let spring = JointSpring {
+                        coordinate,
+                        stiffness,
+                        rest: 0.0,
+                    };
+                    mechanism.add_potential(spring).expect("spring");
+                }
+            }
+            let exact = [k1 / m1, 3.0 / 0.01];
+            let mut sorted = exact;
+            sorted.sort_by(f64::total_cmp);
+            match mechanism_modes(&mut mechanism, &[0.25, -1.4], &SolveOptions::default()) {
+                Ok(modes) => {
+                    for mode in &modes.solution.modes {
+                        assert!(
+                            !mode.error_bound.is_nan() && mode.error_bound >= 0.0,
+                            "m₁ {m1:e}, k₁ {k1:e}: {mode:?}"
+                        );
+                    }
+                    assert_within_bounds(&modes, &sorted);
+                }
+                Err(e) => assert!(exact.iter().any(|w| *w > 1e300), "m₁ {m1:e}, k₁ {k1:e}: {e}"),
+            }
+        }
+    }
+}
