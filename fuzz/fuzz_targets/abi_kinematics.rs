@@ -10,6 +10,7 @@ use libfuzzer_sys::fuzz_target;
 use mechanica::ffi::*;
 use mechanica_fuzz::input::{mat_vec, rotation_of};
 use mechanica_fuzz::oracle::{Sentinel, check_outputs, check_status, doubles_of, doubles_untouched, sentinel_doubles};
+use mechanica_fuzz::tree::JointLayout;
 use mechanica_fuzz::{Input, trace};
 
 const MAX_BODIES: usize = 8;
@@ -358,16 +359,10 @@ impl Tree {
             assert_eq!(body.value, self.bodies, "bodies are numbered in the order of the calls");
             self.bodies += 1;
             self.reach += translation.x.abs() + translation.y.abs() + translation.z.abs();
-            let (dof, moved) = match joint {
-                MECH_JOINT_PRISMATIC => (1, 0..1),
-                MECH_JOINT_SPHERICAL => (3, 0..0),
-                MECH_JOINT_FREE => (6, 0..3),
-                MECH_JOINT_PLANAR => (3, 0..2),
-                MECH_JOINT_FIXED => (0, 0..0),
-                _ => (1, 0..0),
-            };
-            self.translations.extend(moved.map(|k| self.coordinates + k));
-            self.coordinates += dof;
+            let layout = JointLayout::of(joint);
+            self.translations
+                .extend(layout.translation.map(|k| self.coordinates + k));
+            self.coordinates += layout.dof;
         } else {
             assert!(body.untouched());
         }

@@ -31,6 +31,34 @@ pub fn v3(a: [f64; 3]) -> mech_vec3_t {
 
 /// A chain or branching tree of 1–4 bodies on valid joints with placements from the input;
 /// `None` when the input picked an invalid joint and finalizing refused it.
+/// Where a joint's coordinates sit: how many, which form a rotation vector and which are
+/// translations (offsets from the joint's first coordinate).
+pub struct JointLayout {
+    pub dof: usize,
+    pub rotation_vector: std::ops::Range<usize>,
+    pub translation: std::ops::Range<usize>,
+}
+
+impl JointLayout {
+    /// The layout of a (valid) MECH_JOINT_* kind: revolute θ; prismatic s; spherical φ;
+    /// free (p, φ); planar (x, y, θ); fixed none.
+    pub fn of(joint: i32) -> Self {
+        let (dof, rotation_vector, translation) = match joint {
+            MECH_JOINT_PRISMATIC => (1, 0..0, 0..1),
+            MECH_JOINT_SPHERICAL => (3, 0..3, 0..0),
+            MECH_JOINT_FREE => (6, 3..6, 0..3),
+            MECH_JOINT_PLANAR => (3, 0..0, 0..2),
+            MECH_JOINT_FIXED => (0, 0..0, 0..0),
+            _ => (1, 0..0, 0..0),
+        };
+        JointLayout {
+            dof,
+            rotation_vector,
+            translation,
+        }
+    }
+}
+
 pub fn build_tree(input: &mut Input) -> Option<OwnedTree> {
     let mut handle = std::ptr::null_mut();
     // SAFETY: `handle` is a writable pointer.
@@ -63,14 +91,10 @@ pub fn build_tree(input: &mut Input) -> Option<OwnedTree> {
             return None;
         }
         tree.bodies += 1;
-        let (dof, rotation) = match joint {
-            MECH_JOINT_SPHERICAL => (3, 0..3),
-            MECH_JOINT_FREE => (6, 3..6),
-            MECH_JOINT_PLANAR => (3, 0..0),
-            MECH_JOINT_FIXED => (0, 0..0),
-            _ => (1, 0..0),
-        };
-        tree.rotation_coordinates.extend(rotation.map(|k| offset + k));
+        let layout = JointLayout::of(joint);
+        tree.rotation_coordinates
+            .extend(layout.rotation_vector.map(|k| offset + k));
+        let dof = layout.dof;
         offset += dof;
     }
     // SAFETY: the handle is live.

@@ -14,6 +14,7 @@ use common::triplets;
 use faer::Mat;
 use faer::sparse::Triplet;
 use mechanica_modal::testing::graded::{GradedFamily, Shape, SpringTree, spring_tree, tree_pencil_spectrum};
+use mechanica_modal::testing::times_power_of_two;
 use mechanica_modal::{
     Mode, ModeKind, PencilProblem, Selection, SolveOptions, SparsePencil, SparseSolveOptions, solve, solve_sparse,
 };
@@ -176,18 +177,6 @@ fn the_reference_reproduces_the_closed_form_of_a_unit_chain() {
     for (r, e) in tree_pencil_spectrum(&system).iter().zip(&exact) {
         assert!((r - e).abs() <= 4.0 * f64::EPSILON * e, "{r} vs {e}");
     }
-}
-
-/// x·2^e in exact steps.
-fn times_power_of_two(x: f64, e: i32) -> f64 {
-    let mut value = x;
-    let mut remaining = e;
-    while remaining != 0 {
-        let step = remaining.clamp(-1000, 1000);
-        value *= 2f64.powi(step);
-        remaining -= step;
-    }
-    value
 }
 
 proptest! {

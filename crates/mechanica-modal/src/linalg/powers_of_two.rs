@@ -17,7 +17,7 @@ pub(crate) fn exponent(x: f64) -> i32 {
 
 /// x·2^e, in steps of at most 2^±1000 that move x towards its result: exact whenever the result
 /// is a normal double.
-pub(crate) fn times_power_of_two(x: f64, e: i32) -> f64 {
+pub fn times_power_of_two(x: f64, e: i32) -> f64 {
     let mut value = x;
     let mut remaining = e;
     while remaining != 0 {

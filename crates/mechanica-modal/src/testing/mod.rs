@@ -4,6 +4,10 @@
 
 pub mod graded;
 
+/// x·2^e, exact unless the result is subnormal (the solver's own scaling, for tests that scale
+/// pencils across the double range).
+pub use crate::linalg::powers_of_two::times_power_of_two;
+
 use faer::Mat;
 use faer::sparse::Triplet;
 use std::f64::consts::PI;
