@@ -59,9 +59,18 @@ fn scaled_shifted(problem: &PencilProblem, shift: f64) -> Mat<f64> {
     let e = e_b.max(e_sa).unwrap_or(0);
     let (e_a, e_s) = (e_a.unwrap_or(0), e_s.unwrap_or(0));
     let unit_shift = times_power_of_two(shift, -e_s);
+    // The shift's factor 2^(e_a + e_s − e)·s/2^e_s ≤ 2 in magnitude; 2^−e and 2^−e_a are single
+    // normal doubles except at the ends of the range, where each entry is scaled in steps.
+    let shift_factor = times_power_of_two(unit_shift, e_a + e_s - e);
+    let normal = |x: i32| (-1021..=1022).contains(&x);
+    if normal(e) && normal(e_a) {
+        let (b_factor, a_factor) = (times_power_of_two(1.0, -e), times_power_of_two(1.0, -e_a));
+        return Mat::from_fn(n, n, |i, j| {
+            b[(i, j)] * b_factor - (a[(i, j)] * a_factor) * shift_factor
+        });
+    }
     Mat::from_fn(n, n, |i, j| {
-        let sa = times_power_of_two(unit_shift * times_power_of_two(a[(i, j)], -e_a), e_a + e_s - e);
-        times_power_of_two(b[(i, j)], -e) - sa
+        times_power_of_two(b[(i, j)], -e) - times_power_of_two(a[(i, j)], -e_a) * shift_factor
     })
 }
 
