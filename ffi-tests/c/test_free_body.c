@@ -100,6 +100,9 @@ static void rejected(void) {
                  MECH_STATUS_INVALID_ARGUMENT);
     CHECK_STATUS(mech_free_body_integrate(&moments, &s0, 1.0, MECH_LIE_SPLITTING6, 0.1, 1e-8, &s, NULL),
                  MECH_STATUS_NULL_POINTER);
+    /* A tolerance below the rounding floor: the estimate stops falling long before 2^30 steps. */
+    CHECK_STATUS(mech_free_body_integrate(&moments, &s0, 50.0, MECH_LIE_RKMK4, 0.05, 1e-18, &s, &rep),
+                 MECH_STATUS_NOT_CONVERGED);
     CHECK(mech_untouched(&s, sizeof s));
     CHECK(mech_untouched(&rep, sizeof rep));
 }

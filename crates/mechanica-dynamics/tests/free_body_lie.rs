@@ -145,11 +145,12 @@ proptest! {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(2))]
 
-    /// The estimate bounds the true error of the reported run (attitude and ω) for at least 95%
-    /// of a family of 600 random bodies (generic, near-axisymmetric, 1e-6..1e-2 from the
+    /// The estimate bounds the true error of the reported run (attitude and ω) for at least
+    /// 97.5% of a family of 600 random bodies (generic, near-axisymmetric, 1e-6..1e-2 from the
     /// separatrix), methods, durations (0.5..5 radians of the fastest rate, times 1..20) and
-    /// steps. (The misses, about 1.5%, are runs at the rounding level near the separatrix; a
-    /// family of 600 keeps the count's spread well inside the 5% allowed.)
+    /// steps. (The misses, 0 to 7 per 600 over 15 families, are runs of order 6 and 8 at the
+    /// rounding level, 1e-13..1e-10, whose three runs share the amplified rounding of the
+    /// initial state.)
     #[test]
     fn the_error_estimate_bounds_the_true_error(seed in any::<u64>()) {
         let mut rng = Rng::new(seed);
@@ -171,7 +172,39 @@ proptest! {
                 report.push((method, attitude, estimate.attitude_error, omega, estimate.omega_error));
             }
         }
-        prop_assert!(honest >= 570, "{honest} of 600 honest; failures {report:?}");
+        prop_assert!(honest >= 585, "{honest} of 600 honest; failures {report:?}");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(4))]
+
+    /// Steps far too long for the motion (0.3..2 rad of the fastest rate per step, over 5..60
+    /// radians): wherever the runs lose the phase, the estimate is the largest error there can
+    /// be, so every estimate bounds the true error, with no exception allowed.
+    #[test]
+    fn estimates_of_runs_that_lose_the_phase_still_bound_the_error(seed in any::<u64>()) {
+        let mut rng = Rng::new(seed);
+        let mut saturated = 0;
+        for _ in 0..100 {
+            let case = random_case(&mut rng);
+            let method = LieMethod::ALL[rng.below(5)];
+            let t = rng.uniform(5.0, 60.0) / rate(&case);
+            let step = 10f64.powf(rng.uniform(-0.5, 0.3)) / rate(&case);
+            let integrator = LieIntegrator::new(case.moments, method).expect("valid moments");
+            let estimate = integrator.integrate_with_estimate(&case.r0, &case.omega0, t, step).expect("a run");
+            let solution = &estimate.solution;
+            let (attitude, omega) = true_error(&case, t, &solution.rotation, &solution.omega);
+            prop_assert!(
+                attitude <= estimate.attitude_error && omega <= estimate.omega_error,
+                "{method:?} {case:?} t {t} step {step}: true ({attitude:e}, {omega:e}), \
+                 estimate ({:e}, {:e})",
+                estimate.attitude_error,
+                estimate.omega_error
+            );
+            saturated += usize::from(estimate.attitude_error >= std::f64::consts::PI);
+        }
+        prop_assert!(saturated >= 10, "only {saturated} of 100 runs lost the phase: the family is too easy");
     }
 }
 
@@ -255,6 +288,28 @@ fn integration_to_a_tolerance_meets_it() {
             attitude <= tolerance && omega <= tolerance,
             "true errors {attitude:e}, {omega:e}"
         );
+    }
+}
+
+/// A tolerance below what rounding allows ends with `NotConverged` once the estimate stops
+/// falling, long before the cap of 2³⁰ steps, and the residual it reports is above the
+/// tolerance.
+#[test]
+fn tolerances_below_the_rounding_floor_end_as_not_converged() {
+    let mut rng = Rng::new(5);
+    for method in [LieMethod::Rkmk4, LieMethod::Splitting6] {
+        let case = near_separatrix(&mut rng, 1e-3, 1.0);
+        let t = 200.0 / rate(&case);
+        let integrator = LieIntegrator::new(case.moments, method).expect("valid moments");
+        match integrator.integrate_to_tolerance(&case.r0, &case.omega0, t, t / 2000.0, 1e-17) {
+            Err(DynamicsError::NotConverged {
+                iterations, residual, ..
+            }) => {
+                assert!(residual > 1e-17, "{method:?}: residual {residual:e}");
+                assert!(iterations < 22, "{method:?}: {iterations} doublings");
+            }
+            other => panic!("{method:?}: expected NotConverged, got {other:?}"),
+        }
     }
 }
 

@@ -9,12 +9,12 @@
 //!   Each sub-step is an exact rotation, so |L| = |Iω| is conserved to rounding and the method
 //!   is symplectic on the momentum sphere.
 //!
-//! [`LieIntegrator::integrate_with_estimate`] runs the method twice (n and 2n steps) and
-//! reports the finer run with the difference of the two as its error estimate.
+//! [`LieIntegrator::integrate_with_estimate`] runs the method with ⌊n/2⌋, n and 2n steps and
+//! reports the finest run with an error estimate formed from the three ([`super::estimate`]).
 
-use mechanica_kinematics::rotation::log_map;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
+use super::estimate::{HalfRun, Runs, estimate};
 use super::rkmk::rkmk4_step;
 use super::splitting::{
     COMPOSITION_4, COMPOSITION_6, COMPOSITION_8, MomentumInvariants, composition_weights, flow_sequence, splitting_step,
@@ -23,6 +23,10 @@ use crate::error::{DynamicsError, check_input, check_result};
 
 /// The most steps one integration may take (2³⁰); the estimate's companion run counts double.
 pub const MAX_LIE_STEPS: u64 = 1 << 30;
+
+/// Doublings in a row over which an estimate that falls by less than half ends
+/// [`LieIntegrator::integrate_to_tolerance`] as not converging.
+pub const STALLED_DOUBLINGS: usize = 4;
 
 /// The largest ‖RᵀR − I‖ (max entry) accepted for an initial attitude.
 pub const ROTATION_TOLERANCE: f64 = 1e-12;
@@ -79,10 +83,10 @@ pub struct LieSolution {
 pub struct LieEstimate {
     /// The run with 2n steps.
     pub solution: LieSolution,
-    /// The geodesic angle ‖log(R_nᵀ R_2n)‖ between the runs with n and 2n steps, plus the
-    /// rounding allowance 2n·ε (rad).
+    /// The estimated geodesic angle ‖log(R_exactᵀ R_2n)‖ (rad), at most π plus the rounding
+    /// allowance 2n·ε; see [`super::estimate`] for how it is formed.
     pub attitude_error: f64,
-    /// ‖ω_n − ω_2n‖/‖ω_2n‖ plus the rounding allowance 2n·ε.
+    /// The estimated ‖ω_2n − ω_exact‖/‖ω_exact‖.
     pub omega_error: f64,
 }
 
@@ -155,10 +159,12 @@ impl LieIntegrator {
         self.run(r0, omega0, duration, steps)
     }
 
-    /// [`Self::integrate`] with n and 2n steps: the 2n run and its error estimate (see
-    /// [`LieEstimate`]). For a method of order p in its asymptotic range the true error of the
-    /// 2n run is the difference divided by 2ᵖ − 1, so the estimate is an upper bound with that
-    /// margin. Errors: those of [`Self::integrate`], with the cap applied to 2n.
+    /// [`Self::integrate`] with 2n steps and its error estimate from the runs with ⌊n/2⌋, n and
+    /// 2n steps ([`super::estimate`]): the difference of the last two where the three runs
+    /// converge at the method's order (the true error is then that difference divided by about
+    /// 2ᵖ − 1); a larger, conservative value where they do not; and the largest possible error
+    /// (π for the attitude) where the runs have lost the phase of the motion. Errors: those of
+    /// [`Self::integrate`], with the cap applied to 2n.
     pub fn integrate_with_estimate(
         &self,
         r0: &Rotation3<f64>,
@@ -168,9 +174,10 @@ impl LieIntegrator {
     ) -> Result<LieEstimate, DynamicsError> {
         let steps = step_count(duration, max_step, 2)?;
         check_state(r0, omega0)?;
+        let half = self.half_run(r0, omega0, duration, steps);
         let coarse = self.run(r0, omega0, duration, steps)?;
         let fine = self.run(r0, omega0, duration, 2 * steps)?;
-        Ok(compare(coarse, fine))
+        Ok(self.estimate(half_of(&half), &coarse, fine, omega0))
     }
 
     /// The runs with n₀, 2n₀, 4n₀, … steps until the estimate of [`Self::integrate_with_estimate`]
@@ -178,7 +185,10 @@ impl LieIntegrator {
     ///
     /// Errors: those of [`Self::integrate`]; [`DynamicsError::OutOfRange`] for a tolerance that
     /// is not > 0; [`DynamicsError::TooManySteps`] when the estimate is still above the
-    /// tolerance at [`MAX_LIE_STEPS`].
+    /// tolerance at [`MAX_LIE_STEPS`]; [`DynamicsError::NotConverged`] when the estimate has
+    /// stopped decreasing above the tolerance (it fell by less than half over
+    /// [`STALLED_DOUBLINGS`] doublings in a row while the phase was resolved: the rounding
+    /// floor of the method on this motion).
     pub fn integrate_to_tolerance(
         &self,
         r0: &Rotation3<f64>,
@@ -197,12 +207,24 @@ impl LieIntegrator {
         }
         let mut steps = step_count(duration, max_step, 2)?;
         check_state(r0, omega0)?;
+        let mut half = self.half_run(r0, omega0, duration, steps);
         let mut coarse = self.run(r0, omega0, duration, steps)?;
+        let (mut previous, mut stalled, mut doublings) = (f64::INFINITY, 0, 0);
         loop {
             let fine = self.run(r0, omega0, duration, 2 * steps)?;
-            let estimate = compare(coarse, fine.clone());
-            if estimate.attitude_error <= tolerance && estimate.omega_error <= tolerance {
+            let estimate = self.estimate(half_of(&half), &coarse, fine.clone(), omega0);
+            let worst = estimate.attitude_error.max(estimate.omega_error);
+            if worst <= tolerance {
                 return Ok(estimate);
+            }
+            let resolved = estimate.attitude_error < std::f64::consts::PI;
+            stalled = if resolved && worst > 0.5 * previous { stalled + 1 } else { 0 };
+            if stalled >= STALLED_DOUBLINGS {
+                return Err(DynamicsError::NotConverged {
+                    what: "free-body integration to the tolerance (the estimate stopped decreasing)",
+                    iterations: doublings,
+                    residual: worst,
+                });
             }
             if 4 * steps > MAX_LIE_STEPS {
                 return Err(DynamicsError::TooManySteps {
@@ -211,9 +233,34 @@ impl LieIntegrator {
                     cap: MAX_LIE_STEPS,
                 });
             }
-            steps *= 2;
+            (previous, doublings, steps) = (worst, doublings + 1, 2 * steps);
+            half = Some(Ok(coarse));
             coarse = fine;
         }
+    }
+
+    /// The run with ⌊n/2⌋ steps for the estimate, when n ≥ 2; its failure is kept, not
+    /// returned (see [`HalfRun::Failed`]).
+    fn half_run(
+        &self,
+        r0: &Rotation3<f64>,
+        omega0: &Vector3<f64>,
+        duration: f64,
+        steps: u64,
+    ) -> Option<Result<LieSolution, DynamicsError>> {
+        (steps >= 2).then(|| self.run(r0, omega0, duration, steps / 2))
+    }
+
+    /// The estimate of `fine` from the runs before it.
+    fn estimate(
+        &self,
+        half: HalfRun<'_>,
+        coarse: &LieSolution,
+        fine: LieSolution,
+        omega0: &Vector3<f64>,
+    ) -> LieEstimate {
+        let runs = Runs { half, coarse, fine };
+        estimate(runs, self.method.order(), &self.moments, omega0)
     }
 
     /// `steps` equal steps over `duration` from a validated state.
@@ -254,18 +301,12 @@ impl LieIntegrator {
     }
 }
 
-/// The estimate from the runs with n and 2n steps.
-fn compare(coarse: LieSolution, fine: LieSolution) -> LieEstimate {
-    let rounding = fine.steps as f64 * f64::EPSILON;
-    let difference = coarse.rotation.transpose() * fine.rotation;
-    let attitude_error = log_map(&difference).norm() + rounding;
-    let scale = fine.omega.norm();
-    let omega_gap = (coarse.omega - fine.omega).norm();
-    let omega_error = if scale > 0.0 { omega_gap / scale } else { omega_gap } + rounding;
-    LieEstimate {
-        solution: fine,
-        attitude_error,
-        omega_error,
+/// The half run as the estimate sees it.
+fn half_of(half: &Option<Result<LieSolution, DynamicsError>>) -> HalfRun<'_> {
+    match half {
+        None => HalfRun::Absent,
+        Some(Err(_)) => HalfRun::Failed,
+        Some(Ok(run)) => HalfRun::Ran(run),
     }
 }
 

@@ -9,12 +9,13 @@
 //!   initial state, as the reference that integrators are judged by.
 //! - [`lie_group`]: [`LieIntegrator`], Lie-group integrators of (R, ω) that keep R on SO(3):
 //!   RKMK of order 4 and a Lie–Poisson splitting into rotations about the principal axes,
-//!   composed to order 4, 6 or 8 ([`splitting`]), with error estimates.
+//!   composed to order 4, 6 or 8 ([`splitting`]), with error estimates ([`estimate`]).
 //! - [`carlson`], [`elliptic`], [`jacobi`]: R_F, R_D, R_J, R_C; K, F, Π; sn, cn, dn, am.
 
 pub mod carlson;
 mod double_double;
 pub mod elliptic;
+pub mod estimate;
 pub mod euler;
 pub mod exact;
 pub mod jacobi;
@@ -27,4 +28,4 @@ pub use elliptic::{EllipticModulus, elliptic_f, elliptic_k, elliptic_pi, ellipti
 pub use euler::{attitude_rate, euler_rates};
 pub use exact::{Regime, TorqueFreeBody};
 pub use jacobi::{JacobiValues, jacobi_amplitude, jacobi_elliptic};
-pub use lie_group::{LieEstimate, LieIntegrator, LieMethod, LieSolution, MAX_LIE_STEPS};
+pub use lie_group::{LieEstimate, LieIntegrator, LieMethod, LieSolution, MAX_LIE_STEPS, STALLED_DOUBLINGS};

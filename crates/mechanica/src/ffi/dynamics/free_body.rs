@@ -47,7 +47,8 @@ c_enum!(LieMethod,
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct mech_free_body_report_t {
-    /// Estimated error of the attitude: the angle of R_n⁻¹ R_2n, rad.
+    /// Estimated error of the attitude (rad): the angle of R_n⁻¹ R_2n where the runs converge
+    /// at the method's order, larger otherwise, and π where they have lost the phase.
     pub attitude_error: f64,
     /// Estimated error of ω relative to |ω|.
     pub omega_error: f64,
@@ -101,14 +102,16 @@ pub unsafe extern "C" fn mech_free_body_exact(
 
 /// Integrates the torque-free body with principal `moments` from `initial` over `duration`
 /// (≥ 0, s) by a Lie-group method that keeps R on SO(3) without renormalising: runs of n₀,
-/// 2n₀, 4n₀, … steps, n₀ = ⌈duration / max_step⌉, until the difference of the last two, the
-/// error estimate, is ≤ `tolerance` (> 0) for the attitude (rad) and for ω (relative). Writes
-/// the finer run's state and the estimate.
+/// 2n₀, 4n₀, … steps, n₀ = ⌈duration / max_step⌉, until the error estimate formed from the
+/// last three runs (docs/theory.md, "Lie-group integration of the free body") is ≤
+/// `tolerance` (> 0) for the attitude (rad) and for ω (relative). Writes the finest run's state
+/// and the estimate.
 ///
 /// Errors: MECH_STATUS_NON_FINITE for a NaN or infinite input; MECH_STATUS_BAD_ENUM for an
 /// unknown method; MECH_STATUS_INVALID_ARGUMENT for a moment ≤ 0, a rotation that is not one,
 /// a negative duration, max_step ≤ 0, tolerance ≤ 0, or when the tolerance is not met within
-/// 2³⁰ steps; MECH_STATUS_OUT_OF_RANGE on overflow.
+/// 2³⁰ steps; MECH_STATUS_NOT_CONVERGED when the estimate stops falling above the tolerance
+/// (the method's rounding floor on this motion); MECH_STATUS_OUT_OF_RANGE on overflow.
 ///
 /// # Safety
 /// `moments` and `initial` must be readable, `out` and `report` writable.
