@@ -405,22 +405,6 @@ fn energy_and_momentum(input: &mut Input) {
     );
 }
 
-/// x = s·2^e with 1 ≤ |s| < 2, for finite nonzero x; (x, 0)
-/// otherwise.
-fn split_power_of_two(x: f64) -> (f64, i32) {
-    if x == 0.0 || !x.is_finite() {
-        return (x, 0);
-    }
-    let e = binary_exponent(x);
-    (x / power_of_two(e), e)
-}
-
-/// 2^e, exact for −1074 ≤ e ≤ 1023 (formed from two halves, each in the normal range).
-fn power_of_two(e: i32) -> f64 {
-    let half = e / 2;
-    2f64.powi(half) * 2f64.powi(e - half)
-}
-
 /// Primitives: the contract for any arguments, the textbook moments for four shapes.
 fn primitive(input: &mut Input) {
     let kind = input.enum_i32(12);
@@ -458,10 +442,11 @@ fn primitive(input: &mut Input) {
     // The moments are formed on m/2^e and dims/2^f (e the exponent of m, f of the largest
     // dimension) and scaled back by 2^(e + 2f) at the end, so that neither 0.4·m nor d² leaves
     // the normal range on the way while the moment itself is a normal number.
-    let (m, mass_exponent) = split_power_of_two(m);
+    let mass_exponent = binary_exponent(m);
+    let m = times_power_of_two(m, -mass_exponent);
     let largest = dims.iter().fold(0.0f64, |a, d| a.max(d.abs()));
-    let (_, length_exponent) = split_power_of_two(largest);
-    let dims: Vec<f64> = dims.iter().map(|d| d / power_of_two(length_exponent)).collect();
+    let length_exponent = binary_exponent(largest);
+    let dims: Vec<f64> = dims.iter().map(|d| times_power_of_two(*d, -length_exponent)).collect();
     let exponent = mass_exponent + 2 * length_exponent;
     let expected = match kind {
         MECH_PRIMITIVE_ROD => Some([m * dims[0] * dims[0] / 12.0, m * dims[0] * dims[0] / 12.0, 0.0]),

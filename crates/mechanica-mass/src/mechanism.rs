@@ -103,6 +103,8 @@ fn field_product(
 pub struct TreeMass {
     bodies: Vec<MassProperties>,
     composite: Vec<MassProperties>,
+    /// Per body: the moments of its subtree about the root's origin (for the mass matrix).
+    subtree_moments: Vec<MomentsAbout>,
     /// Per coordinate l: the motion column (w_l, v̄_l) with v̄_l = v_l + (o_j − r) × w_l, the
     /// velocity per unit q̇_l of the body point at the reference r (see `mass_matrix`).
     columns: Vec<(Vector3<f64>, Vector3<f64>)>,
@@ -122,6 +124,51 @@ fn union(a: &MassProperties, b: &MassProperties) -> MassProperties {
         mass,
         p_oc: c,
         inertia_c: a.inertia_about(&c) + b.inertia_about(&c),
+    }
+}
+
+/// The mass moments of a set of bodies about a fixed world point r: the mass m, the first
+/// moment h = Σ m_b (c_b − r) and the inertia tensor about r, I_r = Σ J_b + m_b [y_b]ₓᵀ[y_b]ₓ
+/// with y_b = c_b − r (Steiner, 3.27–3.29). All three add over bodies, so the moments of a
+/// subtree are the sums of its bodies' moments, with no division and no change of point.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct MomentsAbout {
+    mass: f64,
+    first: Vector3<f64>,
+    second: Matrix3<f64>,
+}
+
+impl MomentsAbout {
+    /// The moments about r of a body of mass `mass`, centre `centre` and central tensor `j`
+    /// (symmetric; world components). A massless body has none, whatever its tensor (as in the
+    /// unions of [`TreeMass`]'s composites).
+    fn of_body(mass: f64, centre: &Vector3<f64>, j: &Matrix3<f64>, r: &Vector3<f64>) -> Self {
+        if mass == 0.0 {
+            return Self::default();
+        }
+        let y = centre - r;
+        let h = y * mass;
+        let (xx, yy, zz) = (h.x * y.x, h.y * y.y, h.z * y.z);
+        let (xy, xz, yz) = (h.x * y.y, h.x * y.z, h.y * y.z);
+        let steiner = Matrix3::new(yy + zz, -xy, -xz, -xy, xx + zz, -yz, -xz, -yz, xx + yy);
+        Self {
+            mass,
+            first: h,
+            second: j + steiner,
+        }
+    }
+
+    fn add(&mut self, other: &Self) {
+        self.mass += other.mass;
+        self.first += other.first;
+        self.second += other.second;
+    }
+
+    /// The momentum (linear p, angular L about r) of the set moving rigidly with angular
+    /// velocity w and velocity v̄ of the point at r: p = m v̄ + w × h, L = I_r w + h × v̄.
+    #[inline]
+    fn momentum(&self, w: &Vector3<f64>, v: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        (v * self.mass + w.cross(&self.first), self.second * w + self.first.cross(v))
     }
 }
 
@@ -153,10 +200,12 @@ impl TreeMass {
             })?;
         }
         let composite = bodies.clone();
+        let subtree_moments = vec![MomentsAbout::default(); bodies.len()];
         let columns = vec![(Vector3::zeros(), Vector3::zeros()); tree.dof()];
         Ok(Self {
             bodies,
             composite,
+            subtree_moments,
             columns,
         })
     }
@@ -182,6 +231,31 @@ impl TreeMass {
         Ok(())
     }
 
+    /// Fills the subtree moments about `r` (world) from the poses of the last
+    /// `update_positions` in `ws`: each body's moments, then children added into parents.
+    fn update_subtree_moments(
+        &mut self,
+        tree: &KinematicTree,
+        ws: &Workspace,
+        r: &Vector3<f64>,
+    ) -> Result<(), MassError> {
+        for (i, body) in self.bodies.iter().enumerate() {
+            let rotation = ws.rotation(i)?;
+            let rotation = rotation.matrix();
+            let j: Matrix3<f64> = rotation * body.inertia_c * rotation.transpose();
+            let centre = rotation * body.p_oc + ws.position(i)?;
+            let j = j * 0.5 + j.transpose() * 0.5;
+            self.subtree_moments[i] = MomentsAbout::of_body(body.mass, &centre, &j, r);
+        }
+        for &i in tree.topological_order().iter().rev() {
+            if let Some(p) = tree.parent(i) {
+                let child = self.subtree_moments[i];
+                self.subtree_moments[p].add(&child);
+            }
+        }
+        Ok(())
+    }
+
     /// The mass matrix A(q) (8.28) at the configuration of the last `update_positions` in `ws`,
     /// into `out` (dof × dof, column-major; kg, kg·m or kg·m² by the units of q_k and q_l), by
     /// the composite-rigid-body recursion: exact up to rounding, symmetric by construction.
@@ -197,17 +271,17 @@ impl TreeMass {
                 got: out.len(),
             });
         }
-        self.update_composites(tree, ws)?;
         if self.columns.len() != n {
             self.columns.resize(n, (Vector3::zeros(), Vector3::zeros()));
         }
         // Moments are taken about the root's origin r, so that the per-pair work is two dot
-        // products: with c' = x_c − r and v̄_l = v_l + (o_j − r) × w_l, the velocity of the
-        // composite's points is u_l(x) = w_l × (x − r) + v̄_l, and
-        // α_kl = m_c u_k·u_l(x_c) + w_l·J_c w_k = w_l·(J_c w_k + c' × f_k) + v̄_l·f_k with
-        // f_k = m_c u_k(x_c). Taking r on the tree keeps the rounding relative to its size.
+        // products: with v̄_l = v_l + (o_j − r) × w_l, the velocity of the subtree's points is
+        // u_l(x) = w_l × (x − r) + v̄_l, and α_kl = ∫ρ u_k·u_l dV = w_l·L_k + v̄_l·p_k with the
+        // momentum (p_k, L_k about r) of the subtree moving with u_k ([`MomentsAbout`]).
+        // Taking r on the tree keeps the rounding relative to its size.
         let root = tree.topological_order().first().copied().unwrap_or(0);
         let r = ws.position(root)?;
+        self.update_subtree_moments(tree, ws, &r)?;
         for i in 0..tree.body_count() {
             let d = ws.position(i)? - r;
             for l in tree.dof_range(i) {
@@ -215,23 +289,21 @@ impl TreeMass {
                 self.columns[l] = (w, v + d.cross(&w));
             }
         }
+        // a·0 is 0 for a finite a and NaN otherwise: one sum tells whether any entry written
+        // is not finite, without a second pass over the n² entries.
+        let mut poison = 0.0;
         for i in 0..tree.body_count() {
-            let c = self.composite[i];
-            let c_r = c.p_oc - r;
+            let moments = self.subtree_moments[i];
             for k in tree.dof_range(i) {
                 let (w_k, v_k) = self.columns[k];
-                let f = c.mass * (w_k.cross(&c_r) + v_k);
-                let moment = c.inertia_c * w_k + c_r.cross(&f);
+                // A massless subtree has zero moments and gives exact zeros.
+                let (p, l_k) = moments.momentum(&w_k, &v_k);
                 let mut b = Some(i);
                 while let Some(j) = b {
                     for l in tree.dof_range(j) {
                         let (w_l, v_l) = &self.columns[l];
-                        // A massless composite gives exact zeros (f = 0 and J_c = 0).
-                        let a = if c.mass == 0.0 {
-                            0.0
-                        } else {
-                            w_l.dot(&moment) + v_l.dot(&f)
-                        };
+                        let a = w_l.dot(&l_k) + v_l.dot(&p);
+                        poison += a * 0.0;
                         out[k + n * l] = a;
                         out[l + n * k] = a;
                     }
@@ -239,7 +311,11 @@ impl TreeMass {
                 }
             }
         }
-        check_result(out.iter(), "mass matrix")
+        if poison == 0.0 {
+            Ok(())
+        } else {
+            check_result(out.iter(), "mass matrix")
+        }
     }
 
     /// The generalized momenta ∂T/∂q̇ = A q̇ (7.113; EB1911 §22 (16)) and the kinetic energy
@@ -322,6 +398,7 @@ impl TreeMass {
             "drag field",
         )?;
         self.mass_matrix(tree, ws, a_out)?;
+        self.update_composites(tree, ws)?;
         let omega0 = drag.omega;
         let mut t0 = 0.0;
         for i in 0..tree.body_count() {

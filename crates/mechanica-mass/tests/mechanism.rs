@@ -373,3 +373,70 @@ fn wrong_lengths_are_named() {
     mass.mass_matrix(&tree, &ws, &mut a).expect("ok");
     assert!((a[0] - 1.0).abs() <= 1e-15);
 }
+
+/// A chain of three revolute joints about z with unit links along x: bodies of mass `masses`
+/// at the end of each link.
+fn planar_chain(masses: [f64; 3], link: f64) -> (KinematicTree, Vec<MassProperties>) {
+    let mut builder = TreeBuilder::new();
+    let mut parent = None;
+    for i in 0..3 {
+        let offset = if i == 0 { Vector3::zeros() } else { Vector3::x() * link };
+        let placement = Isometry3::from_parts(Translation3::from(offset), UnitQuaternion::identity());
+        parent = Some(builder.add_body(parent, Joint::Revolute { axis: Vector3::z() }, placement));
+    }
+    let bodies = masses
+        .iter()
+        .map(|&m| MassProperties {
+            mass: m,
+            p_oc: Vector3::x() * link,
+            inertia_c: nalgebra::Matrix3::zeros(),
+        })
+        .collect();
+    (builder.build().expect("valid tree"), bodies)
+}
+
+/// A massless last body adds exact zeros; the entries match the closed form of point masses on
+/// a straight chain (α_kl = Σ_{b ≥ max(k,l)} m_b (x_b − x_k)·(x_b − x_l) along the line).
+#[test]
+fn massless_bodies_add_nothing_and_point_masses_match_the_closed_form() {
+    for masses in [[1.0, 2.0, 0.0], [0.0, 0.0, 3.0], [1e-12, 1.0, 1e12]] {
+        let (tree, bodies) = planar_chain(masses, 0.5);
+        let mut ws = tree.workspace();
+        tree.update_positions(&mut ws, &[0.0; 3]).expect("positions");
+        let mut mass = TreeMass::new(&tree, bodies).expect("valid bodies");
+        let mut a = vec![0.0; 9];
+        mass.mass_matrix(&tree, &ws, &mut a).expect("mass matrix");
+        // Body b sits at x = 0.5 (b + 1); joint k at x = 0.5 k.
+        for k in 0..3 {
+            for l in 0..3 {
+                let expected: f64 = (k.max(l)..3)
+                    .map(|b| masses[b] * (0.5 * (b + 1 - k) as f64) * (0.5 * (b + 1 - l) as f64))
+                    .sum();
+                let scale: f64 = masses.iter().sum::<f64>() * 2.25;
+                assert!(
+                    (a[k + 3 * l] - expected).abs() <= 8.0 * f64::EPSILON * scale,
+                    "{masses:?}: α[{k}][{l}] = {} against {expected}",
+                    a[k + 3 * l]
+                );
+                if masses[k.max(l)..].iter().all(|&m| m == 0.0) {
+                    assert_eq!(a[k + 3 * l], 0.0, "{masses:?}: α[{k}][{l}] of a massless subtree");
+                }
+            }
+        }
+    }
+}
+
+/// Entries beyond the double range are a typed error, not ∞ or NaN.
+#[test]
+fn an_overflowing_mass_matrix_is_a_typed_error() {
+    let (tree, bodies) = planar_chain([1.0, 1.0, 1e300], 1e10);
+    let mut ws = tree.workspace();
+    tree.update_positions(&mut ws, &[0.0; 3]).expect("positions");
+    let mut mass = TreeMass::new(&tree, bodies).expect("valid bodies");
+    let mut a = vec![0.0; 9];
+    let result = mass.mass_matrix(&tree, &ws, &mut a);
+    assert!(
+        matches!(result, Err(mechanica_mass::MassError::NonFiniteResult { quantity: "mass matrix" })),
+        "{result:?}"
+    );
+}

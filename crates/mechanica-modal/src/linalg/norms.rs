@@ -3,6 +3,8 @@
 
 use faer::MatRef;
 
+use super::powers_of_two::{exponent, times_power_of_two};
+
 /// ‖M‖_F, summed in one pass; only when the sum of squares over- or underflows is it summed
 /// again on the entries scaled by a power of two (exact), so that it is finite whenever the
 /// norm is representable.
@@ -15,18 +17,16 @@ pub(crate) fn frobenius_norm(m: MatRef<'_, f64>) -> f64 {
     }
 }
 
-/// √Σ vᵢ² computed on vᵢ·2⁻ᵉ with 2ᵉ ≤ max|vᵢ| < 2ᵉ⁺¹, then times 2ᵉ: no intermediate
+/// √Σ vᵢ² computed on vᵢ·2⁻ᵉ with 2ᵉ⁻¹ ≤ max|vᵢ| < 2ᵉ, then times 2ᵉ: no intermediate
 /// over- or underflows (a NaN or ∞ entry gives itself).
 fn scaled_norm<I: Iterator<Item = f64>>(values: impl Fn() -> I) -> f64 {
     let largest = values().fold(0.0_f64, |m, v| m.max(v.abs()));
     if largest == 0.0 || !largest.is_finite() {
         return largest;
     }
-    let exponent = largest.log2().floor() as i32;
-    // Two steps: 2^±1074 alone is out of range.
-    let (down_1, down_2) = (2f64.powi(-exponent / 2), 2f64.powi(-exponent + exponent / 2));
-    let sum: f64 = values().map(|v| (v * down_1 * down_2).powi(2)).sum();
-    sum.sqrt() / down_1 / down_2
+    let e = exponent(largest);
+    let sum: f64 = values().map(|v| times_power_of_two(v, -e).powi(2)).sum();
+    times_power_of_two(sum.sqrt(), e)
 }
 
 /// Σ v_i² with four independent partial sums (vectorisable when `v` is contiguous).
