@@ -88,9 +88,15 @@ pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> 
 /// Whether B itself is positive definite beyond rounding: its Cholesky factorization succeeds
 /// and every pivot l_jj² exceeds 4n·u·max_k b_kk, the rounding that elimination can leave in a
 /// pivot of a matrix singular up to rounding (the stiffness of a free structure, assembled
-/// from springs up to max b_kk). Then, by Sylvester's law, no mode has ω² ≤ 0: the pencil has
-/// neither rigid-body nor unstable modes.
+/// from springs up to max b_kk); or, where that cannot decide and B's pattern is a forest
+/// (spring chains and trees), the extended-precision proof of [`super::forest`]. Then, by
+/// Sylvester's law, no mode has ω² ≤ 0: the pencil has neither rigid-body nor unstable modes.
 pub(crate) fn stiffness_is_definite(problem: &PencilProblem, par: faer::Par) -> bool {
+    double_precision_definite(problem, par) || super::forest::forest_is_positive_definite(problem.b())
+}
+
+/// The Cholesky test with the pivot margin 4n·u·max_k b_kk of [`stiffness_is_definite`].
+fn double_precision_definite(problem: &PencilProblem, par: faer::Par) -> bool {
     let b = problem.b();
     let n = problem.dim();
     let largest = (0..n).map(|j| b[(j, j)]).fold(0.0_f64, f64::max);
