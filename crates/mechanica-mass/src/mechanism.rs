@@ -168,7 +168,10 @@ impl MomentsAbout {
     /// velocity w and velocity v̄ of the point at r: p = m v̄ + w × h, L = I_r w + h × v̄.
     #[inline]
     fn momentum(&self, w: &Vector3<f64>, v: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-        (v * self.mass + w.cross(&self.first), self.second * w + self.first.cross(v))
+        (
+            v * self.mass + w.cross(&self.first),
+            self.second * w + self.first.cross(v),
+        )
     }
 }
 

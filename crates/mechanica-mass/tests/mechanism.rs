@@ -436,7 +436,12 @@ fn an_overflowing_mass_matrix_is_a_typed_error() {
     let mut a = vec![0.0; 9];
     let result = mass.mass_matrix(&tree, &ws, &mut a);
     assert!(
-        matches!(result, Err(mechanica_mass::MassError::NonFiniteResult { quantity: "mass matrix" })),
+        matches!(
+            result,
+            Err(mechanica_mass::MassError::NonFiniteResult {
+                quantity: "mass matrix"
+            })
+        ),
         "{result:?}"
     );
 }

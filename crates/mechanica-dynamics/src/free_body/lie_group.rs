@@ -218,7 +218,11 @@ impl LieIntegrator {
                 return Ok(estimate);
             }
             let resolved = estimate.attitude_error < std::f64::consts::PI;
-            stalled = if resolved && worst > 0.5 * previous { stalled + 1 } else { 0 };
+            stalled = if resolved && worst > 0.5 * previous {
+                stalled + 1
+            } else {
+                0
+            };
             if stalled >= STALLED_DOUBLINGS {
                 return Err(DynamicsError::NotConverged {
                     what: "free-body integration to the tolerance (the estimate stopped decreasing)",
