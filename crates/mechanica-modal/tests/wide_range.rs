@@ -257,3 +257,135 @@ fn tridiagonal_eigenvalue(masses: &[f64], i: usize) -> f64 {
     }
     0.5 * (lo + hi)
 }
+
+/// A pencil (A = I) whose B spans 345 decades: a coupling of 1e308 and a block of entries near
+/// 2e-37. The exact scaling that brings it into range puts its soft modes (ω² ≈ 4e-37) next to
+/// the bottom of the normal numbers, where their residuals are subnormal: squaring them gave
+/// zero, and bounds of 2e-52 on values 1e-39 off. Exact ω² by mpmath at 400 digits on the
+/// stored doubles; the permuted copy (found by the fuzz target `abi_modal`) must hold them too.
+#[test]
+fn soft_modes_of_a_pencil_spanning_the_whole_range_keep_true_bounds() {
+    let tiny = 2.08310546875e-37;
+    let mut b = Mat::<f64>::zeros(7, 7);
+    for (i, j, v) in [
+        (0, 0, -9.765625000000001e-32),
+        (0, 1, -9.765625e-12),
+        (0, 2, -3.12333984375e-22),
+        (0, 3, 1e308),
+        (2, 4, tiny),
+        (2, 5, tiny),
+        (2, 6, tiny),
+        (3, 3, tiny),
+        (3, 4, tiny),
+        (3, 5, tiny),
+        (3, 6, tiny),
+        (4, 4, tiny),
+    ] {
+        b[(i, j)] = v;
+        b[(j, i)] = v;
+    }
+    let exact = vec![
+        (-1e308, -4.882802084472657e-32),
+        (-3.3705354505882815e-37, -1.9259089240799186e-53),
+        (0.0, 0.0),
+        (0.0, 0.0),
+        (1.2874299818382818e-37, -1.6218850567960923e-54),
+        (4.1662109375e-37, 7.670458539527698e-94),
+        (1e308, -4.882802084472657e-32),
+    ];
+    let order = [1, 2, 3, 4, 5, 6, 0];
+    let permuted = Mat::from_fn(7, 7, |i, j| b[(order[i], order[j])]);
+    for b in [b, permuted] {
+        let case = Case {
+            a: Mat::identity(7, 7),
+            b,
+            exact: exact.clone(),
+        };
+        for usage in [
+            Use::All(Refinement::Auto),
+            Use::All(Refinement::Always),
+            Use::All(Refinement::Off),
+            Use::ValuesOnly,
+            Use::Lowest(3),
+            Use::Sparse(3),
+        ] {
+            match modes_of(&case, usage) {
+                Ok(modes) => {
+                    let failed = failures(&case, &modes);
+                    assert!(failed.is_empty(), "{usage:?}: {failed:?}");
+                }
+                Err(ModalError::OutOfRange { .. }) => {}
+                Err(other) => panic!("{usage:?}: {other}"),
+            }
+        }
+    }
+}
+
+/// Diagonal A and a B with a coupling of 3e236 between two coordinates beside entries from
+/// 1e-39 to 3e24 (found by the fuzz target `abi_modal`): one ordering reported ω² = 151.97 with
+/// a bound of 3e-14 where the exact value is 6.8e-9. Exact ω² by mpmath at 600 digits.
+#[test]
+fn modes_beside_a_coupling_of_1e236_keep_true_bounds_in_every_ordering() {
+    let a = [
+        0.5843137254901961,
+        0.1897764553292134,
+        0.40737010757610437,
+        0.6213931486991684,
+        0.35625238422217137,
+        0.00729381246662089,
+    ];
+    let small = 2.7858398437500002e-9;
+    let mut b = Mat::<f64>::from_fn(6, 6, |_, _| small);
+    for (i, j, v) in [
+        (0, 0, -2.2679687500000003e-16),
+        (0, 1, 3.204898491568124e236),
+        (0, 2, 2.77666015625e-9),
+        (2, 3, 1829785156250000.0),
+        (2, 4, 1.0513671874999999e-39),
+        (2, 5, 0.0),
+        (3, 4, -2.88916015625e24),
+        (3, 5, 0.5),
+        (4, 4, 0.5),
+        (5, 5, 278583984375.0),
+    ] {
+        b[(i, j)] = v;
+        b[(j, i)] = v;
+    }
+    let exact = vec![
+        (-9.624320331581576e236, -1.3129867357547846e220),
+        (-6.140581458690555e24, 85048399.36682881),
+        (6.838596627834567e-9, 3.1174581542345484e-25),
+        (38194563631831.85, -0.0006637444398503094),
+        (6.140581458690555e24, -85048397.96332943),
+        (9.624320331581576e236, 1.3129867357547846e220),
+    ];
+    for order in [
+        [0, 1, 2, 3, 4, 5],
+        [1, 5, 4, 0, 3, 2],
+        [5, 4, 3, 2, 1, 0],
+        [2, 0, 4, 1, 5, 3],
+    ] {
+        let case = Case {
+            a: Mat::from_fn(6, 6, |i, j| if i == j { a[order[i]] } else { 0.0 }),
+            b: Mat::from_fn(6, 6, |i, j| b[(order[i], order[j])]),
+            exact: exact.clone(),
+        };
+        for usage in [
+            Use::All(Refinement::Auto),
+            Use::All(Refinement::Always),
+            Use::All(Refinement::Off),
+            Use::ValuesOnly,
+            Use::Lowest(3),
+            Use::Sparse(3),
+        ] {
+            match modes_of(&case, usage) {
+                Ok(modes) => {
+                    let failed = failures(&case, &modes);
+                    assert!(failed.is_empty(), "order {order:?} {usage:?}: {failed:?}");
+                }
+                Err(ModalError::OutOfRange { .. }) => {}
+                Err(other) => panic!("order {order:?} {usage:?}: {other}"),
+            }
+        }
+    }
+}

@@ -3,7 +3,7 @@
 
 use crate::certify::a_priori::APrioriModel;
 use crate::certify::report::{AccuracyReport, BoundKind};
-use crate::linalg::norms::vector_norm;
+use crate::linalg::norms::{euclidean_norm, square_over, vector_norm};
 use crate::spectrum::clusters;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, MatRef, Par};
@@ -183,7 +183,11 @@ impl SplitResiduals {
             unselected,
         } = *spectrum;
         let m = omega_sq.len();
-        let eps = columns.iter().map(|(_, e)| e * e).sum::<f64>().sqrt();
+        // Norms and quadratic terms are formed without squaring small numbers: after the exact
+        // scaling of a pencil whose entries span most of the double range, residuals of its
+        // softest modes are subnormal, and their squares would vanish.
+        let norms: Vec<f64> = columns.iter().map(|&(_, e)| e).collect();
+        let eps = euclidean_norm(&norms);
         let distance = |w: f64| {
             group
                 .clone()
@@ -198,11 +202,8 @@ impl SplitResiduals {
             gap = gap.min(d);
             if let Some(basis_col) = self.column_of[j] {
                 if d > 0.0 {
-                    weighted += columns
-                        .iter()
-                        .map(|&(col, _)| self.c[(basis_col, col)].powi(2))
-                        .sum::<f64>()
-                        / d;
+                    let components: Vec<f64> = columns.iter().map(|&(col, _)| self.c[(basis_col, col)]).collect();
+                    weighted += square_over(euclidean_norm(&components), d);
                 } else {
                     usable = false;
                 }
@@ -214,11 +215,11 @@ impl SplitResiduals {
                 gap = gap.min(distance(w) - uncertainty);
             }
         }
-        let eps_rest = columns
+        let rest_norms: Vec<f64> = columns
             .iter()
-            .map(|&(col, _)| vector_norm(self.rest.col(col)).powi(2))
-            .sum::<f64>()
-            .sqrt();
+            .map(|&(col, _)| vector_norm(self.rest.col(col)))
+            .collect();
+        let eps_rest = euclidean_norm(&rest_norms);
         // The gap-weighted bounds hold for the eigenvalues of H = XᵀBX, not for its diagonal
         // (the members' values): Weyl's theorem puts them within ‖H − diag(ω²)‖_F of it.
         let Some(coupling) = self.in_block_coupling(group, columns) else {
@@ -227,9 +228,9 @@ impl SplitResiduals {
         let gap = gap - coupling;
         let mut bound = eps;
         if gap > eps {
-            bound = bound.min(coupling + eps * eps / gap);
+            bound = bound.min(coupling + square_over(eps, gap));
             if usable && gap > eps_rest {
-                bound = bound.min(coupling + weighted + eps_rest * eps_rest / gap);
+                bound = bound.min(coupling + weighted + square_over(eps_rest, gap));
             }
         }
         bound
@@ -243,16 +244,16 @@ impl SplitResiduals {
             .clone()
             .map(|g| self.column_of[g])
             .collect::<Option<Vec<usize>>>()?;
-        let mut sum = 0.0;
-        let mut residual_sq = 0.0;
+        let mut components = Vec::with_capacity(columns.len() * rows.len());
+        let mut rest_norms = Vec::with_capacity(columns.len());
         for &(col, _) in columns {
-            residual_sq += vector_norm(self.rest.col(col)).powi(2);
-            for &row in &rows {
-                sum += self.c[(row, col)].powi(2);
-            }
+            rest_norms.push(vector_norm(self.rest.col(col)));
+            components.extend(rows.iter().map(|&row| self.c[(row, col)]));
         }
-        let rounding = 8.0 * self.rest.nrows() as f64 * f64::EPSILON * (sum + residual_sq).sqrt();
-        Some(sum.sqrt() + rounding)
+        let sum = euclidean_norm(&components);
+        let rounding =
+            8.0 * self.rest.nrows() as f64 * f64::EPSILON * euclidean_norm(&[sum, euclidean_norm(&rest_norms)]);
+        Some(sum + rounding)
     }
 }
 

@@ -57,3 +57,64 @@ pub(crate) fn vector_norm(v: faer::ColRef<'_, f64>) -> f64 {
         scaled_norm(|| v.iter().copied())
     }
 }
+
+/// √Σ vᵢ² of a few values (norms of columns, residual norms) without over- or underflow of the
+/// squares: exact scaling by a power of two where the plain sum leaves the safe range.
+pub(crate) fn euclidean_norm(values: &[f64]) -> f64 {
+    let sum: f64 = values.iter().map(|v| v * v).sum();
+    if sum.is_finite() && sum > 1e-280 {
+        sum.sqrt()
+    } else {
+        scaled_norm(|| values.iter().copied())
+    }
+}
+
+/// a·(a/b) for a ≥ 0 and b > 0, the quadratic residual bound ε²/δ without the underflow of ε²
+/// (an ε below 1e-154 squares to zero): rounded up by one subnormal spacing, the most a
+/// product that lands among subnormal numbers can lose.
+pub(crate) fn square_over(a: f64, b: f64) -> f64 {
+    a * (a / b) + f64::from_bits(1)
+}
+
+/// √(Σ xᵢyᵢ) for a non-negative sum (as xᵀK⁻¹x with y = K⁻¹x), with x and y scaled by one power
+/// of two 2ᵉ near their largest entry first: neither the products nor the square root over- or
+/// underflow while the result is a normal number. A negative sum (rounding) gives 0.
+pub(crate) fn sqrt_of_dot(x: &[f64], y: &[f64]) -> f64 {
+    let plain: f64 = x.iter().zip(y).map(|(a, b)| a * b).sum();
+    if plain.is_finite() && plain > 1e-280 {
+        return plain.sqrt();
+    }
+    let largest = x.iter().chain(y).fold(0.0_f64, |m, v| m.max(v.abs()));
+    if largest == 0.0 || !largest.is_finite() {
+        return plain.max(0.0).sqrt();
+    }
+    let e = exponent(largest);
+    let sum: f64 = x
+        .iter()
+        .zip(y)
+        .map(|(a, b)| times_power_of_two(*a, -e) * times_power_of_two(*b, -e))
+        .sum();
+    times_power_of_two(sum.max(0.0).sqrt(), e)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// At 2^±600 the plain squares over- or underflow; the scaled forms are exact for these
+    /// powers of two (3-4-5 triangles).
+    #[test]
+    fn norms_dots_and_quadratic_bounds_keep_tiny_and_huge_values() {
+        for e in [-1000, -600, -300, 0, 300, 600] {
+            let s = times_power_of_two(1.0, e);
+            assert_eq!(euclidean_norm(&[3.0 * s, 4.0 * s]), 5.0 * s, "2^{e}");
+            assert_eq!(sqrt_of_dot(&[3.0 * s, 4.0 * s], &[3.0 * s, 4.0 * s]), 5.0 * s, "2^{e}");
+        }
+        // ε²/δ with ε = 2^-600, δ = 2^-500: 2^-700, where ε² alone would be 0.
+        let eps = times_power_of_two(1.0, -600);
+        let bound = square_over(eps, times_power_of_two(1.0, -500));
+        assert!(bound >= times_power_of_two(1.0, -700) && bound <= times_power_of_two(1.0, -699));
+        // A product below the normal range is rounded up, never down to zero.
+        assert!(square_over(times_power_of_two(1.0, -540), 1.0) > 0.0);
+    }
+}

@@ -3,6 +3,7 @@
 //! bounds made rigorous by the inertia count at τ.
 
 use crate::dd::{self, Dd};
+use crate::linalg::norms::{euclidean_norm, sqrt_of_dot, square_over};
 use crate::sparse::inertia::SparseInertiaCount;
 use crate::sparse::operator::{Mass, Operator, dot, product, solve_with};
 use crate::sparse::pencil::{SparsePencil, abs_quadratic};
@@ -145,7 +146,7 @@ fn residuals_of(
         );
         xkx[c] = xbx.minus(Dd::of(sigma).times(xax)).to_f64();
         let xn = dot(x, x).sqrt();
-        eta[c] = dot(&r, &r).sqrt() / ((norm_b + w.abs() * norm_a) * xn).max(f64::MIN_POSITIVE);
+        eta[c] = sqrt_of_dot(&r, &r) / ((norm_b + w.abs() * norm_a) * xn).max(f64::MIN_POSITIVE);
         let xax = xax.to_f64().max(f64::MIN_POSITIVE);
         // Rounding of the double-double quotient and its final rounding to double.
         let componentwise = (abs_quadratic(b, x) + w.abs() * abs_quadratic(a, x)) / xax;
@@ -159,7 +160,9 @@ fn residuals_of(
     for c in 0..cols {
         let sc = &residuals[n * c..n * (c + 1)];
         let kc = &solved[n * c..n * (c + 1)];
-        delta[c] = (dot(sc, kc).max(0.0) / xkx[c].max(f64::MIN_POSITIVE)).sqrt();
+        // Subnormal residuals of the softest modes of a pencil scaled to the edge of the range
+        // would square to zero: the square root is taken on scaled data.
+        delta[c] = sqrt_of_dot(sc, kc) / xkx[c].max(f64::MIN_POSITIVE).sqrt();
     }
     let residuals = PairResiduals {
         omega_sq,
@@ -262,16 +265,16 @@ fn omega_bounds(
         };
         // Quadratic residual bound for a Rayleigh–Ritz cluster (Mathias, SIMAX 19, 1998):
         // |Δθ| ≤ ‖R‖²/gap with ‖R‖² ≤ Σ δ_d² over the cluster.
-        let mut cluster_sq = 0.0;
+        let mut cluster = Vec::new();
         for d in 0..cols {
             if in_cluster(d) {
-                cluster_sq += delta[d] * delta[d];
+                cluster.push(delta[d]);
             } else {
                 g = g.min((theta[c] - theta[d]).abs() - delta[d]);
             }
         }
         let e = if g > 0.0 {
-            delta[c].min(cluster_sq / g)
+            delta[c].min(square_over(euclidean_norm(&cluster), g))
         } else {
             delta[c]
         };
