@@ -110,7 +110,7 @@ fn check_symmetry(j: &Matrix3<f64>, scale: f64) -> Result<(), MassError> {
 
 /// The principal axes of a symmetric tensor with entries of order one.
 fn scaled_principal_axes(j: &Matrix3<f64>, relative_tolerance: f64) -> PrincipalAxes {
-    let eig = j.symmetric_eigen();
+    let eig = crate::validity::symmetric_eigen(j);
     let mut order = [0usize, 1, 2];
     order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
     let l = Vector3::new(
