@@ -750,35 +750,54 @@ fn tree_quantities(input: &mut Input) {
         "tree quantities: bodies {bodies:?}, q {q:?}, q̇ {q_dot:?}, A {a:?}, T {}",
         energy.value
     );
-    // In units of 2^e ≈ max |A|: entries near f64::MAX overflow the plain sums of A q̇, and
-    // subnormal ones round to the absolute spacing 2⁻¹⁰⁷⁴ (which `slack` allows for).
-    let e = binary_exponent(a.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+    // In units of 2^e ≈ the largest term |a_ij q̇_i q̇_j|: entries near f64::MAX overflow the
+    // plain sums, and terms far below the largest (an entry of 1e301 on a coordinate at rest
+    // beside entries of 1e-2) must not be scaled away; subnormal results round to the absolute
+    // spacing 2⁻¹⁰⁷⁴, which `slack` allows for.
+    let e = (0..n * n)
+        .filter(|&k| a[k] != 0.0 && q_dot[k % n] != 0.0 && q_dot[k / n] != 0.0)
+        .map(|k| binary_exponent(a[k]) + binary_exponent(q_dot[k % n]) + binary_exponent(q_dot[k / n]))
+        .max()
+        .unwrap_or(0);
     let down = |x: f64| times_power_of_two(x, -e);
-    let a_scaled: Vec<f64> = a.iter().map(|&x| down(x)).collect();
-    let slack = down(16.0 * f64::from_bits(1));
-    let aq: Vec<f64> = (0..n)
-        .map(|i| (0..n).map(|j| a_scaled[i + n * j] * q_dot[j]).sum())
-        .collect();
-    let t: f64 = 0.5 * (0..n).map(|i| q_dot[i] * aq[i]).sum::<f64>();
-    let scale: f64 = (0..n)
-        .map(|i| {
-            (0..n)
-                .map(|j| (a_scaled[i + n * j] * q_dot[i] * q_dot[j]).abs())
-                .sum::<f64>()
+    let terms: Vec<f64> = (0..n * n)
+        .map(|k| {
+            let (qi, qj) = (q_dot[k % n], q_dot[k / n]);
+            // A term with a coordinate at rest is exactly zero, whatever its entry.
+            if qi == 0.0 || qj == 0.0 {
+                0.0
+            } else {
+                down(a[k]) * qi * qj
+            }
         })
-        .sum::<f64>();
+        .collect();
+    let slack = down(16.0 * f64::from_bits(1));
+    let t = 0.5 * terms.iter().sum::<f64>();
+    let scale: f64 = terms.iter().map(|x| x.abs()).sum();
     assert!(
         (down(energy.value) - t).abs() <= 1e-12 * scale + slack,
-        "T = {} but ½ q̇ᵀAq̇ = {t}·2^{e}",
+        "T = {:e} but ½ q̇ᵀAq̇ = {t:e}·2^{e}",
         energy.value
     );
+    // Each momentum in units of its own largest term |a_ij q̇_j|, as T above.
     for i in 0..n {
-        let row_scale: f64 = (0..n).map(|j| (a_scaled[i + n * j] * q_dot[j]).abs()).sum();
+        let moving = |j: &usize| q_dot[*j] != 0.0 && a[i + n * j] != 0.0;
+        let row_exponent = (0..n)
+            .filter(moving)
+            .map(|j| binary_exponent(a[i + n * j]) + binary_exponent(q_dot[j]))
+            .max()
+            .unwrap_or(0);
+        let row_terms: Vec<f64> = (0..n)
+            .filter(moving)
+            .map(|j| times_power_of_two(a[i + n * j], -row_exponent) * q_dot[j])
+            .collect();
+        let want: f64 = row_terms.iter().sum();
+        let row_scale: f64 = row_terms.iter().map(|x| x.abs()).sum();
+        let row_slack = times_power_of_two(16.0 * f64::from_bits(1), -row_exponent);
         assert!(
-            (down(momenta[i]) - aq[i]).abs() <= 1e-12 * row_scale + slack,
-            "momentum {i}: {} ≠ (A q̇) = {}·2^{e}",
-            momenta[i],
-            aq[i]
+            (times_power_of_two(momenta[i], -row_exponent) - want).abs() <= 1e-12 * row_scale + row_slack,
+            "momentum {i}: {:e} ≠ (A q̇) = {want:e}·2^{row_exponent}",
+            momenta[i]
         );
     }
     assert!(
