@@ -258,6 +258,28 @@ fn tridiagonal_eigenvalue(masses: &[f64], i: usize) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// Every refinement policy, values only, the lowest three and the sparse solver on `case`: each
+/// mode holds its exact ω² within its bound, or the pencil is refused as out of range.
+fn every_use_holds(case: &Case, label: &str) {
+    for usage in [
+        Use::All(Refinement::Auto),
+        Use::All(Refinement::Always),
+        Use::All(Refinement::Off),
+        Use::ValuesOnly,
+        Use::Lowest(3),
+        Use::Sparse(3),
+    ] {
+        match modes_of(case, usage) {
+            Ok(modes) => {
+                let failed = failures(case, &modes);
+                assert!(failed.is_empty(), "{label} {usage:?}: {failed:?}");
+            }
+            Err(ModalError::OutOfRange { .. }) => {}
+            Err(other) => panic!("{label} {usage:?}: {other}"),
+        }
+    }
+}
+
 /// A pencil (A = I) whose B spans 345 decades: a coupling of 1e308 and a block of entries near
 /// 2e-37. The exact scaling that brings it into range puts its soft modes (ω² ≈ 4e-37) next to
 /// the bottom of the normal numbers, where their residuals are subnormal: squaring them gave
@@ -301,23 +323,7 @@ fn soft_modes_of_a_pencil_spanning_the_whole_range_keep_true_bounds() {
             b,
             exact: exact.clone(),
         };
-        for usage in [
-            Use::All(Refinement::Auto),
-            Use::All(Refinement::Always),
-            Use::All(Refinement::Off),
-            Use::ValuesOnly,
-            Use::Lowest(3),
-            Use::Sparse(3),
-        ] {
-            match modes_of(&case, usage) {
-                Ok(modes) => {
-                    let failed = failures(&case, &modes);
-                    assert!(failed.is_empty(), "{usage:?}: {failed:?}");
-                }
-                Err(ModalError::OutOfRange { .. }) => {}
-                Err(other) => panic!("{usage:?}: {other}"),
-            }
-        }
+        every_use_holds(&case, "");
     }
 }
 
@@ -370,22 +376,6 @@ fn modes_beside_a_coupling_of_1e236_keep_true_bounds_in_every_ordering() {
             b: Mat::from_fn(6, 6, |i, j| b[(order[i], order[j])]),
             exact: exact.clone(),
         };
-        for usage in [
-            Use::All(Refinement::Auto),
-            Use::All(Refinement::Always),
-            Use::All(Refinement::Off),
-            Use::ValuesOnly,
-            Use::Lowest(3),
-            Use::Sparse(3),
-        ] {
-            match modes_of(&case, usage) {
-                Ok(modes) => {
-                    let failed = failures(&case, &modes);
-                    assert!(failed.is_empty(), "order {order:?} {usage:?}: {failed:?}");
-                }
-                Err(ModalError::OutOfRange { .. }) => {}
-                Err(other) => panic!("order {order:?} {usage:?}: {other}"),
-            }
-        }
+        every_use_holds(&case, &format!("order {order:?}"));
     }
 }
