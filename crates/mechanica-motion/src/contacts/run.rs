@@ -8,6 +8,11 @@ use crate::error::StepFailure;
 use crate::integrator::{Integrator, Point};
 use std::sync::Arc;
 
+/// Impacts per contact allowed at one instant (the time not advancing between them) before
+/// [`ContactRun::advance_to`] reports sustained contact: a simultaneous impact of several
+/// contacts is resolved as one, so a few per contact already mean they repeat.
+pub(crate) const STALLED_IMPACTS_PER_CONTACT: usize = 4;
+
 /// The contact state that goes with one integrator.
 #[derive(Debug, Clone)]
 pub(crate) struct ContactRun {
@@ -51,7 +56,12 @@ impl ContactRun {
     /// Integrates `run` to `target` (no step passes it), resolving the impacts on the way,
     /// and gives the state at `target` in the current charts. A failure leaves `run` at the
     /// start of the step that failed.
+    ///
+    /// Impacts that follow one another at one instant without the time advancing (the
+    /// velocities an impact leaves still close a contact at once) end the run, after
+    /// [`STALLED_IMPACTS_PER_CONTACT`] per contact, as the sustained contact they amount to.
     pub(crate) fn advance_to(&mut self, run: &mut Integrator, target: f64) -> Result<Point, StepFailure> {
+        let mut stalled = 0;
         while run.time() < target {
             let saved = run.clone();
             run.step_toward(target, target)
@@ -59,6 +69,10 @@ impl ContactRun {
             if let Err(failure) = self.after_step(&saved, run) {
                 *run = saved;
                 return Err(self.accumulation(failure));
+            }
+            stalled = if run.time() > saved.time() { 0 } else { stalled + 1 };
+            if stalled > STALLED_IMPACTS_PER_CONTACT * self.contacts.len().max(1) {
+                return Err(self.accumulation(StepFailure::StepSizeUnderflow { step: 0.0 }));
             }
         }
         run.state_at(target)
