@@ -18,6 +18,7 @@
 //! overflows f64 is [`MassError::NonFiniteResult`].
 
 use crate::error::check_result;
+use crate::validity::symmetric_part;
 use crate::{MassError, MassProperties};
 use mechanica_kinematics::tree::{BaseState, KinematicTree, Workspace};
 use nalgebra::{Matrix3, Vector3};
@@ -213,18 +214,24 @@ impl TreeMass {
         })
     }
 
+    /// Body `i`'s mass properties in world components at the pose in `ws`: centre R p_BC + o,
+    /// central tensor R J Rᵀ (symmetrized).
+    fn body_in_world(&self, ws: &Workspace, i: usize) -> Result<MassProperties, MassError> {
+        let body = &self.bodies[i];
+        let rotation = ws.rotation(i)?;
+        let rotation = rotation.matrix();
+        Ok(MassProperties {
+            mass: body.mass,
+            p_oc: rotation * body.p_oc + ws.position(i)?,
+            inertia_c: symmetric_part(&(rotation * body.inertia_c * rotation.transpose())),
+        })
+    }
+
     /// Fills the composites (subtree mass properties in world components) from the poses of
     /// the last `update_positions` in `ws`.
     fn update_composites(&mut self, tree: &KinematicTree, ws: &Workspace) -> Result<(), MassError> {
-        for (i, body) in self.bodies.iter().enumerate() {
-            let r = ws.rotation(i)?;
-            let r = r.matrix();
-            let j: Matrix3<f64> = r * body.inertia_c * r.transpose();
-            self.composite[i] = MassProperties {
-                mass: body.mass,
-                p_oc: r * body.p_oc + ws.position(i)?,
-                inertia_c: j * 0.5 + j.transpose() * 0.5,
-            };
+        for i in 0..self.bodies.len() {
+            self.composite[i] = self.body_in_world(ws, i)?;
         }
         for &i in tree.topological_order().iter().rev() {
             if let Some(p) = tree.parent(i) {
@@ -242,13 +249,9 @@ impl TreeMass {
         ws: &Workspace,
         r: &Vector3<f64>,
     ) -> Result<(), MassError> {
-        for (i, body) in self.bodies.iter().enumerate() {
-            let rotation = ws.rotation(i)?;
-            let rotation = rotation.matrix();
-            let j: Matrix3<f64> = rotation * body.inertia_c * rotation.transpose();
-            let centre = rotation * body.p_oc + ws.position(i)?;
-            let j = j * 0.5 + j.transpose() * 0.5;
-            self.subtree_moments[i] = MomentsAbout::of_body(body.mass, &centre, &j, r);
+        for i in 0..self.bodies.len() {
+            let body = self.body_in_world(ws, i)?;
+            self.subtree_moments[i] = MomentsAbout::of_body(body.mass, &body.p_oc, &body.inertia_c, r);
         }
         for &i in tree.topological_order().iter().rev() {
             if let Some(p) = tree.parent(i) {

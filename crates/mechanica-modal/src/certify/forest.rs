@@ -3,7 +3,8 @@
 //! own rounding, |Δb_ij| ≤ u|b_ij|: for the case double precision cannot decide, B's smallest
 //! eigenvalue below the rounding 4n·u·max b_kk of a Cholesky factorization
 //! ([`super::inertia::stiffness_is_definite`]), as in a chain whose springs span twelve
-//! decades. docs/theory.md, "Positive definite stiffness of a spring forest".
+//! decades. docs/theory.md, §6 "Numerical eigenproblem and certified accuracy", item 5
+//! (Classification), gives the argument.
 //!
 //! Any symmetric ΔB obeys ΔB ⪰ −diag(Σ_j |Δb_ij|) (the difference is diagonally dominant with
 //! a non-negative diagonal), so B + ΔB ⪰ B − D with D = diag(u Σ_j |b_ij|), and it suffices to

@@ -146,7 +146,7 @@ fn residuals_of(
         );
         xkx[c] = xbx.minus(Dd::of(sigma).times(xax)).to_f64();
         let xn = dot(x, x).sqrt();
-        eta[c] = sqrt_of_dot(&r, &r) / ((norm_b + w.abs() * norm_a) * xn).max(f64::MIN_POSITIVE);
+        eta[c] = euclidean_norm(&r) / ((norm_b + w.abs() * norm_a) * xn).max(f64::MIN_POSITIVE);
         let xax = xax.to_f64().max(f64::MIN_POSITIVE);
         // Rounding of the double-double quotient and its final rounding to double.
         let componentwise = (abs_quadratic(b, x) + w.abs() * abs_quadratic(a, x)) / xax;
