@@ -83,13 +83,15 @@ fn checked_symmetric(what: &'static str, m: MatRef<'_, f64>, n: usize) -> Result
             }
         }
     }
-    // The mean of two entries near the largest double must not overflow: halve first (exact for
-    // normal numbers; an entry and its mirror are equal or within SYMMETRY_ULPS, so this is the
-    // midpoint to the last bit except among subnormals).
-    Ok(Mat::from_fn(n, n, |i, j| {
-        let (x, y) = (m[(i, j)], m[(j, i)]);
-        if x == y { x } else { 0.5 * x + 0.5 * y }
-    }))
+    Ok(Mat::from_fn(n, n, |i, j| symmetric_mean(m[(i, j)], m[(j, i)])))
+}
+
+/// The entry of ½(M + Mᵀ) from an entry x and its mirror y. Equal entries are kept as they are
+/// (halving each would round among subnormal numbers). Otherwise each is halved first, so that
+/// entries near the largest double do not overflow: exact for normal numbers, and since an entry
+/// and its mirror are within SYMMETRY_ULPS, the midpoint to the last bit except among subnormals.
+pub(crate) fn symmetric_mean(x: f64, y: f64) -> f64 {
+    if x == y { x } else { 0.5 * x + 0.5 * y }
 }
 
 #[cfg(test)]

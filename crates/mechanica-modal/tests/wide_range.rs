@@ -379,3 +379,171 @@ fn modes_beside_a_coupling_of_1e236_keep_true_bounds_in_every_ordering() {
         every_use_holds(&case, &format!("order {order:?}"));
     }
 }
+
+/// Every ordering of the coordinates of `case`: each must hold every exact ω².
+fn every_ordering_holds(case: &Case) {
+    let n = case.a.nrows();
+    let mut order: Vec<usize> = (0..n).collect();
+    let mut orderings = 0;
+    loop {
+        let permuted = Case {
+            a: Mat::from_fn(n, n, |i, j| case.a[(order[i], order[j])]),
+            b: Mat::from_fn(n, n, |i, j| case.b[(order[i], order[j])]),
+            exact: case.exact.clone(),
+        };
+        every_use_holds(&permuted, &format!("order {order:?}"));
+        orderings += 1;
+        if !next_permutation(&mut order) {
+            break;
+        }
+    }
+    assert_eq!(orderings, (1..=n).product::<usize>());
+}
+
+/// The next permutation in lexicographic order; false after the last.
+fn next_permutation(p: &mut [usize]) -> bool {
+    let Some(i) = (1..p.len()).rev().find(|&i| p[i - 1] < p[i]) else {
+        return false;
+    };
+    let j = (i..p.len())
+        .rev()
+        .find(|&j| p[j] > p[i - 1])
+        .expect("a larger entry after i − 1");
+    p.swap(i - 1, j);
+    p[i..].reverse();
+    true
+}
+
+fn symmetric(n: usize, entries: &[(usize, usize, f64)]) -> Mat<f64> {
+    let mut m = Mat::<f64>::zeros(n, n);
+    for &(i, j, v) in entries {
+        m[(i, j)] = v;
+        m[(j, i)] = v;
+    }
+    m
+}
+
+/// A dense A and a B with entries from 1e-137 to 1e22 (found by the fuzz target `abi_modal`):
+/// the reduction cannot separate ω² ≈ −4.4e-32 from 3.18 (its bounds are 1.8e7), and in one
+/// ordering the polishing of the refined soft mode converged to the eigenpair of 3.18, reported
+/// twice. A refined or polished value must stay within the bound it started from. Exact ω² by
+/// `tools/modal_found_pencils_reference.py`; all 24 orderings.
+#[test]
+fn a_refined_mode_never_takes_the_eigenpair_of_its_neighbour() {
+    let a = [
+        [
+            1.5371442801070985,
+            -0.3408479252830148,
+            -0.6911467285826802,
+            0.7035937365144491,
+        ],
+        [
+            -0.3408479252830148,
+            1.2798205931422886,
+            0.5351544953882694,
+            -0.34600993152707815,
+        ],
+        [
+            -0.6911467285826802,
+            0.5351544953882694,
+            2.2062756345359262,
+            -0.7405649181455374,
+        ],
+        [
+            0.7035937365144491,
+            -0.34600993152707815,
+            -0.7405649181455374,
+            2.0814717394051727,
+        ],
+    ];
+    let b = symmetric(
+        4,
+        &[
+            (0, 0, -9.765625e21),
+            (0, 1, 188916015625.0),
+            (0, 2, -1.40556640625e-32),
+            (0, 3, 2.9072265625000003e-28),
+            (1, 1, 7.926859425671704e-137),
+            (1, 2, -9.765625000000001e-32),
+            (1, 3, -9.765625000000001e-32),
+            (2, 2, -9.765625000000001e-32),
+            (2, 3, 1.22275390625e-12),
+            (3, 3, -3.759765625e20),
+        ],
+    );
+    every_ordering_holds(&Case {
+        a: Mat::from_fn(4, 4, |i, j| a[i][j]),
+        b,
+        exact: vec![
+            (-8.265690672732003e21, 367881.1268458769),
+            (-2.0735819330377584e20, -3201.079013832632),
+            (-4.426294179717817e-32, 1.5981230094689223e-48),
+            (3.177858761323168, 1.4077939887984742e-16),
+        ],
+    });
+}
+
+/// A B whose only entries are a subnormal coupling 1.09e-321 (found by the fuzz target
+/// `abi_modal`): the sparse pencil halved the entry and its mirror before adding them, which
+/// rounds among subnormals (1.09e-321 is an odd multiple of the smallest double), and solved a
+/// pencil 0.45 % away with a bound of two units of the last place. Exact ω² by
+/// `tools/modal_found_pencils_reference.py` (the five middle ones are below the smallest double).
+#[test]
+fn a_subnormal_coupling_is_the_same_pencil_to_the_sparse_solver() {
+    let diagonal = [
+        0.0010610388815402985,
+        0.004910071216523647,
+        0.0010000065192580223,
+        0.0010000065192580223,
+        0.0010000065192580223,
+        0.0010000065192580223,
+        0.0025258844941854477,
+    ];
+    let off = [
+        (0, 1, 2.1494925022125244e-6),
+        (0, 2, 2.421438694000244e-7),
+        (0, 3, 2.421438694000244e-7),
+        (0, 4, 2.421438694000244e-7),
+        (0, 5, 2.421438694000244e-7),
+        (0, 6, -9.527429938316345e-7),
+        (1, 2, 1.9138678908348083e-6),
+        (1, 3, 1.9138678908348083e-6),
+        (1, 4, 1.9138678908348083e-6),
+        (1, 5, 1.9138678908348083e-6),
+        (1, 6, -3.0957162380218506e-6),
+        (2, 3, 6.51925802230835e-9),
+        (2, 4, 6.51925802230835e-9),
+        (2, 5, 6.51925802230835e-9),
+        (2, 6, -1.1883676052093506e-6),
+        (3, 4, 6.51925802230835e-9),
+        (3, 5, 6.51925802230835e-9),
+        (3, 6, -1.1883676052093506e-6),
+        (4, 5, 6.51925802230835e-9),
+        (4, 6, -1.1883676052093506e-6),
+        (5, 6, -1.1883676052093506e-6),
+    ];
+    let mut a = symmetric(7, &off);
+    for (i, d) in diagonal.iter().enumerate() {
+        a[(i, i)] = *d;
+    }
+    let case = Case {
+        a,
+        b: symmetric(7, &[(0, 4, 1.09e-321)]),
+        exact: vec![
+            (-1.06026e-318, 0.0),
+            (-0.0, -0.0),
+            (-0.0, -0.0),
+            (0.0, 0.0),
+            (0.0, 0.0),
+            (0.0, 0.0),
+            (1.05976e-318, 0.0),
+        ],
+    };
+    every_use_holds(&case, "");
+    let pencil = SparsePencil::from_triplets(7, &triplets(&case.a), &triplets(&case.b)).expect("a valid pencil");
+    assert_eq!(
+        pencil.b().val(),
+        &[1.09e-321, 1.09e-321],
+        "the stored coupling, to the last bit"
+    );
+}

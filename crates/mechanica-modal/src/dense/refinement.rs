@@ -71,7 +71,16 @@ impl Stage<'_> {
             stiffness,
             shifts,
         };
-        let refined = self.refine_jobs(&operands, &jobs, x.as_ref(), omega);
+        let mut refined = self.refine_jobs(&operands, &jobs, x.as_ref(), omega);
+        let n = self.a.nrows();
+        for (g, cluster) in jobs.iter().zip(refined.iter_mut()) {
+            if cluster
+                .as_ref()
+                .is_some_and(|c| !stays_in_its_interval(c, g, omega, |i| report.bound_with_rounding(i, n)))
+            {
+                *cluster = None;
+            }
+        }
         let (mut residuals, changed) = apply_refined(&jobs, refined, x, report, omega);
         products.update_columns(self.a, self.b, x.as_ref(), &changed, self.par);
         for &i in &changed {
@@ -227,7 +236,9 @@ impl Stage<'_> {
         let mut improved: Vec<usize> = Vec::new();
         for (&k, pair) in weak.iter().zip(polished) {
             let i = residuals[k].mode;
-            let Some(p) = pair.filter(|p| Some(p.residual_a_inv) < report.residual_norms_a_inv[i]) else {
+            let within_bound = |p: &RefinedPair| (p.omega_sq - omega[i]).abs() <= report.error_bounds[i];
+            let lower_residual = |p: &RefinedPair| Some(p.residual_a_inv) < report.residual_norms_a_inv[i];
+            let Some(p) = pair.filter(|p| within_bound(p) && lower_residual(p)) else {
                 continue;
             };
             x.col_as_slice_mut(i).copy_from_slice(&p.x);
@@ -278,6 +289,21 @@ impl Stage<'_> {
             report.error_bounds[i] += r;
         }
     }
+}
+
+/// Whether every refined value of cluster `g` lies in the union of the cluster's intervals
+/// ω²_i ± bound(i) before refinement. Those bounds hold, so a value outside them belongs to an
+/// eigenpair of another mode: the iteration has left the cluster (a start vector mixing modes
+/// that the reduction could not separate) and its result is not taken.
+fn stays_in_its_interval(
+    cluster: &RefinedCluster,
+    g: &Range<usize>,
+    omega: &[f64],
+    bound: impl Fn(usize) -> f64,
+) -> bool {
+    let lowest = g.clone().map(|i| omega[i] - bound(i)).fold(f64::INFINITY, f64::min);
+    let highest = g.clone().map(|i| omega[i] + bound(i)).fold(f64::NEG_INFINITY, f64::max);
+    cluster.pairs.iter().all(|p| (lowest..=highest).contains(&p.omega_sq))
 }
 
 /// Writes the refined clusters into `x`, `omega` and the report's residual norms and steps;

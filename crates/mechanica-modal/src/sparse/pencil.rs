@@ -5,7 +5,7 @@
 
 use crate::ModalError;
 use crate::linalg::norms::vector_norm;
-use crate::problem::SYMMETRY_ULPS;
+use crate::problem::{SYMMETRY_ULPS, symmetric_mean};
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 
 /// A sparse symmetric pencil: mass matrix A (positive semidefinite; not checked here) and
@@ -86,6 +86,11 @@ impl Csc {
 
     /// α·X + β·Y on the union pattern (both sorted).
     pub fn combine(alpha: f64, x: &Csc, beta: f64, y: &Csc) -> Csc {
+        Self::merge(x, y, |u, v| alpha * u + beta * v)
+    }
+
+    /// f(x_ij, y_ij) on the union pattern (both sorted), an entry missing from one taken as 0.
+    fn merge(x: &Csc, y: &Csc, f: impl Fn(f64, f64) -> f64) -> Csc {
         let n = x.n;
         let mut out = Csc {
             n,
@@ -101,16 +106,16 @@ impl Csc {
                 let rp = if p < pe { x.row_idx[p] } else { usize::MAX };
                 let rq = if q < qe { y.row_idx[q] } else { usize::MAX };
                 let (r, v) = if rp == rq {
-                    let v = alpha * x.val[p] + beta * y.val[q];
+                    let v = f(x.val[p], y.val[q]);
                     p += 1;
                     q += 1;
                     (rp, v)
                 } else if rp < rq {
                     p += 1;
-                    (rp, alpha * x.val[p - 1])
+                    (rp, f(x.val[p - 1], 0.0))
                 } else {
                     q += 1;
-                    (rq, beta * y.val[q - 1])
+                    (rq, f(0.0, y.val[q - 1]))
                 };
                 out.row_idx.push(r);
                 out.val.push(v);
@@ -170,7 +175,8 @@ fn check_entries(
     Ok(max_abs)
 }
 
-/// Checks symmetry of a canonical matrix within SYMMETRY_ULPS·u·max|entry| and returns ½(M + Mᵀ).
+/// Checks symmetry of a canonical matrix within SYMMETRY_ULPS·u·max|entry| and returns ½(M + Mᵀ)
+/// (each entry by [`symmetric_mean`], as the dense [`crate::PencilProblem`] takes it).
 fn symmetrised(what: &'static str, m: Csc, max_abs: f64) -> Result<Csc, ModalError> {
     let t = m.transpose();
     let tolerance = SYMMETRY_ULPS * f64::EPSILON * max_abs;
@@ -189,7 +195,7 @@ fn symmetrised(what: &'static str, m: Csc, max_abs: f64) -> Result<Csc, ModalErr
             }
         }
     }
-    Ok(Csc::combine(0.5, &m, 0.5, &t))
+    Ok(Csc::merge(&m, &t, symmetric_mean))
 }
 
 impl SparsePencil {

@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""Exact ω² of small pencils kept as regression tests in crates/mechanica-modal/tests/wide_range.rs.
+
+Each pencil is given by its stored doubles (A dense, B as its nonzero entries of the upper
+triangle); its ω² (the eigenvalues of B x = ω² A x) are computed by mpmath at 400 digits through
+the Cholesky factor of A and printed as (hi, lo) double pairs, ascending, hi + lo equal to ω² to
+about 32 digits. Output: tools/modal_found_pencils_reference.out.
+
+Run: python3 tools/modal_found_pencils_reference.py > tools/modal_found_pencils_reference.out
+"""
+
+import mpmath as mp
+
+mp.mp.dps = 400
+
+PENCILS = {
+    # A refined mode converged to its neighbour's eigenpair in one ordering (coordinates 2, 0, 1, 3).
+    "entries from 1e-137 to 1e22": (
+        [
+            [1.5371442801070985, -0.3408479252830148, -0.6911467285826802, 0.7035937365144491],
+            [-0.3408479252830148, 1.2798205931422886, 0.5351544953882694, -0.34600993152707815],
+            [-0.6911467285826802, 0.5351544953882694, 2.2062756345359262, -0.7405649181455374],
+            [0.7035937365144491, -0.34600993152707815, -0.7405649181455374, 2.0814717394051727],
+        ],
+        [
+            (0, 0, -9.765625e21),
+            (0, 1, 188916015625.0),
+            (0, 2, -1.40556640625e-32),
+            (0, 3, 2.9072265625000003e-28),
+            (1, 1, 7.926859425671704e-137),
+            (1, 2, -9.765625000000001e-32),
+            (1, 3, -9.765625000000001e-32),
+            (2, 2, -9.765625000000001e-32),
+            (2, 3, 1.22275390625e-12),
+            (3, 3, -3.759765625e20),
+        ],
+    ),
+    # One subnormal coupling; halving it in the sparse symmetrisation changed the pencil.
+    "a subnormal coupling": (
+        "diagonal-dominant 7x7",
+        [(0, 4, 1.09e-321)],
+    ),
+}
+
+SUBNORMAL_A_DIAGONAL = [0.0010610388815402985, 0.004910071216523647, 0.0010000065192580223,
+                        0.0010000065192580223, 0.0010000065192580223, 0.0010000065192580223,
+                        0.0025258844941854477]
+SUBNORMAL_A_ROWS = {
+    0: [2.1494925022125244e-6, 2.421438694000244e-7, 2.421438694000244e-7, 2.421438694000244e-7,
+        2.421438694000244e-7, -9.527429938316345e-7],
+    1: [1.9138678908348083e-6, 1.9138678908348083e-6, 1.9138678908348083e-6, 1.9138678908348083e-6,
+        -3.0957162380218506e-6],
+    2: [6.51925802230835e-9, 6.51925802230835e-9, 6.51925802230835e-9, -1.1883676052093506e-6],
+    3: [6.51925802230835e-9, 6.51925802230835e-9, -1.1883676052093506e-6],
+    4: [6.51925802230835e-9, -1.1883676052093506e-6],
+    5: [-1.1883676052093506e-6],
+}
+
+
+def subnormal_mass():
+    n = 7
+    a = [[0.0] * n for _ in range(n)]
+    for i in range(n):
+        a[i][i] = SUBNORMAL_A_DIAGONAL[i]
+        for k, v in enumerate(SUBNORMAL_A_ROWS.get(i, [])):
+            a[i][i + 1 + k] = v
+            a[i + 1 + k][i] = v
+    return a
+
+
+def spectrum(a, entries):
+    n = len(a)
+    am = mp.matrix([[mp.mpf(x) for x in row] for row in a])
+    bm = mp.matrix(n, n)
+    for i, j, v in entries:
+        bm[i, j] = mp.mpf(v)
+        bm[j, i] = mp.mpf(v)
+    li = mp.inverse(mp.cholesky(am))
+    m = li * bm * li.T
+    m = (m + m.T) / 2
+    return sorted(mp.eigsy(m, eigvals_only=True))
+
+
+def main():
+    for name, (a, entries) in PENCILS.items():
+        if isinstance(a, str):
+            a = subnormal_mass()
+        print(f"# {name}")
+        for w in spectrum(a, entries):
+            hi = float(w)
+            lo = float(w - mp.mpf(hi))
+            print(f"({hi!r}, {lo!r}),")
+
+
+if __name__ == "__main__":
+    main()
