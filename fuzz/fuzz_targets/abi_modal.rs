@@ -205,8 +205,12 @@ fn check_modes(p: &Pencil, s: &Solved) {
         let lambda_unit = times_power_of_two(m.lambda, -e_l);
         let mass_term = |a_ij: f64| times_power_of_two(lambda_unit * times_power_of_two(a_ij, -e_a), e_l + e_a - e);
         // The solver decomposes the symmetric parts (entries symmetric within its tolerance are
-        // accepted): the residual is theirs.
-        let sym = |m: &[f64], i: usize, j: usize| 0.5 * m[i + n * j] + 0.5 * m[j + n * i];
+        // accepted): the residual is theirs. Equal entries are kept (halving a subnormal one
+        // rounds).
+        let sym = |m: &[f64], i: usize, j: usize| {
+            let (x, y) = (m[i + n * j], m[j + n * i]);
+            if x == y { x } else { 0.5 * x + 0.5 * y }
+        };
         let rows: Vec<f64> = (0..n)
             .map(|i| {
                 (0..n)

@@ -31,6 +31,7 @@
 //! which its rate bound √e expresses.
 
 use crate::dense::{ModalSolution, SolveOptions, solve};
+use crate::linalg::norms::euclidean_norm;
 use crate::spectrum::ModeKind;
 use crate::{ModalError, PencilProblem};
 use faer::Mat;
@@ -109,10 +110,6 @@ fn check_vector(what: &'static str, v: &[f64], n: usize) -> Result<(), ModalErro
         }),
         None => Ok(()),
     }
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// The bound on |√|w'| − √|w|| over |w' − w| ≤ e with w' of the same sign as w.
@@ -209,7 +206,7 @@ impl FreeResponse {
         let mut rebuilt = vec![0.0; n];
         let residual = |rebuilt: &[f64], v: &[f64]| {
             let r: Vec<f64> = v.iter().zip(rebuilt).map(|(a, b)| a - b).collect();
-            let (rn, vn) = (norm(&r), norm(v));
+            let (rn, vn) = (euclidean_norm(&r), euclidean_norm(v));
             (rn, if vn > 0.0 { rn / vn } else { 0.0 })
         };
         response.at(0.0, &mut rebuilt)?;
@@ -290,7 +287,7 @@ impl FreeResponse {
         let tau = t.abs();
         let mut bound = 0.0;
         for (c, coord) in self.coordinates.iter().enumerate() {
-            let shape_norm = norm(&(0..n).map(|i| self.shapes[(i, c)]).collect::<Vec<_>>());
+            let shape_norm = euclidean_norm(&(0..n).map(|i| self.shapes[(i, c)]).collect::<Vec<_>>());
             let (q, v, e) = (coord.q0.abs(), coord.q_dot0.abs(), coord.rate_error_bound);
             let sensitivity = match coord.law {
                 CoordinateLaw::Oscillatory { omega } => {
