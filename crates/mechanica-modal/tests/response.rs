@@ -421,8 +421,10 @@ fn scaled_norm(v: &[f64]) -> f64 {
     if largest == 0.0 {
         return 0.0;
     }
-    let s = 2f64.powi(-largest.log2().floor() as i32);
-    norm(&v.iter().map(|x| x * s).collect::<Vec<_>>()) / s
+    // 2^e in two factors: 2^e alone overflows for subnormal entries.
+    let e = -(largest.log2().floor() as i32);
+    let (s1, s2) = (2f64.powi(e / 2), 2f64.powi(e - e / 2));
+    norm(&v.iter().map(|x| x * s1 * s2).collect::<Vec<_>>()) / s1 / s2
 }
 
 proptest! {

@@ -147,7 +147,7 @@ fn solve_in_range(problem: &PencilProblem, options: &SolveOptions) -> Result<Mod
                     def.timings.factor += first_try.factor;
                     def.timings.eigen += first_try.eigen;
                 }
-                adopt_reversed_bottom(&mut def, &bottom, l.as_ref());
+                adopt_reversed_bottom(&mut def, &bottom, l.as_ref(), par);
             }
             let early = early_inputs.and_then(IdleTask::finished);
             let (norm_a, norm_b) = match &early {

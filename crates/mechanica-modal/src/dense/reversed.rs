@@ -18,8 +18,9 @@
 
 use crate::dense::definite::Definite;
 use crate::linalg::eigen::symmetric_eigen_returning_input;
-use crate::linalg::reduce::{Cholesky, back_transform, cholesky_owned, lower_entry, reduce};
-use faer::{Mat, MatRef, Par};
+use crate::linalg::reduce::{Cholesky, back_transform, cholesky_owned, is_diagonal, lower_entry, reduce};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatRef, Par};
 
 /// Factor by which the shift grows between Cholesky attempts of B + sA.
 const SHIFT_GROWTH: f64 = 1e3;
@@ -75,7 +76,7 @@ pub(crate) fn reversed_bottom(
         .collect();
     let mut vectors = Mat::from_fn(a.nrows(), taken.len(), |i, c| z[(i, taken[c])]);
     back_transform(r.as_ref(), vectors.as_mut(), par);
-    normalise_in_a(a, &mut vectors);
+    normalise_in_a(a, &mut vectors, par);
     omega_sq.iter().all(|w| w.is_finite()).then_some(ReversedBottom {
         omega_sq,
         estimates,
@@ -110,12 +111,22 @@ fn shifted_factor(a: MatRef<'_, f64>, b: MatRef<'_, f64>, attempts: usize, par: 
     None
 }
 
-/// Scales every column x to xᵀAx = 1.
-fn normalise_in_a(a: MatRef<'_, f64>, x: &mut Mat<f64>) {
-    for c in 0..x.ncols() {
-        let col = x.col(c);
-        let ax = a * col;
-        let norm_sq: f64 = col.iter().zip(ax.iter()).map(|(u, v)| u * v).sum();
+/// Scales every column x to xᵀAx = 1: for a lumped (diagonal) A from its diagonal, otherwise
+/// from AX formed as one matrix product (a product per column reads A from memory once per
+/// column).
+fn normalise_in_a(a: MatRef<'_, f64>, x: &mut Mat<f64>, par: Par) {
+    let norms_sq: Vec<f64> = if is_diagonal(a) {
+        (0..x.ncols())
+            .map(|c| x.col(c).iter().enumerate().map(|(i, v)| a[(i, i)] * v * v).sum())
+            .collect()
+    } else {
+        let mut ax = Mat::<f64>::zeros(a.nrows(), x.ncols());
+        matmul(ax.as_mut(), Accum::Replace, a, x.as_ref(), 1.0, par);
+        (0..x.ncols())
+            .map(|c| x.col(c).iter().zip(ax.col(c).iter()).map(|(u, v)| u * v).sum())
+            .collect()
+    };
+    for (c, norm_sq) in norms_sq.into_iter().enumerate() {
         if norm_sq > 0.0 && norm_sq.is_finite() {
             let s = norm_sq.sqrt().recip();
             x.col_mut(c).iter_mut().for_each(|v| *v *= s);
@@ -177,9 +188,10 @@ pub(crate) fn reversed_bottom_of(
 }
 
 /// Replaces the lowest modes of the reduction's spectrum `def` (values, selected shapes, and
-/// the reduced eigenvectors Y = LᵀX that refinement corrects through) by those of `bottom`
-/// ([`reversed_bottom_of`]), where that gains. Returns whether anything was replaced.
-pub(crate) fn adopt_reversed_bottom(def: &mut Definite, bottom: &ReversedBottom, l: MatRef<'_, f64>) -> bool {
+/// the reduced eigenvectors Y = LᵀX that refinement corrects through, formed as one product) by
+/// those of `bottom` ([`reversed_bottom_of`]), where that gains. Returns whether anything was
+/// replaced.
+pub(crate) fn adopt_reversed_bottom(def: &mut Definite, bottom: &ReversedBottom, l: MatRef<'_, f64>, par: Par) -> bool {
     let scale = def.omega_sq.iter().fold(0.0_f64, |m, w| m.max(w.abs()));
     let n = def.omega_sq.len();
     // Keep the spectrum ascending across the seam between the two sides.
@@ -201,9 +213,15 @@ pub(crate) fn adopt_reversed_bottom(def: &mut Definite, bottom: &ReversedBottom,
         }
     }
     if let Some(y) = def.reduced.as_mut() {
-        for j in 0..m {
-            let reduced = l.transpose() * bottom.vectors.col(j);
-            y.col_mut(j).copy_from(&reduced);
+        let x = bottom.vectors.as_ref().subcols(0, m);
+        let mut y = y.as_mut().subcols_mut(0, m);
+        if is_diagonal(l) {
+            y.copy_from(x);
+            for i in 0..x.nrows() {
+                y.as_mut().row_mut(i).iter_mut().for_each(|v| *v *= l[(i, i)]);
+            }
+        } else {
+            matmul(y, Accum::Replace, l.transpose(), x, 1.0, par);
         }
     }
     true
