@@ -547,3 +547,65 @@ fn a_subnormal_coupling_is_the_same_pencil_to_the_sparse_solver() {
         "the stored coupling, to the last bit"
     );
 }
+
+/// Two massless coordinates coupled by 1e308, and a coupling of 2.3e-25 between two massed ones
+/// (found by the fuzz target `abi_modal`): the exact scaling puts the condensed pencil at
+/// 1e-293, where the residual norms of the soft pair were formed from squares that underflowed
+/// to zero, and ω² = −1.9e-30 and 4.4e-24 were reported with bounds of 4e-46 and 1e-39 where
+/// the exact values are ∓1.06e-24. Exact ω² by mpmath at 1000 digits (the condensed pencil
+/// formed exactly); several orderings.
+#[test]
+fn residual_norms_of_a_pencil_scaled_to_the_bottom_of_the_range_do_not_underflow() {
+    let mut a = Mat::<f64>::zeros(6, 6);
+    for (i, v) in [(0, 0.05215533684290837), (2, 0.8889906157015335), (4, 1.0), (5, 1.0)] {
+        a[(i, i)] = v;
+    }
+    let tiny = -9.765625000000001e-32;
+    let b = symmetric(
+        6,
+        &[
+            (0, 0, tiny),
+            (0, 1, 2.62490234375e18),
+            (0, 2, 2.29052734375e-25),
+            (0, 3, -2.4232421875e38),
+            (0, 4, 7.8125e-22),
+            (0, 5, -4.8710937499999995e-40),
+            (1, 1, -0.00010618164062500001),
+            (1, 2, 4.1943359375e16),
+            (1, 3, 1e308),
+            (1, 4, -1.38310546875e-12),
+            (1, 5, -9.960937500000001e-30),
+            (2, 2, tiny),
+            (2, 3, tiny),
+            (2, 4, tiny),
+            (2, 5, tiny),
+            (3, 3, tiny),
+            (3, 4, 1.22705078125e-13),
+            (3, 5, 2.2298828125000002e-8),
+            (4, 4, 734863281.25),
+            (4, 5, 1.32607421875e-24),
+            (5, 5, 336230468750000.0),
+        ],
+    );
+    let exact = vec![
+        (-1.0637459502754536e-24, 5.023079953983739e-41),
+        (1.0637439680132916e-24, -2.0654286781838652e-41),
+        (734863281.25, 1.5924828298099973e-50),
+        (336230468750000.0, 5.229974200395649e-63),
+        (f64::INFINITY, 0.0),
+        (f64::INFINITY, 0.0),
+    ];
+    for order in [
+        [0, 1, 2, 3, 4, 5],
+        [1, 5, 4, 2, 0, 3],
+        [5, 4, 3, 2, 1, 0],
+        [3, 0, 5, 1, 2, 4],
+    ] {
+        let case = Case {
+            a: Mat::from_fn(6, 6, |i, j| a[(order[i], order[j])]),
+            b: Mat::from_fn(6, 6, |i, j| b[(order[i], order[j])]),
+            exact: exact.clone(),
+        };
+        every_use_holds(&case, &format!("order {order:?}"));
+    }
+}

@@ -3,7 +3,7 @@
 //! refinement changes columns of X.
 
 use crate::certify::sketch::{Sketch, SketchRows};
-use crate::linalg::norms::vector_norm;
+use crate::linalg::norms::{euclidean_norm, vector_norm};
 use faer::sparse::SparseColMat;
 use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::{Mat, MatMut, MatRef, Par};
@@ -191,7 +191,8 @@ impl PairProducts {
         let (r, xax) = match self {
             Self::Exact { ax, bx, .. } => {
                 let (axi, bxi) = (ax.col(i), bx.col(i));
-                let r = (0..n).map(|k| (bxi[k] - omega_sq * axi[k]).powi(2)).sum::<f64>().sqrt();
+                let r: Vec<f64> = (0..n).map(|k| bxi[k] - omega_sq * axi[k]).collect();
+                let r = euclidean_norm(&r);
                 (r, (0..n).map(|k| xi[k] * axi[k]).sum::<f64>())
             }
             Self::Sketched {

@@ -9,6 +9,7 @@
 //! arguments than the single term χ²_k·Σσ_i² (Π(1 + 2s·w_i) ≥ 1 + 2s for weights summing to 1).
 //! The sketches use a fixed seed (reproducible reports); they are independent of the pencil.
 
+use crate::linalg::norms::euclidean_norm;
 use faer::{Accum, Mat, MatRef, Par};
 
 /// Rows of the residual sketch (and columns of the orthogonality sketch).
@@ -127,8 +128,8 @@ impl Sketch {
     /// An upper bound of ‖B x_i − ω² A x_i‖ that fails with probability ≤ [`FAILURE_PROBABILITY`].
     pub(crate) fn residual_bound(&self, i: usize, omega_sq: f64) -> f64 {
         let (sax, sbx) = (self.sax.col(i), self.sbx.col(i));
-        let sum: f64 = (0..SKETCH_SIZE).map(|r| (sbx[r] - omega_sq * sax[r]).powi(2)).sum();
-        self.factor * sum.sqrt()
+        let rows: Vec<f64> = (0..SKETCH_SIZE).map(|r| sbx[r] - omega_sq * sax[r]).collect();
+        self.factor * euclidean_norm(&rows)
     }
 
     /// An upper bound of ‖XᵀAX − I‖_F (≥ every |(XᵀAX − I)_ij|) that fails with probability

@@ -14,6 +14,7 @@ use super::linearize::Eigenpair;
 use super::scaling::ScaledProblem;
 use super::{QuadraticBoundKind, QuadraticEigenvalue};
 use crate::error::ModalError;
+use crate::linalg::norms::euclidean_norm;
 use crate::linalg::powers_of_two::times_power_of_two;
 use faer::{Mat, c64};
 
@@ -68,7 +69,8 @@ fn column(m: &(Mat<f64>, Mat<f64>), k: usize) -> impl Iterator<Item = c64> + '_ 
 }
 
 fn norm(v: &[c64]) -> f64 {
-    v.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt()
+    let parts: Vec<f64> = v.iter().flat_map(|z| [z.re, z.im]).collect();
+    euclidean_norm(&parts)
 }
 
 /// y*(M x) for column k of a product M X.

@@ -2,7 +2,7 @@
 //! exactly to residuals of the condensed definite pencil (S, A₁), and corrections by block
 //! elimination through the condensed spectrum.
 
-use crate::linalg::norms::frobenius_norm;
+use crate::linalg::norms::{euclidean_norm, frobenius_norm};
 use crate::refine::correction::ReducedCorrection;
 use faer::{Mat, MatRef};
 
@@ -81,19 +81,16 @@ impl Condensation {
             .enumerate()
             .map(|(row, &i)| r[i] - (0..self.massless).map(|k| self.b10[(row, k)] * t[k]).sum::<f64>())
             .collect();
-        let r0_norm = r0.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let r0_norm = euclidean_norm(&r0);
         (s, t, r0_norm)
     }
 
     /// ‖L₁⁻¹s‖ for the condensed residual s of [`Self::condensed_residual`], plus the rounding
     /// allowance of s (a bound of ‖L₁⁻¹‖ times [`Self::rounding`]·‖r₀‖).
     pub(crate) fn inverse_mass_norm(&self, s: &[f64], r0_norm: f64) -> f64 {
-        let scaled = s
-            .iter()
-            .enumerate()
-            .map(|(i, v)| (v / self.l1[(i, i)]).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        // Without squaring: residuals of a pencil scaled to the edge of the range are tiny.
+        let scaled: Vec<f64> = s.iter().enumerate().map(|(i, v)| v / self.l1[(i, i)]).collect();
+        let scaled = euclidean_norm(&scaled);
         let lmin = (0..self.l1.nrows()).fold(f64::INFINITY, |m, i| m.min(self.l1[(i, i)]));
         scaled + self.rounding * r0_norm / lmin
     }

@@ -1,6 +1,7 @@
 //! The definite pencil in which refinement corrects a mode and measures its residual: (B, A)
 //! itself through the Cholesky factor of A, or the statically condensed pencil (S, A₁).
 
+use crate::linalg::norms::euclidean_norm;
 use crate::linalg::reduce::LowerFactor;
 use crate::refine::condensed::Condensation;
 use crate::refine::correction::ReducedCorrection;
@@ -37,7 +38,8 @@ impl Metric<'_> {
             Self::Cholesky(l) => {
                 let mut y = Mat::from_fn(r.len(), 1, |i, _| r[i]);
                 l.solve(y.as_mut(), Par::Seq);
-                (r, y.norm_l2())
+                let norm = euclidean_norm(y.col_as_slice(0));
+                (r, norm)
             }
             Self::Condensed(c) => {
                 let (s, _, r0_norm) = c.condensed_residual(&r);
