@@ -5,6 +5,7 @@ use crate::certify::a_priori::APrioriModel;
 use crate::certify::report::{AccuracyReport, BoundKind};
 use crate::linalg::norms::{euclidean_norm, square_over, vector_norm};
 use crate::spectrum::clusters;
+use crate::tuning::Tuning;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, MatRef, Par};
 use std::ops::Range;
@@ -57,6 +58,13 @@ pub(crate) struct RefinedResidual {
 /// bound of a Ritz block separated by δ from the rest of the spectrum (Mathias, SIMAX 19, 1998).
 /// p·γ·s and u·s are added for the block's A-orthogonality defect γ and the rounding, with s
 /// the largest |ω²| of the block.
+///
+/// A residual alone places *some* eigenvalue within ε of ρ, not the mode's own (the i-th in
+/// ascending order): it is the i-th only where the interval ρ ± ε is apart from every other
+/// mode's, the gap δ > ε. Where it is not, the mode keeps the interval it was refined from,
+/// `prior[i]` = (ω², bound) before refinement, which holds for the i-th eigenvalue: the bound
+/// becomes |ρ − ω²_prior| + bound_prior.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn residual_bounds(
     report: &mut AccuracyReport,
     omega_sq: &[f64],
@@ -64,6 +72,7 @@ pub(crate) fn residual_bounds(
     first: usize,
     residuals: &[RefinedResidual],
     basis: &ModeBasis<'_>,
+    prior: &[(f64, f64)],
     par: Par,
 ) {
     let m = omega_sq.len();
@@ -96,7 +105,17 @@ pub(crate) fn residual_bounds(
         else {
             continue;
         };
-        let bound = split.block_bound(&spectrum, &group, &columns);
+        let Some(bound) = split.block_bound(&spectrum, &group, &columns) else {
+            let norms = &report.residual_norms_a_inv;
+            match split.chained_bound(&spectrum, basis, norms, &group, &columns) {
+                Some(bound) => {
+                    report.error_bounds[i] = bound;
+                    report.bound_kinds[i] = BoundKind::Residual;
+                }
+                None => report.error_bounds[i] = (omega_sq[i] - prior[i].0).abs() + prior[i].1,
+            }
+            continue;
+        };
         // Rounding and the block's A-orthogonality defect at the cluster's largest |ω²|: the
         // Rayleigh–Ritz step in double leaves a mixing of order u between members, which moves a
         // member's Rayleigh quotient by up to u² times the cluster's spread (a zero mode chained
@@ -172,8 +191,9 @@ impl SplitResiduals {
 
     /// The bound of the block `group` (its members' residual columns and residual norms
     /// `columns`) before its orthogonality defect and rounding: min(ε, ε²/δ, Σ c²/δ_j +
-    /// ‖R_⊥‖²/δ) where the gap δ allows it.
-    fn block_bound(&self, spectrum: &Spectrum<'_>, group: &Range<usize>, columns: &[(usize, f64)]) -> f64 {
+    /// ‖R_⊥‖²/δ) where the gap δ exceeds ε; None where it does not (ε then bounds the distance
+    /// to some eigenvalue, not necessarily the members' own).
+    fn block_bound(&self, spectrum: &Spectrum<'_>, group: &Range<usize>, columns: &[(usize, f64)]) -> Option<f64> {
         let Spectrum {
             omega_sq,
             omega_all,
@@ -222,8 +242,11 @@ impl SplitResiduals {
         let eps_rest = euclidean_norm(&rest_norms);
         // The gap-weighted bounds hold for the eigenvalues of H = XᵀBX, not for its diagonal
         // (the members' values): Weyl's theorem puts them within ‖H − diag(ω²)‖_F of it.
+        if !(gap > eps) {
+            return None;
+        }
         let Some(coupling) = self.in_block_coupling(group, columns) else {
-            return eps;
+            return Some(eps);
         };
         let gap = gap - coupling;
         let mut bound = eps;
@@ -233,7 +256,72 @@ impl SplitResiduals {
                 bound = bound.min(coupling + weighted + square_over(eps_rest, gap));
             }
         }
-        bound
+        Some(bound)
+    }
+
+    /// The linear bound ε of block `group` (its residual columns and norms `columns`) where its
+    /// interval meets other modes': that ε bounds the distance to *some* eigenvalue, and it is
+    /// the members' own when every mode whose interval chains with the block's was refined too
+    /// and all their vectors are A-orthogonal (distinct eigenvectors, so the refined modes own
+    /// distinct eigenvalues, each within its own residual), and no unselected mode meets the
+    /// chain. |K|·γ·s and u·s are added for the A-orthogonality defect γ = max |x_kᵀAx_l| of the
+    /// chain K (formed here) and the rounding, s the largest |ω²| of the block. None when the
+    /// chain reaches a mode that was not refined (its interval is its bound from the reduction,
+    /// and the eigenvalue found may be its), grows past [`Tuning::max_refined_cluster`] members,
+    /// or its vectors are not A-orthogonal to 1/(2|K|): the mode then keeps its prior interval.
+    fn chained_bound(
+        &self,
+        spectrum: &Spectrum<'_>,
+        basis: &ModeBasis<'_>,
+        norms: &[Option<f64>],
+        group: &Range<usize>,
+        columns: &[(usize, f64)],
+    ) -> Option<f64> {
+        let (omega_sq, linear) = (spectrum.omega_sq, spectrum.linear);
+        let block_norms: Vec<f64> = columns.iter().map(|&(_, e)| e).collect();
+        let eps = euclidean_norm(&block_norms);
+        let mut members: Vec<usize> = group.clone().collect();
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        loop {
+            for &j in &members {
+                let reach = if group.contains(&j) { eps } else { norms[j]? };
+                lo = lo.min(omega_sq[j] - reach);
+                hi = hi.max(omega_sq[j] + reach);
+            }
+            let meeting: Vec<usize> = (0..omega_sq.len())
+                .filter(|j| !members.contains(j))
+                .filter(|&j| omega_sq[j] + linear[j] >= lo && omega_sq[j] - linear[j] <= hi)
+                .collect();
+            if meeting.is_empty() {
+                break;
+            }
+            members.extend(meeting);
+            if members.len() > Tuning::DEFAULT.max_refined_cluster {
+                return None;
+            }
+        }
+        let m = omega_sq.len();
+        let unselected_meets = spectrum.omega_all.iter().enumerate().any(|(k, &w)| {
+            let outside = k < spectrum.first || k >= spectrum.first + m;
+            let uncertainty = spectrum
+                .unselected
+                .map_or(spectrum.others_bound, |model| model.bound(w).max(spectrum.others_bound));
+            outside && w + uncertainty >= lo && w - uncertainty <= hi
+        });
+        if unselected_meets {
+            return None;
+        }
+        let basis_columns = members
+            .iter()
+            .map(|&j| self.column_of[j])
+            .collect::<Option<Vec<usize>>>()?;
+        let p = members.len() as f64;
+        let gamma = a_orthogonality(basis, &basis_columns);
+        if !(p * gamma < 0.5) {
+            return None;
+        }
+        let scale = group.clone().map(|j| omega_sq[j].abs()).fold(0.0, f64::max);
+        Some(eps + p * gamma * scale + f64::EPSILON * scale)
     }
 
     /// ‖H − diag(ω²)‖_F for the block's members, with H = X_GᵀBX_G: for A-orthonormal X, the
@@ -255,6 +343,25 @@ impl SplitResiduals {
             8.0 * self.rest.nrows() as f64 * f64::EPSILON * euclidean_norm(&[sum, euclidean_norm(&rest_norms)]);
         Some(sum + rounding)
     }
+}
+
+/// max_{k≠l} |x_kᵀAx_l| over the basis columns `columns`.
+fn a_orthogonality(basis: &ModeBasis<'_>, columns: &[usize]) -> f64 {
+    let products: Vec<Vec<f64>> = columns
+        .iter()
+        .map(|&c| {
+            let ax = basis.a * basis.x.col(c);
+            ax.iter().copied().collect()
+        })
+        .collect();
+    let mut gamma = 0.0_f64;
+    for (k, &c) in columns.iter().enumerate() {
+        for ax in products.iter().skip(k + 1) {
+            let dot: f64 = basis.x.col(c).iter().zip(ax).map(|(u, v)| u * v).sum();
+            gamma = gamma.max(dot.abs());
+        }
+    }
+    gamma
 }
 
 /// Narrows the clusters of refined modes to what their refined residuals can tell apart.

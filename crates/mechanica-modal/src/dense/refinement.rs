@@ -59,6 +59,10 @@ impl Stage<'_> {
         report: &mut AccuracyReport,
         omega: &mut [f64],
     ) {
+        let n = self.a.nrows();
+        let prior: Vec<(f64, f64)> = (0..omega.len())
+            .map(|i| (omega[i], report.bound_with_rounding(i, n)))
+            .collect();
         let jobs = self.jobs(report, omega);
         let (mass, stiffness) = (Operand::new(self.a), Operand::new(self.b));
         let shifts = if jobs.is_empty() {
@@ -72,7 +76,6 @@ impl Stage<'_> {
             shifts,
         };
         let mut refined = self.refine_jobs(&operands, &jobs, x.as_ref(), omega);
-        let n = self.a.nrows();
         for (g, cluster) in jobs.iter().zip(refined.iter_mut()) {
             if cluster
                 .as_ref()
@@ -88,8 +91,16 @@ impl Stage<'_> {
         }
         split_refined_clusters(&mut residuals, omega, &report.residual_norms_a_inv);
         let first_order = (report.error_bounds.clone(), report.bound_kinds.clone());
-        self.residual_bounds(report, omega, &residuals, x.as_ref());
-        self.polish(&operands, &mut residuals, first_order, x, products, report, omega);
+        self.residual_bounds(report, omega, &residuals, x.as_ref(), &prior);
+        self.polish(
+            &operands,
+            &mut residuals,
+            (first_order, &prior),
+            x,
+            products,
+            report,
+            omega,
+        );
     }
 
     /// The clusters to refine: those the policy asks for (a weakly bounded member, or all under
@@ -200,7 +211,7 @@ impl Stage<'_> {
         &self,
         operands: &Operands<'_>,
         residuals: &mut [RefinedResidual],
-        first_order: (Vec<f64>, Vec<BoundKind>),
+        (first_order, prior): ((Vec<f64>, Vec<BoundKind>), &[(f64, f64)]),
         x: &mut Mat<f64>,
         products: &mut PairProducts,
         report: &mut AccuracyReport,
@@ -254,7 +265,7 @@ impl Stage<'_> {
             for &i in &improved {
                 report.set_pair_error(products, x.as_ref(), i, omega[i]);
             }
-            self.residual_bounds(report, omega, residuals, x.as_ref());
+            self.residual_bounds(report, omega, residuals, x.as_ref(), prior);
         }
     }
 
@@ -267,6 +278,7 @@ impl Stage<'_> {
         omega: &[f64],
         residuals: &[RefinedResidual],
         x: MatRef<'_, f64>,
+        prior: &[(f64, f64)],
     ) {
         let all: Vec<usize> = (0..omega.len()).collect();
         let condensed = self.condensation.map(|c| (c.condensed_mass(), c.massed_rows(x)));
@@ -281,7 +293,16 @@ impl Stage<'_> {
             modes: &all,
             unselected: None,
         };
-        residual_bounds(report, omega, self.omega_all, self.first, residuals, &basis, self.par);
+        residual_bounds(
+            report,
+            omega,
+            self.omega_all,
+            self.first,
+            residuals,
+            &basis,
+            prior,
+            self.par,
+        );
         let columns: Vec<usize> = residuals.iter().map(|r| r.mode).collect();
         let values: Vec<f64> = columns.iter().map(|&i| omega[i]).collect();
         let rounding = extended_roundings(self.a, self.b, x, &columns, &values, self.par);

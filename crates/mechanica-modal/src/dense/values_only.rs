@@ -67,6 +67,7 @@ pub(crate) fn sharpen(
     if flagged.is_empty() {
         return Vec::new();
     }
+    let prior: Vec<(f64, f64)> = (0..omega.len()).map(|i| (omega[i], report.error_bounds[i])).collect();
     let values: Vec<f64> = flagged.iter().map(|&i| omega_all[first + i]).collect();
     let Ok((mut x, z)) = form.eigenvectors(&values) else {
         return Vec::new();
@@ -107,7 +108,7 @@ pub(crate) fn sharpen(
         modes: &flagged,
         unselected: Some(a_priori),
     };
-    residual_bounds(report, omega, omega_all, first, &residuals, &basis, pencil.par);
+    residual_bounds(report, omega, omega_all, first, &residuals, &basis, &prior, pencil.par);
     let columns: Vec<usize> = residuals
         .iter()
         .filter_map(|r| flagged.iter().position(|&i| i == r.mode))
