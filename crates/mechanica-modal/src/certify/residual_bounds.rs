@@ -8,6 +8,7 @@ use crate::spectrum::clusters;
 use crate::tuning::Tuning;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Mat, MatRef, Par};
+use std::cmp::Ordering;
 use std::ops::Range;
 
 /// The computed modes used to split a residual into its modal components.
@@ -242,7 +243,7 @@ impl SplitResiduals {
         let eps_rest = euclidean_norm(&rest_norms);
         // The gap-weighted bounds hold for the eigenvalues of H = XᵀBX, not for its diagonal
         // (the members' values): Weyl's theorem puts them within ‖H − diag(ω²)‖_F of it.
-        if !(gap > eps) {
+        if gap.partial_cmp(&eps) != Some(Ordering::Greater) {
             return None;
         }
         let Some(coupling) = self.in_block_coupling(group, columns) else {
@@ -317,7 +318,7 @@ impl SplitResiduals {
             .collect::<Option<Vec<usize>>>()?;
         let p = members.len() as f64;
         let gamma = a_orthogonality(basis, &basis_columns);
-        if !(p * gamma < 0.5) {
+        if (p * gamma).partial_cmp(&0.5) != Some(Ordering::Less) {
             return None;
         }
         let scale = group.clone().map(|j| omega_sq[j].abs()).fold(0.0, f64::max);
