@@ -64,7 +64,9 @@ pub(crate) struct RefinedResidual {
 /// ascending order): it is the i-th only where the interval ρ ± ε is apart from every other
 /// mode's, the gap δ > ε. Where it is not, the mode keeps the interval it was refined from,
 /// `prior[i]` = (ω², bound) before refinement, which holds for the i-th eigenvalue: the bound
-/// becomes |ρ − ω²_prior| + bound_prior.
+/// becomes |ρ − ω²_prior| + bound_prior. The one exception is a chain of overlapping intervals
+/// whose members were all refined and whose vectors are A-orthogonal: distinct eigenvectors own
+/// distinct eigenvalues, so each keeps its residual bound (see `chained_bound`).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn residual_bounds(
     report: &mut AccuracyReport,
@@ -143,6 +145,25 @@ struct Spectrum<'a> {
     unselected: Option<APrioriModel>,
 }
 
+impl Spectrum<'_> {
+    /// The ω² of the modes outside the selection.
+    fn unselected_values(&self) -> impl Iterator<Item = f64> + '_ {
+        let selection = self.first..self.first + self.omega_sq.len();
+        self.omega_all
+            .iter()
+            .enumerate()
+            .filter(move |(k, _)| !selection.contains(k))
+            .map(|(_, &w)| w)
+    }
+
+    /// The uncertainty of an unselected mode's value `w`: the largest bound of the selection,
+    /// or (values only) its a-priori error if that is larger.
+    fn unselected_uncertainty(&self, w: f64) -> f64 {
+        self.unselected
+            .map_or(self.others_bound, |model| model.bound(w).max(self.others_bound))
+    }
+}
+
 /// The refined residuals R split along the computed modes: C = Xᵀ R, and R_⊥ = L⁻¹(R − A X C),
 /// whose column norms are the A⁻¹-norms of the parts outside the basis.
 struct SplitResiduals {
@@ -195,14 +216,7 @@ impl SplitResiduals {
     /// ‖R_⊥‖²/δ) where the gap δ exceeds ε; None where it does not (ε then bounds the distance
     /// to some eigenvalue, not necessarily the members' own).
     fn block_bound(&self, spectrum: &Spectrum<'_>, group: &Range<usize>, columns: &[(usize, f64)]) -> Option<f64> {
-        let Spectrum {
-            omega_sq,
-            omega_all,
-            first,
-            linear,
-            others_bound,
-            unselected,
-        } = *spectrum;
+        let (omega_sq, linear) = (spectrum.omega_sq, spectrum.linear);
         let m = omega_sq.len();
         // Norms and quadratic terms are formed without squaring small numbers: after the exact
         // scaling of a pencil whose entries span most of the double range, residuals of its
@@ -230,11 +244,8 @@ impl SplitResiduals {
                 }
             }
         }
-        for (k, &w) in omega_all.iter().enumerate() {
-            if k < first || k >= first + m {
-                let uncertainty = unselected.map_or(others_bound, |model| model.bound(w).max(others_bound));
-                gap = gap.min(distance(w) - uncertainty);
-            }
+        for w in spectrum.unselected_values() {
+            gap = gap.min(distance(w) - spectrum.unselected_uncertainty(w));
         }
         let rest_norms: Vec<f64> = columns
             .iter()
@@ -301,13 +312,9 @@ impl SplitResiduals {
                 return None;
             }
         }
-        let m = omega_sq.len();
-        let unselected_meets = spectrum.omega_all.iter().enumerate().any(|(k, &w)| {
-            let outside = k < spectrum.first || k >= spectrum.first + m;
-            let uncertainty = spectrum
-                .unselected
-                .map_or(spectrum.others_bound, |model| model.bound(w).max(spectrum.others_bound));
-            outside && w + uncertainty >= lo && w - uncertainty <= hi
+        let unselected_meets = spectrum.unselected_values().any(|w| {
+            let uncertainty = spectrum.unselected_uncertainty(w);
+            w + uncertainty >= lo && w - uncertainty <= hi
         });
         if unselected_meets {
             return None;
