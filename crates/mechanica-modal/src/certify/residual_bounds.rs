@@ -49,7 +49,8 @@ pub(crate) struct RefinedResidual {
 /// residual bound ε = ‖r‖_{A⁻¹}, and u|ρ| is added for rounding ρ to double. Selected modes
 /// missing from the basis only enter through δ (their components stay in r_⊥), and so do
 /// unselected modes (outside `first..first + m` of `omega_all`), with the largest bound of the
-/// selection as their uncertainty, or (values only) their a-priori error if that is larger.
+/// selection before refinement as their uncertainty, or (values only) their a-priori error if
+/// that is larger.
 ///
 /// A cluster G of p modes refined as one block gets one bound for all its members, the same
 /// sums taken over the block: ε² = Σ_{k∈G} ‖r_k‖²_{A⁻¹} (the Frobenius norm of the block
@@ -82,7 +83,15 @@ pub(crate) fn residual_bounds(
     if residuals.is_empty() {
         return;
     }
-    let others_bound = report.error_bounds.iter().copied().fold(0.0, f64::max);
+    // The unselected modes were never refined: their uncertainty is that of the reduction, which
+    // the selection's bounds before refinement measure (after it, the refined ones are far
+    // smaller than any unselected mode's error).
+    let others_bound = report
+        .error_bounds
+        .iter()
+        .chain(prior.iter().map(|(_, bound)| bound))
+        .copied()
+        .fold(0.0, f64::max);
     let linear: Vec<f64> = (0..m)
         .map(|i| {
             report.residual_norms_a_inv[i].map_or(report.error_bounds[i], |e| e + f64::EPSILON * omega_sq[i].abs())
@@ -139,7 +148,8 @@ struct Spectrum<'a> {
     first: usize,
     /// Each selected mode's linear bound (its residual norm, or its bound before refinement).
     linear: &'a [f64],
-    /// The largest bound of the selection, the uncertainty of the unselected modes.
+    /// The largest bound of the selection before or after refinement, the uncertainty of the
+    /// unselected modes.
     others_bound: f64,
     /// Values only: the error model of the unselected modes' values.
     unselected: Option<APrioriModel>,

@@ -8,6 +8,7 @@ use crate::certify::residual_bounds::{ModeBasis, RefinedResidual, residual_bound
 use crate::certify::resolution::extended_roundings;
 use crate::dd::Operand;
 use crate::dense::options::{Refinement, weakly_bounded};
+use crate::linalg::norms::euclidean_norm;
 use crate::refine::{
     Condensation, Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts,
     polish_simple_mode, refine_cluster, refine_simple_modes,
@@ -77,10 +78,12 @@ impl Stage<'_> {
         };
         let mut refined = self.refine_jobs(&operands, &jobs, x.as_ref(), omega);
         for (g, cluster) in jobs.iter().zip(refined.iter_mut()) {
-            if cluster
-                .as_ref()
-                .is_some_and(|c| !stays_in_its_interval(c, g, omega, |i| report.bound_with_rounding(i, n)))
-            {
+            let first_order = g.clone().any(|i| report.bound_kinds[i] == BoundKind::FirstOrder);
+            let kept = cluster.as_ref().is_none_or(|c| {
+                stays_in_its_interval(c, g, omega, |i| report.bound_with_rounding(i, n))
+                    || (first_order && stays_in_its_span(c, g, self.a, x.as_ref()))
+            });
+            if !kept {
                 *cluster = None;
             }
         }
@@ -105,8 +108,12 @@ impl Stage<'_> {
     }
 
     /// The clusters to refine: those the policy asks for (a weakly bounded member, or all under
-    /// [`Refinement::Always`]) that refinement can take ([`refinable`]).
+    /// [`Refinement::Always`] and on a condensation whose first-order bounds are not to be
+    /// trusted, [`Condensation::perturbs_beyond_first_order`]) that refinement can take
+    /// ([`refinable`]).
     fn jobs(&self, report: &AccuracyReport, omega: &[f64]) -> Vec<Range<usize>> {
+        let every_mode = self.policy == Refinement::Always
+            || self.condensation.is_some_and(Condensation::perturbs_beyond_first_order);
         let separation: Vec<f64> = match self.estimates {
             Some(estimates) => report
                 .error_bounds
@@ -119,7 +126,7 @@ impl Stage<'_> {
         let jobs: Vec<Range<usize>> = clusters(omega, &separation)
             .into_iter()
             .filter(|g| {
-                let wanted = self.policy == Refinement::Always
+                let wanted = every_mode
                     || g.clone()
                         .any(|i| weakly_bounded(report.bound_with_rounding(i, self.a.nrows()), omega[i]));
                 wanted && refinable(g, omega, &separation, self.omega_all, self.first)
@@ -327,6 +334,36 @@ fn stays_in_its_interval(
     let lowest = g.clone().map(|i| omega[i] - bound(i)).fold(f64::INFINITY, f64::min);
     let highest = g.clone().map(|i| omega[i] + bound(i)).fold(f64::NEG_INFINITY, f64::max);
     cluster.pairs.iter().all(|p| (lowest..=highest).contains(&p.omega_sq))
+}
+
+/// Whether every refined vector of cluster `g` lies mostly in the span of the cluster's
+/// starting vectors `x`: its A-orthogonal projection onto them keeps at least half its squared
+/// A-norm. A first-order bound is not a proof (the perturbation theory behind it fails where the
+/// pencil is near a singular one, e.g. a condensation through a nearly singular B₀₀), so a value
+/// outside it may still be the mode's own; a refined vector that kept its direction is, where
+/// one that converged to another mode's eigenvector is nearly A-orthogonal to its start.
+fn stays_in_its_span(cluster: &RefinedCluster, g: &Range<usize>, a: MatRef<'_, f64>, x: MatRef<'_, f64>) -> bool {
+    let start = x.subcols(g.start, g.len());
+    let a_start = a * start;
+    let gram = start.transpose() * &a_start;
+    // ‖G − I‖₂ ≤ p·max|G − I| =: δ, and the squared A-norm of the projection of y onto the
+    // span is cᵀG⁻¹c ≥ ‖c‖²/(1 + δ) with c = XᵀAy.
+    let p = g.len();
+    let defect = (0..p)
+        .flat_map(|k| (0..p).map(move |l| (k, l)))
+        .map(|(k, l)| (gram[(k, l)] - if k == l { 1.0 } else { 0.0 }).abs())
+        .fold(0.0, f64::max);
+    let gram_norm = p as f64 * defect;
+    if gram_norm.partial_cmp(&0.5) != Some(std::cmp::Ordering::Less) {
+        return false;
+    }
+    cluster.pairs.iter().all(|pair| {
+        let components: Vec<f64> = (0..p)
+            .map(|k| a_start.col(k).iter().zip(&pair.x).map(|(u, v)| u * v).sum())
+            .collect();
+        let projected = euclidean_norm(&components);
+        projected * projected >= 0.5 * (1.0 + gram_norm)
+    })
 }
 
 /// Writes the refined clusters into `x`, `omega` and the report's residual norms and steps;
