@@ -62,6 +62,16 @@ PENCILS = {
          (0, 4, -9.765625000000001e-32), (0, 5, -2.27509765625e-27),
          (0, 6, -9.765625000000001e-32), (1, 1, 2.0996093749999998e-41)],
     ),
+    # A = 0.96 I and couplings up to 1e100: four refined modes near zero chained through one
+    # wide interval, and each kept its own residual bound although the sorted values and the
+    # sorted eigenvalues did not pair that way (1.2e-68 ± 1.3e21 for the exact 1.63e36).
+    "four chained modes under a coupling of 1e100": (
+        [[0.9607843137254902 if i == j else 0.0 for j in range(6)] for i in range(6)],
+        [(0, 0, -2.5107421875e-38), (2, 3, 1.25009765625e21), (2, 4, -3.0295711161086577e-128),
+         (2, 5, -2.74814453125e31), (3, 3, 1.56630859375e36), (3, 4, -0.215107421875),
+         (3, 5, 1.9481445312499998e-35), (4, 4, 4.717996333842129e-105), (4, 5, -1e100),
+         (5, 5, 1.6709960937500002e-28)],
+    ),
     # One subnormal coupling; halving it in the sparse symmetrisation changed the pencil.
     "a subnormal coupling": (
         "diagonal-dominant 7x7",

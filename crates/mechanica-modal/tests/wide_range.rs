@@ -922,3 +922,40 @@ fn unselected_modes_keep_the_uncertainty_of_the_reduction() {
         }
     }
 }
+
+/// A = 0.96·I and a B with couplings up to 1e100 (found by the fuzz target `abi_modal` at
+/// ±1e100): four refined modes near zero whose intervals chain through one wide interval each
+/// kept their own residual bound, although sorted values and sorted eigenvalues do not pair that
+/// way; ω² = 1.2e-68 ± 1.3e21 was reported for the exact 1.63e36. A chain's members now share
+/// the chain's block bound. Exact ω² by `tools/modal_found_pencils_reference.py`.
+#[test]
+fn modes_chained_through_a_wide_interval_share_its_bound() {
+    let b = symmetric(
+        6,
+        &[
+            (0, 0, -2.5107421875e-38),
+            (2, 3, 1.25009765625e21),
+            (2, 4, -3.0295711161086577e-128),
+            (2, 5, -2.74814453125e31),
+            (3, 3, 1.56630859375e36),
+            (3, 4, -0.215107421875),
+            (3, 5, 1.9481445312499998e-35),
+            (4, 4, 4.717996333842129e-105),
+            (4, 5, -1e100),
+            (5, 5, 1.6709960937500002e-28),
+        ],
+    );
+    let case = Case {
+        a: Mat::from_fn(6, 6, |i, j| if i == j { 0.9607843137254902 } else { 0.0 }),
+        b,
+        exact: vec![
+            (-1.0408163265306122e100, -3.277694902867525e83),
+            (-1038447.7440581296, -1.7938535475334055e-11),
+            (-2.613221460459184e-38, 4.501149289144137e-55),
+            (0.0, 0.0),
+            (1.630239556760204e36, 3.0286008740628226e19),
+            (1.0408163265306122e100, 3.277694902867525e83),
+        ],
+    };
+    each_ordering_holds(&case, &[[0, 1, 2, 3, 4, 5], [1, 2, 0, 3, 4, 5]]);
+}

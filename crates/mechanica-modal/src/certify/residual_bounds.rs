@@ -66,8 +66,8 @@ pub(crate) struct RefinedResidual {
 /// mode's, the gap δ > ε. Where it is not, the mode keeps the interval it was refined from,
 /// `prior[i]` = (ω², bound) before refinement, which holds for the i-th eigenvalue: the bound
 /// becomes |ρ − ω²_prior| + bound_prior. The one exception is a chain of overlapping intervals
-/// whose members were all refined and whose vectors are A-orthogonal: distinct eigenvectors own
-/// distinct eigenvalues, so each keeps its residual bound (see `chained_bound`).
+/// whose members were all refined and whose vectors are A-orthogonal: it is bounded as one block
+/// and every member gets the chain's bound (see `chained_bound`).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn residual_bounds(
     report: &mut AccuracyReport,
@@ -119,7 +119,7 @@ pub(crate) fn residual_bounds(
         };
         let Some(bound) = split.block_bound(&spectrum, &group, &columns) else {
             let norms = &report.residual_norms_a_inv;
-            match split.chained_bound(&spectrum, basis, norms, &group, &columns) {
+            match split.chained_bound(&spectrum, basis, norms, &group) {
                 Some(bound) => {
                     report.error_bounds[i] = bound;
                     report.bound_kinds[i] = BoundKind::Residual;
@@ -281,65 +281,55 @@ impl SplitResiduals {
         Some(bound)
     }
 
-    /// The linear bound ε of block `group` (its residual columns and norms `columns`) where its
-    /// interval meets other modes': that ε bounds the distance to *some* eigenvalue, and it is
-    /// the members' own when every mode whose interval chains with the block's was refined too
-    /// and all their vectors are A-orthogonal (distinct eigenvectors, so the refined modes own
-    /// distinct eigenvalues, each within its own residual), and no unselected mode meets the
-    /// chain. |K|·γ·s and u·s are added for the A-orthogonality defect γ = max |x_kᵀAx_l| of the
-    /// chain K (formed here) and the rounding, s the largest |ω²| of the block. None when the
-    /// chain reaches a mode that was not refined (its interval is its bound from the reduction,
-    /// and the eigenvalue found may be its), grows past [`Tuning::max_refined_cluster`] members,
-    /// or its vectors are not A-orthogonal to 1/(2|K|): the mode then keeps its prior interval.
+    /// The bound of block `group` (its residual columns and norms `columns`) where its interval
+    /// meets other modes': its residual then bounds the distance to *some* eigenvalue, not
+    /// necessarily its own. The modes whose intervals chain with the block's form a chain K; when
+    /// every one of them was refined, the chain is a contiguous run of the selection, its vectors
+    /// are A-orthogonal to 1/(2|K|), and no unselected mode meets it, the |K| eigenvalues of
+    /// H = X_KᵀBX_K lie within ‖R_K‖_F of |K| eigenvalues of the pencil (Kahan's theorem, as for a
+    /// refined block), and the values within ‖H − diag(ω²)‖_F of H's (Weyl). Sorted values and
+    /// sorted eigenvalues then pair within the same bound E = ‖R_K‖_F + ‖H − diag‖_F + |K|·γ·s +
+    /// u·s (γ = max |x_kᵀAx_l| over K, s the largest |ω²| of K): a matching within E exists, and
+    /// the sorted pairing is the best one. Those |K| eigenvalues are the chain's own (its modes'
+    /// indices) when no other mode's interval meets the chain's values widened by E. None
+    /// otherwise, or past [`Tuning::max_refined_cluster`] members: the mode then keeps its prior
+    /// interval.
     fn chained_bound(
         &self,
         spectrum: &Spectrum<'_>,
         basis: &ModeBasis<'_>,
         norms: &[Option<f64>],
         group: &Range<usize>,
-        columns: &[(usize, f64)],
     ) -> Option<f64> {
+        let chain = chain_of(spectrum, norms, group)?;
         let (omega_sq, linear) = (spectrum.omega_sq, spectrum.linear);
-        let block_norms: Vec<f64> = columns.iter().map(|&(_, e)| e).collect();
-        let eps = euclidean_norm(&block_norms);
-        let mut members: Vec<usize> = group.clone().collect();
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        loop {
-            for &j in &members {
-                let reach = if group.contains(&j) { eps } else { norms[j]? };
-                lo = lo.min(omega_sq[j] - reach);
-                hi = hi.max(omega_sq[j] + reach);
-            }
-            let meeting: Vec<usize> = (0..omega_sq.len())
-                .filter(|j| !members.contains(j))
-                .filter(|&j| omega_sq[j] + linear[j] >= lo && omega_sq[j] - linear[j] <= hi)
-                .collect();
-            if meeting.is_empty() {
-                break;
-            }
-            members.extend(meeting);
-            if members.len() > Tuning::DEFAULT.max_refined_cluster {
-                return None;
-            }
-        }
-        let unselected_meets = spectrum.unselected_values().any(|w| {
-            let uncertainty = spectrum.unselected_uncertainty(w);
-            w + uncertainty >= lo && w - uncertainty <= hi
-        });
-        if unselected_meets {
-            return None;
-        }
-        let basis_columns = members
-            .iter()
-            .map(|&j| self.column_of[j])
+        let columns = chain
+            .clone()
+            .map(|j| self.residual_of[j].zip(norms[j]))
+            .collect::<Option<Vec<(usize, f64)>>>()?;
+        let basis_columns = chain
+            .clone()
+            .map(|j| self.column_of[j])
             .collect::<Option<Vec<usize>>>()?;
-        let p = members.len() as f64;
+        let p = chain.len() as f64;
         let gamma = a_orthogonality(basis, &basis_columns);
         if (p * gamma).partial_cmp(&0.5) != Some(Ordering::Less) {
             return None;
         }
-        let scale = group.clone().map(|j| omega_sq[j].abs()).fold(0.0, f64::max);
-        Some(eps + p * gamma * scale + f64::EPSILON * scale)
+        let chain_norms: Vec<f64> = columns.iter().map(|&(_, e)| e).collect();
+        let coupling = self.in_block_coupling(&chain, &columns)?;
+        let scale = chain.clone().map(|j| omega_sq[j].abs()).fold(0.0, f64::max);
+        let bound = euclidean_norm(&chain_norms) + coupling + p * gamma * scale + f64::EPSILON * scale;
+        let lo = chain.clone().map(|j| omega_sq[j]).fold(f64::INFINITY, f64::min) - bound;
+        let hi = chain.clone().map(|j| omega_sq[j]).fold(f64::NEG_INFINITY, f64::max) + bound;
+        let meets = |w: f64, e: f64| w + e >= lo && w - e <= hi;
+        let other_meets = (0..omega_sq.len())
+            .filter(|j| !chain.contains(j))
+            .any(|j| meets(omega_sq[j], linear[j]))
+            || spectrum
+                .unselected_values()
+                .any(|w| meets(w, spectrum.unselected_uncertainty(w)));
+        (!other_meets && bound.is_finite()).then_some(bound)
     }
 
     /// ‖H − diag(ω²)‖_F for the block's members, with H = X_GᵀBX_G: for A-orthonormal X, the
@@ -361,6 +351,37 @@ impl SplitResiduals {
             8.0 * self.rest.nrows() as f64 * f64::EPSILON * euclidean_norm(&[sum, euclidean_norm(&rest_norms)]);
         Some(sum + rounding)
     }
+}
+
+/// The modes whose intervals chain with the refined block `group`'s: each refined member reaches
+/// its residual norm (`norms`), each other mode its linear bound. None when the chain takes in a
+/// mode that was not refined or more than [`Tuning::max_refined_cluster`] modes, or is not a
+/// contiguous run of the selection.
+fn chain_of(spectrum: &Spectrum<'_>, norms: &[Option<f64>], group: &Range<usize>) -> Option<Range<usize>> {
+    let (omega_sq, linear) = (spectrum.omega_sq, spectrum.linear);
+    let mut members: Vec<usize> = group.clone().collect();
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    loop {
+        for &j in &members {
+            let reach = norms[j]?;
+            lo = lo.min(omega_sq[j] - reach);
+            hi = hi.max(omega_sq[j] + reach);
+        }
+        let meeting: Vec<usize> = (0..omega_sq.len())
+            .filter(|j| !members.contains(j))
+            .filter(|&j| omega_sq[j] + linear[j] >= lo && omega_sq[j] - linear[j] <= hi)
+            .collect();
+        if meeting.is_empty() {
+            break;
+        }
+        members.extend(meeting);
+        if members.len() > Tuning::DEFAULT.max_refined_cluster {
+            return None;
+        }
+    }
+    let first = members.iter().copied().min()?;
+    let end = members.iter().copied().max()? + 1;
+    (end - first == members.len()).then_some(first..end)
 }
 
 /// max_{k≠l} |x_kᵀAx_l| over the basis columns `columns`.
