@@ -2,6 +2,7 @@
 //! modes ([`crate::dense::refinement`]), the Sturm check, classification and grouping.
 
 use crate::certify::a_priori::APrioriModel;
+use crate::certify::forest::forest_count_below;
 use crate::certify::inertia::stiffness_is_definite;
 use crate::certify::products::PairProducts;
 use crate::certify::report::{AccuracyReport, BoundKind};
@@ -128,6 +129,7 @@ impl Finish<'_> {
         widen_overlapping_estimates(&mut modes, &mut report);
         order_above_positive_modes(&mut modes);
         certify_positive_stiffness(self.problem, &mut modes, self.par);
+        sign_undecided_by_forest_counts(self.problem, &mut modes, first);
         if matches!(self.options.selection, Selection::All) && !infinite.is_empty() {
             x = append_infinite(&mut modes, x, &infinite);
         }
@@ -399,6 +401,38 @@ fn certify_positive_stiffness(problem: &PencilProblem, modes: &mut [Mode], par: 
         mode.kind = ModeKind::Oscillatory {
             omega: mode.omega_sq.max(0.0).sqrt(),
         };
+    }
+}
+
+/// Decides the sign of undecided modes where A is diagonal and positive and B's pattern is a
+/// forest: the mode of ascending index k = `first` + its position is oscillatory when the count
+/// at s = ω²/2 > 0 proves at most k eigenvalues below s − m > 0, unstable when the count at
+/// s = ω²/2 < 0 proves at least k + 1 below s + m < 0 ([`forest_count_below`], Sylvester's law of
+/// inertia). Its interval is left as it is.
+fn sign_undecided_by_forest_counts(problem: &PencilProblem, modes: &mut [Mode], first: usize) {
+    if !modes.iter().any(|m| m.kind == ModeKind::Undecided) {
+        return;
+    }
+    for (position, mode) in modes.iter_mut().enumerate() {
+        if mode.kind != ModeKind::Undecided {
+            continue;
+        }
+        let (k, shift) = (first + position, 0.5 * mode.omega_sq);
+        if shift == 0.0 {
+            continue;
+        }
+        let Some(count) = forest_count_below(problem.a(), problem.b(), shift) else {
+            return;
+        };
+        if shift > 0.0 && shift - count.margin > 0.0 && count.below <= k {
+            mode.kind = ModeKind::Oscillatory {
+                omega: mode.omega_sq.sqrt(),
+            };
+        } else if shift < 0.0 && shift + count.margin < 0.0 && count.below > k {
+            mode.kind = ModeKind::Unstable {
+                growth_rate: (-mode.omega_sq).sqrt(),
+            };
+        }
     }
 }
 
