@@ -58,14 +58,15 @@ pub fn fix_point(body: &RigidBody, p_wx: &Vector3<f64>) -> Result<Fixation, Impu
     check_result("fixation impulse", impulse.iter().chain(moment.iter()))?;
     let response = body.respond(&impulse, &moment);
     response.check_finite()?;
-    let residual = (response.v_wc_after + response.w_w_after.cross(&lever)).norm();
+    // Norms without squares: the speeds of a body moving at 1e-308 would square to zero.
+    let residual = scaling::norm(&(response.v_wc_after + response.w_w_after.cross(&lever)));
     check_result("energy change", [energy_change, residual].iter())?;
     // ΔT = ½ S·(u⁻ + u⁺) exactly; the reported ½ S·u⁻ holds only while the point is at rest
     // after. A point left moving at more than 1e-8 of its speed before (a mobility too
-    // ill-conditioned to solve) is refused.
-    if residual > FIXATION_RESIDUAL * v.norm() {
+    // ill-conditioned to solve, or an impulse below the double range) is refused.
+    if residual > FIXATION_RESIDUAL * scaling::norm(&v) {
         return Err(ImpulseError::Singular {
-            what: "fixation: the point mobility is too ill-conditioned to bring the point to rest (speed left)",
+            what: "fixation: the point cannot be brought to rest in double precision (an ill-conditioned mobility or an impulse below the double range; speed left)",
             value: residual,
         });
     }
@@ -128,8 +129,8 @@ fn general_fixation(body: &RigidBody, p_wx: &Vector3<f64>, v: &Vector3<f64>) -> 
                 nalgebra::Matrix3::zeros()
             };
             let s = -pinv * v;
-            let left = (v + w * s).norm();
-            if left > 1e-9 * v.norm() {
+            let left = scaling::norm(&(v + w * s));
+            if left > 1e-9 * scaling::norm(v) {
                 return Err(ImpulseError::Singular {
                     what: "fixation: the point cannot be brought to rest by an impulse there (|v_X| left)",
                     value: left,
@@ -170,6 +171,30 @@ mod tests {
         // The impulse: S = m(V₀ − v₀) = m(ΩL/2 − v) ŷ = −m v/4 ŷ.
         assert!((fix.impulse_w - Vector3::new(0.0, -m * v / 4.0, 0.0)).norm() < 1e-13);
         assert!(fix.residual < 1e-14 * v);
+    }
+
+    /// A body moving at 1e-308 fixed at a point 5.8e30 m away (found by the fuzz target
+    /// `abi_impulse`): the impulse that would stop the point is below the double range, and the
+    /// point's speed after, 8e-278, was formed from squares that underflowed, so it was reported
+    /// at rest (residual 0). Either the point is stopped to 1e-8 of its speed, measured without
+    /// squares, or the fixation is refused.
+    #[test]
+    fn a_point_left_moving_below_the_range_of_squares_is_not_reported_at_rest() {
+        let inverse_inertia = Matrix3::new(1.367, -0.0138, 0.0812, -0.0138, 1.362, -0.0512, 0.0812, -0.0512, 1.531);
+        let speed = Vector3::new(1e-308, 1e-308, 1e-308);
+        let centre = Vector3::new(0.53533935546875, 0.5333251953125, -0.1854248046875);
+        let body = RigidBody::from_inverse(0.42355696723258346, &inverse_inertia, centre, speed, speed).expect("ok");
+        let point = Vector3::new(1e-308, 0.0, -5.7734375e30);
+        let before = scaling::norm(&body.velocity_at(&point));
+        match fix_point(&body, &point) {
+            Ok(fix) => {
+                let lever = point - centre;
+                let after = scaling::norm(&(fix.v_wc_after + fix.w_w_after.cross(&lever)));
+                assert!(after <= FIXATION_RESIDUAL * before, "left at {after:e} of {before:e}");
+                assert_eq!(fix.residual, after);
+            }
+            Err(error) => assert!(matches!(error, ImpulseError::Singular { .. }), "{error}"),
+        }
     }
 
     /// Points 10^k m from a body of 1 m (k up to 150, random directions, speeds up to 1e30 m/s):
