@@ -26,7 +26,7 @@
 //! after scaling that its square would leave the normal range, or a pivot is not positive.
 //!
 //! The same elimination of B − sA with a diagonal A > 0 counts the pencil's eigenvalues below s
-//! (its negative pivots, Sylvester's law of inertia) up to a margin ([`forest_count_below`]):
+//! (its negative pivots, Sylvester's law of inertia) up to a margin ([`ForestPencil`]):
 //! what orders and signs modes whose residual intervals cannot.
 
 use faer::MatRef;
@@ -96,55 +96,74 @@ pub(crate) struct ForestCount {
     pub(crate) margin: f64,
 }
 
-/// [`ForestCount`] of (B, A) at `shift`; None when A is not diagonal with positive entries, B's
-/// pattern is not a forest, the shift or an entry is not finite, an entry is too small after
-/// scaling to be squared, or a pivot vanishes.
-pub(crate) fn forest_count_below(a: MatRef<'_, f64>, b: MatRef<'_, f64>, shift: f64) -> Option<ForestCount> {
-    let n = b.nrows();
-    let masses: Vec<f64> = (0..n).map(|i| a[(i, i)]).collect();
-    let diagonal = (0..n).all(|j| (0..n).all(|i| i == j || a[(i, j)] == 0.0));
-    if !diagonal || !masses.iter().all(|&m| m > 0.0 && m.is_finite()) || !shift.is_finite() {
-        return None;
-    }
-    let forest = Forest::of(b)?;
-    let largest = (0..n)
-        .map(|i| b[(i, i)].abs().max(shift.abs() * masses[i]))
-        .chain(forest.edges.iter().map(|e| e.2.abs()))
-        .fold(0.0_f64, f64::max);
-    if largest == 0.0 || !largest.is_finite() {
-        return None;
-    }
-    let scale = exponent(largest);
-    let scaled = |x: f64| times_power_of_two(x, -scale);
-    if forest.edges.iter().any(|e| scaled(e.2).abs() < SMALLEST_SCALED_ENTRY) {
-        return None;
-    }
-    let gamma = 16.0 * (n as f64 + 8.0) * times_power_of_two(1.0, -104);
-    let mut spread: Vec<f64> = (0..n)
-        .map(|i| 2.0 * gamma * (b[(i, i)].abs() + shift.abs() * masses[i]) / masses[i])
-        .collect();
-    for &(i, j, value) in &forest.edges {
-        let term = gamma * value.abs() / (masses[i].sqrt() * masses[j].sqrt());
-        spread[i] += term;
-        spread[j] += term;
-    }
-    let margin = spread.iter().fold(0.0_f64, |m, &v| m.max(v));
-    let mut pivot: Vec<Dd> = (0..n)
-        .map(|i| Dd::of(scaled(b[(i, i)])).minus(Dd::of(shift).times(Dd::of(scaled(masses[i])))))
-        .collect();
-    let mut below = 0;
-    for &node in forest.leaves_first.iter() {
-        let d = pivot[node];
-        if d.hi == 0.0 || !d.hi.is_finite() {
+/// A pencil (B, A) with A diagonal and positive and B's off-diagonal pattern a forest, ready to
+/// count its eigenvalues below any shift ([`ForestPencil::count_below`]).
+pub(crate) struct ForestPencil<'a> {
+    b: MatRef<'a, f64>,
+    masses: Vec<f64>,
+    forest: Forest,
+}
+
+impl<'a> ForestPencil<'a> {
+    /// None when A is not diagonal with positive finite entries or B's pattern is not a forest.
+    pub(crate) fn new(a: MatRef<'a, f64>, b: MatRef<'a, f64>) -> Option<Self> {
+        let n = b.nrows();
+        let masses: Vec<f64> = (0..n).map(|i| a[(i, i)]).collect();
+        let diagonal = (0..n).all(|j| (0..n).all(|i| i == j || a[(i, j)] == 0.0));
+        if !diagonal || !masses.iter().all(|&m| m > 0.0 && m.is_finite()) {
             return None;
         }
-        below += usize::from(d.hi < 0.0);
-        if let Some((parent, coupling)) = forest.parent[node] {
-            let c = Dd::of(scaled(coupling));
-            pivot[parent] = pivot[parent].minus(c.times(c).over(d));
-        }
+        let forest = Forest::of(b)?;
+        Some(Self { b, masses, forest })
     }
-    margin.is_finite().then_some(ForestCount { below, margin })
+
+    /// [`ForestCount`] at `shift`; None when the shift or an entry is not finite, an entry is
+    /// too small after scaling to be squared, or a pivot vanishes. O(n).
+    pub(crate) fn count_below(&self, shift: f64) -> Option<ForestCount> {
+        let (b, masses, forest) = (self.b, &self.masses, &self.forest);
+        let n = b.nrows();
+        if !shift.is_finite() {
+            return None;
+        }
+        let largest = (0..n)
+            .map(|i| b[(i, i)].abs().max(shift.abs() * masses[i]))
+            .chain(forest.edges.iter().map(|e| e.2.abs()))
+            .fold(0.0_f64, f64::max);
+        if largest == 0.0 || !largest.is_finite() {
+            return None;
+        }
+        let scale = exponent(largest);
+        let scaled = |x: f64| times_power_of_two(x, -scale);
+        if forest.edges.iter().any(|e| scaled(e.2).abs() < SMALLEST_SCALED_ENTRY) {
+            return None;
+        }
+        let gamma = 16.0 * (n as f64 + 8.0) * times_power_of_two(1.0, -104);
+        let mut spread: Vec<f64> = (0..n)
+            .map(|i| 2.0 * gamma * (b[(i, i)].abs() + shift.abs() * masses[i]) / masses[i])
+            .collect();
+        for &(i, j, value) in &forest.edges {
+            let term = gamma * value.abs() / (masses[i].sqrt() * masses[j].sqrt());
+            spread[i] += term;
+            spread[j] += term;
+        }
+        let margin = spread.iter().fold(0.0_f64, |m, &v| m.max(v));
+        let mut pivot: Vec<Dd> = (0..n)
+            .map(|i| Dd::of(scaled(b[(i, i)])).minus(Dd::of(shift).times(Dd::of(scaled(masses[i])))))
+            .collect();
+        let mut below = 0;
+        for &node in forest.leaves_first.iter() {
+            let d = pivot[node];
+            if d.hi == 0.0 || !d.hi.is_finite() {
+                return None;
+            }
+            below += usize::from(d.hi < 0.0);
+            if let Some((parent, coupling)) = forest.parent[node] {
+                let c = Dd::of(scaled(coupling));
+                pivot[parent] = pivot[parent].minus(c.times(c).over(d));
+            }
+        }
+        margin.is_finite().then_some(ForestCount { below, margin })
+    }
 }
 
 /// The forest of B's off-diagonal pattern: its edges (i > j, b_ij ≠ 0), each coordinate's
@@ -299,7 +318,9 @@ mod tests {
                     exact.get(k).copied().unwrap_or(4.0),
                 );
                 let shift = lo + 0.45 * (hi - lo);
-                let count = forest_count_below(a.as_ref(), b.as_ref(), shift).expect("a forest with positive masses");
+                let count = ForestPencil::new(a.as_ref(), b.as_ref())
+                    .and_then(|p| p.count_below(shift))
+                    .expect("a forest with positive masses");
                 assert_eq!(count.below, k, "trial {trial}: count at {shift}");
                 assert!(
                     count.margin < 1e-20 * (hi - lo),
@@ -315,15 +336,15 @@ mod tests {
         let springs = [(1, 0, 1.0), (2, 1, 1.0)];
         let b = assemble(3, &springs, &[(0, 1.0)]);
         let mut a = Mat::<f64>::identity(3, 3);
-        assert!(forest_count_below(a.as_ref(), b.as_ref(), 0.5).is_some());
+        assert!(ForestPencil::new(a.as_ref(), b.as_ref()).is_some());
         a[(1, 1)] = 0.0;
-        assert!(forest_count_below(a.as_ref(), b.as_ref(), 0.5).is_none());
+        assert!(ForestPencil::new(a.as_ref(), b.as_ref()).is_none());
         a[(1, 1)] = 1.0;
         a[(0, 1)] = 0.1;
         a[(1, 0)] = 0.1;
-        assert!(forest_count_below(a.as_ref(), b.as_ref(), 0.5).is_none());
+        assert!(ForestPencil::new(a.as_ref(), b.as_ref()).is_none());
         let ring = assemble(3, &[(1, 0, 1.0), (2, 1, 1.0), (2, 0, 1.0)], &[]);
-        assert!(forest_count_below(Mat::<f64>::identity(3, 3).as_ref(), ring.as_ref(), 0.5).is_none());
+        assert!(ForestPencil::new(Mat::<f64>::identity(3, 3).as_ref(), ring.as_ref()).is_none());
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! modes ([`crate::dense::refinement`]), the Sturm check, classification and grouping.
 
 use crate::certify::a_priori::APrioriModel;
-use crate::certify::forest::forest_count_below;
+use crate::certify::forest::ForestPencil;
 use crate::certify::inertia::stiffness_is_definite;
 use crate::certify::products::PairProducts;
 use crate::certify::report::{AccuracyReport, BoundKind};
@@ -407,12 +407,15 @@ fn certify_positive_stiffness(problem: &PencilProblem, modes: &mut [Mode], par: 
 /// Decides the sign of undecided modes where A is diagonal and positive and B's pattern is a
 /// forest: the mode of ascending index k = `first` + its position is oscillatory when the count
 /// at s = ω²/2 > 0 proves at most k eigenvalues below s − m > 0, unstable when the count at
-/// s = ω²/2 < 0 proves at least k + 1 below s + m < 0 ([`forest_count_below`], Sylvester's law of
-/// inertia). Its interval is left as it is.
+/// s = ω²/2 < 0 proves at least k + 1 below s + m < 0 ([`ForestPencil::count_below`],
+/// Sylvester's law of inertia; the forest is formed once). Its interval is left as it is.
 fn sign_undecided_by_forest_counts(problem: &PencilProblem, modes: &mut [Mode], first: usize) {
     if !modes.iter().any(|m| m.kind == ModeKind::Undecided) {
         return;
     }
+    let Some(pencil) = ForestPencil::new(problem.a(), problem.b()) else {
+        return;
+    };
     for (position, mode) in modes.iter_mut().enumerate() {
         if mode.kind != ModeKind::Undecided {
             continue;
@@ -421,8 +424,8 @@ fn sign_undecided_by_forest_counts(problem: &PencilProblem, modes: &mut [Mode], 
         if shift == 0.0 {
             continue;
         }
-        let Some(count) = forest_count_below(problem.a(), problem.b(), shift) else {
-            return;
+        let Some(count) = pencil.count_below(shift) else {
+            continue;
         };
         if shift > 0.0 && shift - count.margin > 0.0 && count.below <= k {
             mode.kind = ModeKind::Oscillatory {
