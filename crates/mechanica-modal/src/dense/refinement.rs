@@ -7,7 +7,7 @@ use crate::certify::report::{AccuracyReport, BoundKind};
 use crate::certify::residual_bounds::{ModeBasis, RefinedResidual, residual_bounds, split_refined_clusters};
 use crate::certify::resolution::extended_roundings;
 use crate::dd::Operand;
-use crate::dense::options::{Refinement, weakly_bounded};
+use crate::dense::options::{AUTO_REFINE_RELATIVE_BOUND, Refinement, weakly_bounded};
 use crate::linalg::norms::euclidean_norm;
 use crate::refine::{
     Condensation, Metric, ReducedCorrection, ReducedSpectrum, RefinedCluster, RefinedPair, SparseShifts,
@@ -109,11 +109,13 @@ impl Stage<'_> {
 
     /// The clusters to refine: those the policy asks for (a weakly bounded member, or all under
     /// [`Refinement::Always`] and on a condensation whose first-order bounds are not to be
-    /// trusted, [`Condensation::perturbs_beyond_first_order`]) that refinement can take
-    /// ([`refinable`]).
+    /// trusted, its [`Condensation::relative_rounding`] above [`AUTO_REFINE_RELATIVE_BOUND`])
+    /// that refinement can take ([`refinable`]).
     fn jobs(&self, report: &AccuracyReport, omega: &[f64]) -> Vec<Range<usize>> {
         let every_mode = self.policy == Refinement::Always
-            || self.condensation.is_some_and(Condensation::perturbs_beyond_first_order);
+            || self
+                .condensation
+                .is_some_and(|c| c.relative_rounding() > AUTO_REFINE_RELATIVE_BOUND);
         let separation: Vec<f64> = match self.estimates {
             Some(estimates) => report
                 .error_bounds

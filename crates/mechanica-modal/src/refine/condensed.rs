@@ -65,15 +65,14 @@ impl Condensation {
         }
     }
 
-    /// Whether the rounding of the condensation, u·κ(B₀₀) relative, exceeds the accuracy that
-    /// `Refinement::Auto` asks of a first-order bound ([`crate::dense::AUTO_REFINE_RELATIVE_BOUND`]):
-    /// the condensed stiffness S is then perturbed along B₀₀'s nearly singular directions by
-    /// more than the first-order theory of the full pencil accounts for (a B₀₀ of condition
-    /// 1.6e10 gave a first-order bound of 5e-11 on a value 7e-10 off), and every mode is refined.
-    pub(crate) fn perturbs_beyond_first_order(&self) -> bool {
+    /// u·κ(B₀₀), the relative rounding of the condensation along B₀₀'s most nearly singular
+    /// direction: where it exceeds the accuracy asked of a first-order bound, the condensed
+    /// stiffness S is perturbed beyond what the first-order theory of the full pencil accounts
+    /// for (a B₀₀ of condition 1.6e10 gave a first-order bound of 5e-11 on a value 7e-10 off).
+    pub(crate) fn relative_rounding(&self) -> f64 {
         let dmin = self.d.iter().fold(f64::INFINITY, |m, v| m.min(v.abs()));
         let dmax = self.d.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        f64::EPSILON * dmax > crate::dense::AUTO_REFINE_RELATIVE_BOUND * dmin
+        f64::EPSILON * dmax / dmin
     }
 
     /// The residual s = r₁ − B₁₀B₀₀⁻¹r₀ of the condensed pencil, t = B₀₀⁻¹r₀, and ‖r₀‖, for a
