@@ -308,9 +308,10 @@ fn coordinates_without_entries_are_refused_before_allocation() {
 /// Fixed chains and trees of a thousand masses, where B's smallest eigenvalues fall below the
 /// rounding that a double-precision Cholesky factorization of B can resolve: no mode is zero
 /// or unstable (B stays positive definite under the rounding of every entry, proven by the
-/// forest elimination), and the lowest five values lie within their bounds and are right to
-/// 1e-8 relative, in every mode of use. The first seed is the work-precision report's chain,
-/// whose lowest mode was called zero before the forest proof.
+/// forest elimination), and the lowest five values lie within bounds of at most 1e-8
+/// relative, in every mode of use. The first seed is the work-precision report's chain, whose
+/// lowest mode was called zero before the forest proof, and whose residual bounds on its
+/// lowest four modes exceed the values (inertia enclosures give them 2e-11).
 #[test]
 fn fixed_systems_of_a_thousand_masses_have_no_zero_modes() {
     for (shape, seed, use_) in [
@@ -335,7 +336,7 @@ fn fixed_systems_of_a_thousand_masses_have_no_zero_modes() {
         for (k, exact) in lowest.iter().enumerate() {
             let error = (modes[k].omega_sq - exact).abs();
             assert!(
-                error <= modes[k].error_bound + 1e-24 * exact && error <= 1e-8 * exact,
+                error <= modes[k].error_bound + 1e-24 * exact && modes[k].error_bound <= 1e-8 * exact,
                 "{shape:?} seed {seed} {use_:?}: mode {k} ω² {:e} exact {exact:e} bound {:e}",
                 modes[k].omega_sq,
                 modes[k].error_bound

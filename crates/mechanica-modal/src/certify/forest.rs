@@ -64,23 +64,18 @@ pub(crate) fn forest_is_positive_definite(b: MatRef<'_, f64>) -> bool {
         row_sums[i] += v;
         row_sums[j] += v;
     }
-    let gamma = 16.0 * (n as f64 + 8.0) * times_power_of_two(1.0, -104);
-    let shift = 4.0 * gamma * row_sums.iter().fold(0.0_f64, |m, &s| m.max(s));
+    let shift = 4.0 * elimination_rounding(n) * row_sums.iter().fold(0.0_f64, |m, &s| m.max(s));
     let rounding = times_power_of_two(1.0, -53);
-    let mut pivot: Vec<Dd> = (0..n)
+    let pivots = (0..n)
         .map(|i| Dd::of(scaled(b[(i, i)])).minus(Dd::of(rounding * row_sums[i] + shift)))
         .collect();
-    for &node in forest.leaves_first.iter() {
-        let d = pivot[node];
-        if !(d.hi > 0.0 && d.hi.is_finite()) {
-            return false;
-        }
-        if let Some((parent, coupling)) = forest.parent[node] {
-            let c = Dd::of(scaled(coupling));
-            pivot[parent] = pivot[parent].minus(c.times(c).over(d));
-        }
-    }
-    true
+    forest.negative_pivots(pivots, scaled) == Some(0)
+}
+
+/// γ = 16(n + 8)·2⁻¹⁰⁴: the relative perturbation of B's entries that accounts for the
+/// double-double elimination of an order-n forest (module documentation).
+fn elimination_rounding(n: usize) -> f64 {
+    16.0 * (n as f64 + 8.0) * times_power_of_two(1.0, -104)
 }
 
 /// The number of eigenvalues of the pencil (B, A) below a shift s, for a diagonal A > 0 and a B
@@ -120,50 +115,116 @@ impl<'a> ForestPencil<'a> {
     /// [`ForestCount`] at `shift`; None when the shift or an entry is not finite, an entry is
     /// too small after scaling to be squared, or a pivot vanishes. O(n).
     pub(crate) fn count_below(&self, shift: f64) -> Option<ForestCount> {
-        let (b, masses, forest) = (self.b, &self.masses, &self.forest);
-        let n = b.nrows();
-        if !shift.is_finite() {
-            return None;
-        }
-        let largest = (0..n)
-            .map(|i| b[(i, i)].abs().max(shift.abs() * masses[i]))
-            .chain(forest.edges.iter().map(|e| e.2.abs()))
-            .fold(0.0_f64, f64::max);
-        if largest == 0.0 || !largest.is_finite() {
-            return None;
-        }
-        let scale = exponent(largest);
-        let scaled = |x: f64| times_power_of_two(x, -scale);
-        if forest.edges.iter().any(|e| scaled(e.2).abs() < SMALLEST_SCALED_ENTRY) {
-            return None;
-        }
-        let gamma = 16.0 * (n as f64 + 8.0) * times_power_of_two(1.0, -104);
-        let mut spread: Vec<f64> = (0..n)
-            .map(|i| 2.0 * gamma * (b[(i, i)].abs() + shift.abs() * masses[i]) / masses[i])
-            .collect();
-        for &(i, j, value) in &forest.edges {
-            let term = gamma * value.abs() / (masses[i].sqrt() * masses[j].sqrt());
-            spread[i] += term;
-            spread[j] += term;
-        }
-        let margin = spread.iter().fold(0.0_f64, |m, &v| m.max(v));
-        let mut pivot: Vec<Dd> = (0..n)
-            .map(|i| Dd::of(scaled(b[(i, i)])).minus(Dd::of(shift).times(Dd::of(scaled(masses[i])))))
-            .collect();
-        let mut below = 0;
-        for &node in forest.leaves_first.iter() {
-            let d = pivot[node];
-            if d.hi == 0.0 || !d.hi.is_finite() {
-                return None;
-            }
-            below += usize::from(d.hi < 0.0);
-            if let Some((parent, coupling)) = forest.parent[node] {
-                let c = Dd::of(scaled(coupling));
-                pivot[parent] = pivot[parent].minus(c.times(c).over(d));
-            }
-        }
-        margin.is_finite().then_some(ForestCount { below, margin })
+        count_below(self.b, &self.masses, &self.forest, shift)
     }
+
+    /// A relative margin ρ of the counts when B is proven positive definite: a count c at a
+    /// shift s > 0 then proves λ_{c+1} ≥ s(1 − ρ) and λ_c < s(1 + ρ) (eigenvalues ascending,
+    /// from 1). The elimination's perturbation of B is componentwise, |E_B| ≤ 2γ|B|, so with
+    /// B = DHD, D² = diag(B), it is at most η = 2γ‖|H|‖∞/λ_min(H) relative to B in the sense
+    /// of quadratic forms; that of A is 2γ relative, and ρ ≥ (η + 2γ)/(1 − η) (docs/theory.md,
+    /// §6, item 5). λ_min(H) ≥ t − m is proven by a count of zero for the pencil (B, diag(B))
+    /// at the first t = 2⁻ʲ that gives one, with its margin m. None when B has a non-positive diagonal entry or no
+    /// such t gives η below 10⁻³. O(n) per trial t.
+    pub(crate) fn relative_margin(&self) -> Option<f64> {
+        let (b, forest) = (self.b, &self.forest);
+        let n = b.nrows();
+        let diagonal: Vec<f64> = (0..n).map(|i| b[(i, i)]).collect();
+        if !diagonal.iter().all(|&d| d > 0.0 && d.is_finite()) {
+            return None;
+        }
+        let mut rows = vec![1.0_f64; n];
+        for &(i, j, value) in &forest.edges {
+            let h = value.abs() / (diagonal[i].sqrt() * diagonal[j].sqrt());
+            rows[i] += h;
+            rows[j] += h;
+        }
+        // Twice the computed ‖|H|‖∞ and twice each margin: room for their own rounding.
+        let coupling = 2.0 * rows.iter().fold(0.0_f64, |m, &r| m.max(r));
+        let gamma = elimination_rounding(n);
+        let mut t = 0.5_f64;
+        while 2.0 * gamma * coupling < 1e-3 * t {
+            // A vanishing pivot (t exactly an eigenvalue) only asks for another t.
+            let count = count_below(b, &diagonal, forest, t);
+            let smallest = count.as_ref().map_or(0.0, |c| t - 2.0 * c.margin);
+            if count.is_some_and(|c| c.below == 0) && smallest > 0.0 {
+                let eta = 2.0 * gamma * coupling / smallest;
+                return Some(2.0 * (eta + 2.0 * gamma) / (1.0 - eta));
+            }
+            t *= 0.5;
+        }
+        None
+    }
+
+    /// A proven bound e with the eigenvalue of ascending rank `rank` (from 0) in
+    /// [value − e, value + e]: counts below value·(1 ∓ r) of at most `rank` and at least
+    /// `rank` + 1, for the first r of 2⁻⁴⁸, 2⁻³⁶, 2⁻²⁴, 2⁻¹² that gives them, widened by the
+    /// counts' margins (`relative`, from [`ForestPencil::relative_margin`], for a positive
+    /// value, and each count's absolute margin) and by the rounding of the interval's ends. None for a zero or non-finite value, or when no r separates. At
+    /// most eight counts.
+    pub(crate) fn enclose(&self, rank: usize, value: f64, relative: Option<f64>) -> Option<f64> {
+        if value == 0.0 || !value.is_finite() {
+            return None;
+        }
+        let positive_margin = relative.filter(|_| value > 0.0);
+        for exponent in [-48, -36, -24, -12] {
+            let r = times_power_of_two(1.0, exponent);
+            let (low_shift, high_shift) = (value - r * value.abs(), value + r * value.abs());
+            let Some(low) = self.count_below(low_shift).filter(|c| c.below <= rank) else {
+                continue;
+            };
+            let Some(high) = self.count_below(high_shift).filter(|c| c.below > rank) else {
+                continue;
+            };
+            // Both margins hold: the tighter end of each is kept.
+            let (low_end, high_end) = match positive_margin {
+                Some(rho) => (
+                    (low_shift - low.margin).max(low_shift * (1.0 - rho)),
+                    (high_shift + high.margin).min(high_shift * (1.0 + rho)),
+                ),
+                None => (low_shift - low.margin, high_shift + high.margin),
+            };
+            let reach = (value - low_end).max(high_end - value);
+            return Some((reach + 2.0 * f64::EPSILON * value.abs()) * (1.0 + 2.0 * f64::EPSILON));
+        }
+        None
+    }
+}
+
+/// The count of [`ForestPencil::count_below`] for the pencil (B, diag(`masses`)) whose
+/// off-diagonal pattern is `forest`.
+fn count_below(b: MatRef<'_, f64>, masses: &[f64], forest: &Forest, shift: f64) -> Option<ForestCount> {
+    let n = b.nrows();
+    if !shift.is_finite() {
+        return None;
+    }
+    let largest = (0..n)
+        .map(|i| b[(i, i)].abs().max(shift.abs() * masses[i]))
+        .chain(forest.edges.iter().map(|e| e.2.abs()))
+        .fold(0.0_f64, f64::max);
+    if largest == 0.0 || !largest.is_finite() {
+        return None;
+    }
+    let scale = exponent(largest);
+    let scaled = |x: f64| times_power_of_two(x, -scale);
+    if forest.edges.iter().any(|e| scaled(e.2).abs() < SMALLEST_SCALED_ENTRY) {
+        return None;
+    }
+    let gamma = elimination_rounding(n);
+    let mut spread: Vec<f64> = (0..n)
+        .map(|i| 2.0 * gamma * (b[(i, i)].abs() + shift.abs() * masses[i]) / masses[i])
+        .collect();
+    for &(i, j, value) in &forest.edges {
+        let term = gamma * value.abs() / (masses[i].sqrt() * masses[j].sqrt());
+        spread[i] += term;
+        spread[j] += term;
+    }
+    let margin = spread.iter().fold(0.0_f64, |m, &v| m.max(v));
+    let pivots = (0..n)
+        .map(|i| Dd::of(scaled(b[(i, i)])).minus(Dd::of(shift).times(Dd::of(scaled(masses[i])))))
+        .collect();
+    let below = forest.negative_pivots(pivots, scaled)?;
+    margin.is_finite().then_some(ForestCount { below, margin })
 }
 
 /// The forest of B's off-diagonal pattern: its edges (i > j, b_ij ≠ 0), each coordinate's
@@ -229,6 +290,25 @@ impl Forest {
             leaves_first: order,
         })
     }
+
+    /// The number of negative pivots of the symmetric matrix with diagonal `pivots` and this
+    /// forest's couplings (each mapped by `scaled`), eliminated from the leaves in double-double
+    /// arithmetic without fill; None when a pivot is zero or not finite.
+    fn negative_pivots(&self, mut pivots: Vec<Dd>, scaled: impl Fn(f64) -> f64) -> Option<usize> {
+        let mut negative = 0;
+        for &node in &self.leaves_first {
+            let d = pivots[node];
+            if d.hi == 0.0 || !d.hi.is_finite() {
+                return None;
+            }
+            negative += usize::from(d.hi < 0.0);
+            if let Some((parent, coupling)) = self.parent[node] {
+                let c = Dd::of(scaled(coupling));
+                pivots[parent] = pivots[parent].minus(c.times(c).over(d));
+            }
+        }
+        Some(negative)
+    }
 }
 
 #[cfg(test)]
@@ -279,17 +359,12 @@ mod tests {
     /// B = S T S and A = S² with T the fixed chain (−1, 2, −1) of order n and S diagonal,
     /// graded at random over eight decades in either direction: the pencil's eigenvalues are
     /// T's, 2 − 2cos(kπ/(n + 1)), up to 4u from rounding the stored entries. A count inside
-    /// every gap (off its midpoint, where B − sA has exactly zero pivots), in any coordinate order (the chain renumbered at random), is
-    /// exact, and its margin is far inside the gap.
+    /// every gap (off its midpoint, where B − sA has exactly zero pivots), in any coordinate
+    /// order (the chain renumbered at random), is exact, and its margin is far inside the gap.
     #[test]
     fn counts_on_graded_chains_match_the_closed_form() {
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::testing::graded::SplitMix::new(0x2545_f491_4f6c_dd1d);
+        let mut uniform = move || rng.unit();
         for trial in 0..20 {
             let n = 8 + trial * 3;
             let scale: Vec<f64> = (0..n).map(|_| 10f64.powf(8.0 * uniform() - 4.0)).collect();
@@ -327,6 +402,60 @@ mod tests {
                     "trial {trial}: margin {:e}",
                     count.margin
                 );
+            }
+        }
+    }
+
+    /// B = S T S and A = S² with T the fixed chain (−1, 2, −1) of order n and S diagonal powers
+    /// of two over eight decades either way, renumbered at random: the stored pencil is exact
+    /// and its eigenvalues are 4 sin²(kπ/(2n + 2)), computed here to a few ulps. Each, offered
+    /// 1e-14 relative off with its rank, is enclosed within 1e-10 relative; offered with the
+    /// rank of a neighbour, any enclosure given still holds that neighbour's eigenvalue.
+    #[test]
+    fn enclosures_hold_the_eigenvalue_of_their_rank() {
+        let mut rng = crate::testing::graded::SplitMix::new(0x0e4c_1057);
+        for trial in 0..16 {
+            let n = 2 + rng.below(70);
+            let scale: Vec<f64> = (0..n)
+                .map(|_| times_power_of_two(1.0, rng.uniform(-26.5, 26.5).round() as i32))
+                .collect();
+            let mut order: Vec<usize> = (0..n).collect();
+            for i in (1..n).rev() {
+                order.swap(i, rng.below(i + 1));
+            }
+            let (mut a, mut b) = (Mat::<f64>::zeros(n, n), Mat::<f64>::zeros(n, n));
+            for i in 0..n {
+                let p = order[i];
+                a[(p, p)] = scale[i] * scale[i];
+                b[(p, p)] = 2.0 * scale[i] * scale[i];
+                if i + 1 < n {
+                    let q = order[i + 1];
+                    b[(p, q)] = -scale[i] * scale[i + 1];
+                    b[(q, p)] = b[(p, q)];
+                }
+            }
+            let exact: Vec<f64> = (1..=n)
+                .map(|k| 4.0 * (k as f64 * std::f64::consts::PI / (2 * n + 2) as f64).sin().powi(2))
+                .collect();
+            let pencil = ForestPencil::new(a.as_ref(), b.as_ref()).expect("a forest with positive masses");
+            let relative = pencil.relative_margin();
+            assert!(relative.is_some_and(|r| r < 1e-16), "trial {trial}: {relative:?}");
+            for (k, &w) in exact.iter().enumerate() {
+                let value = w * (1.0 + rng.uniform(-1e-14, 1e-14));
+                let bound = pencil.enclose(k, value, relative).expect("an enclosure");
+                assert!(
+                    (value - w).abs() <= bound + 8.0 * f64::EPSILON * w,
+                    "trial {trial} rank {k}"
+                );
+                assert!(bound <= 1e-10 * w, "trial {trial} rank {k}: bound {bound:e} on {w:e}");
+                for other in [k.wrapping_sub(1), k + 1].into_iter().filter(|&o| o < n) {
+                    if let Some(bound) = pencil.enclose(other, value, relative) {
+                        assert!(
+                            (value - exact[other]).abs() <= bound,
+                            "trial {trial}: rank {other} at {value:e}"
+                        );
+                    }
+                }
             }
         }
     }

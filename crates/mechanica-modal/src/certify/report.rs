@@ -27,6 +27,9 @@ pub enum BoundKind {
     APriori,
     /// Residual / Kato–Temple bound from an extended-precision residual (refined modes).
     Residual,
+    /// An enclosure of the eigenvalue of the mode's rank by two inertia counts (Sylvester's
+    /// law on B − sA eliminated in double-double), where A is diagonal and B's pattern a forest.
+    Inertia,
 }
 
 /// Accuracy of every number of a [`crate::ModalSolution`]; per-mode vectors are in mode order.

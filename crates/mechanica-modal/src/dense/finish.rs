@@ -117,6 +117,9 @@ impl Finish<'_> {
             idle.certificate,
             self.par,
         )?;
+        if self.options.refinement != Refinement::Off {
+            enclose_weak_modes_by_forest_counts(self.problem, &mut report, &omega, first);
+        }
         timings.inertia = clock.elapsed();
         let resolution = self.resolution(x.as_ref(), a_priori, &omega, measured_resolution);
         if !self.options.vectors {
@@ -343,7 +346,8 @@ fn widen_overlapping_estimates(modes: &mut [Mode], report: &mut AccuracyReport) 
             .iter()
             .map(|m| m.omega_sq - m.error_bound)
             .fold(f64::INFINITY, f64::min);
-        for k in (start..end).filter(|&k| end - start > 1 && report.bound_kinds[k] != BoundKind::Residual) {
+        let rank_proven = |k: usize| matches!(report.bound_kinds[k], BoundKind::Residual | BoundKind::Inertia);
+        for k in (start..end).filter(|&k| end - start > 1 && !rank_proven(k)) {
             let mode = &mut modes[k];
             let widened = (mode.omega_sq - low).max(reach - mode.omega_sq).max(mode.error_bound);
             if widened > mode.error_bound {
@@ -435,6 +439,45 @@ fn sign_undecided_by_forest_counts(problem: &PencilProblem, modes: &mut [Mode], 
             mode.kind = ModeKind::Unstable {
                 growth_rate: (-mode.omega_sq).sqrt(),
             };
+        }
+    }
+}
+
+/// Replaces the bound of each weakly bounded mode ([`weakly_bounded`]) by an inertia enclosure
+/// of the eigenvalue of its rank where that is tighter ([`ForestPencil::enclose`]; A diagonal
+/// and positive, B's pattern a forest): the rank of ω²_i is `first` plus its place among the
+/// selected values in ascending order. Residual bounds of modes left near the reduction's error
+/// level (low modes of graded chains of a thousand masses) can exceed the value itself; the
+/// counts place those eigenvalues to a few units of 2⁻⁴⁸ relative. Classification follows the
+/// new bound.
+fn enclose_weak_modes_by_forest_counts(
+    problem: &PencilProblem,
+    report: &mut AccuracyReport,
+    omega: &[f64],
+    first: usize,
+) {
+    let weak: Vec<usize> = (0..omega.len())
+        .filter(|&i| weakly_bounded(report.error_bounds[i], omega[i]))
+        .collect();
+    if weak.is_empty() {
+        return;
+    }
+    let Some(pencil) = ForestPencil::new(problem.a(), problem.b()) else {
+        return;
+    };
+    let relative = pencil.relative_margin();
+    let mut order: Vec<usize> = (0..omega.len()).collect();
+    order.sort_by(|&p, &q| omega[p].total_cmp(&omega[q]));
+    let mut rank = vec![0; omega.len()];
+    for (place, &i) in order.iter().enumerate() {
+        rank[i] = first + place;
+    }
+    for i in weak {
+        if let Some(bound) = pencil.enclose(rank[i], omega[i], relative)
+            && bound < report.error_bounds[i]
+        {
+            report.error_bounds[i] = bound;
+            report.bound_kinds[i] = BoundKind::Inertia;
         }
     }
 }

@@ -354,13 +354,8 @@ mod tests {
     /// back as the same entries, for random sizes with random zero entries.
     #[test]
     fn array_files_read_as_their_coordinate_twins() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rng = crate::testing::graded::SplitMix::new(0x2545_f491_4f6c_dd1d);
+        let mut next = move || rng.next_u64();
         for _ in 0..40 {
             let n = 1 + (next() % 7) as usize;
             let mut dense = vec![0.0; n * n];
