@@ -443,13 +443,17 @@ fn sign_undecided_by_forest_counts(problem: &PencilProblem, modes: &mut [Mode], 
     }
 }
 
-/// Replaces the bound of each weakly bounded mode ([`weakly_bounded`]) by an inertia enclosure
-/// of the eigenvalue of its rank where that is tighter ([`ForestPencil::enclose`]; A diagonal
-/// and positive, B's pattern a forest): the rank of ω²_i is `first` plus its place among the
-/// selected values in ascending order. Residual bounds of modes left near the reduction's error
-/// level (low modes of graded chains of a thousand masses) can exceed the value itself; the
-/// counts place those eigenvalues to a few units of 2⁻⁴⁸ relative. Classification follows the
-/// new bound.
+/// Replaces the bound of each refined mode still weakly bounded ([`weakly_bounded`]) by an
+/// inertia enclosure of the eigenvalue of its rank where that is tighter
+/// ([`ForestPencil::enclose`]; A diagonal and positive, B's pattern a forest): the rank of ω²_i
+/// is `first` plus its place among the selected values in ascending order. Residual bounds of
+/// refined modes near the reduction's error level (low modes of graded chains of a thousand
+/// masses) can exceed the value itself, although the value is right, and a refinement whose
+/// residual interval could not be accepted keeps the reduction's bound; the counts place those
+/// eigenvalues to a few units of 2⁻⁴⁸ relative where the pencil's margins allow. Modes left
+/// unrefined (beyond the budget of `Refinement::Auto`) are not offered: their values are not
+/// accurate enough for a narrow enclosure, and up to eight O(n) counts each would cost more
+/// than their refinement. Classification follows the new bound.
 fn enclose_weak_modes_by_forest_counts(
     problem: &PencilProblem,
     report: &mut AccuracyReport,
@@ -457,7 +461,7 @@ fn enclose_weak_modes_by_forest_counts(
     first: usize,
 ) {
     let weak: Vec<usize> = (0..omega.len())
-        .filter(|&i| weakly_bounded(report.error_bounds[i], omega[i]))
+        .filter(|&i| report.refinement_steps[i] > 0 && weakly_bounded(report.error_bounds[i], omega[i]))
         .collect();
     if weak.is_empty() {
         return;
