@@ -349,7 +349,9 @@ fn fixed_systems_of_a_thousand_masses_have_no_zero_modes() {
 /// positive definite stiffness asks for room for the rounding of every entry, which a free
 /// structure's assembled stiffness (singular up to that rounding) never has. The next modes are
 /// oscillatory: where their intervals chain with the zero mode's wide one (the chain's members
-/// share its bound), an inertia count of the forest B − sA orders them above it.
+/// share its bound), an inertia count of the forest B − sA orders them above it, and the four
+/// above the zero mode lie within bounds of at most 1e-8 relative (inertia enclosures with a
+/// margin relative to B + ω²A).
 #[test]
 fn free_systems_of_a_thousand_masses_keep_one_zero_mode() {
     for (shape, seed, use_) in [
@@ -365,5 +367,15 @@ fn free_systems_of_a_thousand_masses_keep_one_zero_mode() {
             kinds[0] == ModeKind::Zero && kinds[1..].iter().all(|k| matches!(k, ModeKind::Oscillatory { .. })),
             "{shape:?} seed {seed} {use_:?}: lowest kinds {kinds:?}"
         );
+        let lowest = mechanica_modal::testing::graded::tree_pencil_lowest(&system, 5);
+        for (k, exact) in lowest.iter().enumerate().skip(1) {
+            let error = (modes[k].omega_sq - exact).abs();
+            assert!(
+                error <= modes[k].error_bound + 1e-24 * exact && modes[k].error_bound <= 1e-8 * exact,
+                "{shape:?} seed {seed} {use_:?}: mode {k} ω² {:e} exact {exact:e} bound {:e}",
+                modes[k].omega_sq,
+                modes[k].error_bound
+            );
+        }
     }
 }

@@ -118,18 +118,29 @@ impl<'a> ForestPencil<'a> {
         count_below(self.b, &self.masses, &self.forest, shift)
     }
 
-    /// A relative margin ρ of the counts when B is proven positive definite: a count c at a
-    /// shift s > 0 then proves λ_{c+1} ≥ s(1 − ρ) and λ_c < s(1 + ρ) (eigenvalues ascending,
-    /// from 1). The elimination's perturbation of B is componentwise, |E_B| ≤ 2γ|B|, so with
-    /// B = DHD, D² = diag(B), it is at most η = 2γ‖|H|‖∞/λ_min(H) relative to B in the sense
-    /// of quadratic forms; that of A is 2γ relative, and ρ ≥ (η + 2γ)/(1 − η) (docs/theory.md,
-    /// §6, item 5). λ_min(H) ≥ t − m is proven by a count of zero for the pencil (B, diag(B))
-    /// at the first t = 2⁻ʲ that gives one, with its margin m. None when B has a non-positive diagonal entry or no
-    /// such t gives η below 10⁻³. O(n) per trial t.
-    pub(crate) fn relative_margin(&self) -> Option<f64> {
+    /// A relative margin of the counts with respect to the shifted pencil (B + σA, A), whose
+    /// eigenvalues are λ + σ, for σ ≥ 0 and B with a non-negative diagonal: a count c at a
+    /// shift s ≥ 0 then proves λ_{c+1} ≥ s − (s + σ)ρ and λ_c < s + (s + σ)ρ (eigenvalues
+    /// ascending, from 1). The elimination's perturbation of B is componentwise,
+    /// |E_B| ≤ 2γ|B| ≤ 2γ|B + σA|, so with B + σA = DHD, D² = diag(B + σA), it is at most
+    /// η = 2γ‖|H|‖∞/λ_min(H) relative to B + σA in the sense of quadratic forms; that of A is
+    /// at most 2γs/(s + σ) ≤ 2γ relative, and ρ ≥ (η + 2γ)/(1 − η) (docs/theory.md, §6,
+    /// item 5, "Inertia enclosures"). λ_min(H) ≥ t − m is proven by a count of zero for
+    /// (B + σA) − t·diag(B + σA), diagonal formed in double-double, at the first t = 2⁻ʲ from
+    /// `start` down that gives one. A shift σ near the mode makes H far better conditioned than
+    /// diag(B)^{-1/2}B diag(B)^{-1/2} where B is singular up to rounding (free structures).
+    /// None when σ or B's diagonal is negative or not finite, or no t gives η below 10⁻³.
+    /// O(n) per trial t.
+    pub(crate) fn relative_margin(&self, sigma: f64, start: f64) -> Option<ShiftedMargin> {
         let (b, forest) = (self.b, &self.forest);
         let n = b.nrows();
-        let diagonal: Vec<f64> = (0..n).map(|i| b[(i, i)]).collect();
+        if !(sigma >= 0.0 && sigma.is_finite() && (0..n).all(|i| b[(i, i)] >= 0.0)) {
+            return None;
+        }
+        let shifted: Vec<Dd> = (0..n)
+            .map(|i| Dd::of(b[(i, i)]).plus(Dd::of(sigma).times(Dd::of(self.masses[i]))))
+            .collect();
+        let diagonal: Vec<f64> = shifted.iter().map(|d| d.hi).collect();
         if !diagonal.iter().all(|&d| d > 0.0 && d.is_finite()) {
             return None;
         }
@@ -139,17 +150,35 @@ impl<'a> ForestPencil<'a> {
             rows[i] += h;
             rows[j] += h;
         }
-        // Twice the computed ‖|H|‖∞ and twice each margin: room for their own rounding.
+        // Twice the computed ‖|H|‖∞, and a count margin 2γ(2 + that) in H's units (the
+        // diagonal perturbed by 2γ·2d_i, each coupling by γ|h_ij| from both rows): room for
+        // their own rounding.
         let coupling = 2.0 * rows.iter().fold(0.0_f64, |m, &r| m.max(r));
         let gamma = elimination_rounding(n);
-        let mut t = 0.5_f64;
+        let count_margin = 2.0 * gamma * (2.0 + coupling);
+        let largest = diagonal
+            .iter()
+            .copied()
+            .chain(forest.edges.iter().map(|e| e.2.abs()))
+            .fold(0.0_f64, f64::max);
+        let scale = exponent(largest);
+        let scaled = |x: f64| times_power_of_two(x, -scale);
+        if forest.edges.iter().any(|e| scaled(e.2).abs() < SMALLEST_SCALED_ENTRY) {
+            return None;
+        }
+        let mut t = start.min(0.5);
         while 2.0 * gamma * coupling < 1e-3 * t {
+            let one_minus_t = Dd::of(1.0).minus(Dd::of(t));
+            let pivots = shifted
+                .iter()
+                .map(|d| Dd::of(scaled(d.hi)).plus(Dd::of(scaled(d.lo))).times(one_minus_t))
+                .collect();
             // A vanishing pivot (t exactly an eigenvalue) only asks for another t.
-            let count = count_below(b, &diagonal, forest, t);
-            let smallest = count.as_ref().map_or(0.0, |c| t - 2.0 * c.margin);
-            if count.is_some_and(|c| c.below == 0) && smallest > 0.0 {
+            let smallest = t - count_margin;
+            if forest.negative_pivots(pivots, scaled) == Some(0) && smallest > 0.0 {
                 let eta = 2.0 * gamma * coupling / smallest;
-                return Some(2.0 * (eta + 2.0 * gamma) / (1.0 - eta));
+                let rho = 2.0 * (eta + 2.0 * gamma) / (1.0 - eta);
+                return Some(ShiftedMargin { sigma, rho, floor: t });
             }
             t *= 0.5;
         }
@@ -159,14 +188,14 @@ impl<'a> ForestPencil<'a> {
     /// A proven bound e with the eigenvalue of ascending rank `rank` (from 0) in
     /// [value − e, value + e]: counts below value·(1 ∓ r) of at most `rank` and at least
     /// `rank` + 1, for the first r of 2⁻⁴⁸, 2⁻³⁶, 2⁻²⁴, 2⁻¹² that gives them, widened by the
-    /// counts' margins (`relative`, from [`ForestPencil::relative_margin`], for a positive
-    /// value, and each count's absolute margin) and by the rounding of the interval's ends. None for a zero or non-finite value, or when no r separates. At
-    /// most eight counts.
-    pub(crate) fn enclose(&self, rank: usize, value: f64, relative: Option<f64>) -> Option<f64> {
+    /// counts' margins (each count's absolute margin, and for non-negative shifts the relative
+    /// one of `relative`, from [`ForestPencil::relative_margin`]; the tighter end is kept) and
+    /// by the rounding of the interval's ends. None for a zero or non-finite value, or when no
+    /// r separates. At most eight counts.
+    pub(crate) fn enclose(&self, rank: usize, value: f64, relative: Option<ShiftedMargin>) -> Option<f64> {
         if value == 0.0 || !value.is_finite() {
             return None;
         }
-        let positive_margin = relative.filter(|_| value > 0.0);
         for exponent in [-48, -36, -24, -12] {
             let r = times_power_of_two(1.0, exponent);
             let (low_shift, high_shift) = (value - r * value.abs(), value + r * value.abs());
@@ -176,19 +205,32 @@ impl<'a> ForestPencil<'a> {
             let Some(high) = self.count_below(high_shift).filter(|c| c.below > rank) else {
                 continue;
             };
-            // Both margins hold: the tighter end of each is kept.
-            let (low_end, high_end) = match positive_margin {
-                Some(rho) => (
-                    (low_shift - low.margin).max(low_shift * (1.0 - rho)),
-                    (high_shift + high.margin).min(high_shift * (1.0 + rho)),
-                ),
-                None => (low_shift - low.margin, high_shift + high.margin),
-            };
+            let mut low_end = low_shift - low.margin;
+            let mut high_end = high_shift + high.margin;
+            if let Some(m) = relative {
+                if low_shift >= 0.0 {
+                    low_end = low_end.max(low_shift - (low_shift + m.sigma) * m.rho);
+                }
+                if high_shift >= 0.0 {
+                    high_end = high_end.min(high_shift + (high_shift + m.sigma) * m.rho);
+                }
+            }
             let reach = (value - low_end).max(high_end - value);
-            return Some((reach + 2.0 * f64::EPSILON * value.abs()) * (1.0 + 2.0 * f64::EPSILON));
+            let rounding = 2.0 * f64::EPSILON * (value.abs() + relative.map_or(0.0, |m| m.sigma * m.rho));
+            return Some((reach + rounding) * (1.0 + 2.0 * f64::EPSILON));
         }
         None
     }
+}
+
+/// The relative margin ρ of [`ForestPencil::relative_margin`] for the shift σ, and the t at
+/// which λ_min(H) was proven (a start for the next, larger σ: λ_min(H) does not fall as σ
+/// grows while it is below 1).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ShiftedMargin {
+    pub(crate) sigma: f64,
+    pub(crate) rho: f64,
+    pub(crate) floor: f64,
 }
 
 /// The count of [`ForestPencil::count_below`] for the pencil (B, diag(`masses`)) whose
@@ -438,8 +480,8 @@ mod tests {
                 .map(|k| 4.0 * (k as f64 * std::f64::consts::PI / (2 * n + 2) as f64).sin().powi(2))
                 .collect();
             let pencil = ForestPencil::new(a.as_ref(), b.as_ref()).expect("a forest with positive masses");
-            let relative = pencil.relative_margin();
-            assert!(relative.is_some_and(|r| r < 1e-16), "trial {trial}: {relative:?}");
+            let relative = pencil.relative_margin(0.0, 0.5);
+            assert!(relative.is_some_and(|m| m.rho < 1e-16), "trial {trial}: {relative:?}");
             for (k, &w) in exact.iter().enumerate() {
                 let value = w * (1.0 + rng.uniform(-1e-14, 1e-14));
                 let bound = pencil.enclose(k, value, relative).expect("an enclosure");
@@ -456,6 +498,54 @@ mod tests {
                         );
                     }
                 }
+            }
+        }
+    }
+
+    /// The free chain (B singular: diagonal 1, 2, …, 2, 1 and −1 beside it) scaled by powers
+    /// of two over eight decades either way and renumbered at random, stored exactly, has the
+    /// eigenvalues 4 sin²(kπ/(2n)), k = 0 … n − 1. Unshifted, no relative margin exists (the
+    /// rigid-body mode makes H singular); shifted by each nonzero eigenvalue, the enclosures
+    /// of that eigenvalue are within 1e-9 relative and hold it.
+    #[test]
+    fn shifted_margins_enclose_the_modes_of_a_free_chain() {
+        let mut rng = crate::testing::graded::SplitMix::new(0xf4ee_c4a1);
+        for trial in 0..12 {
+            let n = 3 + rng.below(60);
+            let scale: Vec<f64> = (0..n)
+                .map(|_| times_power_of_two(1.0, rng.uniform(-26.5, 26.5).round() as i32))
+                .collect();
+            let mut order: Vec<usize> = (0..n).collect();
+            for i in (1..n).rev() {
+                order.swap(i, rng.below(i + 1));
+            }
+            let (mut a, mut b) = (Mat::<f64>::zeros(n, n), Mat::<f64>::zeros(n, n));
+            for i in 0..n {
+                let p = order[i];
+                let ends = usize::from(i > 0) + usize::from(i + 1 < n);
+                a[(p, p)] = scale[i] * scale[i];
+                b[(p, p)] = ends as f64 * scale[i] * scale[i];
+                if i + 1 < n {
+                    let q = order[i + 1];
+                    b[(p, q)] = -scale[i] * scale[i + 1];
+                    b[(q, p)] = b[(p, q)];
+                }
+            }
+            let exact: Vec<f64> = (0..n)
+                .map(|k| 4.0 * (k as f64 * std::f64::consts::PI / (2 * n) as f64).sin().powi(2))
+                .collect();
+            let pencil = ForestPencil::new(a.as_ref(), b.as_ref()).expect("a forest with positive masses");
+            assert!(pencil.relative_margin(0.0, 0.5).is_none(), "trial {trial}");
+            for (k, &w) in exact.iter().enumerate().skip(1) {
+                let relative = pencil.relative_margin(w, 0.5);
+                assert!(relative.is_some(), "trial {trial} rank {k}");
+                let value = w * (1.0 + rng.uniform(-1e-14, 1e-14));
+                let bound = pencil.enclose(k, value, relative).expect("an enclosure");
+                assert!(
+                    (value - w).abs() <= bound + 8.0 * f64::EPSILON * w,
+                    "trial {trial} rank {k}"
+                );
+                assert!(bound <= 1e-9 * w, "trial {trial} rank {k}: bound {bound:e} on {w:e}");
             }
         }
     }

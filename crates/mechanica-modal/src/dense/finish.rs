@@ -469,14 +469,19 @@ fn enclose_weak_modes_by_forest_counts(
     let Some(pencil) = ForestPencil::new(problem.a(), problem.b()) else {
         return;
     };
-    let relative = pencil.relative_margin();
     let mut order: Vec<usize> = (0..omega.len()).collect();
     order.sort_by(|&p, &q| omega[p].total_cmp(&omega[q]));
     let mut rank = vec![0; omega.len()];
     for (place, &i) in order.iter().enumerate() {
         rank[i] = first + place;
     }
+    // Ascending, so that each shifted margin starts its search where the last one ended.
+    let mut weak = weak;
+    weak.sort_by(|&p, &q| omega[p].total_cmp(&omega[q]));
+    let mut start = 0.5_f64;
     for i in weak {
+        let relative = pencil.relative_margin(omega[i].max(0.0), (1024.0 * start).min(0.5));
+        start = relative.map_or(start, |m| m.floor);
         if let Some(bound) = pencil.enclose(rank[i], omega[i], relative)
             && bound < report.error_bounds[i]
         {
