@@ -448,6 +448,32 @@ mod tests {
         }
     }
 
+    /// A = S², B = S T S for the chain T of order n (−1 beside the diagonal; 2 on it when
+    /// `fixed`, else the number of neighbours), S diagonal powers of two over eight decades
+    /// either way, coordinates renumbered at random: stored exactly.
+    fn power_of_two_chain(rng: &mut crate::testing::graded::SplitMix, n: usize, fixed: bool) -> (Mat<f64>, Mat<f64>) {
+        let scale: Vec<f64> = (0..n)
+            .map(|_| times_power_of_two(1.0, rng.uniform(-26.5, 26.5).round() as i32))
+            .collect();
+        let mut order: Vec<usize> = (0..n).collect();
+        for i in (1..n).rev() {
+            order.swap(i, rng.below(i + 1));
+        }
+        let (mut a, mut b) = (Mat::<f64>::zeros(n, n), Mat::<f64>::zeros(n, n));
+        for i in 0..n {
+            let p = order[i];
+            let neighbours = usize::from(i > 0) + usize::from(i + 1 < n);
+            a[(p, p)] = scale[i] * scale[i];
+            b[(p, p)] = if fixed { 2.0 } else { neighbours as f64 } * scale[i] * scale[i];
+            if i + 1 < n {
+                let q = order[i + 1];
+                b[(p, q)] = -scale[i] * scale[i + 1];
+                b[(q, p)] = b[(p, q)];
+            }
+        }
+        (a, b)
+    }
+
     /// B = S T S and A = S² with T the fixed chain (−1, 2, −1) of order n and S diagonal powers
     /// of two over eight decades either way, renumbered at random: the stored pencil is exact
     /// and its eigenvalues are 4 sin²(kπ/(2n + 2)), computed here to a few ulps. Each, offered
@@ -458,24 +484,7 @@ mod tests {
         let mut rng = crate::testing::graded::SplitMix::new(0x0e4c_1057);
         for trial in 0..16 {
             let n = 2 + rng.below(70);
-            let scale: Vec<f64> = (0..n)
-                .map(|_| times_power_of_two(1.0, rng.uniform(-26.5, 26.5).round() as i32))
-                .collect();
-            let mut order: Vec<usize> = (0..n).collect();
-            for i in (1..n).rev() {
-                order.swap(i, rng.below(i + 1));
-            }
-            let (mut a, mut b) = (Mat::<f64>::zeros(n, n), Mat::<f64>::zeros(n, n));
-            for i in 0..n {
-                let p = order[i];
-                a[(p, p)] = scale[i] * scale[i];
-                b[(p, p)] = 2.0 * scale[i] * scale[i];
-                if i + 1 < n {
-                    let q = order[i + 1];
-                    b[(p, q)] = -scale[i] * scale[i + 1];
-                    b[(q, p)] = b[(p, q)];
-                }
-            }
+            let (a, b) = power_of_two_chain(&mut rng, n, true);
             let exact: Vec<f64> = (1..=n)
                 .map(|k| 4.0 * (k as f64 * std::f64::consts::PI / (2 * n + 2) as f64).sin().powi(2))
                 .collect();
@@ -512,25 +521,7 @@ mod tests {
         let mut rng = crate::testing::graded::SplitMix::new(0xf4ee_c4a1);
         for trial in 0..12 {
             let n = 3 + rng.below(60);
-            let scale: Vec<f64> = (0..n)
-                .map(|_| times_power_of_two(1.0, rng.uniform(-26.5, 26.5).round() as i32))
-                .collect();
-            let mut order: Vec<usize> = (0..n).collect();
-            for i in (1..n).rev() {
-                order.swap(i, rng.below(i + 1));
-            }
-            let (mut a, mut b) = (Mat::<f64>::zeros(n, n), Mat::<f64>::zeros(n, n));
-            for i in 0..n {
-                let p = order[i];
-                let ends = usize::from(i > 0) + usize::from(i + 1 < n);
-                a[(p, p)] = scale[i] * scale[i];
-                b[(p, p)] = ends as f64 * scale[i] * scale[i];
-                if i + 1 < n {
-                    let q = order[i + 1];
-                    b[(p, q)] = -scale[i] * scale[i + 1];
-                    b[(q, p)] = b[(p, q)];
-                }
-            }
+            let (a, b) = power_of_two_chain(&mut rng, n, false);
             let exact: Vec<f64> = (0..n)
                 .map(|k| 4.0 * (k as f64 * std::f64::consts::PI / (2 * n) as f64).sin().powi(2))
                 .collect();
