@@ -460,7 +460,7 @@ fn enclose_weak_modes_by_forest_counts(
     omega: &[f64],
     first: usize,
 ) {
-    let weak: Vec<usize> = (0..omega.len())
+    let mut weak: Vec<usize> = (0..omega.len())
         .filter(|&i| report.refinement_steps[i] > 0 && weakly_bounded(report.error_bounds[i], omega[i]))
         .collect();
     if weak.is_empty() {
@@ -476,7 +476,6 @@ fn enclose_weak_modes_by_forest_counts(
         rank[i] = first + place;
     }
     // Ascending, so that each shifted margin starts its search where the last one ended.
-    let mut weak = weak;
     weak.sort_by(|&p, &q| omega[p].total_cmp(&omega[q]));
     let mut start = 0.5_f64;
     for i in weak {
