@@ -44,23 +44,13 @@ pub(crate) fn forest_is_positive_definite(b: MatRef<'_, f64>) -> bool {
     let Some(forest) = Forest::of(b) else {
         return false;
     };
-    let largest = forest
-        .edges
-        .iter()
-        .map(|e| e.2.abs())
-        .chain((0..n).map(|i| b[(i, i)].abs()))
-        .fold(0.0_f64, f64::max);
-    if largest == 0.0 || !largest.is_finite() {
+    let Some(scale) = forest.scale((0..n).map(|i| b[(i, i)].abs()).fold(0.0_f64, f64::max)) else {
         return false;
-    }
-    let scale = exponent(largest);
+    };
     let scaled = |x: f64| times_power_of_two(x, -scale);
     let mut row_sums: Vec<f64> = (0..n).map(|i| scaled(b[(i, i)]).abs()).collect();
     for &(i, j, value) in &forest.edges {
         let v = scaled(value).abs();
-        if v < SMALLEST_SCALED_ENTRY {
-            return false;
-        }
         row_sums[i] += v;
         row_sums[j] += v;
     }
@@ -115,7 +105,31 @@ impl<'a> ForestPencil<'a> {
     /// [`ForestCount`] at `shift`; None when the shift or an entry is not finite, an entry is
     /// too small after scaling to be squared, or a pivot vanishes. O(n).
     pub(crate) fn count_below(&self, shift: f64) -> Option<ForestCount> {
-        count_below(self.b, &self.masses, &self.forest, shift)
+        let (b, masses, forest) = (self.b, &self.masses, &self.forest);
+        let n = b.nrows();
+        if !shift.is_finite() {
+            return None;
+        }
+        let diagonal_largest = (0..n)
+            .map(|i| b[(i, i)].abs().max(shift.abs() * masses[i]))
+            .fold(0.0_f64, f64::max);
+        let scale = forest.scale(diagonal_largest)?;
+        let scaled = |x: f64| times_power_of_two(x, -scale);
+        let gamma = elimination_rounding(n);
+        let mut spread: Vec<f64> = (0..n)
+            .map(|i| 2.0 * gamma * (b[(i, i)].abs() + shift.abs() * masses[i]) / masses[i])
+            .collect();
+        for &(i, j, value) in &forest.edges {
+            let term = gamma * value.abs() / (masses[i].sqrt() * masses[j].sqrt());
+            spread[i] += term;
+            spread[j] += term;
+        }
+        let margin = spread.iter().fold(0.0_f64, |m, &v| m.max(v));
+        let pivots = (0..n)
+            .map(|i| Dd::of(scaled(b[(i, i)])).minus(Dd::of(shift).times(Dd::of(scaled(masses[i])))))
+            .collect();
+        let below = forest.negative_pivots(pivots, scaled)?;
+        margin.is_finite().then_some(ForestCount { below, margin })
     }
 
     /// A relative margin of the counts with respect to the shifted pencil (B + σA, A), whose
@@ -156,16 +170,8 @@ impl<'a> ForestPencil<'a> {
         let coupling = 2.0 * rows.iter().fold(0.0_f64, |m, &r| m.max(r));
         let gamma = elimination_rounding(n);
         let count_margin = 2.0 * gamma * (2.0 + coupling);
-        let largest = diagonal
-            .iter()
-            .copied()
-            .chain(forest.edges.iter().map(|e| e.2.abs()))
-            .fold(0.0_f64, f64::max);
-        let scale = exponent(largest);
+        let scale = forest.scale(diagonal.iter().copied().fold(0.0_f64, f64::max))?;
         let scaled = |x: f64| times_power_of_two(x, -scale);
-        if forest.edges.iter().any(|e| scaled(e.2).abs() < SMALLEST_SCALED_ENTRY) {
-            return None;
-        }
         let mut t = start.min(0.5);
         while 2.0 * gamma * coupling < 1e-3 * t {
             let one_minus_t = Dd::of(1.0).minus(Dd::of(t));
@@ -233,42 +239,6 @@ pub(crate) struct ShiftedMargin {
     pub(crate) floor: f64,
 }
 
-/// The count of [`ForestPencil::count_below`] for the pencil (B, diag(`masses`)) whose
-/// off-diagonal pattern is `forest`.
-fn count_below(b: MatRef<'_, f64>, masses: &[f64], forest: &Forest, shift: f64) -> Option<ForestCount> {
-    let n = b.nrows();
-    if !shift.is_finite() {
-        return None;
-    }
-    let largest = (0..n)
-        .map(|i| b[(i, i)].abs().max(shift.abs() * masses[i]))
-        .chain(forest.edges.iter().map(|e| e.2.abs()))
-        .fold(0.0_f64, f64::max);
-    if largest == 0.0 || !largest.is_finite() {
-        return None;
-    }
-    let scale = exponent(largest);
-    let scaled = |x: f64| times_power_of_two(x, -scale);
-    if forest.edges.iter().any(|e| scaled(e.2).abs() < SMALLEST_SCALED_ENTRY) {
-        return None;
-    }
-    let gamma = elimination_rounding(n);
-    let mut spread: Vec<f64> = (0..n)
-        .map(|i| 2.0 * gamma * (b[(i, i)].abs() + shift.abs() * masses[i]) / masses[i])
-        .collect();
-    for &(i, j, value) in &forest.edges {
-        let term = gamma * value.abs() / (masses[i].sqrt() * masses[j].sqrt());
-        spread[i] += term;
-        spread[j] += term;
-    }
-    let margin = spread.iter().fold(0.0_f64, |m, &v| m.max(v));
-    let pivots = (0..n)
-        .map(|i| Dd::of(scaled(b[(i, i)])).minus(Dd::of(shift).times(Dd::of(scaled(masses[i])))))
-        .collect();
-    let below = forest.negative_pivots(pivots, scaled)?;
-    margin.is_finite().then_some(ForestCount { below, margin })
-}
-
 /// The forest of B's off-diagonal pattern: its edges (i > j, b_ij ≠ 0), each coordinate's
 /// parent with the coupling b_ip, and an order with every child before its parent.
 struct Forest {
@@ -331,6 +301,19 @@ impl Forest {
             parent,
             leaves_first: order,
         })
+    }
+
+    /// The power-of-two exponent that brings the largest magnitude of an elimination, the
+    /// larger of `diagonal_largest` and the largest coupling, near one; None when that is zero
+    /// or not finite, or when a coupling so scaled is too small to be squared.
+    fn scale(&self, diagonal_largest: f64) -> Option<i32> {
+        let largest = self.edges.iter().map(|e| e.2.abs()).fold(diagonal_largest, f64::max);
+        if largest == 0.0 || !largest.is_finite() {
+            return None;
+        }
+        let scale = exponent(largest);
+        let tiny = |value: f64| times_power_of_two(value, -scale).abs() < SMALLEST_SCALED_ENTRY;
+        (!self.edges.iter().any(|e| tiny(e.2))).then_some(scale)
     }
 
     /// The number of negative pivots of the symmetric matrix with diagonal `pivots` and this
