@@ -304,16 +304,15 @@ impl TreeMass {
                 let (w_k, v_k) = self.columns[k];
                 // A massless subtree has zero moments and gives exact zeros.
                 let (p, l_k) = moments.momentum(&w_k, &v_k);
-                let mut b = Some(i);
-                while let Some(j) = b {
-                    for l in tree.dof_range(j) {
-                        let (w_l, v_l) = &self.columns[l];
-                        let a = w_l.dot(&l_k) + v_l.dot(&p);
-                        poison += a * 0.0;
-                        out[k + n * l] = a;
-                        out[l + n * k] = a;
-                    }
-                    b = tree.parent(j);
+                // k itself, the earlier coordinates of its joint, then every ancestor's.
+                let mut carrier = Some(k);
+                while let Some(l) = carrier {
+                    let (w_l, v_l) = &self.columns[l];
+                    let a = w_l.dot(&l_k) + v_l.dot(&p);
+                    poison += a * 0.0;
+                    out[k + n * l] = a;
+                    out[l + n * k] = a;
+                    carrier = tree.previous_dof(l);
                 }
             }
         }

@@ -116,6 +116,7 @@ impl TreeBuilder {
         let order = self.depth_first_order(root)?;
         let (dof_start, dof_body, nv) = self.dof_layout();
         let depth = self.depths(&order);
+        let previous_dof = self.previous_dofs(&order, &dof_start, nv);
         Ok(KinematicTree {
             parent: self.bodies.iter().map(|b| b.parent).collect(),
             joint: self.bodies.iter().map(|b| normalized_joint(b.joint)).collect(),
@@ -131,6 +132,7 @@ impl TreeBuilder {
             dof_start,
             dof_body,
             depth,
+            previous_dof,
             nv,
         })
     }
@@ -216,6 +218,23 @@ impl TreeBuilder {
         (dof_start, dof_body, nv)
     }
 
+    /// Each coordinate's predecessor on its root path (see [`KinematicTree::previous_dof`]),
+    /// from a parents-first `order` and the coordinate ranges `dof_start`.
+    fn previous_dofs(&self, order: &[usize], dof_start: &[usize], nv: usize) -> Vec<Option<usize>> {
+        let mut previous = vec![None; nv];
+        // The last coordinate on the path from the base to each body, the body's own included.
+        let mut last_on_path: Vec<Option<usize>> = vec![None; self.bodies.len()];
+        for &b in order {
+            let above = self.bodies[b].parent.and_then(|p| last_on_path[p]);
+            let range = dof_start[b]..dof_start[b + 1];
+            for k in range.clone() {
+                previous[k] = if k == range.start { above } else { Some(k - 1) };
+            }
+            last_on_path[b] = range.last().or(above);
+        }
+        previous
+    }
+
     /// The number of joints between each body and the base, from a parents-first `order`.
     fn depths(&self, order: &[usize]) -> Vec<usize> {
         let mut depth = vec![0usize; self.bodies.len()];
@@ -298,6 +317,7 @@ pub struct KinematicTree {
     dof_start: Vec<usize>,
     dof_body: Vec<usize>,
     depth: Vec<usize>,
+    previous_dof: Vec<Option<usize>>,
     nv: usize,
 }
 
@@ -349,6 +369,14 @@ impl KinematicTree {
             Some(&end) => self.dof_start[body]..end,
             None => 0..0,
         }
+    }
+
+    /// The coordinate before `k` on its path to the base: k − 1 within k's joint, else the last
+    /// coordinate of the nearest ancestor joint that has one (`None` at the first coordinate of
+    /// a root path, or when k is out of range). Following it from k visits every coordinate
+    /// that carries k, k's own included, in O(depth) with no joint of zero coordinates on the way.
+    pub fn previous_dof(&self, k: usize) -> Option<usize> {
+        self.previous_dof.get(k).copied().flatten()
     }
 
     /// The body whose joint owns coordinate `k`.

@@ -256,6 +256,57 @@ proptest! {
     }
 }
 
+/// A tree of `n` bodies whose parents are drawn at random among bodies of any index (numbered
+/// by a random permutation of a parents-first order), with joints of every coordinate count.
+fn randomly_numbered_tree(rng: &mut Rng, n: usize) -> KinematicTree {
+    let mut label: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        label.swap(i, (rng.next() % (i as u64 + 1)) as usize);
+    }
+    let mut specs = vec![None; n];
+    for created in 0..n {
+        let parent = (created > 0).then(|| label[(rng.next() % created as u64) as usize]);
+        let joint = match rng.next() % 5 {
+            0 => Joint::Revolute { axis: rng.unit() },
+            1 => Joint::Spherical,
+            2 if created == 0 => Joint::Free,
+            2 => Joint::Planar,
+            3 => Joint::Fixed,
+            _ => Joint::Prismatic { axis: rng.unit() },
+        };
+        specs[label[created]] = Some((parent, joint));
+    }
+    let mut b = TreeBuilder::new();
+    for (parent, joint) in specs.into_iter().flatten() {
+        b.add_body(parent, joint, Isometry3::identity());
+    }
+    b.build().expect("valid random tree")
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    #[test]
+    fn previous_dofs_walk_exactly_the_carriers_of_each_coordinate(seed in 1u64..u64::MAX, n in 1usize..=30) {
+        let tree = randomly_numbered_tree(&mut Rng(seed), n);
+        let body = |k: usize| tree.dof_body(k).expect("coordinate in range");
+        for k in 0..tree.dof() {
+            let mut walked = Vec::new();
+            let mut next = Some(k);
+            while let Some(l) = next {
+                prop_assert!(walked.len() <= tree.dof(), "the walk from {} does not end", k);
+                walked.push(l);
+                next = tree.previous_dof(l);
+            }
+            walked.sort_unstable();
+            let carriers: Vec<usize> = (0..tree.dof())
+                .filter(|&l| tree.is_ancestor_or_self(body(l), body(k)) && (body(l) != body(k) || l <= k))
+                .collect();
+            prop_assert_eq!(walked, carriers, "coordinate {}", k);
+        }
+        prop_assert_eq!(tree.previous_dof(tree.dof()), None);
+    }
+}
+
 #[test]
 fn a_fifty_joint_tree_with_every_joint_type() {
     let (tree, q, qd, qdd) = random_tree(42, 50);
