@@ -73,16 +73,17 @@ pub const UNDECIDED_RATIO: f64 = 1e3;
 /// ω² ± bound contains the exact ω² of the stored pencil) and data `resolution` (how far
 /// rounding A and B entrywise can move it, [`crate::certify::resolution::data_resolution`]):
 /// - infinite ω²: [`ModeKind::Infinite`];
-/// - |ω²| within the resolution: [`ModeKind::Zero`], the data cannot tell it from zero;
-/// - an interval that excludes zero: oscillatory or unstable by its sign;
-/// - an interval that contains zero: zero when the bound is within [`UNDECIDED_RATIO`] of the
-///   resolution, else [`ModeKind::Undecided`]: neither the sign nor the size is known.
+/// - an interval that excludes zero, with |ω²| above the resolution: oscillatory or unstable
+///   by its sign;
+/// - otherwise (|ω²| within the resolution, or an interval that contains zero):
+///   [`ModeKind::Zero`] when the bound is within [`UNDECIDED_RATIO`] of the resolution (the
+///   exact value is then proven within that distance of zero, where the data cannot tell it
+///   from zero), else [`ModeKind::Undecided`]: neither the sign nor the size is known. A value
+///   near zero with a wide bound is never called zero.
 pub fn classify(omega_sq: f64, bound: f64, resolution: f64) -> ModeKind {
     if omega_sq.is_infinite() {
         ModeKind::Infinite
-    } else if omega_sq.abs() <= resolution {
-        ModeKind::Zero
-    } else if omega_sq.abs() > bound {
+    } else if omega_sq.abs() > bound && omega_sq.abs() > resolution {
         if omega_sq > 0.0 {
             ModeKind::Oscillatory { omega: omega_sq.sqrt() }
         } else {
@@ -171,8 +172,12 @@ mod tests {
         // Resolved values: by sign.
         assert_eq!(classify(4.0, 1e-3, 1e-12), ModeKind::Oscillatory { omega: 2.0 });
         assert_eq!(classify(-4.0, 1e-3, 1e-12), ModeKind::Unstable { growth_rate: 2.0 });
-        // Within the data's resolution: zero, whatever the bound.
+        // Within the data's resolution and with a bound to match: zero.
         assert_eq!(classify(1e-13, 1e-20, 1e-12), ModeKind::Zero);
+        // Within the resolution, but with a bound that reaches far beyond it: undecided (the
+        // exact value may be anywhere in the interval).
+        assert_eq!(classify(0.0, 8e4, 1e-4), ModeKind::Undecided);
+        assert_eq!(classify(1e-13, 1e-8, 1e-12), ModeKind::Undecided);
         // An interval containing zero, within three orders of the resolution: zero.
         assert_eq!(classify(1e-11, 1e-10, 1e-12), ModeKind::Zero);
         // An interval containing zero, far wider than the resolution: undecided.

@@ -79,8 +79,6 @@ fn probe_seed(l: MatRef<'_, f64>) -> u64 {
 pub(crate) struct APrioriModel {
     /// n·u·‖A⁻¹‖₂.
     scale: f64,
-    /// The order n.
-    order: usize,
     norm_a: f64,
     norm_b: f64,
 }
@@ -89,21 +87,11 @@ impl APrioriModel {
     pub(crate) fn new(l: MatRef<'_, f64>, norm_a: f64, norm_b: f64, par: Par) -> Self {
         let order = l.nrows();
         let scale = order as f64 * f64::EPSILON * a_inverse_norm_bound(l, par);
-        Self {
-            scale,
-            order,
-            norm_a,
-            norm_b,
-        }
+        Self { scale, norm_a, norm_b }
     }
 
     pub(crate) fn bound(&self, omega_sq: f64) -> f64 {
         self.scale * (self.norm_b + omega_sq.abs() * self.norm_a)
-    }
-
-    /// [`normwise_resolution`] without the mode shape: ‖x‖₂² ≤ ‖A⁻¹‖₂ for an A-normalised x.
-    pub(crate) fn data_resolution(&self, omega_sq: f64) -> f64 {
-        self.bound(omega_sq) / self.order.max(1) as f64
     }
 
     /// The bounds of the values `omega_sq`.

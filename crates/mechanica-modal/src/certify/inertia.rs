@@ -85,27 +85,53 @@ pub(crate) fn all_above(problem: &PencilProblem, shift: f64, par: faer::Par) -> 
     positive
 }
 
-/// Whether B itself is positive definite beyond rounding: its Cholesky factorization succeeds
-/// and every pivot l_jj² exceeds 4n·u·max_k b_kk, the rounding that elimination can leave in a
-/// pivot of a matrix singular up to rounding (the stiffness of a free structure, assembled
-/// from springs up to max b_kk); or, where that cannot decide and B's pattern is a forest
-/// (spring chains and trees), the extended-precision proof of [`super::forest`]. Then, by
+/// Whether B itself is proven positive definite: by the scaled and shifted Cholesky test of
+/// [`proven_positive_definite`], or, where that cannot decide and B's pattern is a forest
+/// (spring chains and trees), by the extended-precision proof of [`super::forest`]. Then, by
 /// Sylvester's law, no mode has ω² ≤ 0: the pencil has neither rigid-body nor unstable modes.
 pub(crate) fn stiffness_is_definite(problem: &PencilProblem, par: faer::Par) -> bool {
-    double_precision_definite(problem, par) || super::forest::forest_is_positive_definite(problem.b())
+    proven_positive_definite(problem.b(), par) || super::forest::forest_is_positive_definite(problem.b())
 }
 
-/// The Cholesky test with the pivot margin 4n·u·max_k b_kk of [`stiffness_is_definite`].
-fn double_precision_definite(problem: &PencilProblem, par: faer::Par) -> bool {
-    let b = problem.b();
-    let n = problem.dim();
-    let largest = (0..n).map(|j| b[(j, j)]).fold(0.0_f64, f64::max);
-    let mut k = shifted_lower(problem, 0.0);
-    let factored = crate::linalg::reduce::factor_unchecked(k.as_mut(), par).is_ok();
-    let tolerance = 4.0 * n as f64 * f64::EPSILON * largest;
-    let definite = factored && (0..n).all(|j| k[(j, j)] * k[(j, j)] > tolerance);
-    crate::runtime::scratch::give_back(k);
-    definite
+/// Whether the symmetric matrix M (lower triangle read) is proven positive definite, whatever
+/// its grading (docs/theory.md, §6, item 5, "Definiteness proofs"): with D = diag(2^{s_j}),
+/// 2^{2s_j} within a factor two of m_jj, H = D⁻¹MD⁻¹ is formed exactly, and the floating-point
+/// Cholesky factorization of G = H − c·diag(H) must run to completion with positive pivots,
+/// c = 2nγ/(1 − γ) + 4u, γ = γ_{2n+2} = (2n + 2)u/(1 − (2n + 2)u). Completion gives
+/// G + E = R̂ᵀR̂ with |E_ij| ≤ γ/(1 − γ)·√(g_ii g_jj) (Higham, Theorem 10.3, whatever the order
+/// of the inner products), so S H S ⪰ (c − 3u − nγ/(1 − γ))·I > 0 for S = diag(H)^{-1/2}.
+/// False for a non-positive or non-finite diagonal entry, or when λ_min(SHS) ≲ c (about
+/// 4n²u): M singular up to rounding is never proven. O(n³/3) flops in kept storage.
+pub(crate) fn proven_positive_definite(m: faer::MatRef<'_, f64>, par: faer::Par) -> bool {
+    let n = m.nrows();
+    let mut half_exponents = Vec::with_capacity(n);
+    for j in 0..n {
+        let d = m[(j, j)];
+        if !(d > 0.0 && d.is_finite()) {
+            return false;
+        }
+        half_exponents.push(exponent(d).div_euclid(2));
+    }
+    let u = f64::EPSILON / 2.0;
+    let gamma_order = 2.0 * n as f64 + 2.0;
+    if gamma_order * u >= 0.5 {
+        return false;
+    }
+    let gamma = gamma_order * u / (1.0 - gamma_order * u);
+    let shift = 2.0 * n as f64 * gamma / (1.0 - gamma) + 4.0 * u;
+    let mut g = crate::runtime::scratch::empty(n, n);
+    g.resize_with(n, n, |i, j| {
+        let h = times_power_of_two(m[(i, j)], -(half_exponents[i] + half_exponents[j]));
+        match i.cmp(&j) {
+            std::cmp::Ordering::Greater => h,
+            std::cmp::Ordering::Equal => h * (1.0 - shift),
+            std::cmp::Ordering::Less => 0.0,
+        }
+    });
+    let factored = crate::linalg::reduce::factor_unchecked(g.as_mut(), par).is_ok()
+        && (0..n).all(|j| g[(j, j)] > 0.0 && g[(j, j)].is_finite());
+    crate::runtime::scratch::give_back(g);
+    factored
 }
 
 /// The lower triangle of B − shift·A (the strict upper triangle zero), in kept storage when
@@ -177,6 +203,99 @@ pub(crate) fn inertia_of(k: &Mat<f64>) -> (usize, usize, usize) {
 mod tests {
     use super::*;
     use crate::testing;
+    use crate::testing::graded::SplitMix;
+    use faer::Par;
+
+    /// D M D for a random diagonal D of powers of two over 2^±`spread` (exact products).
+    fn graded_by_powers_of_two(m: &Mat<f64>, rng: &mut SplitMix, spread: usize) -> Mat<f64> {
+        let n = m.nrows();
+        let e: Vec<i32> = (0..n)
+            .map(|_| rng.below(2 * spread + 1) as i32 - spread as i32)
+            .collect();
+        Mat::from_fn(n, n, |i, j| times_power_of_two(m[(i, j)], e[i] + e[j]))
+    }
+
+    /// The Laplacian of a random connected graph with small integer weights (a spanning tree
+    /// and a few extra edges, cycles included): exactly singular, its null vector the ones.
+    fn integer_laplacian(rng: &mut SplitMix, n: usize) -> Mat<f64> {
+        let mut l = Mat::<f64>::zeros(n, n);
+        let mut couple = |i: usize, j: usize, w: f64| {
+            l[(i, j)] -= w;
+            l[(j, i)] -= w;
+            l[(i, i)] += w;
+            l[(j, j)] += w;
+        };
+        for i in 1..n {
+            let parent = rng.below(i);
+            couple(i, parent, 1.0 + rng.below(9) as f64);
+        }
+        for _ in 0..n / 2 {
+            let (i, j) = (rng.below(n), rng.below(n));
+            if i != j {
+                couple(i, j, 1.0 + rng.below(9) as f64);
+            }
+        }
+        l
+    }
+
+    #[test]
+    fn graded_definite_matrices_are_proven_whatever_the_grading() {
+        let mut rng = SplitMix::new(31);
+        for case in 0..60 {
+            let n = 1 + rng.below(60);
+            let q = testing::random_orthogonal(n, case);
+            let lambda: Vec<f64> = (0..n).map(|_| 10f64.powf(rng.uniform(-6.0, 0.0))).collect();
+            let c = Mat::from_fn(n, n, |i, j| {
+                (0..n).map(|k| q[(i, k)] * lambda[k] * q[(j, k)]).sum::<f64>()
+            });
+            let c = Mat::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
+            let by_powers = graded_by_powers_of_two(&c, &mut rng, 200);
+            assert!(
+                proven_positive_definite(by_powers.as_ref(), Par::Seq),
+                "case {case}, n = {n}"
+            );
+            // A grading that rounds every entry once: still far inside the definite cone.
+            let d: Vec<f64> = (0..n).map(|_| 10f64.powf(rng.uniform(-100.0, 100.0))).collect();
+            let rounded = Mat::from_fn(n, n, |i, j| d[i] * c[(i, j)] * d[j]);
+            assert!(
+                proven_positive_definite(rounded.as_ref(), Par::Seq),
+                "case {case}, n = {n}, rounded"
+            );
+        }
+    }
+
+    #[test]
+    fn singular_and_indefinite_matrices_are_never_proven() {
+        let mut rng = SplitMix::new(32);
+        for case in 0..200 {
+            let n = 2 + rng.below(60);
+            let laplacian = integer_laplacian(&mut rng, n);
+            let free = graded_by_powers_of_two(&laplacian, &mut rng, 200);
+            assert!(
+                !proven_positive_definite(free.as_ref(), Par::Seq),
+                "case {case}: singular, n = {n}"
+            );
+            // Less than its own rounding removed from one diagonal entry: one negative eigenvalue.
+            let mut indefinite = laplacian.clone();
+            let k = rng.below(n);
+            indefinite[(k, k)] -= times_power_of_two(1.0, -40);
+            let indefinite = graded_by_powers_of_two(&indefinite, &mut rng, 200);
+            assert!(
+                !proven_positive_definite(indefinite.as_ref(), Par::Seq),
+                "case {case}: indefinite"
+            );
+            // A rank-deficient Gram matrix X Xᵀ of small integers (exact), X with n − 1 columns.
+            let x = Mat::from_fn(n, n - 1, |_, _| rng.below(7) as f64 - 3.0);
+            let gram = Mat::from_fn(n, n, |i, j| (0..n - 1).map(|k| x[(i, k)] * x[(j, k)]).sum::<f64>());
+            if (0..n).all(|i| gram[(i, i)] > 0.0) {
+                let gram = graded_by_powers_of_two(&gram, &mut rng, 200);
+                assert!(
+                    !proven_positive_definite(gram.as_ref(), Par::Seq),
+                    "case {case}: rank deficient"
+                );
+            }
+        }
+    }
 
     #[test]
     fn fixed_chain_counts_match_the_closed_form() {

@@ -121,15 +121,19 @@ impl Finish<'_> {
             enclose_weak_modes_by_forest_counts(self.problem, &mut report, &omega, first);
         }
         timings.inertia = clock.elapsed();
-        let resolution = self.resolution(x.as_ref(), a_priori, &omega, measured_resolution);
+        let mut resolution = self.resolution(x.as_ref(), a_priori, &omega, &report.error_bounds, measured_resolution);
         if !self.options.vectors {
             x = None;
             report.backward_errors.iter_mut().for_each(|e| *e = None);
             report.orthogonality_error = None;
         }
-        let mut modes = finite_modes(&omega, &report, &resolution);
-        sort_ascending(&mut modes, &mut report, x.as_mut());
+        let mut modes = finite_modes(&omega, &report);
+        sort_ascending(&mut modes, &mut report, &mut resolution, x.as_mut());
         widen_overlapping_estimates(&mut modes, &mut report);
+        self.measure_widened(x.as_ref(), &modes, &mut resolution);
+        for (mode, &(r, _)) in modes.iter_mut().zip(&resolution) {
+            mode.kind = classify(mode.omega_sq, mode.error_bound, r);
+        }
         order_above_positive_modes(&mut modes);
         certify_positive_stiffness(self.problem, &mut modes, self.par);
         sign_undecided_by_forest_counts(self.problem, &mut modes, first);
@@ -251,56 +255,82 @@ impl Finish<'_> {
         }
     }
 
-    /// What the data resolve of each mode, for the zero classification: its
-    /// [`zero_resolution`] from its shape, or (values only) the a-priori model's, replaced by
-    /// the `measured` values of the modes whose vectors were formed.
+    /// What the data resolve of each mode, for the zero classification: the componentwise
+    /// [`data_resolutions`] from its shape wherever the class depends on it (|ω²| within the
+    /// cheap normwise value, or within its `bound`), the normwise value elsewhere; or (values
+    /// only) the `measured` values of the modes whose vectors were formed, and zero for the
+    /// others. Each value comes with whether it was measured (componentwise or `measured`).
     fn resolution(
         &self,
         x: Option<&Mat<f64>>,
         a_priori: Option<APrioriModel>,
         omega: &[f64],
+        bounds: &[f64],
         measured: Vec<(usize, f64)>,
-    ) -> Vec<f64> {
+    ) -> Vec<(f64, bool)> {
         let (a, b) = (self.problem.a(), self.problem.b());
-        let mut resolution: Vec<f64> = (0..omega.len())
+        let resolution: Vec<f64> = (0..omega.len())
             .map(|i| match (x, &a_priori) {
                 (Some(x), _) => {
                     let shape_norm_sq = x.col(i).iter().map(|v| v * v).sum::<f64>();
                     normwise_resolution(omega[i], self.norm_a, self.norm_b, shape_norm_sq)
                 }
-                (None, Some(model)) => model.data_resolution(omega[i]),
-                (None, None) => 0.0,
+                // Without a shape only the normwise value is known, an overestimate by up to
+                // the grading of the data: it can call zero what the data resolve, so a mode
+                // that was not measured is never called zero.
+                (None, _) => 0.0,
             })
             .collect();
-        // Where |ω²| is within the cheap normwise value, only the componentwise one can decide
-        // (crate::certify::resolution::zero_resolution), computed for those modes at once.
+        // Where |ω²| is within the cheap normwise value or its interval contains zero, the
+        // normwise value (an overestimate on graded data) would call zero what the data may
+        // resolve: the componentwise one decides, computed for those modes at once.
+        let mut resolution: Vec<(f64, bool)> = resolution.into_iter().map(|r| (r, false)).collect();
         if let Some(x) = x {
-            let columns: Vec<usize> = (0..omega.len()).filter(|&i| omega[i].abs() <= resolution[i]).collect();
+            let candidate = |i: usize| omega[i].abs() <= resolution[i].0.max(bounds.get(i).copied().unwrap_or(0.0));
+            let columns: Vec<usize> = (0..omega.len()).filter(|&i| candidate(i)).collect();
             let values: Vec<f64> = columns.iter().map(|&i| omega[i]).collect();
             for (&i, r) in columns
                 .iter()
                 .zip(data_resolutions(a, b, x.as_ref(), &columns, &values, self.par))
             {
-                resolution[i] = r;
+                resolution[i] = (r, true);
             }
         }
         for (i, value) in measured {
-            resolution[i] = value;
+            resolution[i] = (value, true);
         }
         resolution
     }
+
+    /// Measures the componentwise resolution of the modes whose widened interval now contains
+    /// zero but whose resolution is still the normwise overestimate (which would call them
+    /// zero where the data may resolve them): their class depends on it.
+    fn measure_widened(&self, x: Option<&Mat<f64>>, modes: &[Mode], resolution: &mut [(f64, bool)]) {
+        let Some(x) = x else { return };
+        let columns: Vec<usize> = (0..modes.len())
+            .filter(|&i| !resolution[i].1 && modes[i].omega_sq.abs() <= modes[i].error_bound && i < x.ncols())
+            .collect();
+        let values: Vec<f64> = columns.iter().map(|&i| modes[i].omega_sq).collect();
+        let (a, b) = (self.problem.a(), self.problem.b());
+        for (&i, r) in columns
+            .iter()
+            .zip(data_resolutions(a, b, x.as_ref(), &columns, &values, self.par))
+        {
+            resolution[i] = (r, true);
+        }
+    }
 }
 
-/// The finite modes from their values, bounds and backward errors, classified against the
-/// larger of their bound and their data resolution.
-fn finite_modes(omega: &[f64], report: &AccuracyReport, resolution: &[f64]) -> Vec<Mode> {
+/// The finite modes from their values, bounds and backward errors, not yet classified
+/// (undecided until their bounds are final).
+fn finite_modes(omega: &[f64], report: &AccuracyReport) -> Vec<Mode> {
     (0..omega.len())
         .map(|i| {
             let bound = report.error_bounds[i];
             Mode {
                 lambda: -omega[i],
                 omega_sq: omega[i],
-                kind: classify(omega[i], bound, resolution[i]),
+                kind: ModeKind::Undecided,
                 error_bound: bound,
                 backward_error: report.backward_errors.get(i).copied().flatten(),
                 group: 0,
@@ -309,16 +339,23 @@ fn finite_modes(omega: &[f64], report: &AccuracyReport, resolution: &[f64]) -> V
         .collect()
 }
 
-/// Puts the finite modes in ascending order of ω², with their report entries and vector
-/// columns: refinement moves values by up to their first-order bounds, which can exceed the
-/// distance between neighbours (wide-range pencils), and every later step relies on the order.
-fn sort_ascending(modes: &mut Vec<Mode>, report: &mut AccuracyReport, x: Option<&mut Mat<f64>>) {
+/// Puts the finite modes in ascending order of ω², with their report entries, resolutions and
+/// vector columns: refinement moves values by up to their first-order bounds, which can exceed
+/// the distance between neighbours (wide-range pencils), and every later step relies on the
+/// order.
+fn sort_ascending(
+    modes: &mut Vec<Mode>,
+    report: &mut AccuracyReport,
+    resolution: &mut Vec<(f64, bool)>,
+    x: Option<&mut Mat<f64>>,
+) {
     if modes.is_sorted_by(|p, q| p.omega_sq <= q.omega_sq) {
         return;
     }
     let mut order: Vec<usize> = (0..modes.len()).collect();
     order.sort_by(|&p, &q| modes[p].omega_sq.total_cmp(&modes[q].omega_sq));
     *modes = order.iter().map(|&k| modes[k]).collect();
+    *resolution = order.iter().map(|&k| resolution[k]).collect();
     report.permute(&order);
     if let Some(x) = x {
         let old = x.clone();
@@ -332,7 +369,8 @@ fn sort_ascending(modes: &mut Vec<Mode>, report: &mut AccuracyReport, x: Option<
 /// run of modes whose intervals ω² ± bound overlap is one cluster, and its exact values can only
 /// be matched to its members as a set, so each unrefined member's bound is widened to reach both
 /// ends of the cluster (a mode with a tight interval inside a wide neighbour's may otherwise
-/// stand for an eigenvalue of another rank). The classification is redone with the new bound.
+/// stand for an eigenvalue of another rank). The modes are classified afterwards, with these
+/// bounds.
 fn widen_overlapping_estimates(modes: &mut [Mode], report: &mut AccuracyReport) {
     let mut start = 0;
     while start < modes.len() {
@@ -353,23 +391,9 @@ fn widen_overlapping_estimates(modes: &mut [Mode], report: &mut AccuracyReport) 
             if widened > mode.error_bound {
                 mode.error_bound = widened;
                 report.error_bounds[k] = widened;
-                if !matches!(mode.kind, ModeKind::Zero) {
-                    mode.kind = reclassified(mode);
-                }
             }
         }
         start = end;
-    }
-}
-
-/// The class of a mode whose bound grew: oscillatory or unstable only while its interval still
-/// excludes zero, else undecided.
-fn reclassified(mode: &Mode) -> ModeKind {
-    match mode.kind {
-        ModeKind::Oscillatory { .. } | ModeKind::Unstable { .. } if mode.omega_sq.abs() <= mode.error_bound => {
-            ModeKind::Undecided
-        }
-        other => other,
     }
 }
 
