@@ -1286,7 +1286,9 @@ typedef int32_t mech_modal_kind_t;
 
 #if defined(MECH_FEATURE_MECHANISM)
 /**
- * The stability verdict of mech_mechanism_modes.
+ * The stability verdict of mech_mechanism_modes. Modes whose sign is not decided (kinds_out
+ * MECH_MODAL_KIND_UNDECIDED) are counted in neither field: an equilibrium is stable only when
+ * both counts are zero and no mode is undecided.
  */
 typedef struct mech_stability_t {
     /**

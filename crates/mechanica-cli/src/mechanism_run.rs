@@ -107,6 +107,7 @@ pub(crate) fn stability_record(stability: &Stability) -> StabilityRecord {
             unstable_directions: 0,
             max_growth_rate: None,
             zero_modes: 0,
+            undecided_modes: 0,
         },
         Stability::Unstable {
             directions,
@@ -116,12 +117,24 @@ pub(crate) fn stability_record(stability: &Stability) -> StabilityRecord {
             unstable_directions: directions,
             max_growth_rate: Some(max_growth_rate),
             zero_modes: 0,
+            undecided_modes: 0,
         },
         Stability::Marginal { zero_modes } => StabilityRecord {
             verdict: Verdict::Marginal,
             unstable_directions: 0,
             max_growth_rate: None,
             zero_modes,
+            undecided_modes: 0,
+        },
+        Stability::Undecided {
+            undecided_modes,
+            zero_modes,
+        } => StabilityRecord {
+            verdict: Verdict::Undecided,
+            unstable_directions: 0,
+            max_growth_rate: None,
+            zero_modes,
+            undecided_modes,
         },
     }
 }

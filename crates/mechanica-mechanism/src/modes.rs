@@ -22,7 +22,9 @@ use crate::assembly_error::AssemblyError;
 use crate::{Mechanism, MechanismError};
 use faer::Mat;
 use faer::c64;
-use mechanica_modal::{ModalSolution, ModeKind, PencilProblem, QuadraticOptions, SolveOptions, quadratic_modes, solve};
+use mechanica_modal::{
+    ModalSolution, Mode, ModeKind, PencilProblem, QuadraticOptions, SolveOptions, quadratic_modes, solve,
+};
 use nalgebra::Vector3;
 
 /// The stability of an equilibrium from the inertia of B relative to A (Lyapunov, 8.79–8.83;
@@ -41,6 +43,15 @@ pub enum Stability {
     /// No negative direction but zero modes within their error bounds: neutral (rigid-body or
     /// higher-order) behaviour decides.
     Marginal {
+        /// Number of zero modes.
+        zero_modes: usize,
+    },
+    /// No proven unstable direction, but modes whose sign is not decided (intervals ω² ± bound
+    /// that contain zero, far wider than the data's resolution): the equilibrium may be stable,
+    /// marginal or unstable.
+    Undecided {
+        /// Number of undecided modes.
+        undecided_modes: usize,
         /// Number of zero modes.
         zero_modes: usize,
     },
@@ -99,17 +110,19 @@ pub struct MechanismModes {
     pub gyroscopic: Option<GyroscopicModes>,
 }
 
-fn stability_of(solution: &ModalSolution) -> Stability {
-    let mut unstable = 0;
-    let mut zero = 0;
+/// The verdict from the modes' classes: unstable if any mode is proven unstable, else
+/// undecided if any mode's sign is open, else marginal with zero modes, else stable.
+fn stability_of(modes: &[Mode]) -> Stability {
+    let (mut unstable, mut zero, mut undecided) = (0, 0, 0);
     let mut growth: f64 = 0.0;
-    for mode in &solution.modes {
+    for mode in modes {
         match mode.kind {
             ModeKind::Unstable { growth_rate } => {
                 unstable += 1;
                 growth = growth.max(growth_rate);
             }
             ModeKind::Zero => zero += 1,
+            ModeKind::Undecided => undecided += 1,
             _ => {}
         }
     }
@@ -117,6 +130,11 @@ fn stability_of(solution: &ModalSolution) -> Stability {
         Stability::Unstable {
             directions: unstable,
             max_growth_rate: growth,
+        }
+    } else if undecided > 0 {
+        Stability::Undecided {
+            undecided_modes: undecided,
+            zero_modes: zero,
         }
     } else if zero > 0 {
         Stability::Marginal { zero_modes: zero }
@@ -191,7 +209,7 @@ fn modes_at(
     let mut solution = solve(&problem, &options)?;
     let assembly = AssemblyError::of(mechanism, &q, &free)?;
     propagate_assembly_error(&mut solution, &assembly);
-    let stability = stability_of(&solution);
+    let stability = stability_of(&solution.modes);
     let gradient_norm = free.iter().map(|&k| evaluation.gradient[k].powi(2)).sum::<f64>().sqrt();
     if let Some(x) = solution.vectors.take() {
         let mut row_of = vec![None; n_all];
@@ -336,4 +354,47 @@ fn gyroscopic_modes(a: &Mat<f64>, g: &Mat<f64>, b: &Mat<f64>) -> Result<Gyroscop
         real_part_bound: finite.iter().map(|p| p.2).fold(0.0, f64::max),
         stable: finite.iter().all(|p| p.0.re <= p.2),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mode(omega_sq: f64, error_bound: f64, kind: ModeKind) -> Mode {
+        Mode {
+            lambda: -omega_sq,
+            omega_sq,
+            kind,
+            error_bound,
+            backward_error: None,
+            group: 0,
+        }
+    }
+
+    #[test]
+    fn an_undecided_mode_keeps_the_verdict_open() {
+        let oscillatory = mode(4.0, 1e-12, ModeKind::Oscillatory { omega: 2.0 });
+        let zero = mode(1e-15, 1e-14, ModeKind::Zero);
+        let undecided = mode(1e-3, 1.0, ModeKind::Undecided);
+        let unstable = mode(-4.0, 1e-12, ModeKind::Unstable { growth_rate: 2.0 });
+        assert_eq!(stability_of(&[oscillatory]), Stability::Stable);
+        assert_eq!(
+            stability_of(&[zero, oscillatory]),
+            Stability::Marginal { zero_modes: 1 }
+        );
+        assert_eq!(
+            stability_of(&[zero, undecided, oscillatory]),
+            Stability::Undecided {
+                undecided_modes: 1,
+                zero_modes: 1
+            }
+        );
+        assert_eq!(
+            stability_of(&[unstable, undecided]),
+            Stability::Unstable {
+                directions: 1,
+                max_growth_rate: 2.0
+            }
+        );
+    }
 }

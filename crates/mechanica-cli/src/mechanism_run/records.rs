@@ -29,6 +29,8 @@ pub enum Verdict {
     Unstable,
     /// No unstable mode, but zero modes within their bounds.
     Marginal,
+    /// No proven unstable mode, but modes whose sign is not decided.
+    Undecided,
 }
 
 /// The stability of an equilibrium from its modes.
@@ -42,6 +44,8 @@ pub struct StabilityRecord {
     pub max_growth_rate: Option<f64>,
     /// Number of zero modes.
     pub zero_modes: usize,
+    /// Number of modes whose sign is not decided.
+    pub undecided_modes: usize,
 }
 
 impl StabilityRecord {
@@ -57,6 +61,10 @@ impl StabilityRecord {
             Verdict::Marginal => format!(
                 "marginal: {} zero mode(s) within their error bounds, none unstable",
                 self.zero_modes
+            ),
+            Verdict::Undecided => format!(
+                "undecided: {} mode(s) whose interval contains zero, far wider than the data's resolution; none proven unstable",
+                self.undecided_modes
             ),
         }
     }

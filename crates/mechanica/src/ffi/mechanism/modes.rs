@@ -8,7 +8,9 @@ use crate::ffi::validate::*;
 use mechanica_mechanism::{MechanismModes, Stability, mechanism_modes};
 use mechanica_modal::{Selection, SolveOptions};
 
-/// The stability verdict of mech_mechanism_modes.
+/// The stability verdict of mech_mechanism_modes. Modes whose sign is not decided (kinds_out
+/// MECH_MODAL_KIND_UNDECIDED) are counted in neither field: an equilibrium is stable only when
+/// both counts are zero and no mode is undecided.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct mech_stability_t {
@@ -37,7 +39,9 @@ fn stability_to_c(modes: &MechanismModes) -> mech_stability_t {
             max_growth_rate,
             ..Default::default()
         },
-        Stability::Marginal { zero_modes } => mech_stability_t {
+        // The struct has no count of undecided modes (kinds_out marks them
+        // MECH_MODAL_KIND_UNDECIDED); its zero modes are reported.
+        Stability::Marginal { zero_modes } | Stability::Undecided { zero_modes, .. } => mech_stability_t {
             zero_modes,
             ..Default::default()
         },
