@@ -205,16 +205,12 @@ impl<'a> Configuration<'a> {
             && self.tree.dof_body(k) == self.tree.dof_body(l)
     }
 
-    /// The coordinates that carry `late` or are `late` itself: those of its own joint up to
-    /// `late` (the earlier ones in [`Configuration::ordered`]'s order), then every coordinate of
-    /// each ancestor joint. Each pair of coordinates on one root path is (carrier, `late`) for
-    /// exactly one `late`, so a loop over all `late` and their carriers visits every such pair
-    /// once, in O(n·depth).
+    /// The coordinates that carry `late` or are `late` itself: `late`, then each
+    /// [`KinematicTree::previous_dof`] on its path to the base. Each pair of coordinates on one
+    /// root path is (carrier, `late`) for exactly one `late`, so a loop over all `late` and
+    /// their carriers visits every such pair once, in O(n·depth).
     pub(crate) fn carriers(&self, late: usize) -> impl Iterator<Item = usize> + '_ {
-        let body = self.tree.dof_body(late);
-        let own = body.map_or(0..0, |b| self.tree.dof_range(b).start..late + 1);
-        let ancestors = std::iter::successors(body.and_then(|b| self.tree.parent(b)), |&b| self.tree.parent(b));
-        own.chain(ancestors.flat_map(|b| self.tree.dof_range(b)))
+        std::iter::successors(Some(late), |&k| self.tree.previous_dof(k))
     }
 
     /// Errors unless the rotation vector of the joint owning k is zero (see the module docs).
