@@ -121,18 +121,22 @@ impl Finish<'_> {
             enclose_weak_modes_by_forest_counts(self.problem, &mut report, &omega, first);
         }
         timings.inertia = clock.elapsed();
-        let mut resolution = self.resolution(x.as_ref(), a_priori, &omega, &report.error_bounds, measured_resolution);
+        let mut measured = vec![None; omega.len()];
+        for (i, value) in measured_resolution {
+            measured[i] = Some(value);
+        }
+        let mut modes = finite_modes(&omega, &report);
+        sort_ascending(&mut modes, &mut report, &mut measured, x.as_mut());
+        widen_overlapping_estimates(&mut modes, &mut report);
+        let resolution = self.resolution(x.as_ref(), &modes, &measured);
+        for (mode, &r) in modes.iter_mut().zip(&resolution) {
+            mode.kind = classify(mode.omega_sq, mode.error_bound, r);
+        }
         if !self.options.vectors {
             x = None;
             report.backward_errors.iter_mut().for_each(|e| *e = None);
             report.orthogonality_error = None;
-        }
-        let mut modes = finite_modes(&omega, &report);
-        sort_ascending(&mut modes, &mut report, &mut resolution, x.as_mut());
-        widen_overlapping_estimates(&mut modes, &mut report);
-        self.measure_widened(x.as_ref(), &modes, &mut resolution);
-        for (mode, &(r, _)) in modes.iter_mut().zip(&resolution) {
-            mode.kind = classify(mode.omega_sq, mode.error_bound, r);
+            modes.iter_mut().for_each(|m| m.backward_error = None);
         }
         order_above_positive_modes(&mut modes);
         certify_positive_stiffness(self.problem, &mut modes, self.par);
@@ -255,69 +259,40 @@ impl Finish<'_> {
         }
     }
 
-    /// What the data resolve of each mode, for the zero classification: the componentwise
-    /// [`data_resolutions`] from its shape wherever the class depends on it (|ω²| within the
-    /// cheap normwise value, or within its `bound`), the normwise value elsewhere; or (values
-    /// only) the `measured` values of the modes whose vectors were formed, and zero for the
-    /// others. Each value comes with whether it was measured (componentwise or `measured`).
-    fn resolution(
-        &self,
-        x: Option<&Mat<f64>>,
-        a_priori: Option<APrioriModel>,
-        omega: &[f64],
-        bounds: &[f64],
-        measured: Vec<(usize, f64)>,
-    ) -> Vec<(f64, bool)> {
-        let (a, b) = (self.problem.a(), self.problem.b());
-        let resolution: Vec<f64> = (0..omega.len())
-            .map(|i| match (x, &a_priori) {
-                (Some(x), _) => {
+    /// What the data resolve of each (sorted, widened) mode, for the zero classification: the
+    /// `measured` value (values only: modes whose vectors were formed); else, with shapes, the
+    /// componentwise [`data_resolutions`] wherever the class depends on it (|ω²| within the
+    /// cheap normwise value, or within its final bound) and the normwise value elsewhere; else
+    /// zero. Without a shape only the normwise value is known, an overestimate by up to the
+    /// grading of the data that could call zero what the data resolve, so a mode that was not
+    /// measured is never called zero.
+    fn resolution(&self, x: Option<&Mat<f64>>, modes: &[Mode], measured: &[Option<f64>]) -> Vec<f64> {
+        let mut resolution: Vec<f64> = modes
+            .iter()
+            .enumerate()
+            .map(|(i, mode)| match (measured[i], x) {
+                (Some(value), _) => value,
+                (None, Some(x)) if i < x.ncols() => {
                     let shape_norm_sq = x.col(i).iter().map(|v| v * v).sum::<f64>();
-                    normwise_resolution(omega[i], self.norm_a, self.norm_b, shape_norm_sq)
+                    normwise_resolution(mode.omega_sq, self.norm_a, self.norm_b, shape_norm_sq)
                 }
-                // Without a shape only the normwise value is known, an overestimate by up to
-                // the grading of the data: it can call zero what the data resolve, so a mode
-                // that was not measured is never called zero.
                 (None, _) => 0.0,
             })
             .collect();
-        // Where |ω²| is within the cheap normwise value or its interval contains zero, the
-        // normwise value (an overestimate on graded data) would call zero what the data may
-        // resolve: the componentwise one decides, computed for those modes at once.
-        let mut resolution: Vec<(f64, bool)> = resolution.into_iter().map(|r| (r, false)).collect();
-        if let Some(x) = x {
-            let candidate = |i: usize| omega[i].abs() <= resolution[i].0.max(bounds.get(i).copied().unwrap_or(0.0));
-            let columns: Vec<usize> = (0..omega.len()).filter(|&i| candidate(i)).collect();
-            let values: Vec<f64> = columns.iter().map(|&i| omega[i]).collect();
-            for (&i, r) in columns
-                .iter()
-                .zip(data_resolutions(a, b, x.as_ref(), &columns, &values, self.par))
-            {
-                resolution[i] = (r, true);
-            }
-        }
-        for (i, value) in measured {
-            resolution[i] = (value, true);
-        }
-        resolution
-    }
-
-    /// Measures the componentwise resolution of the modes whose widened interval now contains
-    /// zero but whose resolution is still the normwise overestimate (which would call them
-    /// zero where the data may resolve them): their class depends on it.
-    fn measure_widened(&self, x: Option<&Mat<f64>>, modes: &[Mode], resolution: &mut [(f64, bool)]) {
-        let Some(x) = x else { return };
-        let columns: Vec<usize> = (0..modes.len())
-            .filter(|&i| !resolution[i].1 && modes[i].omega_sq.abs() <= modes[i].error_bound && i < x.ncols())
-            .collect();
+        let Some(x) = x else { return resolution };
+        let depends = |i: usize| {
+            measured[i].is_none() && i < x.ncols() && modes[i].omega_sq.abs() <= resolution[i].max(modes[i].error_bound)
+        };
+        let columns: Vec<usize> = (0..modes.len()).filter(|&i| depends(i)).collect();
         let values: Vec<f64> = columns.iter().map(|&i| modes[i].omega_sq).collect();
         let (a, b) = (self.problem.a(), self.problem.b());
         for (&i, r) in columns
             .iter()
             .zip(data_resolutions(a, b, x.as_ref(), &columns, &values, self.par))
         {
-            resolution[i] = (r, true);
+            resolution[i] = r;
         }
+        resolution
     }
 }
 
@@ -339,14 +314,14 @@ fn finite_modes(omega: &[f64], report: &AccuracyReport) -> Vec<Mode> {
         .collect()
 }
 
-/// Puts the finite modes in ascending order of ω², with their report entries, resolutions and
-/// vector columns: refinement moves values by up to their first-order bounds, which can exceed
-/// the distance between neighbours (wide-range pencils), and every later step relies on the
-/// order.
+/// Puts the finite modes in ascending order of ω², with their report entries, measured
+/// resolutions and vector columns: refinement moves values by up to their first-order bounds,
+/// which can exceed the distance between neighbours (wide-range pencils), and every later step
+/// relies on the order.
 fn sort_ascending(
     modes: &mut Vec<Mode>,
     report: &mut AccuracyReport,
-    resolution: &mut Vec<(f64, bool)>,
+    measured: &mut Vec<Option<f64>>,
     x: Option<&mut Mat<f64>>,
 ) {
     if modes.is_sorted_by(|p, q| p.omega_sq <= q.omega_sq) {
@@ -355,7 +330,7 @@ fn sort_ascending(
     let mut order: Vec<usize> = (0..modes.len()).collect();
     order.sort_by(|&p, &q| modes[p].omega_sq.total_cmp(&modes[q].omega_sq));
     *modes = order.iter().map(|&k| modes[k]).collect();
-    *resolution = order.iter().map(|&k| resolution[k]).collect();
+    *measured = order.iter().map(|&k| measured[k]).collect();
     report.permute(&order);
     if let Some(x) = x {
         let old = x.clone();
