@@ -27,6 +27,7 @@ mod trajectory_file;
 mod urdf;
 
 use clap::{Parser, Subcommand};
+use std::io::Write as _;
 use std::process::ExitCode;
 
 /// Analytical mechanics for simulators.
@@ -162,10 +163,16 @@ fn main() -> ExitCode {
         }
     };
     if cli.json {
-        match serde_json::to_string_pretty(&report) {
-            Ok(text) => println!("{text}"),
+        // Streamed: a long mechanism's report (every body's displacement in every mode) runs
+        // to hundreds of megabytes, which need not be held in memory as one string.
+        let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+        let written = serde_json::to_writer_pretty(&mut out, &report)
+            .map_err(|e| e.to_string())
+            .and_then(|()| writeln!(out).and_then(|()| out.flush()).map_err(|e| e.to_string()));
+        match written {
+            Ok(()) => {}
             Err(error) => {
-                eprintln!("mechanica: could not encode the report as JSON: {error}");
+                eprintln!("mechanica: could not write the report as JSON: {error}");
                 return ExitCode::FAILURE;
             }
         }

@@ -23,6 +23,7 @@ use crate::configuration::Configuration;
 use crate::{Mechanism, MechanismError, Potential, PotentialSum};
 use faer::Mat;
 use mechanica_kinematics::scaling;
+use mechanica_kinematics::tree::Workspace;
 use mechanica_mass::MassProperties;
 
 /// Beyond this many entries (bodies × n²), the field is taken as one contribution instead of
@@ -36,11 +37,24 @@ struct Contribution {
     support: Vec<usize>,
 }
 
+/// A's contributions, one per body: γ‖A_b‖_F on the free coordinates of the body's root path.
+/// The paths nest, so Σ_b scale_b ‖x|S_b‖² is summed from the root outwards in O(n) per mode.
+#[derive(Debug, Clone, Default)]
+struct BodyContributions {
+    /// γ‖A_b‖_F per body.
+    scale: Vec<f64>,
+    /// The bodies, parents before children.
+    order: Vec<usize>,
+    parent: Vec<Option<usize>>,
+    /// Per body: the indices into the free coordinates of its own joint's coordinates.
+    own: Vec<Vec<usize>>,
+}
+
 /// The assembly errors of B and A over the free coordinates, contribution by contribution.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct AssemblyError {
     stiffness: Vec<Contribution>,
-    inertia: Vec<Contribution>,
+    inertia: BodyContributions,
 }
 
 impl AssemblyError {
@@ -74,12 +88,7 @@ impl AssemblyError {
         for potential in mechanism.potentials() {
             add(evaluate(&config, |c, s| potential.accumulate(c, s))?);
         }
-        for (b, body) in bodies.iter().enumerate() {
-            let centre = ws.point_position(b, &body.p_oc)?;
-            error
-                .inertia
-                .push(Contribution::of_body(&config, b, body, &centre, free, gamma));
-        }
+        error.inertia = BodyContributions::of(&config, &ws, bodies, free, gamma)?;
         Ok(error)
     }
 
@@ -95,7 +104,7 @@ impl AssemblyError {
         if omega_sq == 0.0 {
             return 0.0;
         }
-        omega_sq.abs() * share(&self.inertia, x)
+        omega_sq.abs() * self.inertia.share(x)
     }
 }
 
@@ -138,33 +147,97 @@ impl Contribution {
     }
 }
 
-impl Contribution {
-    /// γ times the bound m‖J_v‖_F² + tr(I_C)‖J_ω‖_F² on ‖A_b‖_F for body `b` with its centre
-    /// of mass at `centre` (world), on the free coordinates of its root path.
-    fn of_body(
+impl BodyContributions {
+    /// Per body b, γ times the bound m‖J_v‖_F² + tr(I_C)‖J_ω‖_F² on ‖A_b‖_F, J the Jacobian of
+    /// its centre of mass (world) over the free coordinates of its root path: O(depth) each.
+    fn of(
         config: &Configuration<'_>,
-        b: usize,
-        body: &MassProperties,
-        centre: &nalgebra::Vector3<f64>,
+        ws: &Workspace,
+        bodies: &[MassProperties],
         free: &[usize],
         gamma: f64,
-    ) -> Self {
+    ) -> Result<Self, MechanismError> {
         let tree = config.tree;
-        let (mut linear, mut angular) = (0.0, 0.0);
-        let mut support = Vec::new();
+        let mut free_index = vec![None; tree.dof()];
         for (i, &k) in free.iter().enumerate() {
-            let Some(owner) = tree.dof_body(k) else { continue };
-            if !tree.is_ancestor_or_self(owner, b) {
-                continue;
-            }
-            let column = config.column(k);
-            linear += (column.a + column.w.cross(centre)).norm_squared();
-            angular += column.w.norm_squared();
-            support.push(i);
+            free_index[k] = Some(i);
         }
-        Contribution {
-            scale: gamma * (body.mass * linear + body.inertia_c.trace() * angular),
-            support,
+        let mut scale = Vec::with_capacity(bodies.len());
+        for (b, body) in bodies.iter().enumerate() {
+            let centre = ws.point_position(b, &body.p_oc)?;
+            let (mut linear, mut angular) = (0.0, 0.0);
+            let path = std::iter::successors(Some(b), |&i| tree.parent(i));
+            for k in path
+                .flat_map(|i| tree.dof_range(i))
+                .filter(|&k| free_index[k].is_some())
+            {
+                let column = config.column(k);
+                linear += (column.a + column.w.cross(&centre)).norm_squared();
+                angular += column.w.norm_squared();
+            }
+            scale.push(gamma * (body.mass * linear + body.inertia_c.trace() * angular));
+        }
+        let own = (0..bodies.len())
+            .map(|b| tree.dof_range(b).filter_map(|k| free_index[k]).collect())
+            .collect();
+        Ok(BodyContributions {
+            scale,
+            order: tree.topological_order().to_vec(),
+            parent: (0..bodies.len()).map(|b| tree.parent(b)).collect(),
+            own,
+        })
+    }
+
+    /// Σ_b scale_b ‖x|S_b‖², S_b the free coordinates on b's root path. Each ‖x|S_b‖² is kept
+    /// as t_b²·s_b with t_b = max |x_i| on S_b and s_b = Σ(x_i/t_b)², grown from the parent's
+    /// pair by rescaling where the maximum rises, so that shapes of light bodies (entries near
+    /// 1e158 for a mass of 1e-316) neither overflow the squares nor swamp the heavy bodies'
+    /// small terms. A square or rescaled sum that underflows errs by less than 2⁻¹⁰²⁰ t_b²,
+    /// added per entry, and the sums' rounding is covered by a factor 1 + 4·len·u. A body whose
+    /// path the mode does not touch, or whose scale is zero, adds nothing, even when the other
+    /// factor overflowed.
+    fn share(&self, x: impl Fn(usize) -> f64) -> f64 {
+        let entries: usize = self.own.iter().map(Vec::len).sum();
+        let underflow = (-1020.0_f64).exp2();
+        let rounding = 1.0 + 4.0 * entries as f64 * f64::EPSILON;
+        let mut path = vec![ScaledSquares::default(); self.scale.len()];
+        let mut total = 0.0;
+        for &b in &self.order {
+            let mut sum = self.parent[b].map_or_else(ScaledSquares::default, |p| path[p]);
+            for &i in &self.own[b] {
+                sum.add(x(i));
+            }
+            path[b] = sum;
+            if sum.top > 0.0 && self.scale[b] != 0.0 {
+                let relative = sum.scaled * rounding + sum.count as f64 * underflow;
+                total += (self.scale[b] * sum.top) * (sum.top * relative);
+            }
+        }
+        total
+    }
+}
+
+/// A sum of squares t²·s with t the largest magnitude added (LAPACK's `dlassq` update), and
+/// the number of terms.
+#[derive(Debug, Clone, Copy, Default)]
+struct ScaledSquares {
+    top: f64,
+    scaled: f64,
+    count: usize,
+}
+
+impl ScaledSquares {
+    fn add(&mut self, value: f64) {
+        let magnitude = value.abs();
+        self.count += 1;
+        if magnitude == 0.0 {
+            return;
+        }
+        if magnitude > self.top {
+            self.scaled = 1.0 + self.scaled * (self.top / magnitude).powi(2);
+            self.top = magnitude;
+        } else {
+            self.scaled += (magnitude / self.top).powi(2);
         }
     }
 }
@@ -185,4 +258,76 @@ fn only_body(bodies: &[MassProperties], b: usize) -> Vec<MassProperties> {
     (0..bodies.len())
         .map(|i| if i == b { bodies[i] } else { nothing })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A random tree of `parents.len()` bodies (each parent an earlier body or none), with
+    /// `dofs[b]` coordinates per body numbered in body order.
+    fn bodies(parents: &[Option<usize>], dofs: &[usize], scale: Vec<f64>) -> BodyContributions {
+        let mut own = Vec::new();
+        let mut next = 0;
+        for &d in dofs {
+            own.push((next..next + d).collect());
+            next += d;
+        }
+        BodyContributions {
+            scale,
+            order: (0..parents.len()).collect(),
+            parent: parents.to_vec(),
+            own,
+        }
+    }
+
+    /// The same terms, one explicit support per body (its root path's coordinates).
+    fn explicit(tree: &BodyContributions) -> Vec<Contribution> {
+        (0..tree.scale.len())
+            .map(|b| {
+                let path = std::iter::successors(Some(b), |&i| tree.parent[i]);
+                Contribution {
+                    scale: tree.scale[b],
+                    support: path.flat_map(|i| tree.own[i].iter().copied()).collect(),
+                }
+            })
+            .collect()
+    }
+
+    proptest! {
+        /// The path sums from the root give each body's Σ_{S_b} x² as the direct sum over its
+        /// support does, to rounding, over random trees and shapes spread over ±150 decades.
+        #[test]
+        fn path_sums_match_the_direct_sum_over_each_support(
+            seed in proptest::collection::vec((0.0..1.0_f64, 0usize..3, -12.0..12.0_f64), 1..40),
+            shape in proptest::collection::vec((-150.0..150.0_f64, any::<bool>()), 120),
+        ) {
+            let parents: Vec<Option<usize>> = seed
+                .iter()
+                .enumerate()
+                .map(|(b, &(p, _, _))| (b > 0 && p < 0.9).then(|| (p / 0.9 * b as f64) as usize))
+                .collect();
+            let dofs: Vec<usize> = seed.iter().map(|s| s.1).collect();
+            let scale: Vec<f64> = seed.iter().map(|s| 10f64.powf(s.2)).collect();
+            let tree = bodies(&parents, &dofs, scale);
+            let x = |i: usize| {
+                let (e, negative) = shape[i];
+                if negative { -(10f64.powf(e)) } else { 10f64.powf(e) }
+            };
+            let by_paths = tree.share(x);
+            let direct = share(&explicit(&tree), x);
+            prop_assert!(direct.is_finite() == by_paths.is_finite(), "{by_paths} vs {direct}");
+            prop_assert!(by_paths >= direct * (1.0 - 1e-13), "{by_paths} < {direct}");
+            prop_assert!(by_paths <= direct * (1.0 + 1e-12) + f64::MIN_POSITIVE, "{by_paths} ≫ {direct}");
+        }
+    }
+
+    #[test]
+    fn a_body_the_mode_does_not_move_adds_nothing_even_with_an_infinite_scale() {
+        let tree = bodies(&[None, None], &[1, 1], vec![f64::INFINITY, 2.0]);
+        let x = |i: usize| if i == 0 { 0.0 } else { 3.0 };
+        let expected = 2.0 * 3.0 * (3.0 * ((1.0 + 8.0 * f64::EPSILON) + (-1020.0_f64).exp2()));
+        assert_eq!(tree.share(x), expected);
+    }
 }

@@ -47,10 +47,19 @@ pub fn check_finite(step: &Step) -> Result<(), NonFiniteResult> {
     }
 }
 
-/// A serializer that remembers the path of the first non-finite float.
+/// One step of a path into the record: a field or variant name, a map key, or an index.
+enum Segment {
+    Name(&'static str),
+    Key(String),
+    Index(usize),
+}
+
+/// A serializer that remembers the path of the first non-finite float. The path is kept as
+/// segments and spelt out only when one is found: a record of millions of numbers is walked
+/// without an allocation per number.
 #[derive(Default)]
 struct Finder {
-    path: Vec<String>,
+    path: Vec<Segment>,
     index: Vec<usize>,
     found: Option<(String, f64)>,
 }
@@ -60,16 +69,17 @@ impl Finder {
         if !value.is_finite() && self.found.is_none() {
             let mut path = String::new();
             for segment in &self.path {
-                if !path.is_empty() && !segment.starts_with('[') {
-                    path.push('.');
+                match segment {
+                    Segment::Index(i) => path.push_str(&format!("[{i}]")),
+                    Segment::Name(name) => push_name(&mut path, name),
+                    Segment::Key(key) => push_name(&mut path, key),
                 }
-                path.push_str(segment);
             }
             self.found = Some((path, value));
         }
     }
 
-    fn visit<T: ?Sized + Serialize>(&mut self, segment: String, value: &T) -> Result<(), Never> {
+    fn visit<T: ?Sized + Serialize>(&mut self, segment: Segment, value: &T) -> Result<(), Never> {
         self.path.push(segment);
         let result = value.serialize(&mut *self);
         self.path.pop();
@@ -81,7 +91,7 @@ impl Finder {
         if let Some(last) = self.index.last_mut() {
             *last += 1;
         }
-        self.visit(format!("[{i}]"), value)
+        self.visit(Segment::Index(i), value)
     }
 
     fn open(&mut self) -> Result<&mut Finder, Never> {
@@ -93,6 +103,14 @@ impl Finder {
         self.index.pop();
         Ok(())
     }
+}
+
+/// Appends `.name` to `path` (without the dot at its start).
+fn push_name(path: &mut String, name: &str) {
+    if !path.is_empty() {
+        path.push('.');
+    }
+    path.push_str(name);
 }
 
 /// The finder's error type; it is never produced by the finder itself.
@@ -160,7 +178,7 @@ impl<'a> ser::Serializer for &'a mut Finder {
         variant: &'static str,
         value: &T,
     ) -> Result<(), Never> {
-        self.visit(variant.into(), value)
+        self.visit(Segment::Name(variant), value)
     }
     fn serialize_seq(self, _: Option<usize>) -> Result<Self, Never> {
         self.open()
@@ -215,7 +233,7 @@ macro_rules! fields {
             type Ok = ();
             type Error = Never;
             fn serialize_field<T: ?Sized + Serialize>(&mut self, key: &'static str, value: &T) -> Result<(), Never> {
-                self.visit(key.into(), value)
+                self.visit(Segment::Name(key), value)
             }
             fn end(self) -> Result<(), Never> {
                 self.close()
@@ -234,7 +252,7 @@ impl ser::SerializeMap for &mut Finder {
     type Error = Never;
     fn serialize_key<T: ?Sized + Serialize>(&mut self, key: &T) -> Result<(), Never> {
         let name = serde_json::to_string(key).unwrap_or_default();
-        self.path.push(name.trim_matches('"').to_string());
+        self.path.push(Segment::Key(name.trim_matches('"').to_string()));
         Ok(())
     }
     fn serialize_value<T: ?Sized + Serialize>(&mut self, value: &T) -> Result<(), Never> {
