@@ -21,7 +21,7 @@
 
 use crate::configuration::Configuration;
 use crate::{Mechanism, MechanismError, Potential, PotentialSum};
-use faer::Mat;
+use faer::{Mat, MatRef};
 use mechanica_kinematics::scaling;
 use mechanica_kinematics::tree::Workspace;
 use mechanica_mass::MassProperties;
@@ -97,6 +97,22 @@ impl AssemblyError {
     /// so only B's rounding can move ω² across zero.
     pub(crate) fn stiffness_share(&self, x: impl Fn(usize) -> f64) -> f64 {
         share(&self.stiffness, x)
+    }
+
+    /// A bound τ on ‖diag(B)^{-1/2} δB diag(B)^{-1/2}‖₂ for the assembly's rounding δB of the
+    /// stored (free-coordinate) Hessian `b`: Σ_c γ‖B_c‖_F / min_{i∈S_c} b_ii, since each δB_c
+    /// lives on S_c. None when a contribution with a non-zero scale touches a diagonal entry
+    /// that is not positive, or the sum is not finite.
+    pub(crate) fn stiffness_margin(&self, b: MatRef<'_, f64>) -> Option<f64> {
+        let mut margin = 0.0;
+        for c in self.stiffness.iter().filter(|c| c.scale != 0.0) {
+            let smallest = c.support.iter().map(|&i| b[(i, i)]).fold(f64::INFINITY, f64::min);
+            if smallest.is_nan() || smallest <= 0.0 {
+                return None;
+            }
+            margin += c.scale / smallest;
+        }
+        margin.is_finite().then_some(margin)
     }
 
     /// A's share, |ω²| Σ_b γ‖A_b‖_F ‖x|S_b‖²: relative to ω², it never changes its sign.

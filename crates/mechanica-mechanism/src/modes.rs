@@ -20,10 +20,11 @@
 
 use crate::assembly_error::AssemblyError;
 use crate::{Mechanism, MechanismError};
-use faer::Mat;
 use faer::c64;
+use faer::{Mat, MatRef, Par};
 use mechanica_modal::{
-    ModalSolution, Mode, ModeKind, PencilProblem, QuadraticOptions, SolveOptions, quadratic_modes, solve,
+    ModalSolution, Mode, ModeKind, PencilProblem, QuadraticOptions, SolveOptions, proven_definite_with_margin,
+    quadratic_modes, solve,
 };
 use nalgebra::Vector3;
 
@@ -208,7 +209,7 @@ fn modes_at(
     };
     let mut solution = solve(&problem, &options)?;
     let assembly = AssemblyError::of(mechanism, &q, &free)?;
-    propagate_assembly_error(&mut solution, &assembly);
+    propagate_assembly_error(&mut solution, &assembly, b.as_ref());
     let stability = stability_of(&solution.modes);
     let gradient_norm = free.iter().map(|&k| evaluation.gradient[k].powi(2)).sum::<f64>().sqrt();
     if let Some(x) = solution.vectors.take() {
@@ -244,8 +245,12 @@ fn modes_at(
 /// The modal solver certifies each ω² for the B it was given; B itself carries the rounding
 /// of its assembly, bounded mode by mode in [`AssemblyError`], which is added to every bound,
 /// and the modes are reclassified with it: a ω² of 1e-29 from a B of size 40 is a zero mode,
-/// not an instability.
-fn propagate_assembly_error(solution: &mut ModalSolution, assembly: &AssemblyError) {
+/// not an instability. Where that leaves a finite mode short of oscillatory, the exact Hessian
+/// is tested for definiteness with the assembly's rounding as margin
+/// ([`AssemblyError::stiffness_margin`], [`proven_definite_with_margin`]): when it is proven,
+/// every finite ω² of the exact linearisation is positive (Sylvester's law), whatever the
+/// bounds, and every finite mode is oscillatory.
+fn propagate_assembly_error(solution: &mut ModalSolution, assembly: &AssemblyError, b: MatRef<'_, f64>) {
     let Some(x) = &solution.vectors else { return };
     for (k, mode) in solution.modes.iter_mut().enumerate() {
         if matches!(mode.kind, ModeKind::Infinite) {
@@ -265,6 +270,20 @@ fn propagate_assembly_error(solution: &mut ModalSolution, assembly: &AssemblyErr
         mode.error_bound = sign_bound + assembly.inertia_share(mode.omega_sq, shape);
         if let Some(bound) = solution.accuracy.error_bounds.get_mut(k) {
             *bound = mode.error_bound;
+        }
+    }
+    let doubtful = |m: &Mode| !matches!(m.kind, ModeKind::Infinite | ModeKind::Oscillatory { .. });
+    if !solution.modes.iter().any(doubtful) {
+        return;
+    }
+    let definite = assembly
+        .stiffness_margin(b)
+        .is_some_and(|margin| proven_definite_with_margin(b, margin, Par::Seq));
+    if definite {
+        for mode in solution.modes.iter_mut().filter(|m| doubtful(m)) {
+            mode.kind = ModeKind::Oscillatory {
+                omega: mode.omega_sq.max(0.0).sqrt(),
+            };
         }
     }
 }

@@ -76,7 +76,9 @@ pub mod spectrum;
 pub mod testing;
 pub mod tuning;
 
-pub use certify::{AccuracyReport, BoundKind, InertiaCheck, InertiaCount, Residuals, count_below};
+pub use certify::{
+    AccuracyReport, BoundKind, InertiaCheck, InertiaCount, Residuals, count_below, proven_definite_with_margin,
+};
 pub use dense::{Method, ModalSolution, Refinement, Selection, SolveOptions, SolveTimings, solve};
 pub use error::ModalError;
 pub use faer;

@@ -103,7 +103,20 @@ pub(crate) fn stiffness_is_definite(problem: &PencilProblem, par: faer::Par) -> 
 /// False for a non-positive or non-finite diagonal entry, or when λ_min(SHS) ≲ c (about
 /// 4n²u): M singular up to rounding is never proven. O(n³/3) flops in kept storage.
 pub(crate) fn proven_positive_definite(m: faer::MatRef<'_, f64>, par: faer::Par) -> bool {
+    proven_definite_with_margin(m, 0.0, par)
+}
+
+/// Whether M − τ·diag(M) is proven positive definite for the `margin` τ ≥ 0 (lower triangle
+/// read): the proof of [`proven_positive_definite`] with the shift c raised to c + τ, which
+/// gives S H S ⪰ (τ + nγ/(1 − γ) + u)·I ≻ τ·I. Then M + E is positive definite for every
+/// symmetric E with ‖diag(M)^{-1/2} E diag(M)^{-1/2}‖₂ ≤ τ: a matrix known only to within such
+/// an E (an assembly's rounding) is proven definite with it. False for τ outside [0, 1/2),
+/// or where the proof fails. O(n³/3) flops.
+pub fn proven_definite_with_margin(m: faer::MatRef<'_, f64>, margin: f64, par: faer::Par) -> bool {
     let n = m.nrows();
+    if m.ncols() != n || !(0.0..0.5).contains(&margin) {
+        return false;
+    }
     let mut half_exponents = Vec::with_capacity(n);
     for j in 0..n {
         let d = m[(j, j)];
@@ -118,7 +131,7 @@ pub(crate) fn proven_positive_definite(m: faer::MatRef<'_, f64>, par: faer::Par)
         return false;
     }
     let gamma = gamma_order * u / (1.0 - gamma_order * u);
-    let shift = 2.0 * n as f64 * gamma / (1.0 - gamma) + 4.0 * u;
+    let shift = 2.0 * n as f64 * gamma / (1.0 - gamma) + 4.0 * u + margin;
     let mut g = crate::runtime::scratch::empty(n, n);
     g.resize_with(n, n, |i, j| {
         let h = times_power_of_two(m[(i, j)], -(half_exponents[i] + half_exponents[j]));
@@ -294,6 +307,34 @@ mod tests {
                     "case {case}: rank deficient"
                 );
             }
+        }
+    }
+
+    /// H = (1 − ρ)I + ρ11ᵀ (unit diagonal, λ_min = 1 − ρ exactly, ρ = 1 − 2⁻ᵏ), graded by
+    /// powers of two: a margin below λ_min/2 is proven, one at or above λ_min never is.
+    #[test]
+    fn margins_are_proven_below_the_smallest_scaled_eigenvalue_and_never_above() {
+        let mut rng = SplitMix::new(33);
+        for case in 0..80 {
+            let n = 2 + rng.below(50);
+            let lambda_min = times_power_of_two(1.0, -(1 + rng.below(12) as i32));
+            let rho = 1.0 - lambda_min;
+            let h = Mat::from_fn(n, n, |i, j| if i == j { 1.0 } else { rho });
+            let graded = graded_by_powers_of_two(&h, &mut rng, 200);
+            let below = lambda_min * rng.uniform(0.0, 0.5);
+            assert!(
+                proven_definite_with_margin(graded.as_ref(), below, Par::Seq),
+                "case {case}: n = {n}, λ_min = {lambda_min}, margin {below}"
+            );
+            let above = lambda_min * rng.uniform(1.0, 4.0);
+            assert!(
+                !proven_definite_with_margin(graded.as_ref(), above, Par::Seq),
+                "case {case}: n = {n}, λ_min = {lambda_min}, margin {above}"
+            );
+        }
+        let identity = Mat::<f64>::identity(3, 3);
+        for bad in [-1e-300, 0.5, f64::NAN, f64::INFINITY] {
+            assert!(!proven_definite_with_margin(identity.as_ref(), bad, Par::Seq), "{bad}");
         }
     }
 

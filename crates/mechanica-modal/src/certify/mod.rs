@@ -15,7 +15,7 @@ pub(crate) mod resolution;
 pub(crate) mod sketch;
 pub(crate) mod sturm;
 
-pub use inertia::{InertiaCount, count_below};
+pub use inertia::{InertiaCount, count_below, proven_definite_with_margin};
 pub use products::Residuals;
 pub use report::{AccuracyReport, BoundKind};
 pub use resolution::{data_resolution, normwise_resolution};
