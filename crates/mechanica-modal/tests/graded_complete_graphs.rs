@@ -153,3 +153,30 @@ fn four_graded_masses_on_a_complete_graph_are_oscillatory() {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+    /// A complete graph of 17 to 64 masses graded over up to 2^±40 has one eigenvalue
+    /// repeated n − 1 times, and the reduction's bounds (u‖B‖‖A⁻¹‖, up to 1e12 here) make the
+    /// whole spectrum one cluster. Refined as one block, with the default options, every mode is
+    /// decided: the rigid-body mode of the free graph zero, all others oscillatory, the values
+    /// to 1e-8 relative.
+    #[test]
+    fn large_repeated_clusters_of_graded_pencils_are_refined_and_decided(
+        seed in any::<u64>(),
+        n in 17usize..65,
+        free in any::<bool>(),
+    ) {
+        let kind = if free { Stiffness::Free } else { Stiffness::Definite };
+        prop_assert_eq!(check(seed, n, kind, Use::Default), Ok(()));
+        let (a, b, exact) = complete_graph(seed, n, kind);
+        for (mode, &exact) in modes_of(&a, &b, Use::Default).iter().zip(&exact) {
+            if exact == 0.0 {
+                prop_assert_eq!(mode.kind, ModeKind::Zero, "{:?}", mode);
+            } else {
+                prop_assert!(matches!(mode.kind, ModeKind::Oscillatory { .. }), "{:?}", mode);
+                prop_assert!(mode.error_bound <= 1e-8 * exact, "{:?}, exact {}", mode, exact);
+            }
+        }
+    }
+}
