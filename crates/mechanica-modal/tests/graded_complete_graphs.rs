@@ -180,3 +180,38 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+    /// The lowest few modes of the same pencils: the selection's edge cuts the repeated
+    /// eigenvalue, and the solve widens it so that the cluster is refined whole. Every selected
+    /// mode is decided, its value to 1e-8 relative, and the Sturm check is consistent.
+    #[test]
+    fn a_lowest_selection_that_cuts_a_repeated_cluster_is_decided(
+        seed in any::<u64>(),
+        n in 17usize..65,
+        k in 2usize..7,
+        free in any::<bool>(),
+    ) {
+        let kind = if free { Stiffness::Free } else { Stiffness::Definite };
+        prop_assert_eq!(check(seed, n, kind, Use::Lowest(k)), Ok(()));
+        let (a, b, exact) = complete_graph(seed, n, kind);
+        let problem = PencilProblem::new(a.as_ref(), b.as_ref()).expect("valid pencil");
+        let options = SolveOptions {
+            selection: Selection::Lowest(k),
+            ..SolveOptions::default()
+        };
+        let solution = solve(&problem, &options).expect("dense solve");
+        prop_assert_eq!(solution.modes.len(), k);
+        prop_assert_eq!(solution.vectors.as_ref().map(|x| x.ncols()), Some(k));
+        prop_assert!(solution.accuracy.inertia_check.is_some_and(|c| c.consistent));
+        for (mode, &exact) in solution.modes.iter().zip(&exact) {
+            if exact == 0.0 {
+                prop_assert_eq!(mode.kind, ModeKind::Zero, "{:?}", mode);
+            } else {
+                prop_assert!(matches!(mode.kind, ModeKind::Oscillatory { .. }), "{:?}", mode);
+                prop_assert!(mode.error_bound <= 1e-8 * exact, "{:?}, exact {}", mode, exact);
+            }
+        }
+    }
+}

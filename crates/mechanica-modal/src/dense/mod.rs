@@ -13,6 +13,7 @@
 //! the values-only sharpening (`values_only`).
 
 mod condense;
+mod cut_cluster;
 mod definite;
 mod finish;
 mod idle_inputs;
@@ -56,8 +57,26 @@ use std::time::Instant;
 /// infinite modes. A indefinite: [`ModalError::IndefiniteMass`], naming the failed pivot.
 /// Entries near the ends of the double range (1e±308, subnormal) are first scaled by powers of
 /// two (`scaling`), exactly; a result outside the range of doubles is
-/// [`ModalError::OutOfRange`].
+/// [`ModalError::OutOfRange`]. A `Lowest(k)` selection whose edge cuts a cluster, leaving a mode
+/// undecided or the Sturm check inconsistent, is solved again with the selection widened by
+/// [`Tuning::max_refined_cluster`] modes so that the cluster is refined whole; its first k
+/// modes are returned (`cut_cluster`).
 pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSolution, ModalError> {
+    let solution = solve_once(problem, options)?;
+    let Some(wide) = cut_cluster::wider_selection(problem, options, &solution) else {
+        return Ok(solution);
+    };
+    let Selection::Lowest(k) = options.selection else {
+        return Ok(solution);
+    };
+    Ok(match cut_cluster::solve_wider(problem, options, k, wide, solve_once) {
+        Some(wider) => cut_cluster::first_modes(wider, k, &solution.timings),
+        None => solution,
+    })
+}
+
+/// [`solve`] with the selection as given.
+fn solve_once(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSolution, ModalError> {
     check_interval(options.selection)?;
     let solution = match PencilScale::of(problem)? {
         None => solve_in_range(problem, options)?,
