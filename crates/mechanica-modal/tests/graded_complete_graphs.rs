@@ -179,10 +179,7 @@ proptest! {
             }
         }
     }
-}
 
-proptest! {
-    #![proptest_config(ProptestConfig::with_cases(12))]
     /// The lowest few modes of the same pencils: the selection's edge cuts the repeated
     /// eigenvalue, and the solve widens it so that the cluster is refined whole. Every selected
     /// mode is decided, its value to 1e-8 relative, and the Sturm check is consistent.
