@@ -132,6 +132,13 @@ impl Finish<'_> {
         for (mode, &r) in modes.iter_mut().zip(&resolution) {
             mode.kind = classify(mode.omega_sq, mode.error_bound, r);
         }
+        let whole = matches!(self.options.selection, Selection::All | Selection::Lowest(_));
+        zero_on_null_columns(
+            self.problem.b(),
+            x.as_ref().map(|x| x.as_ref()),
+            &mut modes,
+            first == 0 && whole,
+        );
         if !self.options.vectors {
             x = None;
             report.backward_errors.iter_mut().for_each(|e| *e = None);
@@ -369,6 +376,48 @@ fn widen_overlapping_estimates(modes: &mut [Mode], report: &mut AccuracyReport) 
             }
         }
         start = end;
+    }
+}
+
+/// Zero modes proven by the columns of B that are exactly zero (a joint no potential depends
+/// on: a robot's vertical first axis under gravity, a wrist turning about a line through its
+/// load's centre of mass), where the data's resolution is itself zero and the solve's bound of
+/// the order of 1e-60 would leave the mode undecided. With z such columns e_j, B e_j = 0 and the
+/// pencil has at least z exact zero eigenvalues, each at a rank whose interval contains zero:
+/// - when the selection starts at the bottom of the spectrum (`from_bottom`), its last mode lies
+///   above zero or it holds every mode, and no more than z of its modes have intervals that
+///   contain zero, every one of those modes is an exact zero;
+/// - otherwise, an undecided mode whose shape x vanishes outside those columns is: Bx = 0
+///   exactly, so (0, x) is an exact eigenpair, the one the mode stands for.
+///
+/// Bounds are kept (they contain zero).
+fn zero_on_null_columns(b: MatRef<'_, f64>, x: Option<MatRef<'_, f64>>, modes: &mut [Mode], from_bottom: bool) {
+    let contains_zero =
+        |m: &Mode| matches!(m.kind, ModeKind::Undecided | ModeKind::Zero) && m.omega_sq.abs() <= m.error_bound;
+    if !modes.iter().any(|m| m.kind == ModeKind::Undecided) {
+        return;
+    }
+    let n = b.nrows();
+    let null_column: Vec<bool> = (0..n).map(|j| (0..n).all(|i| b[(i, j)] == 0.0)).collect();
+    let null_dimension = null_column.iter().filter(|&&z| z).count();
+    if null_dimension == 0 {
+        return;
+    }
+    let above_zero = |m: &Mode| m.omega_sq - m.error_bound > 0.0;
+    let all_zeros_selected = from_bottom && (modes.len() == n || modes.last().is_some_and(above_zero));
+    if all_zeros_selected && modes.iter().filter(|m| contains_zero(m)).count() <= null_dimension {
+        for mode in modes.iter_mut().filter(|m| contains_zero(m)) {
+            mode.kind = ModeKind::Zero;
+        }
+        return;
+    }
+    let Some(x) = x else { return };
+    for (k, mode) in modes.iter_mut().enumerate().filter(|(k, _)| *k < x.ncols()) {
+        let on_null_columns = (0..n).all(|i| x[(i, k)] == 0.0 || null_column[i]);
+        let moves = (0..n).any(|i| x[(i, k)] != 0.0);
+        if mode.kind == ModeKind::Undecided && contains_zero(mode) && on_null_columns && moves {
+            mode.kind = ModeKind::Zero;
+        }
     }
 }
 
