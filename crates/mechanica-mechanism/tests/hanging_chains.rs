@@ -53,7 +53,7 @@ fn unproven_modes(masses: &[f64], lengths: &[f64], planar: bool) -> Result<usize
     let q = vec![0.0; masses.len()];
     let modes = mechanism_modes(&mut mechanism, &q, &SolveOptions::default()).expect("modes");
     for mode in &modes.solution.modes {
-        prop_assert!(mode.error_bound.is_finite() && mode.omega_sq.is_finite());
+        prop_assert!(mode.error_bound.is_finite() && mode.omega_sq.is_finite(), "{:?}", mode);
         prop_assert!(
             !matches!(mode.kind, ModeKind::Zero | ModeKind::Unstable { .. }),
             "{:?}",

@@ -41,7 +41,7 @@ use crate::dense::solution::empty_solution;
 use crate::error::ModalError;
 use crate::linalg::eigen::OnTridiagonal;
 use crate::linalg::norms::frobenius_norm;
-use crate::linalg::reduce::{Cholesky, cholesky_owned, lower_entry};
+use crate::linalg::reduce::{Cholesky, cholesky_mass_owned, lower_entry};
 use crate::problem::PencilProblem;
 use crate::runtime::fork_join::join;
 use crate::runtime::idle_task::IdleTask;
@@ -144,7 +144,7 @@ fn solve_in_range(problem: &PencilProblem, options: &SolveOptions) -> Result<Mod
         || b_copy.resize_with(n, n, |i, j| lower_entry(b, i, j)),
         par,
     );
-    match cholesky_owned(a_copy, par) {
+    match cholesky_mass_owned(a_copy, par) {
         Cholesky::Factor(l) => {
             let cholesky_time = clock.elapsed();
             // The bottom certificate is factored on idle time once T is known.

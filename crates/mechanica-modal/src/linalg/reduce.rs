@@ -67,6 +67,33 @@ pub(crate) fn cholesky_owned(mut l: Mat<f64>, par: Par) -> Cholesky {
     }
 }
 
+/// [`cholesky_owned`] of a mass matrix, with the pivot test scaled column by column: a pivot
+/// fails when l_ii² ≤ n·u·a_ii (its own diagonal entry) rather than n·u·max_j a_jj. Cholesky's
+/// rounding is invariant under diagonal scaling, so this is the test on the unit-diagonal
+/// D^{-1/2}AD^{-1/2}: a graded mass matrix (a chain of point masses over decades) is not taken
+/// for a semidefinite one because its light coordinates have small pivots beside heavy ones.
+pub(crate) fn cholesky_mass_owned(mut l: Mat<f64>, par: Par) -> Cholesky {
+    if is_diagonal(l.as_ref()) {
+        return cholesky_owned(l, par);
+    }
+    let n = l.nrows();
+    let diagonal: Vec<f64> = (0..n).map(|i| l[(i, i)]).collect();
+    let factored = factor_recursive(l.as_mut(), factor_parallelism(n, par)).and_then(|()| {
+        let tolerance = n as f64 * f64::EPSILON;
+        match (0..n).find(|&i| {
+            let pivot = l[(i, i)] * l[(i, i)];
+            pivot.is_nan() || pivot <= tolerance * diagonal[i]
+        }) {
+            Some(pivot) => Err(pivot),
+            None => Ok(()),
+        }
+    });
+    match factored {
+        Err(pivot) => Cholesky::Failed { pivot },
+        Ok(()) => Cholesky::Factor(l),
+    }
+}
+
 /// Whether the strict lower triangle of `m` is zero (an exact test: early exit at the first
 /// nonzero, so a dense matrix costs a few reads).
 pub(crate) fn is_diagonal(m: MatRef<'_, f64>) -> bool {
