@@ -33,7 +33,8 @@ fn factor_parallelism(n: usize, par: Par) -> Par {
 pub(crate) enum Cholesky {
     /// A = L Lᵀ with every pivot l_ii² above the semidefiniteness tolerance.
     Factor(Mat<f64>),
-    /// Pivot `pivot` was not positive, or smaller than n·u·max|A| (numerically singular).
+    /// Pivot `pivot` was not positive, or negligible (numerically singular): below n·u·max|A|,
+    /// or for a mass matrix ([`cholesky_mass_owned`]) below n·u times its own diagonal entry.
     Failed {
         /// Index of the first failing or negligible pivot.
         pivot: usize,
