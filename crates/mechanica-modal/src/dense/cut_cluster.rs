@@ -7,7 +7,7 @@
 //! of that solve are returned: their bounds and classes hold whatever else was computed.
 
 use crate::certify::report::AccuracyReport;
-use crate::dense::options::{Refinement, Selection, SolveOptions};
+use crate::dense::options::{Refinement, Selection, SolveOptions, weakly_bounded};
 use crate::dense::solution::{ModalSolution, SolveTimings};
 use crate::error::ModalError;
 use crate::problem::PencilProblem;
@@ -15,7 +15,8 @@ use crate::spectrum::{ModeKind, group_modes};
 use crate::tuning::Tuning;
 
 /// The wider selection to solve again with, when `solution` (of `options`) left a selected mode
-/// undecided or its Sturm check inconsistent under a `Lowest(k)` that is not every mode.
+/// undecided or weakly bounded, or its Sturm check inconsistent, under a `Lowest(k)` that is not
+/// every mode.
 pub(crate) fn wider_selection(
     problem: &PencilProblem,
     options: &SolveOptions,
@@ -25,7 +26,10 @@ pub(crate) fn wider_selection(
         return None;
     };
     let n = problem.dim();
-    let doubtful = solution.modes.iter().any(|m| m.kind == ModeKind::Undecided)
+    let doubtful = solution
+        .modes
+        .iter()
+        .any(|m| m.kind == ModeKind::Undecided || weakly_bounded(m.error_bound, m.omega_sq))
         || solution.accuracy.inertia_check.is_some_and(|c| !c.consistent);
     (options.refinement != Refinement::Off && k < n && doubtful)
         .then(|| n.min(k.saturating_add(Tuning::DEFAULT.max_refined_cluster)))

@@ -58,7 +58,7 @@ use std::time::Instant;
 /// Entries near the ends of the double range (1e±308, subnormal) are first scaled by powers of
 /// two (`scaling`), exactly; a result outside the range of doubles is
 /// [`ModalError::OutOfRange`]. A `Lowest(k)` selection whose edge cuts a cluster, leaving a mode
-/// undecided or the Sturm check inconsistent, is solved again with the selection widened by
+/// undecided or weakly bounded or the Sturm check inconsistent, is solved again with the selection widened by
 /// [`Tuning::max_refined_cluster`] modes so that the cluster is refined whole; its first k
 /// modes are returned (`cut_cluster`).
 pub fn solve(problem: &PencilProblem, options: &SolveOptions) -> Result<ModalSolution, ModalError> {
