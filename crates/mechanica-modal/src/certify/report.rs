@@ -74,6 +74,15 @@ impl AccuracyReport {
         take(&mut self.refinement_steps, order);
     }
 
+    /// Keeps the per-mode entries of the first `k` modes.
+    pub(crate) fn truncate(&mut self, k: usize) {
+        self.backward_errors.truncate(k);
+        self.error_bounds.truncate(k);
+        self.bound_kinds.truncate(k);
+        self.residual_norms_a_inv.truncate(k);
+        self.refinement_steps.truncate(k);
+    }
+
     pub(crate) fn empty() -> Self {
         Self {
             norm_a: 0.0,

@@ -1,12 +1,11 @@
 //! A `Lowest(k)` selection whose edge cuts a cluster: the modes above the edge that the
 //! cluster's bounds cannot tell apart from the selected ones are missing members of its block,
 //! so refinement declines the block ([`crate::spectrum::refinable`]) and the Sturm check cannot
-//! place a shift at the edge. Where that leaves a selected mode undecided or the Sturm check
-//! inconsistent, the solve is repeated with the selection widened by
+//! place a shift at the edge. Where that leaves a selected mode undecided or weakly bounded, or
+//! the Sturm check inconsistent, the solve is repeated with the selection widened by
 //! [`crate::Tuning::max_refined_cluster`] modes (or to every finite mode), and the first k modes
 //! of that solve are returned: their bounds and classes hold whatever else was computed.
 
-use crate::certify::report::AccuracyReport;
 use crate::dense::options::{Refinement, Selection, SolveOptions, weakly_bounded};
 use crate::dense::solution::{ModalSolution, SolveTimings};
 use crate::error::ModalError;
@@ -43,7 +42,7 @@ pub(crate) fn first_modes(mut wide: ModalSolution, k: usize, first_try: &SolveTi
     if wide.modes.len() > k {
         wide.modes.truncate(k);
         wide.vectors = wide.vectors.map(|x| x.subcols(0, k.min(x.ncols())).to_owned());
-        truncate_report(&mut wide.accuracy, k);
+        wide.accuracy.truncate(k);
         wide.groups = group_modes(&mut wide.modes);
     }
     let t = &mut wide.timings;
@@ -53,15 +52,6 @@ pub(crate) fn first_modes(mut wide: ModalSolution, k: usize, first_try: &SolveTi
     t.refine += first_try.refine;
     t.inertia += first_try.inertia;
     wide
-}
-
-/// Keeps the per-mode entries of the first `k` modes.
-fn truncate_report(report: &mut AccuracyReport, k: usize) {
-    report.backward_errors.truncate(k);
-    report.error_bounds.truncate(k);
-    report.bound_kinds.truncate(k);
-    report.residual_norms_a_inv.truncate(k);
-    report.refinement_steps.truncate(k);
 }
 
 /// Solves `problem` again for the lowest `wide` modes with `options` otherwise unchanged; where
