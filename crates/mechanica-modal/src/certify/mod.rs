@@ -5,6 +5,7 @@
 //! of B − sA ([`count_below`]) and the bottom-of-spectrum certificate factored on idle time.
 
 pub(crate) mod a_priori;
+pub(crate) mod extended_definiteness;
 pub(crate) mod forest;
 pub(crate) mod idle_certificate;
 pub(crate) mod inertia;

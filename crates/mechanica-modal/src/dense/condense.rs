@@ -1,7 +1,9 @@
 //! Semidefinite mass matrices: static condensation of the massless directions.
 //!
-//! With A = Q diag(a) Qᵀ and the null space Q₀ of A (a_i ≤ 2n·u·max a), write x = Q₁z + Q₀w.
-//! The pencil splits as [[B₁₁ − ω²A₁, B₁₀], [B₀₁, B₀₀]] [z; w] = 0 with A₁ = diag(a₁) > 0, so
+//! With QᵀAQ = diag(a) and the null space Q₀ of A (a_i ≤ 2n·u·max a), write x = Q₁z + Q₀w.
+//! (For a dense A, Q = D⁻¹Q_H from the orthogonal eigenvectors Q_H of the unit-diagonal
+//! H = D⁻¹AD⁻¹, D a diagonal of powers of two: a congruence, so the pencil keeps its
+//! eigenvalues, and a graded A's massless directions are judged on H.) The pencil splits as [[B₁₁ − ω²A₁, B₁₀], [B₀₁, B₀₀]] [z; w] = 0 with A₁ = diag(a₁) > 0, so
 //! w = −B₀₀⁻¹B₀₁z and (B₁₁ − B₁₀B₀₀⁻¹B₀₁) z = ω² A₁ z: a definite pencil of order n − r, plus r
 //! infinite eigenvalues (λ = −∞) with eigenvectors Q₀ (the Fix–Heiberger reduction, SIAM J.
 //! Numer. Anal. 9, 1972, in its simplest form). B₀₀ singular makes det(λA + B) ≡ 0.
@@ -14,6 +16,7 @@
 
 use crate::error::ModalError;
 use crate::linalg::eigen::symmetric_eigen;
+use crate::linalg::powers_of_two::{exponent, times_power_of_two};
 use crate::linalg::reduce::is_diagonal;
 use crate::problem::PencilProblem;
 use crate::refine::{Blocks, Condensation};
@@ -45,17 +48,25 @@ impl Condensed {
     }
 }
 
-/// Condenses the pencil whose Cholesky factorization of A failed at `pivot` (‖B‖_F = `norm_b`):
-/// [`ModalError::IndefiniteMass`] when A has an eigenvalue below −2n·u·max|a|,
-/// [`ModalError::SingularPencil`] when B₀₀ is singular to working precision (det(λA + B) ≡ 0).
-pub(crate) fn condense(problem: &PencilProblem, pivot: usize, norm_b: f64, par: Par) -> Result<Condensed, ModalError> {
-    let (a, b) = (problem.a(), problem.b());
-    let n = problem.dim();
-    let (values, q) = mass_eigen(a, par)?;
+/// A's eigenvalues (ascending) and eigenvectors, with the number of massless directions: the
+/// eigenvalues at or below the tolerance (0 for a diagonal A, whose entries are exact data;
+/// 2n·u·max|a| for a dense A, the rounding of its computed eigenvalues).
+pub(crate) struct MassSpectrum {
+    values: Vec<f64>,
+    basis: MassBasis,
+    /// How many eigenvalues lie at or below the tolerance.
+    pub(crate) massless: usize,
+}
+
+/// The [`MassSpectrum`] of A, or [`ModalError::IndefiniteMass`] (naming `pivot`, the Cholesky
+/// pivot that failed or was weakest) when A has an eigenvalue below minus the tolerance.
+pub(crate) fn mass_spectrum(a: MatRef<'_, f64>, pivot: usize, par: Par) -> Result<MassSpectrum, ModalError> {
+    let n = a.nrows();
+    let (values, basis) = mass_eigen(a, par)?;
     let amax = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     // A lumped mass is exact data: massless only when it is exactly zero, however small it is
     // beside the others. A dense A's computed eigenvalues carry rounding of 2n·u·max|a|.
-    let tolerance = match q {
+    let tolerance = match basis {
         MassBasis::Permutation(_) => 0.0,
         MassBasis::Dense(_) => 2.0 * n as f64 * f64::EPSILON * amax,
     };
@@ -66,7 +77,27 @@ pub(crate) fn condense(problem: &PencilProblem, pivot: usize, norm_b: f64, par: 
             tolerance,
         });
     }
-    let r = values.partition_point(|&v| v <= tolerance).max(1);
+    let massless = values.partition_point(|&v| v <= tolerance);
+    Ok(MassSpectrum {
+        values,
+        basis,
+        massless,
+    })
+}
+
+/// Condenses the pencil whose mass matrix has the `spectrum` (at least one direction is taken
+/// as massless: the weakest, when none is at or below the tolerance) with ‖B‖_F = `norm_b`:
+/// [`ModalError::SingularPencil`] when B₀₀ is singular to working precision
+/// (det(λA + B) ≡ 0).
+pub(crate) fn condense(problem: &PencilProblem, spectrum: MassSpectrum, norm_b: f64) -> Result<Condensed, ModalError> {
+    let b = problem.b();
+    let n = problem.dim();
+    let MassSpectrum {
+        values,
+        basis: q,
+        massless,
+    } = spectrum;
+    let r = massless.max(1);
     let bq = q.congruence(b);
     let b00 = bq.as_ref().submatrix(0, 0, r, r).to_owned();
     let b10 = bq.as_ref().submatrix(r, 0, n - r, r).to_owned();
@@ -108,14 +139,19 @@ pub(crate) fn condense(problem: &PencilProblem, pivot: usize, norm_b: f64, par: 
     })
 }
 
-/// The eigenvectors Q of the mass matrix: a dense orthogonal matrix, or, for a diagonal A, the
+/// The eigenvectors Q of the mass matrix (QᵀAQ diagonal): a dense matrix D⁻¹Q_H, or, for a diagonal A, the
 /// permutation that sorts the diagonal (column c of Q is the unit vector e_order[c]).
 enum MassBasis {
     Dense(Mat<f64>),
     Permutation(Vec<usize>),
 }
 
-/// Eigenvalues of A ascending and their eigenvectors; a diagonal A is sorted, not decomposed.
+/// Eigenvalues of A ascending with a basis P of eigenvectors, PᵀAP = diag(values); a diagonal A
+/// is sorted, not decomposed. A dense A is first scaled to H = D⁻¹AD⁻¹ with D = diag(2^{s_j}),
+/// 2^{2s_j} within a factor two of a_jj (exact), and P = D⁻¹Q for H = Q diag(values) Qᵀ: the
+/// massless directions are then judged on the unit-diagonal H, so that a graded A's small but
+/// nonzero eigenvalues (an A of rank n − 2 graded over 2^±20 had a third taken as massless)
+/// are not mistaken for rounding of zero.
 fn mass_eigen(a: MatRef<'_, f64>, par: Par) -> Result<(Vec<f64>, MassBasis), ModalError> {
     let n = a.nrows();
     if is_diagonal(a) {
@@ -124,9 +160,23 @@ fn mass_eigen(a: MatRef<'_, f64>, par: Par) -> Result<(Vec<f64>, MassBasis), Mod
         let values = order.iter().map(|&i| a[(i, i)]).collect();
         return Ok((values, MassBasis::Permutation(order)));
     }
-    let eig = symmetric_eigen(a.to_owned(), true, par)?;
+    let half_exponents: Vec<i32> = (0..n)
+        .map(|j| {
+            let d = a[(j, j)];
+            if d > 0.0 && d.is_finite() {
+                exponent(d).div_euclid(2)
+            } else {
+                0
+            }
+        })
+        .collect();
+    let h = Mat::from_fn(n, n, |i, j| {
+        times_power_of_two(a[(i, j)], -(half_exponents[i] + half_exponents[j]))
+    });
+    let eig = symmetric_eigen(h, true, par)?;
     let q = eig.vectors.ok_or(ModalError::NoConvergence { n })?;
-    Ok((eig.values, MassBasis::Dense(q)))
+    let p = Mat::from_fn(n, n, |i, j| times_power_of_two(q[(i, j)], -half_exponents[i]));
+    Ok((eig.values, MassBasis::Dense(p)))
 }
 
 impl MassBasis {
@@ -138,10 +188,14 @@ impl MassBasis {
         }
     }
 
-    /// Column c of Q.
+    /// Column c of Q, of unit length.
     fn column(&self, c: usize) -> Vec<f64> {
         match self {
-            Self::Dense(q) => q.col(c).iter().copied().collect(),
+            Self::Dense(q) => {
+                let column: Vec<f64> = q.col(c).iter().copied().collect();
+                let norm = crate::linalg::norms::euclidean_norm(&column);
+                column.iter().map(|x| x / norm).collect()
+            }
             Self::Permutation(order) => {
                 let mut e = vec![0.0; order.len()];
                 e[order[c]] = 1.0;

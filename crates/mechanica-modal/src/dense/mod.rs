@@ -17,6 +17,7 @@ mod cut_cluster;
 mod definite;
 mod finish;
 mod idle_inputs;
+mod mass_factor;
 mod options;
 mod refinement;
 mod reversed;
@@ -30,10 +31,11 @@ pub use solution::{Method, ModalSolution, SolveTimings};
 use crate::certify::a_priori::APrioriModel;
 use crate::certify::idle_certificate;
 use crate::certify::products::Residuals;
-use crate::dense::condense::condense;
+use crate::dense::condense::{MassSpectrum, condense};
 use crate::dense::definite::{select, solve_definite, solve_definite_owned};
 use crate::dense::finish::Finish;
 use crate::dense::idle_inputs::{EarlyInputs, IdleResults};
+use crate::dense::mass_factor::{MassFactor, mass_factor};
 use crate::dense::options::{check_interval, weakly_bounded};
 use crate::dense::reversed::{adopt_reversed_bottom, reversed_bottom_of};
 use crate::dense::scaling::PencilScale;
@@ -41,7 +43,7 @@ use crate::dense::solution::empty_solution;
 use crate::error::ModalError;
 use crate::linalg::eigen::OnTridiagonal;
 use crate::linalg::norms::frobenius_norm;
-use crate::linalg::reduce::{Cholesky, cholesky_mass_owned, lower_entry};
+use crate::linalg::reduce::{cholesky_mass_owned, lower_entry};
 use crate::problem::PencilProblem;
 use crate::runtime::fork_join::join;
 use crate::runtime::idle_task::IdleTask;
@@ -52,9 +54,9 @@ use std::time::Instant;
 
 /// Solves det(λA + B) = 0 (8.89) for the selected modes, with a full accuracy report.
 ///
-/// A positive definite: Cholesky reduction. A positive semidefinite: the massless directions
-/// (null space of A, from its eigen-decomposition) are condensed out statically and reported as
-/// infinite modes. A indefinite: [`ModalError::IndefiniteMass`], naming the failed pivot.
+/// A positive definite (proven, `mass_factor`): Cholesky reduction. A positive semidefinite: the
+/// massless directions (null space of A, from its eigen-decomposition) are condensed out
+/// statically and reported as infinite modes. A indefinite: [`ModalError::IndefiniteMass`], naming the failed pivot.
 /// Entries near the ends of the double range (1e±308, subnormal) are first scaled by powers of
 /// two (`scaling`), exactly; a result outside the range of doubles is
 /// [`ModalError::OutOfRange`]. A `Lowest(k)` selection whose edge cuts a cluster, leaving a mode
@@ -144,8 +146,8 @@ fn solve_in_range(problem: &PencilProblem, options: &SolveOptions) -> Result<Mod
         || b_copy.resize_with(n, n, |i, j| lower_entry(b, i, j)),
         par,
     );
-    match cholesky_mass_owned(a_copy, par) {
-        Cholesky::Factor(l) => {
+    match mass_factor(a, cholesky_mass_owned(a_copy, par), par)? {
+        MassFactor::Definite(l) => {
             let cholesky_time = clock.elapsed();
             // The bottom certificate is factored on idle time once T is known.
             let mut certificate = None;
@@ -210,25 +212,25 @@ fn solve_in_range(problem: &PencilProblem, options: &SolveOptions) -> Result<Mod
             scratch::give_back(l);
             solution
         }
-        Cholesky::Failed { pivot } => {
+        MassFactor::Massless(spectrum) => {
             let (norm_a, norm_b) = (frobenius_norm(a), frobenius_norm(b));
-            solve_semidefinite(problem, pivot, options, (norm_a, norm_b), par)
+            solve_semidefinite(problem, spectrum, options, (norm_a, norm_b), par)
         }
     }
 }
 
-/// Solves a pencil whose Cholesky factorization of A failed at `pivot`: the massless directions
-/// are condensed out ([`condense`]), the definite pencil (S, A₁) is solved, and its modes are
+/// Solves a pencil whose mass matrix has massless directions (its `spectrum`): they are
+/// condensed out ([`condense`]), the definite pencil (S, A₁) is solved, and its modes are
 /// lifted back, with the infinite modes appended.
 fn solve_semidefinite(
     problem: &PencilProblem,
-    pivot: usize,
+    spectrum: MassSpectrum,
     options: &SolveOptions,
     (norm_a, norm_b): (f64, f64),
     par: Par,
 ) -> Result<ModalSolution, ModalError> {
     let clock = Instant::now();
-    let mut condensed = condense(problem, pivot, norm_b, par)?;
+    let mut condensed = condense(problem, spectrum, norm_b)?;
     // Always with vectors: an a-priori bound would measure the condensed pencil (S, A₁), not
     // the stored one, and forming S = B₁₁ − B₁₀B₀₀⁻¹B₀₁ can cancel far beyond it; only the
     // residuals of the lifted vectors in (A, B) see that error. Values only drops them at the end.
