@@ -280,11 +280,11 @@ fn propagate_assembly_error(solution: &mut ModalSolution, assembly: &AssemblyErr
         .stiffness_margin(b)
         .is_some_and(|margin| proven_definite_with_margin(b, margin, Par::Seq));
     if definite {
-        for mode in solution.modes.iter_mut().filter(|m| doubtful(m)) {
-            mode.kind = ModeKind::Oscillatory {
-                omega: mode.omega_sq.max(0.0).sqrt(),
-            };
-        }
+        solution
+            .modes
+            .iter_mut()
+            .filter(|m| doubtful(m))
+            .for_each(Mode::set_proven_oscillatory);
     }
 }
 

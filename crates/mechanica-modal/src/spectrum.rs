@@ -53,6 +53,17 @@ pub struct Mode {
     pub group: usize,
 }
 
+impl Mode {
+    /// Classifies the mode oscillatory because its exact ω² is proven positive by an argument
+    /// beyond its own bound (an inertia count, a definiteness proof of the stiffness):
+    /// ω = √ω², or 0 where the computed ω² is not positive. The bound is left as it is.
+    pub fn set_proven_oscillatory(&mut self) {
+        self.kind = ModeKind::Oscillatory {
+            omega: self.omega_sq.max(0.0).sqrt(),
+        };
+    }
+}
+
 /// A set of modes whose ω² cannot be told apart within their error bounds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModeGroup {

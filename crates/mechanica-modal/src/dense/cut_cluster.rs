@@ -45,12 +45,7 @@ pub(crate) fn first_modes(mut wide: ModalSolution, k: usize, first_try: &SolveTi
         wide.accuracy.truncate(k);
         wide.groups = group_modes(&mut wide.modes);
     }
-    let t = &mut wide.timings;
-    t.factor += first_try.factor;
-    t.eigen += first_try.eigen;
-    t.accuracy += first_try.accuracy;
-    t.refine += first_try.refine;
-    t.inertia += first_try.inertia;
+    wide.timings += *first_try;
     wide
 }
 

@@ -449,11 +449,10 @@ fn certify_positive_stiffness(problem: &PencilProblem, modes: &mut [Mode], par: 
     if !modes.iter().any(doubtful) || !stiffness_is_definite(problem, par) {
         return;
     }
-    for mode in modes.iter_mut().filter(|m| doubtful(m)) {
-        mode.kind = ModeKind::Oscillatory {
-            omega: mode.omega_sq.max(0.0).sqrt(),
-        };
-    }
+    modes
+        .iter_mut()
+        .filter(|m| doubtful(m))
+        .for_each(Mode::set_proven_oscillatory);
 }
 
 /// Decides the sign of undecided modes where A is diagonal and positive and B's pattern is a

@@ -9,12 +9,12 @@
 //! Cholesky test ([`crate::certify::inertia`]), its shift taken from the spread of the factor
 //! already computed, and where that cannot decide (λ_min of the unit-diagonal A below a few
 //! hundred units of rounding) by the same test in double-double arithmetic
-//! ([`crate::certify::extended_definiteness`]) up to [`EXTENDED_PROOF_UP_TO`] coordinates. An A
+//! ([`crate::certify::extended_definiteness`]) up to [`MASS_PROOF_UP_TO`] coordinates. An A
 //! that fails both is singular or within 1e-24 of it: its massless directions are condensed out
 //! as for a failed pivot. An A whose pivot test failed but which the double-double test proves
 //! definite is refused ([`ModalError::OutOfRange`]): condensing would call its finite top mode
-//! infinite. Above that order an A unproven in double is reduced with its factor
-//! (docs/limits.md).
+//! infinite. Above that order a dense A that passes the pivot test is reduced with its factor,
+//! unproven (docs/limits.md).
 
 use crate::certify::extended_definiteness::proven_definite_extended;
 use crate::certify::inertia::{factor_spread, proven_definite_with_spread_guess};
@@ -26,8 +26,8 @@ use faer::{Mat, MatRef, Par};
 
 /// How the solve treats A.
 pub(crate) enum MassFactor {
-    /// A is positive definite (proven, or unproven above [`EXTENDED_PROOF_UP_TO`]): its
-    /// Cholesky factor.
+    /// A is positive definite (proven, or, above [`MASS_PROOF_UP_TO`] coordinates, passing the
+    /// pivot test): its Cholesky factor.
     Definite(Mat<f64>),
     /// A has massless directions: its eigen-decomposition, for the condensation.
     Massless(MassSpectrum),
@@ -42,29 +42,32 @@ pub(crate) enum MassFactor {
 pub(crate) fn mass_factor(a: MatRef<'_, f64>, cholesky: Cholesky, par: Par) -> Result<MassFactor, ModalError> {
     let l = match cholesky {
         Cholesky::Failed { pivot } => {
-            if !is_diagonal(a) && proven_definite_extended(a, EXTENDED_PROOF_UP_TO) {
+            if !is_diagonal(a) && proven_definite_extended(a, MASS_PROOF_UP_TO) {
+                // Definite, yet singular to double precision.
                 return Err(beyond_double_precision(pivot));
             }
             return mass_spectrum(a, pivot, par).map(MassFactor::Massless);
         }
         Cholesky::Factor(l) => l,
     };
-    let n = a.nrows();
-    if is_diagonal(a)
-        || proven_definite_with_spread_guess(a, 0.0, scaled_spread(a, l.as_ref()), par)
-        || n > EXTENDED_PROOF_UP_TO
-        || proven_definite_extended(a, EXTENDED_PROOF_UP_TO)
-    {
+    let proven = |l: &Mat<f64>| {
+        proven_definite_with_spread_guess(a, 0.0, scaled_spread(a, l.as_ref()), par)
+            || proven_definite_extended(a, MASS_PROOF_UP_TO)
+    };
+    if is_diagonal(a) || a.nrows() > MASS_PROOF_UP_TO || proven(&l) {
         return Ok(MassFactor::Definite(l));
     }
-    let spectrum = mass_spectrum(a, weakest_pivot(a, l.as_ref()), par)?;
+    let weakest = weakest_pivot(a, l.as_ref());
     scratch::give_back(l);
-    Ok(MassFactor::Massless(spectrum))
+    mass_spectrum(a, weakest, par).map(MassFactor::Massless)
 }
 
-/// The largest order at which a mass matrix unproven in double is tested in double-double
-/// (about 20n³/3 flops: 0.1 s at 256).
-pub(crate) const EXTENDED_PROOF_UP_TO: usize = 256;
+/// The largest order at which a dense mass matrix is proven definite before it is reduced
+/// (the double-double test costs about 20n³/3 flops: 0.1 s at 256). Above it no proof is made:
+/// a failed one would leave no better choice than the factor, since taking the directions of
+/// small scaled eigenvalues as massless calls a graded definite A's top mode infinite (a
+/// hanging planar chain of 300–450 point masses over four decades).
+pub(crate) const MASS_PROOF_UP_TO: usize = 256;
 
 /// The refusal of an A that is definite but singular to working precision.
 fn beyond_double_precision(pivot: usize) -> ModalError {

@@ -165,8 +165,7 @@ fn solve_in_range(problem: &PencilProblem, options: &SolveOptions) -> Result<Mod
                     // The reversed modes are refined from their shapes, so the solve needs all of them.
                     let first_try = def.timings;
                     def = solve_definite(l.as_ref(), b, options.selection, true, par)?;
-                    def.timings.factor += first_try.factor;
-                    def.timings.eigen += first_try.eigen;
+                    def.timings += first_try;
                 }
                 adopt_reversed_bottom(&mut def, &bottom, l.as_ref(), par);
             }
@@ -186,9 +185,7 @@ fn solve_in_range(problem: &PencilProblem, options: &SolveOptions) -> Result<Mod
                 if flagged > Tuning::DEFAULT.flagged_vectors_up_to.max(n / 4) {
                     let first_try = def.timings;
                     def = solve_definite(l.as_ref(), b, options.selection, true, par)?;
-                    def.timings.factor += first_try.factor;
-                    def.timings.eigen += first_try.eigen;
-                    def.timings.accuracy += first_try.accuracy;
+                    def.timings += first_try;
                 } else {
                     def.a_priori = Some(model);
                 }

@@ -52,6 +52,18 @@ pub struct SolveTimings {
     pub inertia: Duration,
 }
 
+impl std::ops::AddAssign for SolveTimings {
+    /// Adds each stage's time: a solve done in parts (a first try, a wider selection) reports
+    /// the sum.
+    fn add_assign(&mut self, other: Self) {
+        self.factor += other.factor;
+        self.eigen += other.eigen;
+        self.accuracy += other.accuracy;
+        self.refine += other.refine;
+        self.inertia += other.inertia;
+    }
+}
+
 pub(crate) fn empty_solution() -> ModalSolution {
     ModalSolution {
         modes: Vec::new(),
