@@ -101,11 +101,11 @@ pub(crate) fn stiffness_is_definite(problem: &PencilProblem, par: faer::Par) -> 
 /// inner products; γ = γ_{2n+2} = (2n + 2)u/(1 − (2n + 2)u)), so with S = diag(H)^{-1/2},
 /// S H S ⪰ (c − 3u − γρ)·I for ρ ≥ ‖S|L̂||L̂ᵀ|S‖₂, measured on the computed factor (`rho`): M
 /// is proven definite when c − 3u − γρ > 0. The shift c = 4u + 1.25γρ is first taken for a
-/// factor of well-separated rows (ρ = 2) and, if the measured ρ is larger, once more from it; ρ ≤ n(1 + γ)
-/// always holds, so every M with λ_min(SHS) above about 2.5nγ ≈ 5n²u is proven, and a banded
-/// or tree-like M (ρ small) down to about 40nu. False for a non-positive or non-finite diagonal entry, or
-/// where the proof fails: M singular up to rounding is never proven. O(n³/3) flops (twice at
-/// worst) in kept storage.
+/// factor of well-separated rows (ρ = 2) and, if the measured ρ is larger, once more from it;
+/// ρ ≤ n(1 + γ) always holds, so every M with λ_min(SHS) above about 2.5nγ ≈ 5n²u is proven,
+/// and a banded or tree-like M (ρ small) down to about 40nu. False for a non-positive or
+/// non-finite diagonal entry, or where the proof fails: M singular up to rounding is never
+/// proven. O(n³/3) flops (twice at worst) in kept storage.
 pub(crate) fn proven_positive_definite(m: faer::MatRef<'_, f64>, par: faer::Par) -> bool {
     proven_definite_with_margin(m, 0.0, par)
 }
@@ -122,9 +122,10 @@ pub fn proven_definite_with_margin(m: faer::MatRef<'_, f64>, margin: f64, par: f
 
 /// [`proven_definite_with_margin`] whose first shift assumes ρ = `spread_guess` (a caller that
 /// has factored M already measures it there; 2 for a factor of well-separated rows). The guess
-/// decides the cost (one factorization or two), never the answer's truth: a guess too small
-/// fails the check and the second shift is taken from the measured ρ; a pivot that fails at
-/// the first shift fails at every larger one.
+/// decides the cost (one factorization or two), never the truth of a proof: a guess too small
+/// fails the check and the second shift is taken from the measured ρ. A pivot that fails at
+/// the first shift ends the test, since a larger shift would fail too (up to rounding: the
+/// answer is then false, which claims nothing).
 pub(crate) fn proven_definite_with_spread_guess(
     m: faer::MatRef<'_, f64>,
     margin: f64,
