@@ -2,8 +2,9 @@
 //! a matrix that is singular and one whose smallest scaled eigenvalue is a few hundred units of
 //! rounding, which double precision cannot (a mass matrix A₀ + 2⁻⁴⁴I beside one of rank n − 1).
 
+use super::inertia::diagonal_half_exponents;
 use crate::dd::Dd;
-use crate::linalg::powers_of_two::{exponent, times_power_of_two};
+use crate::linalg::powers_of_two::times_power_of_two;
 use faer::MatRef;
 
 /// The unit roundoff taken for double-double operations: 2⁻⁹⁶, a thousand times the 2⁻¹⁰⁶ of
@@ -24,14 +25,9 @@ pub(crate) fn proven_definite_extended(m: MatRef<'_, f64>, max_order: usize) -> 
     if m.ncols() != n || n > max_order {
         return false;
     }
-    let mut half_exponents = Vec::with_capacity(n);
-    for j in 0..n {
-        let d = m[(j, j)];
-        if !(d > 0.0 && d.is_finite()) {
-            return false;
-        }
-        half_exponents.push(exponent(d).div_euclid(2));
-    }
+    let Some(half_exponents) = diagonal_half_exponents(m) else {
+        return false;
+    };
     let u = EXTENDED_UNIT_ROUNDOFF;
     let gamma_order = 2.0 * n as f64 + 2.0;
     let gamma = gamma_order * u / (1.0 - gamma_order * u);

@@ -136,14 +136,9 @@ pub(crate) fn proven_definite_with_spread_guess(
     if m.ncols() != n || !(0.0..0.5).contains(&margin) || spread_guess.is_nan() || spread_guess < 0.0 {
         return false;
     }
-    let mut half_exponents = Vec::with_capacity(n);
-    for j in 0..n {
-        let d = m[(j, j)];
-        if !(d > 0.0 && d.is_finite()) {
-            return false;
-        }
-        half_exponents.push(exponent(d).div_euclid(2));
-    }
+    let Some(half_exponents) = diagonal_half_exponents(m) else {
+        return false;
+    };
     let u = f64::EPSILON / 2.0;
     let gamma_order = 2.0 * n as f64 + 2.0;
     if gamma_order * u >= 0.25 {
@@ -168,6 +163,18 @@ pub(crate) fn proven_definite_with_spread_guess(
         }
     }
     false
+}
+
+/// The exponents s_j with 2^{2s_j} within a factor two of m_jj, by which the definiteness
+/// proofs scale M to H = D⁻¹MD⁻¹ exactly (D = diag(2^{s_j})); None when a diagonal entry is
+/// not positive and finite.
+pub(crate) fn diagonal_half_exponents(m: faer::MatRef<'_, f64>) -> Option<Vec<i32>> {
+    (0..m.nrows())
+        .map(|j| {
+            let d = m[(j, j)];
+            (d > 0.0 && d.is_finite()).then(|| exponent(d).div_euclid(2))
+        })
+        .collect()
 }
 
 /// Factors G = H − shift·diag(H), H = D⁻¹MD⁻¹ (D = diag(2^{half_exponents})), and returns
