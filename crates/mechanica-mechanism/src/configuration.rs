@@ -56,7 +56,7 @@ impl Moments {
         }
     }
 
-    fn add(&mut self, other: &Moments) {
+    pub(crate) fn add(&mut self, other: &Moments) {
         self.mass += other.mass;
         self.first += other.first;
         self.second += other.second;

@@ -12,6 +12,7 @@
 //!   through the modal crate, with body displacements, effective masses and, in a rotating
 //!   frame, the gyroscopic (quadratic) eigenproblem.
 
+mod arithmetic;
 mod assembly_error;
 pub mod configuration;
 pub mod equilibrium;

@@ -253,6 +253,15 @@ impl Mechanism {
         Ok(())
     }
 
+    /// A componentwise bound E on the rounding of the field's part of B(q) as
+    /// [`Mechanism::potential`] forms it (gravity and the rotating frame's −T₀; zero without
+    /// them): |B_computed − B_exact| ≤ E entry by entry, with the rounding model of
+    /// docs/theory.md, "Assembly error of A and B". Rotation vectors must be zero, as for the
+    /// Hessian.
+    pub fn field_hessian_rounding(&self, q: &[f64]) -> Result<Mat<f64>, MechanismError> {
+        crate::assembly_error::AssemblyError::field_rounding(self, q)
+    }
+
     /// The gyroscopic matrix G(q) of the motion relative to a rotating frame (zero without
     /// one): G_kl = 2 ∫ρ ∂x/∂q_k · (Ω × ∂x/∂q_l) dV, skew-symmetric, so that small motions obey
     /// A δ̈ + G δ̇ + B δ = 0. With the subtree moments (m, h, S) of the later of k, l:

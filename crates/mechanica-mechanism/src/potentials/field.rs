@@ -2,6 +2,7 @@
 //! the subtree mass moments (no per-point work).
 
 use super::{Potential, PotentialSum};
+use crate::arithmetic::{Arithmetic, Values};
 use crate::configuration::{Column, Moments};
 use crate::{Configuration, MechanismError};
 use mechanica_kinematics::tree::KinematicTree;
@@ -55,40 +56,50 @@ impl UniformField {
     /// l's subtree. The Gram part ∫ρ J_eᵀ K J_l and the curvature part ∫ρ (Kx − g)·(w_e × J_l)
     /// (module docs) are both linear in (w_e, a_e); with tr([w]× M) = −w·ax(M):
     /// p = ax(K W_l S) − ax(W_l S K) + h × K a_l + a_l × K h − (w_l × h) × g − m a_l × g and
-    /// r = K (w_l × h) + m K a_l.
-    fn pair_weights(&self, m: &Moments, late: &Column) -> (Vector3<f64>, Vector3<f64>) {
+    /// r = K (w_l × h) + m K a_l. In [`Magnitudes`](crate::arithmetic::Magnitudes) on magnitudes of the field, moments and
+    /// column, the same formula gives the magnitudes of its terms.
+    pub(crate) fn pair_weights<E: Arithmetic>(&self, m: &Moments, late: &Column) -> (Vector3<f64>, Vector3<f64>) {
         let (g, k) = (&self.gravity, &self.k);
-        let wl = late.w.cross_matrix();
-        let spin_h = late.w.cross(&m.first);
-        let on_w = axial(&(k * wl * m.second)) - axial(&(wl * m.second * k))
-            + m.first.cross(&(k * late.a))
-            + late.a.cross(&(k * m.first))
-            - spin_h.cross(g)
-            - late.a.cross(g) * m.mass;
+        let wl = E::skew(&late.w);
+        let spin_h = E::cross(&late.w, &m.first);
+        let crossed = E::difference(E::axial(&(k * wl * m.second)), E::axial(&(wl * m.second * k)))
+            + E::cross(&m.first, &(k * late.a))
+            + E::cross(&late.a, &(k * m.first));
+        let on_w = E::difference(
+            E::difference(crossed, E::cross(&spin_h, g)),
+            E::cross(&late.a, g) * m.mass,
+        );
         let on_a = k * spin_h + k * late.a * m.mass;
         (on_w, on_a)
     }
 
     /// ∂²U/∂q_e∂q_l for two coordinates of one rotation vector at φ = 0: the Gram part plus
-    /// the symmetric part of the curvature (see [`Configuration`]), over l's subtree moments.
-    fn rotation_block_entry(&self, m: &Moments, early: &Column, late: &Column) -> f64 {
+    /// the symmetric part of the curvature (see [`Configuration`]), over l's subtree moments;
+    /// in [`Magnitudes`](crate::arithmetic::Magnitudes), the magnitudes of its terms.
+    pub(crate) fn rotation_block_entry<E: Arithmetic>(&self, m: &Moments, early: &Column, late: &Column) -> f64 {
         let (g, k) = (&self.gravity, &self.k);
-        let (we, wl) = (early.w.cross_matrix(), late.w.cross_matrix());
+        let (we, wl) = (E::skew(&early.w), E::skew(&late.w));
         let gram = trace_of_product(&(we.transpose() * k * wl), &m.second)
             + early.a.dot(&(k * wl * m.first))
             + (we * m.first).dot(&(k * late.a))
             + m.mass * early.a.dot(&(k * late.a));
         let curvature = |e: &Matrix3<f64>, l: &Matrix3<f64>, la: &Vector3<f64>| {
-            trace_of_product(&(k * e * l), &m.second) + (k * m.first).dot(&(e * la))
-                - g.dot(&(e * l * m.first))
-                - m.mass * g.dot(&(e * la))
+            let first = trace_of_product(&(k * e * l), &m.second) + (k * m.first).dot(&(e * la));
+            E::difference(
+                E::difference(first, g.dot(&(e * l * m.first))),
+                m.mass * g.dot(&(e * la)),
+            )
         };
         gram + 0.5 * (curvature(&we, &wl, &late.a) + curvature(&wl, &we, &early.a))
     }
-}
 
-fn axial(m: &Matrix3<f64>) -> Vector3<f64> {
-    Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)])
+    /// The field with every component replaced by its magnitude.
+    pub(crate) fn magnitudes(&self) -> Self {
+        Self {
+            gravity: self.gravity.abs(),
+            k: self.k.abs(),
+        }
+    }
 }
 
 /// tr(P S) for 3×3 matrices without forming P S.
@@ -120,8 +131,8 @@ impl Potential for UniformField {
         for c in 0..n {
             let m = config.subtree_moments(body_of(c));
             let col = config.column(c);
-            sum.gradient[c] +=
-                col.w.dot(&(axial(&(k * m.second)) - m.first.cross(g))) + (k * m.first - g * m.mass).dot(&col.a);
+            sum.gradient[c] += col.w.dot(&(Values::axial(&(k * m.second)) - m.first.cross(g)))
+                + (k * m.first - g * m.mass).dot(&col.a);
         }
         let Some(hessian) = sum.hessian.as_mut() else {
             return Ok(());
@@ -129,12 +140,12 @@ impl Potential for UniformField {
         for late in 0..n {
             let m = config.subtree_moments(body_of(late));
             let cl = config.column(late);
-            let (on_w, on_a) = self.pair_weights(&m, &cl);
+            let (on_w, on_a) = self.pair_weights::<Values>(&m, &cl);
             for early in config.carriers(late) {
                 let ce = config.column(early);
                 let value = if config.same_rotation_block(early, late) {
                     config.require_rebased(early)?;
-                    self.rotation_block_entry(&m, &ce, &cl)
+                    self.rotation_block_entry::<Values>(&m, &ce, &cl)
                 } else {
                     ce.w.dot(&on_w) + ce.a.dot(&on_a)
                 };

@@ -2,13 +2,14 @@
 //! "Assembly error of A and B").
 //!
 //! B = ∂²U*/∂q∂q is a sum of contributions B_c: the field (gravity and the rotating frame's
-//! −T₀) of each body, and each added potential. Each B_c is formed from rounded kinematic
-//! quantities along root paths of at most n joints; its rounding is bounded by
-//! ‖δB_c‖ ≤ γ‖B_c‖_F with γ = 64·n·u (generous: each entry is a sum of O(n) products), and it
-//! lives on the rows and columns S_c where B_c is non-zero. To first order a perturbation δB
-//! moves ω²_k by x_kᵀ δB x_k (x_k A-normalised), so
+//! −T₀), and each added potential. The field's rounding is bounded entry by entry, |δB_f| ≤ E
+//! ([`field`]). Each added potential's B_c is formed from rounded kinematic quantities along
+//! root paths of at most n joints; its rounding is bounded by ‖δB_c‖ ≤ γ‖B_c‖_F with
+//! γ = 64·n·u (generous: each entry is a sum of O(n) products), and it lives on the rows and
+//! columns S_c where B_c is non-zero. To first order a perturbation δB moves ω²_k by
+//! x_kᵀ δB x_k (x_k A-normalised), so
 //!
-//! |δω²_k| ≤ Σ_c γ ‖B_c‖_F ‖x_k|S_c‖².
+//! |δω²_k| ≤ |x_k|ᵀE|x_k| + Σ_c γ ‖B_c‖_F ‖x_k|S_c‖².
 //!
 //! A is the sum of the bodies' A_b = m J_vᵀJ_v + J_ωᵀ I_C J_ω (J_v the Jacobian of the centre
 //! of mass, J_ω the angular one), each on the coordinates of the body's root path, with
@@ -19,16 +20,15 @@
 //! stiff spring it hardly moves; per contribution, the stiff spring's share is weighted by the
 //! soft mode's tiny component on the stiff coordinate.
 
+mod field;
+
 use crate::configuration::Configuration;
-use crate::{Mechanism, MechanismError, Potential, PotentialSum};
+use crate::{Mechanism, MechanismError, PotentialSum};
 use faer::{Mat, MatRef};
+use field::FieldRounding;
 use mechanica_kinematics::scaling;
 use mechanica_kinematics::tree::Workspace;
 use mechanica_mass::MassProperties;
-
-/// Beyond this many entries (bodies × n²), the field is taken as one contribution instead of
-/// one per body, so the bound never costs more than a dense solve of the same order.
-const PER_BODY_BUDGET: f64 = 3e8;
 
 /// One contribution's share: γ‖B_c‖_F and the free coordinates it touches.
 #[derive(Debug, Clone)]
@@ -53,6 +53,7 @@ struct BodyContributions {
 /// The assembly errors of B and A over the free coordinates, contribution by contribution.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct AssemblyError {
+    field: Option<FieldRounding>,
     stiffness: Vec<Contribution>,
     inertia: BodyContributions,
 }
@@ -62,49 +63,62 @@ impl AssemblyError {
     /// (indices into q).
     pub(crate) fn of(mechanism: &Mechanism, q: &[f64], free: &[usize]) -> Result<Self, MechanismError> {
         let gamma = 64.0 * mechanism.dof() as f64 * f64::EPSILON;
+        let ws = mechanism.positions(q)?;
+        let bodies = mechanism.bodies();
+        let config = Configuration::new(mechanism.tree(), &ws, q, bodies)?;
         let mut error = AssemblyError::default();
-        let mut add = |sum: PotentialSum| {
+        if mechanism.field_is_active() {
+            error.field = Some(FieldRounding::of(
+                &mechanism.field(),
+                &config,
+                &ws,
+                bodies,
+                free,
+                gamma,
+            )?);
+        }
+        for potential in mechanism.potentials() {
+            let sum = evaluate(&config, |c, s| potential.accumulate(c, s))?;
             if let Some(h) = sum.hessian {
                 error.stiffness.push(Contribution::of(&h, free, gamma));
             }
-        };
-        let ws = mechanism.positions(q)?;
-        let bodies = mechanism.bodies();
-        let field = mechanism.field();
-        if mechanism.field_is_active() {
-            let n = mechanism.dof() as f64;
-            if bodies.len() as f64 * n * n <= PER_BODY_BUDGET {
-                for b in 0..bodies.len() {
-                    let alone = only_body(bodies, b);
-                    let config = Configuration::new(mechanism.tree(), &ws, q, &alone)?;
-                    add(evaluate(&config, |c, s| field.accumulate(c, s))?);
-                }
-            } else {
-                let config = Configuration::new(mechanism.tree(), &ws, q, bodies)?;
-                add(evaluate(&config, |c, s| field.accumulate(c, s))?);
-            }
-        }
-        let config = Configuration::new(mechanism.tree(), &ws, q, bodies)?;
-        for potential in mechanism.potentials() {
-            add(evaluate(&config, |c, s| potential.accumulate(c, s))?);
         }
         error.inertia = BodyContributions::of(&config, &ws, bodies, free, gamma)?;
         Ok(error)
     }
 
+    /// The field's componentwise rounding bound E over all coordinates of `mechanism` at q
+    /// (zero without a field).
+    pub(crate) fn field_rounding(mechanism: &Mechanism, q: &[f64]) -> Result<Mat<f64>, MechanismError> {
+        let n = mechanism.dof();
+        if !mechanism.field_is_active() {
+            return Ok(Mat::zeros(n, n));
+        }
+        let all: Vec<usize> = (0..n).collect();
+        let ws = mechanism.positions(q)?;
+        let config = Configuration::new(mechanism.tree(), &ws, q, mechanism.bodies())?;
+        let gamma = 64.0 * n as f64 * f64::EPSILON;
+        Ok(FieldRounding::of(&mechanism.field(), &config, &ws, mechanism.bodies(), &all, gamma)?.dense())
+    }
+
     /// B's share of the bound on |δω²| for the mode shape `x` (A-normalised, free
-    /// coordinates): Σ_c γ‖B_c‖_F ‖x|S_c‖². It decides the sign of ω²: A is positive definite,
+    /// coordinates): |x|ᵀE|x| + Σ_c γ‖B_c‖_F ‖x|S_c‖². It decides the sign of ω²: A is positive definite,
     /// so only B's rounding can move ω² across zero.
     pub(crate) fn stiffness_share(&self, x: impl Fn(usize) -> f64) -> f64 {
-        share(&self.stiffness, x)
+        let field = self.field.as_ref().map_or(0.0, |f| f.share(&x));
+        field + share(&self.stiffness, x)
     }
 
     /// A bound τ on ‖diag(B)^{-1/2} δB diag(B)^{-1/2}‖₂ for the assembly's rounding δB of the
-    /// stored (free-coordinate) Hessian `b`: Σ_c γ‖B_c‖_F / min_{i∈S_c} b_ii, since each δB_c
-    /// lives on S_c. None when a contribution with a non-zero scale touches a diagonal entry
-    /// that is not positive, or the sum is not finite.
+    /// stored (free-coordinate) Hessian `b`: the field's [`FieldRounding::margin`] plus
+    /// Σ_c γ‖B_c‖_F / min_{i∈S_c} b_ii over the other contributions, since each δB_c lives on
+    /// S_c. None when a contribution with a non-zero scale touches a diagonal entry that is not
+    /// positive, or the sum is not finite.
     pub(crate) fn stiffness_margin(&self, b: MatRef<'_, f64>) -> Option<f64> {
-        let mut margin = 0.0;
+        let mut margin = match &self.field {
+            Some(field) => field.margin(b)?,
+            None => 0.0,
+        };
         for c in self.stiffness.iter().filter(|c| c.scale != 0.0) {
             let smallest = c.support.iter().map(|&i| b[(i, i)]).fold(f64::INFINITY, f64::min);
             if smallest.is_nan() || smallest <= 0.0 {
@@ -174,10 +188,7 @@ impl BodyContributions {
         gamma: f64,
     ) -> Result<Self, MechanismError> {
         let tree = config.tree;
-        let mut free_index = vec![None; tree.dof()];
-        for (i, &k) in free.iter().enumerate() {
-            free_index[k] = Some(i);
-        }
+        let free_index = free_positions(tree.dof(), free);
         let mut scale = Vec::with_capacity(bodies.len());
         for (b, body) in bodies.iter().enumerate() {
             let centre = ws.point_position(b, &body.p_oc)?;
@@ -258,6 +269,15 @@ impl ScaledSquares {
     }
 }
 
+/// Per coordinate of n, its index in `free` (None for a locked one).
+fn free_positions(n: usize, free: &[usize]) -> Vec<Option<usize>> {
+    let mut index = vec![None; n];
+    for (i, &k) in free.iter().enumerate() {
+        index[k] = Some(i);
+    }
+    index
+}
+
 /// One contribution's U, gradient and Hessian at `config`.
 fn evaluate(
     config: &Configuration<'_>,
@@ -266,14 +286,6 @@ fn evaluate(
     let mut sum = PotentialSum::new(config.dof(), true);
     accumulate(config, &mut sum)?;
     Ok(sum)
-}
-
-/// The bodies with every mass property but body `b`'s set to zero.
-fn only_body(bodies: &[MassProperties], b: usize) -> Vec<MassProperties> {
-    let nothing = MassProperties::ZERO;
-    (0..bodies.len())
-        .map(|i| if i == b { bodies[i] } else { nothing })
-        .collect()
 }
 
 #[cfg(test)]
