@@ -21,7 +21,7 @@
 //!   at most [`certify::FAILURE_PROBABILITY`] each.
 //! - **Stiff and graded problems.** With [`Refinement::Auto`] the modes whose bound guarantees
 //!   fewer than 8 digits ([`dense::AUTO_REFINE_RELATIVE_BOUND`]) are refined from the lowest up
-//!   (at most max(256, n/4)) by Newton steps with double-double residuals and get a residual
+//!   (at most max(64, n/16)) by Newton steps with double-double residuals and get a residual
 //!   bound; where the reduction cannot resolve the bottom at all, the low modes are first taken
 //!   from the reversed pencil A x = μ(B + sA)x. Tested on graded chains with ratios up to 1e12
 //!   against 60-digit references (tools/modal_reference.py) and on random chains and trees with

@@ -37,9 +37,12 @@ pub struct Tuning {
     /// decades: ω² = 100 forty-nine times) can otherwise not be told from its zero mode.
     pub max_refined_cluster: usize,
     /// `Refinement::Auto` refines the weakly bounded modes of a selection from the lowest up, at
-    /// most max(`auto_refined_at_least`, n / `auto_refined_fraction`) of them (default 256 and
-    /// 4): each costs O(n²) double-double work, so refining all n of a graded pencil would cost
-    /// many dense solves. The others keep their (true, weaker) bounds.
+    /// most max(`auto_refined_at_least`, n / `auto_refined_fraction`) of them (default 64 and
+    /// 16): each costs O(n²) double-double work, so refining all n of a graded pencil would cost
+    /// many dense solves; with these defaults the certified solve of a randomly graded pencil
+    /// costs at most about twice the plain one (docs/benchmarks.md). At least
+    /// [`Tuning::max_refined_cluster`], so that the largest cluster refined as one block fits.
+    /// The others keep their (true, weaker) bounds.
     pub auto_refined_at_least: usize,
     /// See [`Tuning::auto_refined_at_least`].
     pub auto_refined_fraction: usize,
@@ -174,8 +177,8 @@ impl Tuning {
         idle_time_from: 192,
         flagged_vectors_up_to: 32,
         max_refined_cluster: 64,
-        auto_refined_at_least: 256,
-        auto_refined_fraction: 4,
+        auto_refined_at_least: 64,
+        auto_refined_fraction: 16,
         cholesky_base_case: 128,
         reduce_base_case: 48,
         reduce_block: 256,

@@ -28,7 +28,7 @@ pub enum Selection {
 pub enum Refinement {
     /// Refine the selected, simple, finite modes whose first-order error bound from the
     /// reduction exceeds [`AUTO_REFINE_RELATIVE_BOUND`]·|ω²| (stiff and graded problems), from
-    /// the lowest up, at most max(256, n/4) of them ([`crate::Tuning::auto_refined_at_least`]);
+    /// the lowest up, at most max(64, n/16) of them ([`crate::Tuning::auto_refined_at_least`]);
     /// on a graded pencil whose low modes the reduction cannot resolve, they are first taken
     /// from the reversed pencil (`dense::reversed`, docs/theory.md).
     Auto,
