@@ -204,12 +204,21 @@ impl FieldRounding {
         v.iter_mut().for_each(|e| *e /= top);
         let product = self.product(&v);
         let quadratic: f64 = v.iter().zip(&product).map(|(a, b)| a * b).sum();
+        if quadratic == 0.0 {
+            // Nothing the mode moves carries a bound, even when top² overflows.
+            return 0.0;
+        }
+        if quadratic.is_nan() {
+            // A magnitude overflowed where the mode does not move (∞·0): the bound is unknown.
+            return f64::INFINITY;
+        }
         (self.gamma * top) * top * quadratic * self.summation()
     }
 
     /// A bound on ‖D^{-1/2} E D^{-1/2}‖₂, D the diagonal of the stored free-coordinate Hessian
-    /// `b`: the largest row sum. None when a free coordinate with a row in E has a diagonal
-    /// entry that is not positive, or the bound is not finite.
+    /// `b`: the largest row sum. None when a free coordinate with a row in E (or a row that is
+    /// not a number, a magnitude having overflowed) has a diagonal entry that is not positive,
+    /// or the bound is not finite.
     pub(crate) fn margin(&self, b: MatRef<'_, f64>) -> Option<f64> {
         let n = self.columns.len();
         let mut scale = vec![0.0; n];
@@ -233,12 +242,16 @@ impl FieldRounding {
             .product(&free)
             .iter()
             .zip(&unscaled)
-            .any(|(&row, &u)| u > 0.0 && row > 0.0)
+            .any(|(&row, &u)| u > 0.0 && row != 0.0)
         {
             return None;
         }
         let rows = self.product(&scale);
-        let largest = rows.iter().zip(&scale).map(|(row, s)| row * s).fold(0.0, f64::max);
+        let scaled: Vec<f64> = rows.iter().zip(&scale).map(|(row, s)| row * s).collect();
+        if scaled.iter().any(|r| r.is_nan()) {
+            return None;
+        }
+        let largest = scaled.iter().copied().fold(0.0, f64::max);
         let margin = self.gamma * largest * self.summation();
         margin.is_finite().then_some(margin)
     }
@@ -288,4 +301,87 @@ fn magnitude_moments(
 /// components of 1e-17 that err by 1e-16).
 fn isotropic(size: f64) -> Vector3<f64> {
     Vector3::repeat(size)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Mechanism;
+    use mechanica_kinematics::tree::{Joint, TreeBuilder};
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+    use proptest::prelude::*;
+
+    /// A tree of one body per entry of `shape` (parent as a fraction of the bodies before, joint
+    /// kind, placement offsets), unit masses, box inertias, tilted gravity.
+    fn mechanism(shape: &[(f64, usize, [f64; 3])]) -> Mechanism {
+        let mut builder = TreeBuilder::new();
+        for (i, &(parent, kind, offset)) in shape.iter().enumerate() {
+            let parent = (i > 0).then_some((parent * i as f64) as usize);
+            let axis = Vector3::new(offset[1], offset[2], 1.0).normalize();
+            let joint = match kind {
+                0 => Joint::Revolute { axis },
+                1 => Joint::Prismatic { axis },
+                2 => Joint::Planar,
+                3 => Joint::Spherical,
+                4 => Joint::Free,
+                _ => Joint::Fixed,
+            };
+            let rotation = UnitQuaternion::from_scaled_axis(Vector3::new(offset[2], offset[0], offset[1]));
+            let placement = Isometry3::from_parts(Translation3::new(offset[0], offset[1], offset[2]), rotation);
+            builder.add_body(parent, joint, placement);
+        }
+        let inertia = Matrix3::from_diagonal(&Vector3::new(0.2, 0.3, 0.4));
+        let body = MassProperties::new(1.0, Vector3::new(0.1, -0.2, 0.3), inertia).expect("body");
+        let tree = builder.build().expect("tree");
+        let mut mechanism = Mechanism::new(tree, vec![body; shape.len()]).expect("mechanism");
+        mechanism.set_gravity(Vector3::new(0.3, -0.4, -9.8)).expect("gravity");
+        mechanism
+    }
+
+    proptest! {
+        /// The O(n) product with E agrees with the product by the explicit E, on random trees of
+        /// every joint kind (rotation vectors and fixed joints included), with random
+        /// coordinates locked.
+        #[test]
+        fn the_path_sums_multiply_by_the_explicit_bound(
+            shape in proptest::collection::vec((0.0..1.0_f64, 0usize..6, [-1.0..1.0_f64, -1.0..1.0, -1.0..1.0]), 1..12),
+            weights in proptest::collection::vec(0.0..1.0_f64, 72),
+            locked in proptest::collection::vec(any::<bool>(), 72),
+        ) {
+            let m = mechanism(&shape);
+            let n = m.dof();
+            let q = vec![0.0; n];
+            let free: Vec<usize> = (0..n).filter(|&k| !locked[k] || k == 0).collect();
+            let ws = m.positions(&q).expect("positions");
+            let config = Configuration::new(m.tree(), &ws, &q, m.bodies()).expect("configuration");
+            let bound = FieldRounding::of(&m.field(), &config, &ws, m.bodies(), &free, 1.0).expect("bound");
+            let dense = bound.dense();
+            let v: Vec<f64> = (0..n).map(|k| if free.contains(&k) { weights[k] } else { 0.0 }).collect();
+            let fast = bound.product(&v);
+            for (i, value) in fast.iter().enumerate() {
+                let explicit: f64 = (0..n).map(|j| dense[(i, j)] * v[j]).sum();
+                prop_assert!((value - explicit).abs() <= 1e-12 * explicit.abs(), "{value} vs {explicit}");
+            }
+            // The share is |x|ᵀE|x| over the free coordinates.
+            let x = |i: usize| weights[free[i]] * if i.is_multiple_of(2) { 1.0 } else { -1.0 };
+            let quadratic: f64 = (0..n).map(|i| v[i] * fast[i]).sum();
+            let share = bound.share(x);
+            prop_assert!(share >= quadratic * (1.0 - 1e-12) && share <= quadratic * (1.0 + 1e-12), "{share} vs {quadratic}");
+        }
+    }
+
+    #[test]
+    fn a_coordinate_without_stiffness_under_the_field_leaves_no_margin() {
+        let shape = [(0.0, 0, [0.1, 0.2, 0.3]), (0.0, 1, [0.3, -0.2, 0.5])];
+        let m = mechanism(&shape);
+        let q = vec![0.0; m.dof()];
+        let ws = m.positions(&q).expect("positions");
+        let config = Configuration::new(m.tree(), &ws, &q, m.bodies()).expect("configuration");
+        let all: Vec<usize> = (0..m.dof()).collect();
+        let bound = FieldRounding::of(&m.field(), &config, &ws, m.bodies(), &all, 1e-12).expect("bound");
+        let definite = Mat::from_fn(2, 2, |i, j| if i == j { 1.0 } else { 0.0 });
+        assert!(bound.margin(definite.as_ref()).is_some_and(|t| t > 0.0 && t < 1e-9));
+        let singular = Mat::from_fn(2, 2, |i, j| if i == j && i == 0 { 1.0 } else { 0.0 });
+        assert_eq!(bound.margin(singular.as_ref()), None);
+    }
 }
