@@ -62,7 +62,7 @@ impl AssemblyError {
     /// The contributions of `mechanism` at q (already re-centred), restricted to `free`
     /// (indices into q).
     pub(crate) fn of(mechanism: &Mechanism, q: &[f64], free: &[usize]) -> Result<Self, MechanismError> {
-        let gamma = 64.0 * mechanism.dof() as f64 * f64::EPSILON;
+        let gamma = rounding_factor(mechanism.dof());
         let ws = mechanism.positions(q)?;
         let bodies = mechanism.bodies();
         let config = Configuration::new(mechanism.tree(), &ws, q, bodies)?;
@@ -97,13 +97,13 @@ impl AssemblyError {
         let all: Vec<usize> = (0..n).collect();
         let ws = mechanism.positions(q)?;
         let config = Configuration::new(mechanism.tree(), &ws, q, mechanism.bodies())?;
-        let gamma = 64.0 * n as f64 * f64::EPSILON;
+        let gamma = rounding_factor(n);
         Ok(FieldRounding::of(&mechanism.field(), &config, &ws, mechanism.bodies(), &all, gamma)?.dense())
     }
 
     /// B's share of the bound on |δω²| for the mode shape `x` (A-normalised, free
-    /// coordinates): |x|ᵀE|x| + Σ_c γ‖B_c‖_F ‖x|S_c‖². It decides the sign of ω²: A is positive definite,
-    /// so only B's rounding can move ω² across zero.
+    /// coordinates): |x|ᵀE|x| + Σ_c γ‖B_c‖_F ‖x|S_c‖². It decides the sign of ω²: A is
+    /// positive definite, so only B's rounding can move ω² across zero.
     pub(crate) fn stiffness_share(&self, x: impl Fn(usize) -> f64) -> f64 {
         let field = self.field.as_ref().map_or(0.0, |f| f.share(&x));
         field + share(&self.stiffness, x)
@@ -267,6 +267,12 @@ impl ScaledSquares {
             self.scaled += (magnitude / self.top).powi(2);
         }
     }
+}
+
+/// γ = 64·n·u, the relative rounding the model allows each assembled quantity of a mechanism
+/// with n coordinates (generous: each entry sums O(n) products along root paths).
+fn rounding_factor(n: usize) -> f64 {
+    64.0 * n as f64 * f64::EPSILON
 }
 
 /// Per coordinate of n, its index in `free` (None for a locked one).

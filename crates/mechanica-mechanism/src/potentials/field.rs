@@ -56,8 +56,9 @@ impl UniformField {
     /// l's subtree. The Gram part ∫ρ J_eᵀ K J_l and the curvature part ∫ρ (Kx − g)·(w_e × J_l)
     /// (module docs) are both linear in (w_e, a_e); with tr([w]× M) = −w·ax(M):
     /// p = ax(K W_l S) − ax(W_l S K) + h × K a_l + a_l × K h − (w_l × h) × g − m a_l × g and
-    /// r = K (w_l × h) + m K a_l. In [`Magnitudes`](crate::arithmetic::Magnitudes) on magnitudes of the field, moments and
-    /// column, the same formula gives the magnitudes of its terms.
+    /// r = K (w_l × h) + m K a_l. In [`Magnitudes`](crate::arithmetic::Magnitudes), on the
+    /// magnitudes of the field, moments and column, the same formula gives the magnitudes of
+    /// its terms.
     pub(crate) fn pair_weights<E: Arithmetic>(&self, m: &Moments, late: &Column) -> (Vector3<f64>, Vector3<f64>) {
         let (g, k) = (&self.gravity, &self.k);
         let wl = E::skew(&late.w);
