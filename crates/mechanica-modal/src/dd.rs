@@ -219,14 +219,7 @@ impl<'a> Operand<'a> {
     /// M x in double-double, with the values of [`mat_vec`].
     pub(crate) fn product(&self, x: &[f64]) -> Vec<Dd> {
         match &self.structure {
-            Structure::Diagonal => x
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| {
-                    let (hi, lo) = two_prod(self.matrix[(i, i)], v);
-                    Dd { hi, lo }
-                })
-                .collect(),
+            Structure::Diagonal => diagonal_product(self.matrix, x),
             Structure::Sparse(m) => sparse_mat_vec(m.as_ref(), x),
             Structure::Dense => mat_vec(self.matrix, x),
         }
@@ -450,6 +443,59 @@ fn dot_as<const FUSED: bool>(x: &[f64], y: &[Dd]) -> Dd {
         acc = acc.plus(Dd::of(xi).times_as::<FUSED>(*yi));
     }
     acc
+}
+
+/// D x in double-double (exact: each entry is one product) for the diagonal of `d`.
+fn diagonal_product(d: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
+    #[cfg(target_arch = "x86_64")]
+    if fused_available() {
+        // SAFETY: the running CPU supports FMA and AVX2, checked just above.
+        return unsafe { diagonal_product_fma(d, x) };
+    }
+    diagonal_product_as::<false>(d, x)
+}
+
+/// [`diagonal_product`] compiled for FMA and AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma,avx2")]
+fn diagonal_product_fma(d: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
+    diagonal_product_as::<true>(d, x)
+}
+
+#[inline(always)]
+fn diagonal_product_as<const FUSED: bool>(d: MatRef<'_, f64>, x: &[f64]) -> Vec<Dd> {
+    x.iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            let (hi, lo) = two_prod_as::<FUSED>(d[(i, i)], v);
+            Dd { hi, lo }
+        })
+        .collect()
+}
+
+/// The residual Bx − ρAx of a pair, from A x and B x in double-double, each entry rounded once.
+pub(crate) fn pair_residual(ax: &[Dd], bx: &[Dd], rho: Dd) -> Vec<f64> {
+    #[cfg(target_arch = "x86_64")]
+    if fused_available() {
+        // SAFETY: the running CPU supports FMA and AVX2, checked just above.
+        return unsafe { pair_residual_fma(ax, bx, rho) };
+    }
+    pair_residual_as::<false>(ax, bx, rho)
+}
+
+/// [`pair_residual`] compiled for FMA and AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma,avx2")]
+fn pair_residual_fma(ax: &[Dd], bx: &[Dd], rho: Dd) -> Vec<f64> {
+    pair_residual_as::<true>(ax, bx, rho)
+}
+
+#[inline(always)]
+fn pair_residual_as<const FUSED: bool>(ax: &[Dd], bx: &[Dd], rho: Dd) -> Vec<f64> {
+    ax.iter()
+        .zip(bx)
+        .map(|(ax, bx)| bx.minus(rho.times_as::<FUSED>(*ax)).to_f64())
+        .collect()
 }
 
 /// The residuals of a pair (ω², x) of the pencil and of its shift-inverted form, from A x and

@@ -1,7 +1,7 @@
 //! The projected Newton step of many simple modes at once, for a positive definite A with the
 //! reduced spectrum at hand: the corrections of all modes still iterating as block products.
 
-use crate::dd::{Operand, SplitVector, dot};
+use crate::dd::{Operand, SplitVector, dot, pair_residual};
 use crate::linalg::reduce::LowerFactor;
 use crate::refine::metric::Metric;
 use crate::refine::pair::{RefinedPair, finish_pair};
@@ -29,7 +29,7 @@ pub(crate) fn refine_simple_modes(
     x0: MatRef<'_, f64>,
     par: Par,
 ) -> Vec<Option<RefinedPair>> {
-    let (n, k) = (x0.nrows(), x0.ncols());
+    let k = x0.ncols();
     let mut x = x0.to_owned();
     let mut state = vec![State::Iterating; k];
     let mut previous = vec![f64::INFINITY; k];
@@ -43,8 +43,7 @@ pub(crate) fn refine_simple_modes(
             let xc = x.col_as_slice(c);
             let (ax, bx) = (a.product(xc), b.product(xc));
             let rho = dot(xc, &bx).over(dot(xc, &ax));
-            let r: Vec<f64> = (0..n).map(|i| bx[i].minus(rho.times(ax[i])).to_f64()).collect();
-            (rho.to_f64(), r)
+            (rho.to_f64(), pair_residual(&ax, &bx, rho))
         };
         let residuals: Vec<(f64, Vec<f64>)> = map_items(&active, par, residual_of);
         let delta = corrections(l, reduced, modes, &active, &residuals, par);

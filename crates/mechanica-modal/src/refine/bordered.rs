@@ -2,7 +2,7 @@
 //! at the starting pair: factored densely (Bunch–Kaufman LBLᵀ), or, when A and B both have few
 //! nonzeros, by a sparse LU of B − ω₀²A with the border eliminated by blocks.
 
-use crate::dd::{Dd, Operand, SplitVector, dot};
+use crate::dd::{Dd, Operand, SplitVector, dot, pair_residual};
 use crate::refine::metric::Metric;
 use crate::refine::pair::{RefinedPair, finish_pair};
 use crate::tuning::Tuning;
@@ -22,7 +22,7 @@ pub(crate) fn refine_pair(
 ) -> Option<RefinedPair> {
     let ax0: Vec<f64> = a.product(x0).iter().map(|v| v.to_f64()).collect();
     let jacobian = BorderedJacobian::dense(a, b, &ax0, omega0);
-    let (x, steps, _) = newton_steps(a, b, &jacobian, x0, omega0)?;
+    let (x, steps, _) = newton_steps(a, b, metric, &jacobian, x0, omega0)?;
     finish_pair(a, b, metric, x, steps)
 }
 
@@ -40,7 +40,7 @@ pub(crate) fn refine_pair_sparse(
 ) -> Option<RefinedPair> {
     let ax0: Vec<f64> = a.product(x0).iter().map(|v| v.to_f64()).collect();
     let jacobian = BorderedJacobian::sparse(shifts, &ax0, omega0)?;
-    match newton_steps(a, b, &jacobian, x0, omega0)? {
+    match newton_steps(a, b, metric, &jacobian, x0, omega0)? {
         (x, steps, true) => finish_pair(a, b, metric, x, steps),
         _ => None,
     }
@@ -102,19 +102,27 @@ impl SparseShifts {
     }
 }
 
+/// Relative residual ‖r‖_{A⁻¹} / (|ω²|·‖x‖_A) below which a converged iterate is not improved
+/// further: u^{3/4}. The refined bound is quadratic in the residual (Kato–Temple,
+/// [`crate::certify::residual_bounds`]), ε²/δ for a gap δ, so at this residual it is below the
+/// rounding u|ω²| of the reported value for every relative gap δ/|ω²| above √u.
+pub(crate) const ACCURATE_RESIDUAL: f64 = 1.8e-12;
+
 /// Newton steps of [`refine_pair`] with the frozen Jacobian `jacobian`: the iterate, the steps
 /// taken and whether a step fell below the rounding of a double iterate; None if a step was not
-/// finite. The iterate is kept in double-double, and the steps go on past that point while
-/// they still halve (to about u² of the iterate): the final residual, and so the certified
-/// bound, is then not limited by rounding the vector to double.
+/// finite. The iterate is kept in double-double. Once a step falls below the rounding of a
+/// double iterate, the steps go on (to about u² of the iterate, while they still halve) only
+/// while the residual, measured in `metric`, is above [`ACCURATE_RESIDUAL`]: a stiff mode's
+/// residual is K·δx with ‖K‖ far above |ω²|, so a vector exact to double can still leave a
+/// residual too large for the bound.
 fn newton_steps(
     a: &Operand<'_>,
     b: &Operand<'_>,
+    metric: Metric<'_>,
     jacobian: &BorderedJacobian,
     x0: &[f64],
     omega0: f64,
 ) -> Option<(SplitVector, usize, bool)> {
-    let n = x0.len();
     let mut x = SplitVector::of(x0.to_vec());
     let mut omega = Dd::of(omega0);
     let mut converged = false;
@@ -122,7 +130,11 @@ fn newton_steps(
     for step in 1..=Tuning::DEFAULT.max_newton_steps {
         let bx = b.product_split(&x);
         let axd = a.product_split(&x);
-        let residual: Vec<f64> = (0..n).map(|i| -(bx[i].minus(omega.times(axd[i]))).to_f64()).collect();
+        let mut residual = pair_residual(&axd, &bx, omega);
+        if converged && accurate(metric, &residual, &x, &axd, omega.hi) {
+            return Some((x, step - 1, true));
+        }
+        residual.iter_mut().for_each(|r| *r = -*r);
         // Normalisation residual: (Ax₀)ᵀx − 1, computed as x₀ᵀ(Ax) in double-double.
         let normalisation = dot(x0, &axd).minus(Dd::of(1.0)).to_f64();
         let (dx, d_omega) = jacobian.solve(residual, normalisation)?;
@@ -137,6 +149,14 @@ fn newton_steps(
         previous = dmax;
     }
     Some((x, Tuning::DEFAULT.max_newton_steps, converged))
+}
+
+/// Whether the `residual` (B − ω²A)x of the iterate x (with A x = `ax`) is below
+/// [`ACCURATE_RESIDUAL`] relative to |ω²|, in the norm the refined bound uses.
+fn accurate(metric: Metric<'_>, residual: &[f64], x: &SplitVector, ax: &[Dd], omega_sq: f64) -> bool {
+    let (_, norm) = metric.definite_residual(residual.to_vec());
+    let xax: f64 = x.hi.iter().zip(ax).map(|(xi, axi)| xi * axi.hi).sum();
+    xax > 0.0 && norm <= ACCURATE_RESIDUAL * omega_sq.abs() * xax.sqrt()
 }
 
 /// The Jacobian [K, −a; −aᵀ, 0] of [`refine_pair`] with K = B − ω₀²A and a = A x₀, factored

@@ -2,7 +2,7 @@
 //! pairs refined together, and the final measurement of a refined vector.
 
 use crate::dd::Operand;
-use crate::dd::{SplitVector, dot_split};
+use crate::dd::{SplitVector, dot_split, pair_residual};
 use crate::refine::metric::Metric;
 
 /// A refined pair.
@@ -50,7 +50,6 @@ pub(crate) fn finish_pair(
     mut x: SplitVector,
     steps: usize,
 ) -> Option<RefinedPair> {
-    let n = a.matrix().nrows();
     let axd = a.product_split(&x);
     let xax = dot_split(&x, &axd);
     if xax.hi.is_nan() || xax.hi <= 0.0 {
@@ -61,7 +60,7 @@ pub(crate) fn finish_pair(
     let bxd = b.product_split(&x);
     let xax = dot_split(&x, &axd);
     let rq = dot_split(&x, &bxd).over(xax);
-    let r: Vec<f64> = (0..n).map(|i| bxd[i].minus(rq.times(axd[i])).to_f64()).collect();
+    let r = pair_residual(&axd, &bxd, rq);
     let (r, norm) = metric.definite_residual(r);
     let residual_a_inv = norm / xax.to_f64().sqrt();
     let omega_sq = rq.to_f64();

@@ -2,7 +2,7 @@
 //! ([`crate::refine::correction`]) in place of a factorization, for one mode or, in block form,
 //! for a cluster of nearly equal eigenvalues.
 
-use crate::dd::{Dd, Operand, SplitVector, dot, dot_split};
+use crate::dd::{Dd, Operand, SplitVector, dot, dot_split, pair_residual};
 use crate::refine::correction::ReducedCorrection;
 use crate::refine::metric::Metric;
 use crate::refine::pair::{RefinedCluster, RefinedPair, finish_pair};
@@ -109,7 +109,8 @@ pub(crate) fn polish_simple_mode(
         let ax = a.product_split(&x);
         let bx = b.product_split(&x);
         let rho = dot_split(&x, &bx).over(dot_split(&x, &ax));
-        let w = Mat::from_fn(n, 1, |i, _| bx[i].minus(rho.times(ax[i])).to_f64());
+        let r = pair_residual(&ax, &bx, rho);
+        let w = Mat::from_fn(n, 1, |i, _| r[i]);
         let delta = metric.correction(w, rho.to_f64(), correction);
         let step: Vec<f64> = delta.col(0).iter().map(|d| -d).collect();
         if !step.iter().all(|v| v.is_finite()) {
