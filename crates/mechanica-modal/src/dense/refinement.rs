@@ -66,7 +66,8 @@ impl Stage<'_> {
             .collect();
         let jobs = self.jobs(report, omega);
         let (mass, stiffness) = (Operand::new(self.a), Operand::new(self.b));
-        let shifts = if jobs.is_empty() {
+        let batch_applies = matches!(self.metric, Metric::Cholesky(_)) && self.reduced.is_some();
+        let shifts = if jobs.is_empty() || (batch_applies && n < Tuning::DEFAULT.sparse_refinement_from) {
             None
         } else {
             SparseShifts::new(&mass, &stiffness)
@@ -154,8 +155,9 @@ impl Stage<'_> {
     /// Each job's refined cluster (None where refinement declined). Simple modes of a definite
     /// pencil are refined as one batch whose corrections are block products
     /// ([`refine_simple_modes`]); a mode whose batch step fails, and every cluster, takes its own
-    /// path. A sparse pencil's simple modes take theirs at once: a sparse bordered factorization
-    /// per mode costs less than the batch's products through Y. Clusters are independent: each
+    /// path. A sparse pencil's simple modes (`shifts`, from order
+    /// [`Tuning::sparse_refinement_from`]) take theirs at once: there a sparse bordered
+    /// factorization per mode costs less than the batch's products through Y. Clusters are independent: each
     /// is refined from its own columns of X, sequentially inside, and the clusters are shared
     /// among the threads.
     fn refine_jobs(
