@@ -40,7 +40,7 @@ pub struct Tuning {
     /// most max(`auto_refined_at_least`, n / `auto_refined_fraction`) of them (default 64 and
     /// 16): each costs O(n²) double-double work, so refining all n of a graded pencil would cost
     /// many dense solves; with these defaults the certified solve of a randomly graded pencil
-    /// costs at most about twice the plain one from n = 250 up, and up to four times below
+    /// costs at most about twice the plain one from n = 250 up, and up to 2.7 times below
     /// (docs/benchmarks.md). At least
     /// [`Tuning::max_refined_cluster`], so that the largest cluster refined as one block fits.
     /// The others keep their (true, weaker) bounds.
