@@ -123,6 +123,26 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+    /// From order 320 (`Tuning::sparse_refinement_from`) the simple modes of these sparse
+    /// pencils are refined on a sparse LU each instead of as one batch: the same properties
+    /// there, over random shapes, supports, full gradings, seeds and modes of use.
+    #[test]
+    fn graded_systems_refined_on_sparse_factorizations(
+        n in 320usize..420,
+        tree in any::<bool>(),
+        fixed in any::<bool>(),
+        code in any::<u8>(),
+        seed in any::<u64>(),
+    ) {
+        let system = spring_tree(&family(n, tree, fixed, 8.0, 12.0), seed);
+        if let Err(failure) = check(&system, usage(code, n)) {
+            prop_assert!(false, "{}", failure);
+        }
+    }
+}
+
 /// The full grading at the larger sizes, one seed per shape, support and use.
 #[test]
 fn fully_graded_systems_of_a_few_hundred_masses() {
