@@ -157,9 +157,9 @@ impl Stage<'_> {
     /// ([`refine_simple_modes`]); a mode whose batch step fails, and every cluster, takes its own
     /// path. A sparse pencil's simple modes (`shifts`, from order
     /// [`Tuning::sparse_refinement_from`]) take theirs at once: there a sparse bordered
-    /// factorization per mode costs less than the batch's products through Y. Clusters are independent: each
-    /// is refined from its own columns of X, sequentially inside, and the clusters are shared
-    /// among the threads.
+    /// factorization per mode costs less than the batch's products through Y. Clusters are
+    /// independent: each is refined from its own columns of X, sequentially inside, and the
+    /// clusters are shared among the threads.
     fn refine_jobs(
         &self,
         operands: &Operands<'_>,
