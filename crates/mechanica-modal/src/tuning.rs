@@ -40,8 +40,8 @@ pub struct Tuning {
     /// most max(`auto_refined_at_least`, n / `auto_refined_fraction`) of them (default 64 and
     /// 16): each costs O(n²) double-double work, so refining all n of a graded pencil would cost
     /// many dense solves; with these defaults the certified solve of a randomly graded pencil
-    /// costs at most about twice the plain one from n = 250 up, and up to 2.7 times below
-    /// (docs/benchmarks.md). At least
+    /// costs at most about twice the plain one from n = 250 up, and up to about four times
+    /// below (docs/benchmarks.md). At least
     /// [`Tuning::max_refined_cluster`], so that the largest cluster refined as one block fits.
     /// The others keep their (true, weaker) bounds.
     pub auto_refined_at_least: usize,
@@ -132,12 +132,6 @@ pub struct Tuning {
     /// Newton steps per pair on the bordered system (default 12): the steps converge
     /// quadratically from a first-order accurate pair.
     pub max_newton_steps: usize,
-    /// Orders from which the simple modes of a pencil whose A and B both have few nonzeros are
-    /// refined on a sparse LU of B − ω₀²A each (default 320); below, they are refined as one
-    /// batch of projected steps through the reduced spectrum, whose block products cost less
-    /// there than a sparse factorization per mode (the two are at par near 350 on randomly
-    /// graded spring trees, measured in docs/benchmarks.md).
-    pub sparse_refinement_from: usize,
     /// Projected Newton steps (through the reduced spectrum) before refinement gives up and
     /// falls back to a factorization (default 8): the projected step converges linearly, each
     /// step at least halving the correction.
@@ -206,7 +200,6 @@ impl Tuning {
         slowest_block_rate: 2e9,
         handover_from: 0.125,
         max_newton_steps: 12,
-        sparse_refinement_from: 320,
         max_projected_steps: 8,
         stagnation_ulps: 16.0,
         dense_limit: 400,

@@ -125,11 +125,11 @@ proptest! {
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(6))]
-    /// From order 320 (`Tuning::sparse_refinement_from`) the simple modes of these sparse
-    /// pencils are refined on a sparse LU each instead of as one batch: the same properties
-    /// there, over random shapes, supports, full gradings, seeds and modes of use.
+    /// The same properties at 320–420 masses, between the random sizes above and the
+    /// thousand-mass systems below, over random shapes, supports, full gradings, seeds and
+    /// modes of use.
     #[test]
-    fn graded_systems_refined_on_sparse_factorizations(
+    fn graded_systems_of_three_to_four_hundred_masses(
         n in 320usize..420,
         tree in any::<bool>(),
         fixed in any::<bool>(),

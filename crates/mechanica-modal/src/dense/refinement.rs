@@ -66,8 +66,7 @@ impl Stage<'_> {
             .collect();
         let jobs = self.jobs(report, omega);
         let (mass, stiffness) = (Operand::new(self.a), Operand::new(self.b));
-        let batch_applies = matches!(self.metric, Metric::Cholesky(_)) && self.reduced.is_some();
-        let shifts = if jobs.is_empty() || (batch_applies && n < Tuning::DEFAULT.sparse_refinement_from) {
+        let shifts = if jobs.is_empty() {
             None
         } else {
             SparseShifts::new(&mass, &stiffness)
@@ -155,11 +154,10 @@ impl Stage<'_> {
     /// Each job's refined cluster (None where refinement declined). Simple modes of a definite
     /// pencil are refined as one batch whose corrections are block products
     /// ([`refine_simple_modes`]); a mode whose batch step fails, and every cluster, takes its own
-    /// path. A sparse pencil's simple modes (`shifts`, from order
-    /// [`Tuning::sparse_refinement_from`]) take theirs at once: there a sparse bordered
-    /// factorization per mode costs less than the batch's products through Y. Clusters are
-    /// independent: each is refined from its own columns of X, sequentially inside, and the
-    /// clusters are shared among the threads.
+    /// path. A sparse pencil's simple modes take theirs at once: a sparse bordered factorization
+    /// per mode costs less than the batch's products through Y. Clusters are independent: each
+    /// is refined from its own columns of X, sequentially inside, and the clusters are shared
+    /// among the threads.
     fn refine_jobs(
         &self,
         operands: &Operands<'_>,
