@@ -368,6 +368,7 @@ fn modes_record(m: &MechanismModes, names: &[String], locked: &[String], bodies:
     ModesRecord {
         coordinates: names.to_vec(),
         locked: locked.to_vec(),
+        idle: named(names, &m.idle),
         stability: stability_record(&m.stability),
         modes: records,
         accuracy: ModalAccuracy {

@@ -3,8 +3,8 @@
 //! mesh fallbacks at water density, validity checks and repairs, the joint mapping) is
 //! documented in `mechanica_urdf`; this module adds the scene around it:
 //!
-//! - every link is a body with explicit mass properties; a link named `ground` is refused
-//!   (the scene's name for the world);
+//! - every link is a body with explicit mass properties; a link named `ground` (the scene's
+//!   name for the world) is renamed `ground (URDF link)`, with a note;
 //! - the root link hangs on the ground by a fixed joint; gravity is −9.81 m/s² along z;
 //! - a limited joint whose range excludes 0 starts at the middle of its limits;
 //! - the analyses are: mass properties, a search for a stable equilibrium from q = 0 within
@@ -13,7 +13,7 @@
 use crate::scene::{Analyses, BodySpec, EquilibriumSpec, ExplicitMass, JointKind, JointSpec, ModesSpec, Scene};
 use mechanica::mass::MassProperties;
 pub use mechanica::urdf::UrdfOptions;
-use mechanica::urdf::{JointKind as UrdfKind, UrdfDocument, UrdfError, UrdfJoint};
+use mechanica::urdf::{JointKind as UrdfKind, UrdfDocument, UrdfError, UrdfJoint, UrdfRobot};
 use std::path::Path;
 use toml::Spanned;
 
@@ -25,16 +25,11 @@ fn spanned<T>(value: T) -> Spanned<T> {
 /// and [`UrdfOptions`]); every link that cannot be used is named in one error.
 pub fn load(path: &Path, options: UrdfOptions) -> Result<(Scene, Vec<String>), String> {
     let document = UrdfDocument::read(path).map_err(|e| located(path, e.to_string()))?;
-    if document.link_names().any(|name| name == "ground") {
-        return Err(located(
-            path,
-            "a link named \"ground\" clashes with the scene's name for the world".into(),
-        ));
-    }
     let mesh_dir = path.parent().unwrap_or(Path::new("."));
-    let robot = document
+    let mut robot = document
         .robot(mesh_dir, options)
         .map_err(|e| located(path, cli_message(e)))?;
+    rename_ground_link(&mut robot);
     let bodies = robot.links.iter().map(|l| explicit_body(&l.name, &l.mass)).collect();
     let mut joints = vec![JointSpec {
         name: "base (fixed to ground)".into(),
@@ -78,6 +73,36 @@ pub fn load(path: &Path, options: UrdfOptions) -> Result<(Scene, Vec<String>), S
     };
     scene.check(path)?;
     Ok((scene, robot.notes))
+}
+
+/// Renames a link named `ground` (the scene's name for the world) to `ground (URDF link)`, or
+/// `ground (URDF link k)` for the first k that names no other link, in the links and joints,
+/// with a note.
+fn rename_ground_link(robot: &mut UrdfRobot) {
+    if !robot.links.iter().any(|l| l.name == "ground") {
+        return;
+    }
+    let taken = |name: &str| robot.links.iter().any(|l| l.name == name);
+    let new_name = (1..=robot.links.len() + 1)
+        .map(|k| match k {
+            1 => "ground (URDF link)".to_string(),
+            k => format!("ground (URDF link {k})"),
+        })
+        .find(|name| !taken(name))
+        .unwrap_or_default();
+    for link in robot.links.iter_mut().filter(|l| l.name == "ground") {
+        link.name.clone_from(&new_name);
+    }
+    for joint in &mut robot.joints {
+        for end in [&mut joint.parent, &mut joint.child] {
+            if end == "ground" {
+                end.clone_from(&new_name);
+            }
+        }
+    }
+    robot.notes.push(format!(
+        "link \"ground\" is called \"{new_name}\" here: \"ground\" names the world in scenes"
+    ));
 }
 
 /// `what`, prefixed by the URDF file's path.

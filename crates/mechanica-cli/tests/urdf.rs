@@ -345,3 +345,41 @@ fn the_modes_at_a_given_configuration_match_the_linearised_rod() {
     let (ok, _, err) = mechanica(&["run", "--q", "0.1"]);
     assert!(!ok && err.contains("--q needs a scene"), "{err}");
 }
+
+/// A link named `ground` (the scene's name for the world) is renamed with a note, and a
+/// massless link on a joint without springs (a finger with neither `<inertial>` nor mesh) is
+/// left out of the modes and named as such: the double rod's frequencies are unchanged.
+#[test]
+fn a_ground_link_and_a_massless_finger_do_not_stop_the_run() {
+    let dir = scratch("ground");
+    let plain = dir.join("plain.urdf");
+    std::fs::write(&plain, two_rods(1.0, 0.8, 0.5, 0.6)).expect("urdf");
+    let (ok, out, err) = mechanica(&["run", plain.to_str().expect("path"), "--json"]);
+    assert!(ok, "{err}");
+    let reference = omega_sq(&serde_json::from_str(&out).expect("JSON"));
+    let finger = r#"  <link name="finger"/>
+  <joint name="finger_joint" type="revolute">
+    <parent link="lower"/><child link="finger"/>
+    <origin xyz="0 0 -0.6" rpy="0 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+</robot>"#;
+    let text = two_rods(1.0, 0.8, 0.5, 0.6)
+        .replace(r#""base""#, r#""ground""#)
+        .replace("</robot>", finger);
+    let quirky = dir.join("quirky.urdf");
+    std::fs::write(&quirky, text).expect("urdf");
+    let (ok, out, err) = mechanica(&["run", quirky.to_str().expect("path"), "--json"]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains(r#"link \"ground\" is called \"ground (URDF link)\""#),
+        "{out}"
+    );
+    let json: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    assert_eq!(step(&json, "modes")["idle"], serde_json::json!(["finger_joint"]));
+    let got = omega_sq(&json);
+    assert_eq!(got.len(), reference.len());
+    for (g, r) in got.iter().zip(&reference) {
+        assert!((g - r).abs() <= 1e-12 * r, "{g} vs {r}");
+    }
+}

@@ -4,9 +4,12 @@
 //! Newton's direction d = −B⁻¹ g is a descent direction of ½‖g‖² whenever B is nonsingular, so
 //! the search finds any equilibrium (stable or not: an inverted pendulum's upright position is
 //! found as readily as the hanging one). B is inverted through its eigen-decomposition with
-//! the eigenvalues kept away from zero by δ = √u·‖B‖, so a singular B (a neutral direction)
-//! gives a bounded step instead of a blow-up. Coordinates resting on a limit that pushes them
-//! outwards are frozen and the Newton step is taken in the others (projected Newton); trial
+//! the eigenvalues kept away from zero by δ = 64·n·u·‖B‖, the rounding level of B, so a
+//! singular B (a neutral direction) gives a bounded step instead of a blow-up (the step is
+//! also capped at `max_step`). A larger floor crawls along soft directions: a joint about a
+//! nearly vertical axis carrying an offset load (a humanoid's wrist) has a curvature of
+//! 1e-9·‖B‖, and a floor of √u·‖B‖ would shorten each of its Newton steps to a few per cent
+//! of the way. Coordinates resting on a limit that pushes them outwards are frozen and the Newton step is taken in the others (projected Newton); trial
 //! points are clipped to the limits. Spherical and free joints are re-centred
 //! ([`Mechanism::rebase`]) before every Hessian, so the returned q is in the mechanism's final
 //! chart.
@@ -108,7 +111,7 @@ fn newton_step(b: &Mat<f64>, g: &[f64], seek: Seek, max_step: f64) -> Result<Vec
         .map_err(|_| MechanismError::Numerical("eigen-decomposition of the Hessian did not converge"))?;
     let (s, u) = (eig.S(), eig.U());
     let scale = (0..n).map(|i| s[i].abs()).fold(0.0, f64::max);
-    let floor = (f64::EPSILON.sqrt() * scale).max(f64::MIN_POSITIVE);
+    let floor = (64.0 * n as f64 * f64::EPSILON * scale).max(f64::MIN_POSITIVE);
     let mut d = vec![0.0; n];
     for i in 0..n {
         let coefficient: f64 = (0..n).map(|r| u[(r, i)] * g[r]).sum();

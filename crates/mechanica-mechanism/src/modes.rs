@@ -23,8 +23,8 @@ use crate::{Mechanism, MechanismError};
 use faer::c64;
 use faer::{Mat, MatRef, Par};
 use mechanica_modal::{
-    ModalSolution, Mode, ModeKind, PencilProblem, QuadraticOptions, SolveOptions, proven_definite_with_margin,
-    quadratic_modes, solve,
+    ModalSolution, Mode, ModeKind, PencilProblem, QuadraticOptions, Selection, SolveOptions,
+    proven_definite_with_margin, quadratic_modes, solve,
 };
 use nalgebra::Vector3;
 
@@ -109,6 +109,11 @@ pub struct MechanismModes {
     pub total_mass: f64,
     /// The gyroscopic problem, in a rotating frame with G ≠ 0.
     pub gyroscopic: Option<GyroscopicModes>,
+    /// Coordinates left out of the pencil because they move no mass and feel no force: their
+    /// rows and columns of A, B and G are exactly zero (a massless link without springs), so
+    /// the linearisation says nothing of their motion and (A, B) would be singular. Their rows
+    /// of the shapes are zero, as for locked coordinates; the matrices above omit them.
+    pub idle: Vec<usize>,
 }
 
 /// The verdict from the modes' classes: unstable if any mode is proven unstable, else
@@ -194,17 +199,29 @@ fn modes_at(
             dof: n_all,
         });
     }
-    let free: Vec<usize> = (0..n_all).filter(|k| !locked.contains(k)).collect();
     let evaluation = mechanism.potential(&q, true)?;
     let b_all = evaluation.hessian.ok_or(MechanismError::Numerical("Hessian missing"))?;
     let a_all = mechanism.mass_matrix(&q)?;
+    let g_all = mechanism.gyroscopic_matrix(&q)?;
+    let unlocked: Vec<usize> = (0..n_all).filter(|k| !locked.contains(k)).collect();
+    let (free, idle): (Vec<usize>, Vec<usize>) = unlocked.iter().partition(|&&k| {
+        [&a_all, &b_all, &g_all]
+            .iter()
+            .any(|m| (0..n_all).any(|j| m[(k, j)] != 0.0))
+    });
     let restrict = |m: &Mat<f64>| Mat::from_fn(free.len(), free.len(), |i, j| m[(free[i], free[j])]);
     let (a, b) = (restrict(&a_all), restrict(&b_all));
     let problem = PencilProblem::new(a.as_ref(), b.as_ref())?;
     // Shapes are always computed: they carry the propagation of B's rounding (below) and the
     // body displacements; for mechanisms (n in the hundreds at most) they cost little.
+    // A count beyond the coordinates kept (some locked or idle) asks for all of them.
+    let selection = match options.selection {
+        Selection::Lowest(k) if k >= free.len() => Selection::All,
+        other => other,
+    };
     let options = SolveOptions {
         vectors: true,
+        selection,
         ..*options
     };
     let mut solution = solve(&problem, &options)?;
@@ -222,7 +239,7 @@ fn modes_at(
         }));
     }
     let (body_displacements, effective_masses, total_mass) = shapes_in_space(mechanism, &q, &solution)?;
-    let g = restrict(&mechanism.gyroscopic_matrix(&q)?);
+    let g = restrict(&g_all);
     let gyroscopic = if g.norm_l2() > 0.0 {
         Some(gyroscopic_modes(&a, &g, &b)?)
     } else {
@@ -239,6 +256,7 @@ fn modes_at(
         effective_masses,
         total_mass,
         gyroscopic,
+        idle,
     })
 }
 

@@ -463,3 +463,69 @@ fn light_sliders_have_true_finite_bounds() {
         }
     }
 }
+
+/// A double pendulum (point masses m on links l, hinges about y) with massless "fingers" at its
+/// tip: revolute joints about random axes carrying massless links, without springs, some
+/// placed between the two pendulum bodies' coordinates in the numbering. Their rows and
+/// columns of A and B are exactly zero, so the pencil of every coordinate is singular; the
+/// fingers are left out (`idle`) and the pendulum's two modes are (2 ∓ √2) g/l, with zero
+/// finger rows in the shapes. A finger with a joint spring moves no mass but feels a force: it
+/// stays in, as an infinite mode, and the finite modes are the same.
+#[test]
+fn massless_joints_without_springs_are_left_out_of_the_modes() {
+    let (m, l) = (1.3, 0.7);
+    for (fingers, sprung) in [(1, false), (3, false), (2, true)] {
+        let mut builder = TreeBuilder::new();
+        let upper = builder.add_body(None, Joint::Revolute { axis: Vector3::y() }, Isometry3::identity());
+        let mut bodies = vec![MassProperties::point(m, Vector3::new(0.0, 0.0, -l)).expect("point")];
+        let mut parent = upper;
+        for f in 0..fingers {
+            let axis = Vector3::new(0.3 + f as f64, -0.5, 0.8 - f as f64).normalize();
+            parent = builder.add_body(
+                Some(parent),
+                Joint::Revolute { axis },
+                Isometry3::translation(0.0, 0.0, -l),
+            );
+            bodies.push(MassProperties::ZERO);
+        }
+        builder.add_body(
+            Some(upper),
+            Joint::Revolute { axis: Vector3::y() },
+            Isometry3::translation(0.0, 0.0, -l),
+        );
+        bodies.push(MassProperties::point(m, Vector3::new(0.0, 0.0, -l)).expect("point"));
+        let mut mechanism = Mechanism::new(builder.build().expect("tree"), bodies).expect("mechanism");
+        mechanism.set_gravity(Vector3::new(0.0, 0.0, -G)).expect("gravity");
+        if sprung {
+            let spring = JointSpring {
+                coordinate: 1,
+                stiffness: 5.0,
+                rest: 0.0,
+            };
+            mechanism.add_potential(spring).expect("spring");
+        }
+        let q = vec![0.0; fingers + 2];
+        let modes = mechanism_modes(&mut mechanism, &q, &SolveOptions::default()).expect("modes");
+        let expected_idle: Vec<usize> = (1..=fingers).filter(|&k| !(sprung && k == 1)).collect();
+        assert_eq!(modes.idle, expected_idle, "fingers {fingers}, sprung {sprung}");
+        let finite: Vec<f64> = modes
+            .solution
+            .modes
+            .iter()
+            .filter(|mode| mode.kind != ModeKind::Infinite)
+            .map(|mode| mode.omega_sq)
+            .collect();
+        let s = 2f64.sqrt();
+        let exact = [(2.0 - s) * G / l, (2.0 + s) * G / l];
+        assert_eq!(finite.len(), 2, "{:?}", modes.solution.modes);
+        for (got, want) in finite.iter().zip(exact) {
+            assert!((got - want).abs() <= 1e-12 * want, "{got} vs {want}");
+        }
+        let x = modes.solution.vectors.as_ref().expect("shapes");
+        assert_eq!(x.nrows(), fingers + 2);
+        for &k in &expected_idle {
+            assert!((0..x.ncols()).all(|c| x[(k, c)] == 0.0), "finger row {k} of the shapes");
+        }
+        assert_eq!(modes.stability, Stability::Stable);
+    }
+}

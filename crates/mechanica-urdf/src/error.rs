@@ -40,7 +40,7 @@ pub enum UrdfError {
         problems: Vec<String>,
     },
     /// Not exactly one link is no joint's child.
-    #[error("a URDF tree has one root link, found {roots:?}")]
+    #[error("{}", root_count_message(roots))]
     RootCount {
         /// The links that are no joint's child.
         roots: Vec<String>,
@@ -84,4 +84,15 @@ pub enum UrdfError {
     /// The joints do not form a tree (a cycle) or a placement is not a rigid motion.
     #[error(transparent)]
     Kinematics(#[from] KinematicsError),
+}
+
+/// The message of [`UrdfError::RootCount`].
+fn root_count_message(roots: &[String]) -> String {
+    if roots.is_empty() {
+        "a URDF tree needs one root link (a link that is no joint's child): the robot has no links, or every link is \
+         a joint's child"
+            .to_string()
+    } else {
+        format!("a URDF tree has one root link (a link that is no joint's child), found {roots:?}")
+    }
 }

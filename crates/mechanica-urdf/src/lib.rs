@@ -5,12 +5,16 @@
 //!   inertial origin and the tensor rotated by its `rpy` into the link frame. Every link's
 //!   tensor is checked (mass crate validity: symmetry, semidefiniteness, triangle inequality);
 //!   all invalid links are reported at once, and [`UrdfOptions::repair_inertia`] replaces each
-//!   by the nearest physical tensor (documented in `mechanica_mass::validity::repair`).
+//!   by the nearest physical tensor (documented in `mechanica_mass::validity::repair`). A
+//!   tensor whose nearest physical tensor is within 1e-12 of the robot's largest link inertia
+//!   (trace) is off by the file's rounding (exporters write zero moments as ±1e-20): it is
+//!   replaced by that tensor with a note, without the option.
 //! - A link without `<inertial>` (or with a zero mass there) whose collision (or else visual)
 //!   geometry is a mesh gets the mesh's mass properties at [`MESH_DENSITY`] (water; URDF gives
 //!   no density); the file name, with `package://` and `file://` prefixes stripped, is resolved
 //!   in the mesh directory (the URDF file's directory for [`read_file`]), then relative to the
-//!   working directory. A mesh that cannot be used (missing file, a format other than STL or
+//!   working directory; a `package://PKG/rest` URI also under each ancestor of the mesh
+//!   directory named PKG and under `PKG` in each ancestor and each `ROS_PACKAGE_PATH` entry. A mesh that cannot be used (missing file, a format other than STL or
 //!   OBJ such as `.dae`, a mesh without a volume) is an error naming the link and the mesh;
 //!   with [`UrdfOptions::allow_missing_mesh`] the link is massless instead and a warning is
 //!   added to the notes. A link with neither `<inertial>` nor a mesh is a massless frame.
@@ -21,6 +25,9 @@
 //!   joints are not followed (each joint is free).
 //! - **Trees** ([`UrdfRobot::tree`]): one body per link in the file's order, the root link
 //!   attached to the base frame by a fixed joint, every other link by its URDF joint.
+//!
+//! `<texture>` elements without a `filename` (some exporters write `<texture/>` in materials)
+//! are dropped before parsing: materials only concern rendering.
 //!
 //! The text is at most [`MAX_URDF_BYTES`] long; every allocation is proportional to it.
 

@@ -37,7 +37,7 @@ pub(crate) fn link_masses(
     let mut problems = LinkProblems::default();
     let mut masses = Vec::with_capacity(links.len());
     for link in links {
-        let mut props = match link_mass_properties(mesh_dir, link, notes) {
+        masses.push(match link_mass_properties(mesh_dir, link, notes) {
             Ok(props) => props,
             Err(problem) if options.allow_missing_mesh => {
                 notes.push(format!("warning: {problem}; the link is massless"));
@@ -47,22 +47,44 @@ pub(crate) fn link_masses(
                 problems.meshes.push(problem);
                 massless()
             }
-        };
-        match checked_inertia(link, &props, options.repair_inertia, notes) {
-            Ok(checked) => props = checked,
+        });
+    }
+    let rounding = ROBOT_ROUNDING * robot_inertia_scale(&masses);
+    for (link, props) in links.iter().zip(&mut masses) {
+        match checked_inertia(link, props, options.repair_inertia, rounding, notes) {
+            Ok(checked) => *props = checked,
             Err(problem) => problems.inertias.push(problem),
         }
-        masses.push(props);
     }
     (masses, problems)
 }
 
-/// `props` when it is physical (a finite mass ≥ 0 and, when massive, a valid tensor), or its
-/// repair when `repair_inertia` is set (noted in `notes`); else the problem, naming the link.
+/// A link tensor whose nearest physical tensor is within this fraction of the robot's largest
+/// link inertia ([`robot_inertia_scale`]) is taken as physical up to the file's rounding, and
+/// replaced by that tensor with a note: exporters write zero moments as ±1e-20 and the like
+/// (a point mass of 0.27 kg with ixz = 1.4e-20), far below what the robot's mass matrix,
+/// assembled with rounding of about 1e-16 of that scale, can resolve.
+const ROBOT_ROUNDING: f64 = 1e-12;
+
+/// The largest trace Σ|J_ii| of a massive link's tensor (0 for a robot without one).
+fn robot_inertia_scale(masses: &[MassProperties]) -> f64 {
+    masses
+        .iter()
+        .filter(|p| p.mass > 0.0)
+        .map(|p| (0..3).map(|k| p.inertia_c[(k, k)].abs()).sum::<f64>())
+        .filter(|s| s.is_finite())
+        .fold(0.0, f64::max)
+}
+
+/// `props` when it is physical (a finite mass ≥ 0 and, when massive, a valid tensor), its
+/// nearest physical tensor when that is within `rounding` (absolute, Frobenius) of it, or its
+/// repair when `repair_inertia` is set (both noted in `notes`); else the problem, naming the
+/// link.
 fn checked_inertia(
     link: &urdf_rs::Link,
     props: &MassProperties,
     repair_inertia: bool,
+    rounding: f64,
     notes: &mut Vec<String>,
 ) -> Result<MassProperties, String> {
     if props.mass < 0.0 || !props.mass.is_finite() {
@@ -74,19 +96,28 @@ fn checked_inertia(
     if props.mass == 0.0 {
         return Ok(*props);
     }
-    match check(props, &ValidityTolerance::default()) {
-        Ok(_) => Ok(*props),
-        Err(error) if repair_inertia => match repair(props, &ValidityTolerance::default()) {
-            Ok((fixed, report)) => {
-                notes.push(format!(
-                    "link \"{}\": inertia repaired (relative change {:.2e}): {error}",
-                    link.name, report.relative_change
-                ));
-                Ok(fixed)
-            }
-            Err(e) => Err(format!("link \"{}\": {e}", link.name)),
-        },
-        Err(error) => Err(format!("link \"{}\": {error}", link.name)),
+    let tolerance = ValidityTolerance::default();
+    let Err(error) = check(props, &tolerance) else {
+        return Ok(*props);
+    };
+    match repair(props, &tolerance) {
+        Ok((fixed, report)) if report.change_norm <= rounding => {
+            notes.push(format!(
+                "link \"{}\": inertia off by rounding ({:.1e} kg·m², below 1e-12 of the robot's largest link \
+                 inertia) set to the nearest physical tensor",
+                link.name, report.change_norm
+            ));
+            Ok(fixed)
+        }
+        Ok((fixed, report)) if repair_inertia => {
+            notes.push(format!(
+                "link \"{}\": inertia repaired (relative change {:.2e}): {error}",
+                link.name, report.relative_change
+            ));
+            Ok(fixed)
+        }
+        Err(e) if repair_inertia => Err(format!("link \"{}\": {e}", link.name)),
+        _ => Err(format!("link \"{}\": {error}", link.name)),
     }
 }
 
@@ -146,13 +177,44 @@ fn first_mesh(link: &urdf_rs::Link) -> Option<LinkMesh> {
     })
 }
 
-/// Where a mesh file name is looked for: in `mesh_dir`, then as written (relative to the
-/// working directory), `package://` and `file://` prefixes stripped.
+/// Where a mesh file name is looked for, in this order: in `mesh_dir`, then as written
+/// (relative to the working directory), `package://` and `file://` prefixes stripped; then,
+/// for `package://PKG/rest`, under the package's root: each ancestor of `mesh_dir` named PKG,
+/// and `PKG` inside each ancestor and inside each directory of `ROS_PACKAGE_PATH`.
 fn mesh_candidates(mesh_dir: &Path, filename: &str) -> Vec<PathBuf> {
     let relative = filename.trim_start_matches("package://").trim_start_matches("file://");
     let mut candidates = vec![mesh_dir.join(relative)];
     if candidates[0] != Path::new(relative) {
         candidates.push(Path::new(relative).to_path_buf());
+    }
+    if let Some(uri) = filename.strip_prefix("package://") {
+        for candidate in package_candidates(mesh_dir, uri) {
+            if !candidates.contains(&candidate) {
+                candidates.push(candidate);
+            }
+        }
+    }
+    candidates
+}
+
+/// The paths a `package://` URI (without its scheme, `PKG/rest`) may name: `rest` under each
+/// ancestor of `mesh_dir` named PKG, and `PKG/rest` under each ancestor and each directory of
+/// `ROS_PACKAGE_PATH` (a directory named PKG there stands for the package itself).
+fn package_candidates(mesh_dir: &Path, uri: &str) -> Vec<PathBuf> {
+    let Some((package, rest)) = uri.split_once('/') else {
+        return Vec::new();
+    };
+    let search_path = std::env::var_os("ROS_PACKAGE_PATH").unwrap_or_default();
+    let roots = mesh_dir
+        .ancestors()
+        .map(Path::to_path_buf)
+        .chain(std::env::split_paths(&search_path));
+    let mut candidates = Vec::new();
+    for root in roots.filter(|r| !r.as_os_str().is_empty()) {
+        if root.file_name().is_some_and(|name| name == package) {
+            candidates.push(root.join(rest));
+        }
+        candidates.push(root.join(package).join(rest));
     }
     candidates
 }
@@ -162,8 +224,18 @@ fn mesh_candidates(mesh_dir: &Path, filename: &str) -> Vec<PathBuf> {
 fn mesh_mass(mesh_dir: &Path, mesh: &LinkMesh) -> Result<(MassProperties, String), String> {
     let candidates = mesh_candidates(mesh_dir, &mesh.filename);
     let Some(path) = candidates.iter().find(|p| p.is_file()) else {
-        let looked: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();
-        return Err(format!("file not found (looked for {})", looked.join(" and ")));
+        let looked: Vec<String> = candidates.iter().take(2).map(|p| p.display().to_string()).collect();
+        let package = match mesh
+            .filename
+            .strip_prefix("package://")
+            .and_then(|uri| uri.split_once('/'))
+        {
+            Some((package, _)) => {
+                format!(", and under package \"{package}\" among the mesh directory's ancestors and ROS_PACKAGE_PATH")
+            }
+            None => String::new(),
+        };
+        return Err(format!("file not found (looked for {}{package})", looked.join(" and ")));
     };
     let mut triangles = mechanica_mass::io::load_mesh(path).map_err(|e| e.to_string())?;
     for v in &mut triangles.vertices {

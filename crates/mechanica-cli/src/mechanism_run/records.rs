@@ -211,6 +211,9 @@ pub struct ModesRecord {
     pub coordinates: Vec<String>,
     /// Coordinates held fixed (resting on a joint limit); their rows of the shapes are 0.
     pub locked: Vec<String>,
+    /// Coordinates left out because they move no mass and feel no force (their rows of A, B
+    /// and G are zero); their rows of the shapes are 0.
+    pub idle: Vec<String>,
     /// The stability verdict.
     pub stability: StabilityRecord,
     /// The modes, ω² ascending.
@@ -257,6 +260,12 @@ impl ModesRecord {
             out.note(&format!(
                 "coordinates {} rest on joint limits at the equilibrium and are held fixed for the modes",
                 self.locked.join(", ")
+            ));
+        }
+        if !self.idle.is_empty() {
+            out.note(&format!(
+                "coordinates {} move no mass and feel no force (massless links without springs): left out of the modes",
+                self.idle.join(", ")
             ));
         }
     }

@@ -1,0 +1,193 @@
+//! What real robot files contain besides mechanics: `<texture/>` elements without a file,
+//! inertia tensors off by rounding (zero moments written as ±1e-20), `package://` mesh URIs
+//! resolved against the package's directory, and empty robots.
+
+use mechanica_mass::validity::{ValidityTolerance, check};
+use mechanica_urdf::{UrdfError, UrdfOptions, read_file, read_str};
+use std::path::{Path, PathBuf};
+
+/// A two-link arm; `material` is inserted in the robot and in the upper link's visual, and
+/// `tensor` is the upper link's `<inertia>` attributes.
+fn arm(material: &str, tensor: &str) -> String {
+    format!(
+        r#"<?xml version="1.0"?>
+<robot name="arm">
+  {material}
+  <link name="base"/>
+  <link name="upper">
+    <inertial>
+      <origin xyz="0 0 -0.3" rpy="0 0 0"/>
+      <mass value="0.27"/>
+      <inertia {tensor}/>
+    </inertial>
+    <visual><geometry><box size="0.1 0.1 0.6"/></geometry>{material}</visual>
+  </link>
+  <link name="lower">
+    <inertial>
+      <origin xyz="0 0 -0.25" rpy="0 0 0"/>
+      <mass value="2.0"/>
+      <inertia ixx="0.04" ixy="0" ixz="0" iyy="0.04" iyz="0" izz="0.002"/>
+    </inertial>
+  </link>
+  <joint name="shoulder" type="revolute">
+    <parent link="base"/><child link="upper"/><axis xyz="0 1 0"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <joint name="elbow" type="continuous">
+    <parent link="upper"/><child link="lower"/><origin xyz="0 0 -0.6" rpy="0 0 0"/><axis xyz="0 1 0"/>
+  </joint>
+</robot>
+"#
+    )
+}
+
+const ROD: &str = r#"ixx="0.0081" ixy="0" ixz="0" iyy="0.0081" iyz="0" izz="0.0001""#;
+
+#[test]
+fn textures_without_a_file_are_ignored_and_the_rest_is_read_unchanged() {
+    let here = Path::new(".");
+    let plain = read_str(&arm("", ROD), here, UrdfOptions::default()).expect("plain arm");
+    for material in [
+        r#"<material name="grey"><color rgba="0.5 0.5 0.5 1"/><texture /></material>"#,
+        r#"<material name="grey"><texture/><color rgba="0.5 0.5 0.5 1"/></material>"#,
+        r#"<material name="grey"><texture></texture></material>"#,
+        r#"<material name="skin"><texture filename="skin.png"/></material>"#,
+    ] {
+        let robot =
+            read_str(&arm(material, ROD), here, UrdfOptions::default()).unwrap_or_else(|e| panic!("{material}: {e}"));
+        assert_eq!(robot.links, plain.links, "{material}");
+        assert_eq!(robot.joints, plain.joints, "{material}");
+    }
+}
+
+#[test]
+fn tensors_off_by_rounding_are_taken_as_physical_with_a_note() {
+    let here = Path::new(".");
+    // Point masses written with noise in their zero tensors: violations far below 1e-12 of
+    // the arm's largest link inertia (0.082 kg·m²), though not of their own (zero) trace.
+    for noisy in [
+        r#"ixx="0" ixy="0" ixz="1.35525e-20" iyy="0" iyz="0" izz="0""#,
+        r#"ixx="-5.42e-20" ixy="0" ixz="0" iyy="-5.42e-20" iyz="0" izz="0""#,
+        r#"ixx="1e-21" ixy="3e-21" ixz="0" iyy="1e-21" iyz="0" izz="0""#,
+    ] {
+        let robot = read_str(&arm("", noisy), here, UrdfOptions::default()).unwrap_or_else(|e| panic!("{noisy}: {e}"));
+        let upper = &robot.links[1];
+        assert!(
+            check(&upper.mass, &ValidityTolerance::default()).is_ok(),
+            "{noisy}: {:?}",
+            upper.mass
+        );
+        assert!(
+            robot
+                .notes
+                .iter()
+                .any(|n| n.contains("link \"upper\": inertia off by rounding")),
+            "{noisy}: {:?}",
+            robot.notes
+        );
+    }
+    // Violations of a real size stay errors (unless repair is asked for).
+    for bad in [
+        r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="3e-6""#,
+        r#"ixx="0.0081" ixy="0" ixz="0" iyy="0.0081" iyz="0" izz="-1e-9""#,
+    ] {
+        match read_str(&arm("", bad), here, UrdfOptions::default()) {
+            Err(UrdfError::InvalidInertias { problems }) => {
+                assert!(problems.iter().any(|p| p.contains("link \"upper\"")), "{problems:?}")
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+        let options = UrdfOptions {
+            repair_inertia: true,
+            ..UrdfOptions::default()
+        };
+        assert!(read_str(&arm("", bad), here, options).is_ok(), "{bad} with repair");
+    }
+}
+
+#[test]
+fn a_robot_without_links_names_the_problem() {
+    let error = read_str(
+        r#"<robot name="empty"></robot>"#,
+        Path::new("."),
+        UrdfOptions::default(),
+    )
+    .expect_err("no links");
+    assert!(error.to_string().contains("no links"), "{error}");
+}
+
+/// A fresh directory under the system temp dir, unique to this test and process.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mechanica-urdf-quirks-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+/// An ASCII STL cube of side `s` centred on the origin (outward normals).
+fn cube_stl(s: f64) -> String {
+    let h = 0.5 * s;
+    let corner = |k: usize| [k & 1, k & 2, k & 4].map(|bit| if bit != 0 { h } else { -h });
+    let faces = [
+        [0, 2, 3],
+        [0, 3, 1],
+        [4, 5, 7],
+        [4, 7, 6],
+        [0, 1, 5],
+        [0, 5, 4],
+        [2, 6, 7],
+        [2, 7, 3],
+        [0, 4, 6],
+        [0, 6, 2],
+        [1, 3, 7],
+        [1, 7, 5],
+    ];
+    let mut text = String::from("solid cube\n");
+    for face in faces {
+        text.push_str("facet normal 0 0 0\nouter loop\n");
+        for k in face {
+            let [x, y, z] = corner(k);
+            text.push_str(&format!("vertex {x} {y} {z}\n"));
+        }
+        text.push_str("endloop\nendfacet\n");
+    }
+    text.push_str("endsolid cube\n");
+    text
+}
+
+#[test]
+fn package_uris_are_found_under_the_package_directory() {
+    // share/<package>/robots/arm.urdf with meshes in share/<package>/meshes, as installed
+    // description packages are laid out, and a package named as a subdirectory of an ancestor.
+    let root = scratch("package");
+    let package = root.join("share").join("arm_description");
+    std::fs::create_dir_all(package.join("robots")).expect("dirs");
+    std::fs::create_dir_all(package.join("meshes")).expect("dirs");
+    std::fs::write(package.join("meshes").join("tool.stl"), cube_stl(0.1)).expect("mesh");
+    for uri in [
+        "package://arm_description/meshes/tool.stl",
+        "package://share/arm_description/meshes/tool.stl",
+    ] {
+        let text = format!(
+            r#"<robot name="r"><link name="base"/>
+            <link name="tool"><collision><geometry><mesh filename="{uri}"/></geometry></collision></link>
+            <joint name="j" type="revolute"><parent link="base"/><child link="tool"/><axis xyz="0 0 1"/></joint></robot>"#
+        );
+        let urdf = package.join("robots").join("arm.urdf");
+        std::fs::write(&urdf, text).expect("urdf");
+        let robot = read_file(&urdf, UrdfOptions::default()).unwrap_or_else(|e| panic!("{uri}: {e}"));
+        // A 0.1 m cube at 1000 kg/m³ (STL stores single precision).
+        assert!(
+            (robot.links[1].mass.mass - 1.0).abs() <= 1e-6,
+            "{uri}: {:?}",
+            robot.links[1].mass
+        );
+    }
+    let missing = r#"<robot name="r"><link name="base"/>
+        <link name="tool"><collision><geometry><mesh filename="package://other/meshes/tool.stl"/></geometry></collision></link>
+        <joint name="j" type="revolute"><parent link="base"/><child link="tool"/><axis xyz="0 0 1"/></joint></robot>"#;
+    let urdf = package.join("robots").join("missing.urdf");
+    std::fs::write(&urdf, missing).expect("urdf");
+    let error = read_file(&urdf, UrdfOptions::default()).expect_err("no package named other");
+    assert!(error.to_string().contains("under package \"other\""), "{error}");
+}
