@@ -29,7 +29,10 @@ pub enum Seek {
     Stationary,
     /// A local minimum of U* (a stable equilibrium when B is definite): Newton with the
     /// Hessian's eigenvalues replaced by their absolute values (a descent direction), line
-    /// search on U* with the Armijo condition.
+    /// search on U* with the Armijo condition. A stationary point whose Hessian (coordinates
+    /// held by limits left out) has an eigenvalue below −64·n·u·‖B‖ is not accepted: the search
+    /// leaves it along that eigenvector, backtracking until U* falls by a quarter of the
+    /// quadratic model's decrease, and goes on (an inverted pendulum started upright falls).
     Minimum,
 }
 
@@ -156,32 +159,45 @@ pub fn find_equilibrium(
     for iteration in 0..=options.max_iterations {
         let (free, at_limit) = free_gradient(&current.gradient, &q, &limits);
         let gradient_norm = norm(&free);
-        if gradient_norm <= tolerance {
-            return Ok(Equilibrium {
-                q,
-                potential: current.value,
-                gradient_norm,
-                tolerance,
-                iterations: iteration,
-                last_step: if last_step.is_finite() { last_step } else { 0.0 },
-                at_limit,
-            });
-        }
-        if iteration == options.max_iterations {
-            break;
-        }
         let hessian = current
             .hessian
             .as_ref()
             .ok_or(MechanismError::Numerical("Hessian missing"))?;
-        let direction = projected_newton_direction(hessian, &free, &at_limit, options)?;
-        let from = Iterate {
-            q: &q,
-            value: current.value,
-            free: &free,
-            gradient_norm,
+        let stationary = gradient_norm <= tolerance;
+        // A stationary point that is not a minimum, when one is sought: leave it along the
+        // Hessian's most negative curvature.
+        let escape = match (stationary, options.seek) {
+            (true, Seek::Minimum) if iteration < options.max_iterations => {
+                negative_curvature_step(hessian, &free, &at_limit, options.max_step)?
+            }
+            _ => None,
         };
-        let Some(mut next) = line_search(mechanism, &limits, options.seek, &from, &direction)? else {
+        let next = match &escape {
+            Some(escape) => descend_along(mechanism, &limits, &q, current.value, escape)?,
+            None if stationary || iteration == options.max_iterations => None,
+            None => {
+                let direction = projected_newton_direction(hessian, &free, &at_limit, options)?;
+                let from = Iterate {
+                    q: &q,
+                    value: current.value,
+                    free: &free,
+                    gradient_norm,
+                };
+                line_search(mechanism, &limits, options.seek, &from, &direction)?
+            }
+        };
+        let Some(mut next) = next else {
+            if stationary {
+                return Ok(Equilibrium {
+                    q,
+                    potential: current.value,
+                    gradient_norm,
+                    tolerance,
+                    iterations: iteration,
+                    last_step: if last_step.is_finite() { last_step } else { 0.0 },
+                    at_limit,
+                });
+            }
             break;
         };
         last_step = q.iter().zip(&next).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
@@ -251,6 +267,80 @@ fn projected_newton_direction(
         direction[k] = *d;
     }
     Ok(direction)
+}
+
+/// At a stationary point, the step of length `max_step` along the eigenvector of the reduced
+/// Hessian (coordinates held by a limit frozen) with the most negative eigenvalue λ, when
+/// λ < −64·n·u·‖B‖ (negative beyond the Hessian's rounding), oriented against the remaining
+/// gradient `free`; with λ. None at a minimum (no such eigenvalue).
+fn negative_curvature_step(
+    hessian: &Mat<f64>,
+    free: &[f64],
+    at_limit: &[usize],
+    max_step: f64,
+) -> Result<Option<CurvatureStep>, MechanismError> {
+    let moving: Vec<usize> = (0..free.len()).filter(|k| !at_limit.contains(k)).collect();
+    let n = moving.len();
+    let reduced = Mat::from_fn(n, n, |i, j| hessian[(moving[i], moving[j])]);
+    let eig = reduced
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|_| MechanismError::Numerical("eigen-decomposition of the Hessian did not converge"))?;
+    let (s, u) = (eig.S(), eig.U());
+    let scale = (0..n).map(|i| s[i].abs()).fold(0.0, f64::max);
+    let Some(lowest) = (0..n).min_by(|&i, &j| s[i].total_cmp(&s[j])) else {
+        return Ok(None);
+    };
+    let curvature = s[lowest];
+    if curvature.is_nan() || curvature >= -64.0 * n as f64 * f64::EPSILON * scale {
+        return Ok(None);
+    }
+    let slope: f64 = moving.iter().enumerate().map(|(i, &k)| u[(i, lowest)] * free[k]).sum();
+    let sign = if slope > 0.0 { -1.0 } else { 1.0 };
+    let mut direction = vec![0.0; free.len()];
+    for (i, &k) in moving.iter().enumerate() {
+        direction[k] = sign * max_step * u[(i, lowest)];
+    }
+    Ok(Some(CurvatureStep { direction, curvature }))
+}
+
+/// A step along negative curvature: its direction (length `max_step`) and the curvature λ < 0.
+struct CurvatureStep {
+    direction: Vec<f64>,
+    curvature: f64,
+}
+
+/// Backtracking along ±`step.direction` from the stationary point `q` (value `value`): the
+/// first trial point (clipped to the limits) where U* has fallen by at least a quarter of the
+/// quadratic model's ½|λ|‖Δq‖², or None when neither sign achieves it before the decrease
+/// falls below the rounding of U*.
+fn descend_along(
+    mechanism: &Mechanism,
+    limits: &[(f64, f64)],
+    q: &[f64],
+    value: f64,
+    step: &CurvatureStep,
+) -> Result<Option<Vec<f64>>, MechanismError> {
+    for sign in [1.0, -1.0] {
+        let mut alpha = 1.0;
+        for _ in 0..40 {
+            let mut trial: Vec<f64> = q
+                .iter()
+                .zip(&step.direction)
+                .map(|(x, d)| x + sign * alpha * d)
+                .collect();
+            clamp(&mut trial, limits);
+            let moved = q.iter().zip(&trial).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+            let predicted = 0.5 * step.curvature.abs() * moved;
+            if predicted <= 64.0 * f64::EPSILON * value.abs() {
+                break;
+            }
+            if mechanism.potential(&trial, false)?.value <= value - 0.25 * predicted {
+                return Ok(Some(trial));
+            }
+            alpha *= 0.5;
+        }
+    }
+    Ok(None)
 }
 
 /// The current point of the Newton iteration, as the line search needs it.
