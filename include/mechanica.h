@@ -4704,7 +4704,9 @@ mech_status_t mech_mechanism_set_limits(struct mech_mechanism_t *mechanism,
  * kinds (MECH_MODAL_KIND_*) into `kinds_out` (each `count` long, or n for all; entries past
  * the modes found are 0, 0 and MECH_MODAL_KIND_INFINITE), the A-normalised shapes into
  * `shapes_out` (n × count column-major, may be NULL) and the verdict into `stability_out`.
- * The number of modes written goes to `*modes_out`. The rows of a spherical or free joint's
+ * The number of modes written goes to `*modes_out`: fewer than n when some coordinates move no
+ * mass and feel no force (massless links without springs; their rows of A and B are zero and
+ * they are left out, with zero rows in the shapes). The rows of a spherical or free joint's
  * rotation vector are in charts re-centred at q (rotation increments about the body frame at
  * q); the handle keeps its own charts, so identical calls give identical results.
  *

@@ -1,6 +1,6 @@
 /* URDF through the C ABI: a double pendulum of point masses read from a string and from a file
- * (names, tree size, modes against the closed form ω² = (2 ∓ √2) g/L), and broken robots whose
- * errors name the link or joint and the field. */
+ * (names, tree size, modes against the closed form ω² = (2 ∓ √2) g/L), broken robots whose
+ * errors name the link or joint and the field, and a massless finger left out of the modes. */
 #include "check.h"
 
 #include <unistd.h>
@@ -170,8 +170,37 @@ static void broken_robots(void) {
     mech_tree_destroy(tree);
 }
 
+/* A massless finger without a spring at the lower link's tip (its rows of A and B are zero),
+ * and a material with a bare <texture/> as some exporters write: the finger is left out of the
+ * modes, which are the pendulum's two with a zero finger row in the shapes. */
+static void a_massless_finger_is_left_out_of_the_modes(void) {
+    char text[2048];
+    variant("</robot>",
+            "<link name=\"finger\"><visual><geometry><box size=\"0.01 0.01 0.01\"/></geometry>"
+            "<material name=\"grey\"><texture/></material></visual></link>"
+            "<joint name=\"finger_joint\" type=\"revolute\"><parent link=\"lower\"/><child link=\"finger\"/>"
+            "<origin xyz=\"0 0 -0.5\"/><axis xyz=\"1 0 0\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" "
+            "velocity=\"1\"/></joint></robot>",
+            text, sizeof text);
+    mech_mechanism_t *m = NULL;
+    CHECK_STATUS(mech_mechanism_from_urdf_string(text, strlen(text), ".", NULL, &m), MECH_STATUS_OK);
+    const double q[3] = {0.0, 0.0, 0.0};
+    double w2[3], bounds[3], shapes[9];
+    mech_modal_kind_t kinds[3];
+    mech_stability_t stability;
+    size_t found = 0;
+    CHECK_STATUS(mech_mechanism_modes(m, q, 3, 0, w2, bounds, kinds, shapes, &found, &stability), MECH_STATUS_OK);
+    CHECK(found == 2 && stability.unstable_directions == 0);
+    CHECK_NEAR(w2[0], (2.0 - sqrt(2.0)) * G / L, 1e-12);
+    CHECK_NEAR(w2[1], (2.0 + sqrt(2.0)) * G / L, 1e-12);
+    CHECK(kinds[2] == MECH_MODAL_KIND_INFINITE && w2[2] == 0.0 && bounds[2] == 0.0);
+    CHECK(shapes[2] == 0.0 && shapes[5] == 0.0);
+    mech_mechanism_destroy(m);
+}
+
 int main(void) {
     from_string_and_file();
     broken_robots();
+    a_massless_finger_is_left_out_of_the_modes();
     return CHECK_DONE();
 }
