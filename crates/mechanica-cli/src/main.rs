@@ -64,8 +64,9 @@ struct RunArgs {
     /// Evaluate at these coordinates instead of q0 (comma-separated, one per coordinate, in the
     /// order the report prints q0): every analysis starts there, and the modes are those of the
     /// linearisation at q, without an equilibrium search.
-    #[arg(long, value_name = "Q1,Q2,...", value_delimiter = ',', allow_hyphen_values = true)]
-    q: Option<Vec<f64>>,
+    /// An empty value is the configuration of a robot without coordinates.
+    #[arg(long, value_name = "Q1,Q2,...", value_parser = parse_coordinates, allow_hyphen_values = true)]
+    q: Option<Coordinates>,
     /// Also report, at the start state (--q, or the scene's q0), the mass matrix A(q), the
     /// potential U*(q), its gradient and its Hessian ∂²U*/∂q∂q, in full, over the named
     /// coordinates.
@@ -107,7 +108,7 @@ enum Command {
 /// Runs a scene file, a URDF robot (by its extension) or the default scene.
 fn run(args: &RunArgs) -> Result<report::Report, String> {
     let plot = args.plot.as_deref();
-    let state = args.q.as_deref();
+    let state = args.q.as_ref().map(|q| q.0.as_slice());
     match &args.scene {
         None if state.is_some() => Err("--q needs a scene or URDF file: the default scene holds two mechanisms".into()),
         None if args.matrices => {
@@ -151,6 +152,25 @@ fn report_of(command: Command) -> Result<report::Report, String> {
         report::check_finite(step).map_err(|e| e.to_string())?;
     }
     Ok(report)
+}
+
+/// The values of `--q`.
+#[derive(Debug, Clone)]
+struct Coordinates(Vec<f64>);
+
+/// `--q`: comma-separated numbers; an empty (or blank) value is no coordinate at all.
+fn parse_coordinates(text: &str) -> Result<Coordinates, String> {
+    if text.trim().is_empty() {
+        return Ok(Coordinates(Vec::new()));
+    }
+    text.split(',')
+        .map(|item| {
+            item.trim()
+                .parse::<f64>()
+                .map_err(|e| format!("\"{}\" is not a number: {e}", item.trim()))
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Coordinates)
 }
 
 fn main() -> ExitCode {

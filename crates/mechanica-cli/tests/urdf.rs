@@ -383,3 +383,24 @@ fn a_ground_link_and_a_massless_finger_do_not_stop_the_run() {
         assert!((g - r).abs() <= 1e-12 * r, "{g} vs {r}");
     }
 }
+
+/// A robot without coordinates (one link, or links joined by fixed joints) runs, and takes an
+/// empty `--q` as its configuration; a `--q` with a value that is not a number names it.
+#[test]
+fn a_robot_without_coordinates_takes_an_empty_q() {
+    let dir = scratch("rigid");
+    let urdf = dir.join("rigid.urdf");
+    let text = r#"<robot name="rigid">
+  <link name="body"><inertial><mass value="1.5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+</robot>"#;
+    std::fs::write(&urdf, text).expect("urdf");
+    let path = urdf.to_str().expect("path");
+    for args in [vec!["run", path, "--json"], vec!["run", path, "--json", "--q", ""]] {
+        let (ok, out, err) = mechanica(&args);
+        assert!(ok, "{args:?}: {err}");
+        let json: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+        assert_eq!(step(&json, "build")["dof"], serde_json::json!(0), "{args:?}");
+    }
+    let (ok, _, err) = mechanica(&["run", path, "--q", "0.5,zero"]);
+    assert!(!ok && err.contains("\"zero\" is not a number"), "{err}");
+}
