@@ -66,6 +66,10 @@ impl MassArgs {
 /// surface, which only the shell model accepts.
 fn explain(file: &std::path::Path, error: &MassError, mesh: Option<&TriangleMesh>) -> String {
     let hint = match error {
+        MassError::OpenMesh { boundary_edges: 0, .. } => " (no edge is open, but some are shared by more than two \
+            triangles: the file may hold its surface twice, or parts that touch along edges; --shell accepts it as a \
+            thin shell)"
+            .into(),
         MassError::OpenMesh { .. } => open_mesh_hint(mesh),
         MassError::InconsistentOrientation { .. } => " (repair the mesh's triangle orientation first)".into(),
         _ => String::new(),

@@ -408,3 +408,22 @@ f 1 2 3
     assert_eq!(out.status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_surface_stored_twice_is_named_as_such() {
+    let dir = temp_dir("twice");
+    let file = dir.join("twice.stl");
+    // Every triangle of a unit cube listed twice: no edge is open, each is used four times.
+    let once = box_triangles([0.0; 3], [1.0; 3]);
+    let twice: Vec<_> = once.iter().chain(&once).cloned().collect();
+    write_ascii_stl(&file, &twice);
+    let out = mechanica(&["mass", file.to_str().expect("utf-8")]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("0 boundary edges") && err.contains("more than two triangles") && err.contains("surface twice"),
+        "{err}"
+    );
+    assert!(!err.contains("large open boundary"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
