@@ -6,7 +6,7 @@
 //!   tensor is checked (mass crate validity: symmetry, semidefiniteness, triangle inequality);
 //!   all invalid links are reported at once, and [`UrdfOptions::repair_inertia`] replaces each
 //!   by the nearest physical tensor (documented in `mechanica_mass::validity::repair`). A
-//!   tensor whose nearest physical tensor is within 1e-12 of the robot's largest link inertia
+//!   tensor whose nearest physical tensor is within 1e-14 of the robot's largest link inertia
 //!   (trace) is off by the file's rounding (exporters write zero moments as ±1e-20): it is
 //!   replaced by that tensor with a note, without the option.
 //! - A link without `<inertial>` (or with a zero mass there) whose collision (or else visual)

@@ -62,9 +62,9 @@ pub(crate) fn link_masses(
 /// A link tensor whose nearest physical tensor is within this fraction of the robot's largest
 /// link inertia ([`robot_inertia_scale`]) is taken as physical up to the file's rounding, and
 /// replaced by that tensor with a note: exporters write zero moments as ±1e-20 and the like
-/// (a point mass of 0.27 kg with ixz = 1.4e-20), far below what the robot's mass matrix,
-/// assembled with rounding of about 1e-16 of that scale, can resolve.
-const ROBOT_ROUNDING: f64 = 1e-12;
+/// (a point mass of 0.27 kg with ixz = 1.4e-20), below what the robot's mass matrix, assembled
+/// with rounding of about n·u (1e-14 for tens of joints) of that scale, resolves.
+const ROBOT_ROUNDING: f64 = 1e-14;
 
 /// The largest trace Σ|J_ii| of a massive link's tensor (0 for a robot without one).
 fn robot_inertia_scale(masses: &[MassProperties]) -> f64 {
@@ -103,7 +103,7 @@ fn checked_inertia(
     match repair(props, &tolerance) {
         Ok((fixed, report)) if report.change_norm <= rounding => {
             notes.push(format!(
-                "link \"{}\": inertia off by rounding ({:.1e} kg·m², below 1e-12 of the robot's largest link \
+                "link \"{}\": inertia off by rounding ({:.1e} kg·m², below 1e-14 of the robot's largest link \
                  inertia) set to the nearest physical tensor",
                 link.name, report.change_norm
             ));

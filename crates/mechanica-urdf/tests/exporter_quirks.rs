@@ -63,7 +63,7 @@ fn textures_without_a_file_are_ignored_and_the_rest_is_read_unchanged() {
 #[test]
 fn tensors_off_by_rounding_are_taken_as_physical_with_a_note() {
     let here = Path::new(".");
-    // Point masses written with noise in their zero tensors: violations far below 1e-12 of
+    // Point masses written with noise in their zero tensors: violations far below 1e-14 of
     // the arm's largest link inertia (0.082 kg·m²), though not of their own (zero) trace.
     for noisy in [
         r#"ixx="0" ixy="0" ixz="1.35525e-20" iyy="0" iyz="0" izz="0""#,
@@ -90,6 +90,8 @@ fn tensors_off_by_rounding_are_taken_as_physical_with_a_note() {
     for bad in [
         r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="3e-6""#,
         r#"ixx="0.0081" ixy="0" ixz="0" iyy="0.0081" iyz="0" izz="-1e-9""#,
+        // Small against the arm (1e-11 of it) but wrong by its own whole size.
+        r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="1e-12""#,
     ] {
         match read_str(&arm("", bad), here, UrdfOptions::default()) {
             Err(UrdfError::InvalidInertias { problems }) => {
