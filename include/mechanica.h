@@ -5424,7 +5424,9 @@ mech_status_t mech_tree_from_urdf(const char *path,
  * As mech_tree_from_urdf, from the URDF text `text` of `length` bytes (UTF-8, no NUL needed,
  * at most MECH_URDF_MAX_BYTES). Mesh file names, with `package://` and `file://` stripped,
  * are looked for in the directory `mesh_dir` (NUL-terminated; NULL: the working directory),
- * then relative to the working directory.
+ * then relative to the working directory, and a `package://PKG/…` name also under the
+ * package's directory among the ancestors of `mesh_dir` and in `ROS_PACKAGE_PATH`
+ * (docs/c-abi.md, "Mesh paths").
  *
  * Errors: as mech_tree_from_urdf; MECH_STATUS_PARSE_ERROR also for a text that is not UTF-8.
  *

@@ -195,6 +195,7 @@ static void a_massless_finger_is_left_out_of_the_modes(void) {
     CHECK_NEAR(w2[1], (2.0 + sqrt(2.0)) * G / L, 1e-12);
     CHECK(kinds[2] == MECH_MODAL_KIND_INFINITE && w2[2] == 0.0 && bounds[2] == 0.0);
     CHECK(shapes[2] == 0.0 && shapes[5] == 0.0);
+    CHECK(shapes[6] == 0.0 && shapes[7] == 0.0 && shapes[8] == 0.0);
     mech_mechanism_destroy(m);
 }
 

@@ -455,7 +455,7 @@ fn response_step(
     timed_step("free response δ(t) by modal superposition (8.91)", || {
         if modes.mass_matrix.nrows() != n || modes.solution.modes.len() != n {
             return Err(
-                "analyses.response: the free response needs every mode of every coordinate (no `lowest`, no coordinate resting on a joint limit)"
+                "analyses.response: the free response needs every mode of every coordinate (no `lowest`, no coordinate resting on a joint limit, none moving no mass and feeling no force)"
                     .to_string(),
             );
         }

@@ -6,10 +6,10 @@
 //! found as readily as the hanging one). B is inverted through its eigen-decomposition with
 //! the eigenvalues kept away from zero by δ = 64·n·u·‖B‖, the rounding level of B, so a
 //! singular B (a neutral direction) gives a bounded step instead of a blow-up (the step is
-//! also capped at `max_step`). A larger floor crawls along soft directions: a joint about a
-//! nearly vertical axis carrying an offset load (a humanoid's wrist) has a curvature of
-//! 1e-9·‖B‖, and a floor of √u·‖B‖ would shorten each of its Newton steps to a few per cent
-//! of the way. Coordinates resting on a limit that pushes them outwards are frozen and the Newton step is taken in the others (projected Newton); trial
+//! also capped at `max_step`). A floor far above the rounding level crawls along soft
+//! directions: a joint about a nearly vertical axis carrying an offset load (a humanoid's
+//! wrist) has a curvature of 1e-9·‖B‖, and each Newton step would cover only λ/floor of the
+//! way. Coordinates resting on a limit that pushes them outwards are frozen and the Newton step is taken in the others (projected Newton); trial
 //! points are clipped to the limits. Spherical and free joints are re-centred
 //! ([`Mechanism::rebase`]) before every Hessian, so the returned q is in the mechanism's final
 //! chart.
@@ -30,9 +30,12 @@ pub enum Seek {
     /// A local minimum of U* (a stable equilibrium when B is definite): Newton with the
     /// Hessian's eigenvalues replaced by their absolute values (a descent direction), line
     /// search on U* with the Armijo condition. A stationary point whose Hessian (coordinates
-    /// held by limits left out) has an eigenvalue below −64·n·u·‖B‖ is not accepted: the search
-    /// leaves it along that eigenvector, backtracking until U* falls by a quarter of the
-    /// quadratic model's decrease, and goes on (an inverted pendulum started upright falls).
+    /// held by limits left out) has an eigenvalue below −64·n·u·‖B‖ is left along that
+    /// eigenvector, backtracking until U* falls by a quarter of the quadratic model's decrease,
+    /// and the search goes on (an inverted pendulum started upright falls). Where no such
+    /// decrease is found above the rounding of U* and of the gradient (a saddle whose negative
+    /// curvature is below what the data resolves), or at the last iteration, the stationary
+    /// point is returned; its modes then show the instability.
     Minimum,
 }
 
@@ -74,7 +77,8 @@ pub struct Equilibrium {
     pub tolerance: f64,
     /// Newton iterations.
     pub iterations: usize,
-    /// ‖d‖ of the last Newton step: an estimate of the distance to the exact equilibrium.
+    /// ‖Δq‖ of the last step taken (Newton, or off a saddle): an estimate of the distance to the
+    /// exact equilibrium.
     pub last_step: f64,
     /// Coordinates resting on a joint limit (there the gradient component is a reaction, not zero).
     pub at_limit: Vec<usize>,
@@ -114,7 +118,7 @@ fn newton_step(b: &Mat<f64>, g: &[f64], seek: Seek, max_step: f64) -> Result<Vec
         .map_err(|_| MechanismError::Numerical("eigen-decomposition of the Hessian did not converge"))?;
     let (s, u) = (eig.S(), eig.U());
     let scale = (0..n).map(|i| s[i].abs()).fold(0.0, f64::max);
-    let floor = (64.0 * n as f64 * f64::EPSILON * scale).max(f64::MIN_POSITIVE);
+    let floor = rounding_level(n, scale).max(f64::MIN_POSITIVE);
     let mut d = vec![0.0; n];
     for i in 0..n {
         let coefficient: f64 = (0..n).map(|r| u[(r, i)] * g[r]).sum();
@@ -173,7 +177,14 @@ pub fn find_equilibrium(
             _ => None,
         };
         let next = match &escape {
-            Some(escape) => descend_along(mechanism, &limits, &q, current.value, escape)?,
+            Some(escape) => {
+                let from = Stationary {
+                    q: &q,
+                    value: current.value,
+                    tolerance,
+                };
+                descend_along(mechanism, &limits, &from, escape)?
+            }
             None if stationary || iteration == options.max_iterations => None,
             None => {
                 let direction = projected_newton_direction(hessian, &free, &at_limit, options)?;
@@ -200,7 +211,7 @@ pub fn find_equilibrium(
             }
             break;
         };
-        last_step = q.iter().zip(&next).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+        last_step = distance(&q, &next);
         if rebase {
             mechanism.rebase(&mut next)?;
         }
@@ -272,7 +283,7 @@ fn projected_newton_direction(
 /// At a stationary point, the step of length `max_step` along the eigenvector of the reduced
 /// Hessian (coordinates held by a limit frozen) with the most negative eigenvalue λ, when
 /// λ < −64·n·u·‖B‖ (negative beyond the Hessian's rounding), oriented against the remaining
-/// gradient `free`; with λ. None at a minimum (no such eigenvalue).
+/// gradient `free`, and λ itself. None at a minimum (no such eigenvalue).
 fn negative_curvature_step(
     hessian: &Mat<f64>,
     free: &[f64],
@@ -291,7 +302,7 @@ fn negative_curvature_step(
         return Ok(None);
     };
     let curvature = s[lowest];
-    if curvature.is_nan() || curvature >= -64.0 * n as f64 * f64::EPSILON * scale {
+    if curvature.is_nan() || curvature >= -rounding_level(n, scale) {
         return Ok(None);
     }
     let slope: f64 = moving.iter().enumerate().map(|(i, &k)| u[(i, lowest)] * free[k]).sum();
@@ -309,38 +320,58 @@ struct CurvatureStep {
     curvature: f64,
 }
 
-/// Backtracking along ±`step.direction` from the stationary point `q` (value `value`): the
-/// first trial point (clipped to the limits) where U* has fallen by at least a quarter of the
-/// quadratic model's ½|λ|‖Δq‖², or None when neither sign achieves it before the decrease
-/// falls below the rounding of U*.
+/// The rounding level 64·n·u·s of a symmetric matrix of order n and spectral scale s.
+fn rounding_level(n: usize, scale: f64) -> f64 {
+    64.0 * n as f64 * f64::EPSILON * scale
+}
+
+/// A stationary point the search leaves along negative curvature.
+struct Stationary<'a> {
+    /// The coordinates.
+    q: &'a [f64],
+    /// U* at `q`.
+    value: f64,
+    /// The gradient tolerance τ (the rounding of grad U*).
+    tolerance: f64,
+}
+
+/// Backtracking along ±`step.direction` from the stationary point `from` (at most 40 halvings
+/// per sign, trial points clipped to the limits): the first trial point where U* has fallen
+/// by at least a quarter of the quadratic model's ½|λ|‖Δq‖², or None when neither sign
+/// achieves it before that decrease falls below what rounding explains (64u|U*| + τ‖Δq‖).
 fn descend_along(
     mechanism: &Mechanism,
     limits: &[(f64, f64)],
-    q: &[f64],
-    value: f64,
+    from: &Stationary<'_>,
     step: &CurvatureStep,
 ) -> Result<Option<Vec<f64>>, MechanismError> {
     for sign in [1.0, -1.0] {
         let mut alpha = 1.0;
         for _ in 0..40 {
-            let mut trial: Vec<f64> = q
+            let mut trial: Vec<f64> = from
+                .q
                 .iter()
                 .zip(&step.direction)
                 .map(|(x, d)| x + sign * alpha * d)
                 .collect();
             clamp(&mut trial, limits);
-            let moved = q.iter().zip(&trial).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
-            let predicted = 0.5 * step.curvature.abs() * moved;
-            if predicted <= 64.0 * f64::EPSILON * value.abs() {
+            let moved = distance(from.q, &trial);
+            let predicted = 0.5 * step.curvature.abs() * moved * moved;
+            if predicted <= 64.0 * f64::EPSILON * from.value.abs() + from.tolerance * moved {
                 break;
             }
-            if mechanism.potential(&trial, false)?.value <= value - 0.25 * predicted {
+            if mechanism.potential(&trial, false)?.value <= from.value - 0.25 * predicted {
                 return Ok(Some(trial));
             }
             alpha *= 0.5;
         }
     }
     Ok(None)
+}
+
+/// The Euclidean distance between two coordinate vectors.
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt()
 }
 
 /// The current point of the Newton iteration, as the line search needs it.

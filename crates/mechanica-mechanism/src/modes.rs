@@ -110,7 +110,8 @@ pub struct MechanismModes {
     /// The gyroscopic problem, in a rotating frame with G ≠ 0.
     pub gyroscopic: Option<GyroscopicModes>,
     /// Coordinates left out of the pencil because they move no mass and feel no force: their
-    /// rows and columns of A, B and G are exactly zero (a massless link without springs), so
+    /// rows and columns of A, B and G and their gradient are exactly zero (a massless link
+    /// without springs or applied forces), so
     /// the linearisation says nothing of their motion and (A, B) would be singular. Their rows
     /// of the shapes are zero, as for locked coordinates; the matrices above omit them.
     pub idle: Vec<usize>,
@@ -205,18 +206,20 @@ fn modes_at(
     let g_all = mechanism.gyroscopic_matrix(&q)?;
     let unlocked: Vec<usize> = (0..n_all).filter(|k| !locked.contains(k)).collect();
     let (free, idle): (Vec<usize>, Vec<usize>) = unlocked.iter().partition(|&&k| {
-        [&a_all, &b_all, &g_all]
-            .iter()
-            .any(|m| (0..n_all).any(|j| m[(k, j)] != 0.0))
+        evaluation.gradient[k] != 0.0
+            || [&a_all, &b_all, &g_all]
+                .iter()
+                .any(|m| (0..n_all).any(|j| m[(k, j)] != 0.0))
     });
     let restrict = |m: &Mat<f64>| Mat::from_fn(free.len(), free.len(), |i, j| m[(free[i], free[j])]);
     let (a, b) = (restrict(&a_all), restrict(&b_all));
     let problem = PencilProblem::new(a.as_ref(), b.as_ref())?;
     // Shapes are always computed: they carry the propagation of B's rounding (below) and the
     // body displacements; for mechanisms (n in the hundreds at most) they cost little.
-    // A count beyond the coordinates kept (some locked or idle) asks for all of them.
+    // A count within the coordinates but beyond those kept (some locked or idle) asks for all
+    // of the kept ones.
     let selection = match options.selection {
-        Selection::Lowest(k) if k >= free.len() => Selection::All,
+        Selection::Lowest(k) if k >= free.len() && k <= n_all => Selection::All,
         other => other,
     };
     let options = SolveOptions {

@@ -95,9 +95,14 @@ fn the_inverted_double_pendulum_falls_to_its_hanging_position() {
     let (m, l) = (1.3, 0.7);
     let mut mechanism = chain(&[(m, l), (m, l)]);
     let eq = find_equilibrium(&mut mechanism, &[PI, 0.0], &options(Seek::Minimum)).expect("minimum");
-    let folded = (eq.q[0] + PI).rem_euclid(2.0 * PI) - PI;
-    assert!(folded.abs() < 1e-9 && eq.q[1].abs() < 1e-9, "{:?}", eq.q);
+    let folded = |angle: f64| (angle + PI).rem_euclid(2.0 * PI) - PI;
+    assert!(
+        folded(eq.q[0]).abs() < 1e-9 && folded(eq.q[1]).abs() < 1e-9,
+        "{:?}",
+        eq.q
+    );
     let modes = mechanism_modes(&mut mechanism, &eq.q, &SolveOptions::default()).expect("modes");
+    assert_eq!(modes.solution.modes.len(), 2);
     let s = 2f64.sqrt();
     for (mode, exact) in modes.solution.modes.iter().zip([(2.0 - s) * G / l, (2.0 + s) * G / l]) {
         assert!(

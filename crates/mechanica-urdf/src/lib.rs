@@ -7,8 +7,9 @@
 //!   all invalid links are reported at once, and [`UrdfOptions::repair_inertia`] replaces each
 //!   by the nearest physical tensor (documented in `mechanica_mass::validity::repair`). A
 //!   tensor whose nearest physical tensor is within 1e-14 of the robot's largest link inertia
-//!   (trace) is off by the file's rounding (exporters write zero moments as ±1e-20): it is
-//!   replaced by that tensor with a note, without the option.
+//!   (trace about the link's frame origin, over physical tensors) is off by the file's
+//!   rounding (exporters write zero moments as ±1e-20): it is replaced by that tensor with a
+//!   note, without the option.
 //! - A link without `<inertial>` (or with a zero mass there) whose collision (or else visual)
 //!   geometry is a mesh gets the mesh's mass properties at [`MESH_DENSITY`] (water; URDF gives
 //!   no density); the file name, with `package://` and `file://` prefixes stripped, is resolved
@@ -26,8 +27,10 @@
 //! - **Trees** ([`UrdfRobot::tree`]): one body per link in the file's order, the root link
 //!   attached to the base frame by a fixed joint, every other link by its URDF joint.
 //!
-//! `<texture>` elements without a `filename` (some exporters write `<texture/>` in materials)
-//! are dropped before parsing: materials only concern rendering.
+//! Before parsing, one linear pass over the text refuses elements nested deeper than
+//! [`MAX_NESTING`] (the XML parsers underneath recurse per level) and drops `<texture>`
+//! elements without a `filename` (some exporters write `<texture/>` in materials, which only
+//! concern rendering).
 //!
 //! The text is at most [`MAX_URDF_BYTES`] long; every allocation is proportional to it.
 
@@ -35,11 +38,13 @@ mod error;
 mod links;
 mod robot;
 mod tree;
+mod xml_scan;
 
 pub use error::UrdfError;
 pub use links::MESH_DENSITY;
 pub use robot::{JointKind, UrdfDocument, UrdfJoint, UrdfLink, UrdfOptions, UrdfRobot, read_file, read_str};
 pub use tree::UrdfTree;
+pub use xml_scan::MAX_NESTING;
 
 /// The longest URDF text read (64 MiB): larger files and strings are refused before parsing.
 pub const MAX_URDF_BYTES: usize = 64 << 20;

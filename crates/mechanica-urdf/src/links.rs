@@ -66,12 +66,14 @@ pub(crate) fn link_masses(
 /// with rounding of about n·u (1e-14 for tens of joints) of that scale, resolves.
 const ROBOT_ROUNDING: f64 = 1e-14;
 
-/// The largest trace Σ|J_ii| of a massive link's tensor (0 for a robot without one).
+/// The largest trace of a physical link's inertia tensor about its frame origin,
+/// tr J_c + 2m|c|² (0 for a robot without one): invalid tensors do not set the scale their
+/// own errors are measured by, and point masses off the origin count.
 fn robot_inertia_scale(masses: &[MassProperties]) -> f64 {
     masses
         .iter()
-        .filter(|p| p.mass > 0.0)
-        .map(|p| (0..3).map(|k| p.inertia_c[(k, k)].abs()).sum::<f64>())
+        .filter(|p| p.mass > 0.0 && check(p, &ValidityTolerance::default()).is_ok())
+        .map(|p| p.inertia_c.trace() + 2.0 * p.mass * p.p_oc.norm_squared())
         .filter(|s| s.is_finite())
         .fold(0.0, f64::max)
 }
@@ -103,8 +105,8 @@ fn checked_inertia(
     match repair(props, &tolerance) {
         Ok((fixed, report)) if report.change_norm <= rounding => {
             notes.push(format!(
-                "link \"{}\": inertia off by rounding ({:.1e} kg·m², below 1e-14 of the robot's largest link \
-                 inertia) set to the nearest physical tensor",
+                "link \"{}\": inertia off by rounding ({:.1e} kg·m², below {ROBOT_ROUNDING:.0e} of the robot's \
+                 largest link inertia) set to the nearest physical tensor",
                 link.name, report.change_norm
             ));
             Ok(fixed)
@@ -201,11 +203,18 @@ fn mesh_candidates(mesh_dir: &Path, filename: &str) -> Vec<PathBuf> {
 /// ancestor of `mesh_dir` named PKG, and `PKG/rest` under each ancestor and each directory of
 /// `ROS_PACKAGE_PATH` (a directory named PKG there stands for the package itself).
 fn package_candidates(mesh_dir: &Path, uri: &str) -> Vec<PathBuf> {
-    let Some((package, rest)) = uri.split_once('/') else {
+    let Some((package, rest)) = package_parts(uri) else {
         return Vec::new();
     };
     let search_path = std::env::var_os("ROS_PACKAGE_PATH").unwrap_or_default();
-    let roots = mesh_dir
+    // Ancestors of the absolute directory: `robot.urdf` alone has a mesh directory "".
+    let base = if mesh_dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        mesh_dir
+    };
+    let absolute = std::path::absolute(base).unwrap_or_else(|_| base.to_path_buf());
+    let roots = absolute
         .ancestors()
         .map(Path::to_path_buf)
         .chain(std::env::split_paths(&search_path));
@@ -219,17 +228,21 @@ fn package_candidates(mesh_dir: &Path, uri: &str) -> Vec<PathBuf> {
     candidates
 }
 
+/// The package name and the path inside it of a `package://` URI without its scheme; None
+/// for an empty, `.` or `..` package name or a path that is empty or absolute.
+fn package_parts(uri: &str) -> Option<(&str, &str)> {
+    let (package, rest) = uri.split_once('/')?;
+    let usable = !matches!(package, "" | "." | "..") && !rest.is_empty() && !rest.starts_with('/');
+    usable.then_some((package, rest))
+}
+
 /// The mass properties of `mesh` at [`MESH_DENSITY`] in the link frame and the file they came
 /// from, or what prevents them: the file is found nowhere, cannot be read, or has no volume.
 fn mesh_mass(mesh_dir: &Path, mesh: &LinkMesh) -> Result<(MassProperties, String), String> {
     let candidates = mesh_candidates(mesh_dir, &mesh.filename);
     let Some(path) = candidates.iter().find(|p| p.is_file()) else {
         let looked: Vec<String> = candidates.iter().take(2).map(|p| p.display().to_string()).collect();
-        let package = match mesh
-            .filename
-            .strip_prefix("package://")
-            .and_then(|uri| uri.split_once('/'))
-        {
+        let package = match mesh.filename.strip_prefix("package://").and_then(package_parts) {
             Some((package, _)) => {
                 format!(", and under package \"{package}\" among the mesh directory's ancestors and ROS_PACKAGE_PATH")
             }

@@ -126,7 +126,7 @@ impl UrdfDocument {
                 limit: MAX_URDF_BYTES,
             });
         }
-        let text = without_bare_textures(text);
+        let text = crate::xml_scan::prepared(text)?;
         let robot = urdf_rs::read_from_string(&text).map_err(|e| UrdfError::Parse { message: e.to_string() })?;
         Ok(Self { robot })
     }
@@ -197,45 +197,6 @@ pub fn read_file(path: &Path, options: UrdfOptions) -> Result<UrdfRobot, UrdfErr
 /// Reads a URDF text; meshes are looked for in `mesh_dir` (see [`UrdfDocument::robot`]).
 pub fn read_str(text: &str, mesh_dir: &Path, options: UrdfOptions) -> Result<UrdfRobot, UrdfError> {
     UrdfDocument::parse(text)?.robot(mesh_dir, options)
-}
-
-/// `text` without its `<texture>` elements that name no file (`<texture/>`, as some exporters
-/// write inside `<material>`): the parser requires the attribute, and a material only concerns
-/// rendering. Every other byte is kept. `<` cannot occur inside a well-formed attribute value,
-/// so the first `>` after `<texture` ends the tag.
-fn without_bare_textures(text: &str) -> std::borrow::Cow<'_, str> {
-    const TAG: &str = "<texture";
-    if !text.contains(TAG) {
-        return std::borrow::Cow::Borrowed(text);
-    }
-    let mut kept = String::with_capacity(text.len());
-    let mut rest = text;
-    while let Some(start) = rest.find(TAG) {
-        let after = &rest[start + TAG.len()..];
-        let is_texture = after.starts_with(|c: char| c.is_whitespace() || c == '/' || c == '>');
-        let Some(tag_end) = after.find('>').filter(|_| is_texture) else {
-            kept.push_str(&rest[..start + TAG.len()]);
-            rest = after;
-            continue;
-        };
-        let attributes = &after[..tag_end];
-        let mut end = start + TAG.len() + tag_end + 1;
-        if !attributes.ends_with('/') {
-            // <texture ...> ... </texture>
-            match rest[end..].find("</texture>") {
-                Some(close) => end += close + "</texture>".len(),
-                None => end = start + TAG.len(),
-            }
-        }
-        if attributes.contains("filename") || end == start + TAG.len() {
-            kept.push_str(&rest[..end]);
-        } else {
-            kept.push_str(&rest[..start]);
-        }
-        rest = &rest[end..];
-    }
-    kept.push_str(rest);
-    std::borrow::Cow::Owned(kept)
 }
 
 /// The index of the one link that is no joint's child; an error when there is not exactly one.

@@ -63,10 +63,12 @@ fn textures_without_a_file_are_ignored_and_the_rest_is_read_unchanged() {
 #[test]
 fn tensors_off_by_rounding_are_taken_as_physical_with_a_note() {
     let here = Path::new(".");
-    // Point masses written with noise in their zero tensors: violations far below 1e-14 of
-    // the arm's largest link inertia (0.082 kg·m²), though not of their own (zero) trace.
+    // Point masses written with noise in their zero tensors: violations below 1e-14 of the
+    // arm's largest link inertia about its frame origin (0.332 kg·m², the lower link), though
+    // not of their own (zero) trace.
     for noisy in [
         r#"ixx="0" ixy="0" ixz="1.35525e-20" iyy="0" iyz="0" izz="0""#,
+        r#"ixx="0" ixy="0" ixz="1e-17" iyy="0" iyz="0" izz="0""#,
         r#"ixx="-5.42e-20" ixy="0" ixz="0" iyy="-5.42e-20" iyz="0" izz="0""#,
         r#"ixx="1e-21" ixy="3e-21" ixz="0" iyy="1e-21" iyz="0" izz="0""#,
     ] {
@@ -90,8 +92,10 @@ fn tensors_off_by_rounding_are_taken_as_physical_with_a_note() {
     for bad in [
         r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="3e-6""#,
         r#"ixx="0.0081" ixy="0" ixz="0" iyy="0.0081" iyz="0" izz="-1e-9""#,
-        // Small against the arm (1e-11 of it) but wrong by its own whole size.
+        // Small against the arm (3e-12 of it) but wrong by its own whole size.
         r#"ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="1e-12""#,
+        // Just above the threshold: 8.5e-14 of the arm's scale.
+        r#"ixx="0" ixy="0" ixz="2e-14" iyy="0" iyz="0" izz="0""#,
     ] {
         match read_str(&arm("", bad), here, UrdfOptions::default()) {
             Err(UrdfError::InvalidInertias { problems }) => {
@@ -192,4 +196,26 @@ fn package_uris_are_found_under_the_package_directory() {
     std::fs::write(&urdf, missing).expect("urdf");
     let error = read_file(&urdf, UrdfOptions::default()).expect_err("no package named other");
     assert!(error.to_string().contains("under package \"other\""), "{error}");
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+#[test]
+fn deep_nesting_is_refused_and_markup_is_read_as_xml() {
+    let here = Path::new(".");
+    // Hostile depth: refused by name before any parser recurses into it.
+    let deep = format!(
+        r#"<robot name="r"><link name="a"/>{}{}</robot>"#,
+        "<x>".repeat(100_000),
+        "</x>".repeat(100_000)
+    );
+    let error = read_str(&deep, here, UrdfOptions::default()).expect_err("too deep");
+    assert!(error.to_string().contains("nested deeper than"), "{error}");
+    // A texture mentioned in a comment, a '>' inside an attribute value and a texture with a
+    // file are kept; the bare texture after them is dropped and nothing else.
+    let material = r#"<!-- <texture> --><material name="a>b"><texture filename="x>y.png"/>
+        <texture name="nofilename"></texture ></material>"#;
+    let robot = read_str(&arm(material, ROD), here, UrdfOptions::default()).expect("read");
+    let plain = read_str(&arm("", ROD), here, UrdfOptions::default()).expect("plain");
+    assert_eq!(robot.links, plain.links);
+    assert_eq!(robot.joints, plain.joints);
 }
