@@ -109,15 +109,29 @@ fn clamp(q: &mut [f64], limits: &[(f64, f64)]) {
     }
 }
 
+/// The coordinates not held by a limit (`at_limit`) among the `n` and the Hessian restricted
+/// to them.
+fn reduced_hessian(hessian: &Mat<f64>, n: usize, at_limit: &[usize]) -> (Vec<usize>, Mat<f64>) {
+    let moving: Vec<usize> = (0..n).filter(|k| !at_limit.contains(k)).collect();
+    let reduced = Mat::from_fn(moving.len(), moving.len(), |i, j| hessian[(moving[i], moving[j])]);
+    (moving, reduced)
+}
+
+/// The eigen-decomposition of the symmetric `b`, and its spectral scale max |λ|.
+fn spectrum(b: &Mat<f64>) -> Result<(faer::linalg::solvers::SelfAdjointEigen<f64>, f64), MechanismError> {
+    let eig = b
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|_| MechanismError::Numerical("eigen-decomposition of the Hessian did not converge"))?;
+    let scale = (0..b.nrows()).map(|i| eig.S()[i].abs()).fold(0.0, f64::max);
+    Ok((eig, scale))
+}
+
 /// The regularised Newton step d = −B̃⁻¹ g (see the module docs), with |B| instead of B when
 /// seeking a minimum, shortened to at most `max_step`.
 fn newton_step(b: &Mat<f64>, g: &[f64], seek: Seek, max_step: f64) -> Result<Vec<f64>, MechanismError> {
     let n = g.len();
-    let eig = b
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|_| MechanismError::Numerical("eigen-decomposition of the Hessian did not converge"))?;
+    let (eig, scale) = spectrum(b)?;
     let (s, u) = (eig.S(), eig.U());
-    let scale = (0..n).map(|i| s[i].abs()).fold(0.0, f64::max);
     let floor = rounding_level(n, scale).max(f64::MIN_POSITIVE);
     let mut d = vec![0.0; n];
     for i in 0..n {
@@ -269,8 +283,7 @@ fn projected_newton_direction(
     at_limit: &[usize],
     options: &EquilibriumOptions,
 ) -> Result<Vec<f64>, MechanismError> {
-    let moving: Vec<usize> = (0..free.len()).filter(|k| !at_limit.contains(k)).collect();
-    let reduced = Mat::from_fn(moving.len(), moving.len(), |i, j| hessian[(moving[i], moving[j])]);
+    let (moving, reduced) = reduced_hessian(hessian, free.len(), at_limit);
     let reduced_gradient: Vec<f64> = moving.iter().map(|&k| free[k]).collect();
     let reduced_step = newton_step(&reduced, &reduced_gradient, options.seek, options.max_step)?;
     let mut direction = vec![0.0; free.len()];
@@ -290,14 +303,10 @@ fn negative_curvature_step(
     at_limit: &[usize],
     max_step: f64,
 ) -> Result<Option<CurvatureStep>, MechanismError> {
-    let moving: Vec<usize> = (0..free.len()).filter(|k| !at_limit.contains(k)).collect();
+    let (moving, reduced) = reduced_hessian(hessian, free.len(), at_limit);
     let n = moving.len();
-    let reduced = Mat::from_fn(n, n, |i, j| hessian[(moving[i], moving[j])]);
-    let eig = reduced
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|_| MechanismError::Numerical("eigen-decomposition of the Hessian did not converge"))?;
+    let (eig, scale) = spectrum(&reduced)?;
     let (s, u) = (eig.S(), eig.U());
-    let scale = (0..n).map(|i| s[i].abs()).fold(0.0, f64::max);
     let Some(lowest) = (0..n).min_by(|&i, &j| s[i].total_cmp(&s[j])) else {
         return Ok(None);
     };
