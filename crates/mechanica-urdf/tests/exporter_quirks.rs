@@ -130,34 +130,20 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// An ASCII STL cube of side `s` centred on the origin (outward normals).
-fn cube_stl(s: f64) -> String {
-    let h = 0.5 * s;
-    let corner = |k: usize| [k & 1, k & 2, k & 4].map(|bit| if bit != 0 { h } else { -h });
-    let faces = [
-        [0, 2, 3],
-        [0, 3, 1],
-        [4, 5, 7],
-        [4, 7, 6],
-        [0, 1, 5],
-        [0, 5, 4],
-        [2, 6, 7],
-        [2, 7, 3],
-        [0, 4, 6],
-        [0, 6, 2],
-        [1, 3, 7],
-        [1, 7, 5],
-    ];
-    let mut text = String::from("solid cube\n");
-    for face in faces {
+/// An ASCII STL of the tetrahedron with a right-angled corner at the origin and edges `a`
+/// along the axes (volume a³/6), faces oriented outward.
+fn corner_tetrahedron_stl(a: f64) -> String {
+    let corners = [[0.0, 0.0, 0.0], [a, 0.0, 0.0], [0.0, a, 0.0], [0.0, 0.0, a]];
+    let mut text = String::from("solid corner\n");
+    for face in [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]] {
         text.push_str("facet normal 0 0 0\nouter loop\n");
         for k in face {
-            let [x, y, z] = corner(k);
+            let [x, y, z] = corners[k];
             text.push_str(&format!("vertex {x} {y} {z}\n"));
         }
         text.push_str("endloop\nendfacet\n");
     }
-    text.push_str("endsolid cube\n");
+    text.push_str("endsolid corner\n");
     text
 }
 
@@ -169,7 +155,8 @@ fn package_uris_are_found_under_the_package_directory() {
     let package = root.join("share").join("arm_description");
     std::fs::create_dir_all(package.join("robots")).expect("dirs");
     std::fs::create_dir_all(package.join("meshes")).expect("dirs");
-    std::fs::write(package.join("meshes").join("tool.stl"), cube_stl(0.1)).expect("mesh");
+    let edge = 0.2;
+    std::fs::write(package.join("meshes").join("tool.stl"), corner_tetrahedron_stl(edge)).expect("mesh");
     for uri in [
         "package://arm_description/meshes/tool.stl",
         "package://share/arm_description/meshes/tool.stl",
@@ -182,9 +169,10 @@ fn package_uris_are_found_under_the_package_directory() {
         let urdf = package.join("robots").join("arm.urdf");
         std::fs::write(&urdf, text).expect("urdf");
         let robot = read_file(&urdf, UrdfOptions::default()).unwrap_or_else(|e| panic!("{uri}: {e}"));
-        // A 0.1 m cube at 1000 kg/m³ (STL stores single precision).
+        // The tetrahedron at 1000 kg/m³ (STL stores single precision).
+        let mass = 1000.0 * edge * edge * edge / 6.0;
         assert!(
-            (robot.links[1].mass.mass - 1.0).abs() <= 1e-6,
+            (robot.links[1].mass.mass - mass).abs() <= 1e-6 * mass,
             "{uri}: {:?}",
             robot.links[1].mass
         );
