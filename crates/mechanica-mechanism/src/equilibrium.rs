@@ -117,7 +117,8 @@ fn reduced_hessian(hessian: &Mat<f64>, n: usize, at_limit: &[usize]) -> (Vec<usi
     (moving, reduced)
 }
 
-/// The eigen-decomposition of the symmetric `b`, and its spectral scale max |λ|.
+/// The eigen-decomposition of the symmetric `b` (at least 1 × 1), and its spectral scale
+/// max |λ|.
 fn spectrum(b: &Mat<f64>) -> Result<(faer::linalg::solvers::SelfAdjointEigen<f64>, f64), MechanismError> {
     let eig = b
         .self_adjoint_eigen(Side::Lower)
@@ -130,6 +131,9 @@ fn spectrum(b: &Mat<f64>) -> Result<(faer::linalg::solvers::SelfAdjointEigen<f64
 /// seeking a minimum, shortened to at most `max_step`.
 fn newton_step(b: &Mat<f64>, g: &[f64], seek: Seek, max_step: f64) -> Result<Vec<f64>, MechanismError> {
     let n = g.len();
+    if n == 0 {
+        return Ok(Vec::new());
+    }
     let (eig, scale) = spectrum(b)?;
     let (s, u) = (eig.S(), eig.U());
     let floor = rounding_level(n, scale).max(f64::MIN_POSITIVE);
@@ -305,6 +309,9 @@ fn negative_curvature_step(
 ) -> Result<Option<CurvatureStep>, MechanismError> {
     let (moving, reduced) = reduced_hessian(hessian, free.len(), at_limit);
     let n = moving.len();
+    if n == 0 {
+        return Ok(None);
+    }
     let (eig, scale) = spectrum(&reduced)?;
     let (s, u) = (eig.S(), eig.U());
     let Some(lowest) = (0..n).min_by(|&i, &j| s[i].total_cmp(&s[j])) else {

@@ -112,3 +112,23 @@ fn the_inverted_double_pendulum_falls_to_its_hanging_position() {
         );
     }
 }
+
+/// A minimum search with nothing left to move: every coordinate resting on a limit that the
+/// gradient pushes against, or no coordinate at all. The search returns the point (the
+/// reduced Hessian is empty) instead of decomposing an empty matrix.
+#[test]
+fn a_minimum_search_with_no_free_coordinate_returns_its_point() {
+    let mut pendulum = chain(&[(1.0, 1.0)]);
+    pendulum.set_limits(0, 0.5, 1.0).expect("limits");
+    let eq = find_equilibrium(&mut pendulum, &[0.7], &options(Seek::Minimum)).expect("minimum");
+    assert_eq!(eq.q, vec![0.5]);
+    assert_eq!(eq.at_limit, vec![0]);
+
+    let mut builder = TreeBuilder::new();
+    builder.add_body(None, Joint::Fixed, Isometry3::identity());
+    let bodies = vec![MassProperties::point(2.0, Vector3::new(0.3, 0.0, -1.0)).expect("point")];
+    let mut rigid = Mechanism::new(builder.build().expect("tree"), bodies).expect("mechanism");
+    rigid.set_gravity(Vector3::new(0.0, 0.0, -G)).expect("gravity");
+    let eq = find_equilibrium(&mut rigid, &[], &options(Seek::Minimum)).expect("minimum");
+    assert!(eq.q.is_empty() && eq.iterations == 0);
+}
