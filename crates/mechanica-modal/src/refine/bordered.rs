@@ -1,8 +1,10 @@
 //! Newton steps on the bordered system [[B − ω₀²A, −Ax₀], [−(Ax₀)ᵀ, 0]] with the Jacobian frozen
 //! at the starting pair: factored densely (Bunch–Kaufman LBLᵀ), or, when A and B both have few
-//! nonzeros, by a sparse LU of B − ω₀²A with the border eliminated by blocks.
+//! nonzeros, by a sparse factorization of B − ω₀²A (without fill on a forest pattern, else an
+//! LU with partial pivoting) with the border eliminated by blocks.
 
 use crate::dd::{Dd, Operand, SplitVector, dot, pair_residual};
+use crate::refine::forest_factor::{ForestFactor, ForestPattern};
 use crate::refine::metric::Metric;
 use crate::refine::pair::{RefinedPair, finish_pair};
 use crate::tuning::Tuning;
@@ -27,9 +29,11 @@ pub(crate) fn refine_pair(
 }
 
 /// [`refine_pair`] for A and B with few nonzeros, the Jacobian factored sparsely
-/// ([`BorderedJacobian::sparse`]): O(n·w²) per mode for a bandwidth w, where the spectral
-/// correction of [`refine_cluster_projected`] costs 4n² per step. None if the factorization
-/// fails or the steps do not converge (then the other methods are tried).
+/// ([`BorderedJacobian::sparse`]): O(n) per mode on a forest pattern and O(n·w²) for a
+/// bandwidth w otherwise, where the spectral correction of [`refine_cluster_projected`] costs
+/// 4n² per step. The forest's factor without pivoting is tried first, rooted where x₀ is
+/// largest, then the LU with partial pivoting. None if neither factorization gives converging
+/// steps (then the other methods are tried).
 pub(crate) fn refine_pair_sparse(
     a: &Operand<'_>,
     b: &Operand<'_>,
@@ -39,21 +43,32 @@ pub(crate) fn refine_pair_sparse(
     omega0: f64,
 ) -> Option<RefinedPair> {
     let ax0: Vec<f64> = a.product(x0).iter().map(|v| v.to_f64()).collect();
-    let jacobian = BorderedJacobian::sparse(shifts, &ax0, omega0)?;
-    match newton_steps(a, b, metric, &jacobian, x0, omega0)? {
-        (x, steps, true) => finish_pair(a, b, metric, x, steps),
-        _ => None,
-    }
+    let converged = |factor: ShiftedFactor| {
+        let jacobian = BorderedJacobian::sparse(factor, &ax0)?;
+        match newton_steps(a, b, metric, &jacobian, x0, omega0)? {
+            (x, steps, true) => Some((x, steps)),
+            _ => None,
+        }
+    };
+    let largest = (0..x0.len())
+        .max_by(|&i, &j| x0[i].abs().total_cmp(&x0[j].abs()))
+        .unwrap_or(0);
+    let (x, steps) = shifts
+        .forest_factor(omega0, largest)
+        .and_then(&converged)
+        .or_else(|| shifts.lu(omega0).and_then(&converged))?;
+    finish_pair(a, b, metric, x, steps)
 }
 
 /// K = B − sA for a pencil whose A and B both have few nonzeros: the union of their patterns
-/// with both values on it, and its LU symbolic analysis (column ordering, structure), found once
-/// for every shift of a refinement stage.
+/// with both values on it, its LU symbolic analysis (column ordering, structure) and, when the
+/// pattern is a forest, its tree structure, found once for every shift of a refinement stage.
 pub(crate) struct SparseShifts {
     pattern: faer::sparse::SymbolicSparseColMat<usize>,
     b_values: Vec<f64>,
     a_values: Vec<f64>,
     symbolic: faer::sparse::linalg::solvers::SymbolicLu<usize>,
+    forest: Option<ForestPattern>,
 }
 
 impl SparseShifts {
@@ -81,16 +96,18 @@ impl SparseShifts {
         }
         let pattern = faer::sparse::SymbolicSparseColMat::new_checked(n, n, column_starts, None, rows);
         let symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.as_ref()).ok()?;
+        let forest = ForestPattern::of(pattern.as_ref());
         Some(Self {
             pattern,
             b_values,
             a_values,
             symbolic,
+            forest,
         })
     }
 
     /// The LU factorization with partial pivoting of B − shift·A; None if it fails.
-    fn factor(&self, shift: f64) -> Option<faer::sparse::linalg::solvers::Lu<usize, f64>> {
+    fn lu(&self, shift: f64) -> Option<ShiftedFactor> {
         let values: Vec<f64> = self
             .b_values
             .iter()
@@ -98,7 +115,35 @@ impl SparseShifts {
             .map(|(b, a)| b - shift * a)
             .collect();
         let k = faer::sparse::SparseColMatRef::new(self.pattern.as_ref(), &values);
-        faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(self.symbolic.clone(), k).ok()
+        let lu = faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(self.symbolic.clone(), k).ok()?;
+        Some(ShiftedFactor::Lu(Box::new(lu)))
+    }
+
+    /// The forest's LDLᵀ factorization of B − shift·A eliminated towards `root`; None when the
+    /// pattern is not a forest or the factor is declined ([`ForestPattern::factor`]).
+    fn forest_factor(&self, shift: f64, root: usize) -> Option<ShiftedFactor> {
+        let forest = self.forest.as_ref()?;
+        let factor = forest.factor(&self.b_values, &self.a_values, shift, root)?;
+        Some(ShiftedFactor::Forest(factor))
+    }
+}
+
+/// A factorization of K = B − ω₀²A for the sparse bordered Jacobian.
+enum ShiftedFactor {
+    Lu(Box<faer::sparse::linalg::solvers::Lu<usize, f64>>),
+    Forest(ForestFactor),
+}
+
+impl ShiftedFactor {
+    /// K⁻¹r.
+    fn solve(&self, r: &[f64]) -> Vec<f64> {
+        match self {
+            Self::Lu(lu) => {
+                let y = lu.solve(Mat::from_fn(r.len(), 1, |i, _| r[i]));
+                y.col(0).iter().copied().collect()
+            }
+            Self::Forest(factor) => factor.solve(r),
+        }
     }
 }
 
@@ -164,10 +209,10 @@ fn accurate(metric: Metric<'_>, residual: &[f64], x: &SplitVector, ax: &[Dd], om
 enum BorderedJacobian {
     /// Bunch–Kaufman LBLᵀ of the dense matrix of order n + 1 ((n + 1)³/3 flops).
     Dense(faer::linalg::solvers::Lblt<f64>),
-    /// A sparse LU of K alone with partial pivoting (the dense border row would fill the
-    /// factors), the border by block elimination: K⁻¹a and aᵀK⁻¹a are formed once.
+    /// A sparse factorization of K alone (the dense border row would fill the factors), the
+    /// border by block elimination: K⁻¹a and aᵀK⁻¹a are formed once.
     Sparse {
-        lu: faer::sparse::linalg::solvers::Lu<usize, f64>,
+        factor: ShiftedFactor,
         a: Vec<f64>,
         k_inv_a: Vec<f64>,
         schur: f64,
@@ -186,22 +231,19 @@ impl BorderedJacobian {
         Self::Dense(border.lblt(Side::Lower))
     }
 
-    /// The sparse factorization of K = B − ω₀²A (O(n·w²) for a bandwidth w instead of
-    /// (n + 1)³/3); None if it fails or gives a non-finite K⁻¹a (K singular to working
-    /// precision). Block elimination loses accuracy along K's near-null vector, which is x₀
-    /// itself; the Newton steps measure their residuals in double-double, and steps that do not
-    /// converge are discarded ([`refine_pair_sparse`]).
-    fn sparse(shifts: &SparseShifts, ax0: &[f64], omega0: f64) -> Option<Self> {
-        let n = ax0.len();
-        let lu = shifts.factor(omega0)?;
-        let k_inv_a = lu.solve(Mat::from_fn(n, 1, |i, _| ax0[i]));
-        let k_inv_a: Vec<f64> = k_inv_a.col(0).iter().copied().collect();
+    /// The border eliminated by blocks around a sparse `factor` of K = B − ω₀²A (O(n) on a
+    /// forest, O(n·w²) for a bandwidth w, instead of (n + 1)³/3); None if it gives a non-finite
+    /// K⁻¹a (K singular to working precision). Block elimination loses accuracy along K's
+    /// near-null vector, which is x₀ itself; the Newton steps measure their residuals in
+    /// double-double, and steps that do not converge are discarded ([`refine_pair_sparse`]).
+    fn sparse(factor: ShiftedFactor, ax0: &[f64]) -> Option<Self> {
+        let k_inv_a = factor.solve(ax0);
         let schur: f64 = ax0.iter().zip(&k_inv_a).map(|(u, v)| u * v).sum();
         if !(schur.is_finite() && schur != 0.0 && k_inv_a.iter().all(|v| v.is_finite())) {
             return None;
         }
         Some(Self::Sparse {
-            lu,
+            factor,
             a: ax0.to_vec(),
             k_inv_a,
             schur,
@@ -217,12 +259,20 @@ impl BorderedJacobian {
                 let delta = lblt.solve(&rhs);
                 ((0..n).map(|i| delta[(i, 0)]).collect::<Vec<f64>>(), delta[(n, 0)])
             }
-            Self::Sparse { lu, a, k_inv_a, schur } => {
+            Self::Sparse {
+                factor,
+                a,
+                k_inv_a,
+                schur,
+            } => {
                 // δx = K⁻¹r + δω² K⁻¹a, and −aᵀδx = s gives δω².
-                let y = lu.solve(Mat::from_fn(n, 1, |i, _| r[i]));
-                let a_y: f64 = a.iter().zip(y.col(0).iter()).map(|(u, v)| u * v).sum();
+                let y = factor.solve(&r);
+                let a_y: f64 = a.iter().zip(&y).map(|(u, v)| u * v).sum();
                 let d_omega = -(s + a_y) / schur;
-                ((0..n).map(|i| y[(i, 0)] + d_omega * k_inv_a[i]).collect(), d_omega)
+                (
+                    y.iter().zip(k_inv_a).map(|(yi, ki)| yi + d_omega * ki).collect(),
+                    d_omega,
+                )
             }
         };
         (dx.iter().all(|v| v.is_finite()) && d_omega.is_finite()).then_some((dx, d_omega))

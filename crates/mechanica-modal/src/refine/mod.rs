@@ -37,6 +37,7 @@ mod batch;
 mod bordered;
 mod condensed;
 mod correction;
+mod forest_factor;
 mod metric;
 mod pair;
 mod projected;
