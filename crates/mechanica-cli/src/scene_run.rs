@@ -9,6 +9,7 @@ use mechanica::kinematics::tree::{Joint, KinematicTree, TreeBuilder};
 use mechanica::mass::MassProperties;
 use mechanica::mass::mesh::MeshOptions;
 use mechanica::mass::primitives::{self, Amount};
+use mechanica::mass::validity::{ValidityTolerance, check_allowing_zero_mass};
 use records::{BodyRecord, BuildRecord, MassRecord, PlotsRecord};
 use std::path::Path;
 
@@ -122,13 +123,17 @@ fn body_mass(body: &BodySpec, index: usize, file: &Path) -> Result<MassPropertie
     if let Some(m) = &body.mass_properties {
         let [ixx, iyy, izz, ixy, ixz, iyz] = m.inertia;
         let inertia = Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz);
-        if m.mass == 0.0 && inertia == Matrix3::zeros() {
-            // A massless link (a frame), common in URDF files.
-            return Ok(MassProperties {
+        if m.mass == 0.0 {
+            // A massless link (a frame), common in URDF files, or a zero mass with a tensor
+            // (a rotor whose mass is negligible), accepted when a body could have that tensor.
+            let props = MassProperties {
                 mass: 0.0,
                 p_oc: Vector3::from(m.com),
                 inertia_c: inertia,
-            });
+            };
+            return check_allowing_zero_mass(&props, &ValidityTolerance::default())
+                .map(|()| props)
+                .map_err(|e| located(&e));
         }
         return MassProperties::new(m.mass, Vector3::from(m.com), inertia).map_err(|e| located(&e));
     }

@@ -404,3 +404,35 @@ fn a_robot_without_coordinates_takes_an_empty_q() {
     let (ok, _, err) = mechanica(&["run", path, "--q", "0.5,zero"]);
     assert!(!ok && err.contains("\"zero\" is not a number"), "{err}");
 }
+
+/// A tool link that declares a zero mass with a rotational inertia (as robot files write for
+/// feet and rotors) keeps that tensor and ignores its mesh: the pendulum's ω² is
+/// m g d / (I_pivot + I_tool,yy), as Pinocchio builds it. A zero-mass tensor no body could have
+/// is refused, naming the link.
+#[test]
+fn a_declared_zero_mass_keeps_its_tensor_and_ignores_the_mesh() {
+    let dir = scratch("zero-mass");
+    std::fs::write(dir.join("cube.obj"), cube_obj(0.1)).expect("mesh");
+    let tool_iyy = 0.02;
+    let declared = |iyy: f64| {
+        pendulum_with_tools(&["cube.obj"]).replace(
+            r#"<link name="tool0">"#,
+            &format!(
+                r#"<link name="tool0"><inertial><mass value="0"/>
+                <inertia ixx="{iyy}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{iyy}"/></inertial>"#
+            ),
+        )
+    };
+    let urdf = dir.join("robot.urdf");
+    std::fs::write(&urdf, declared(tool_iyy)).expect("urdf");
+    let (ok, out, err) = mechanica(&["run", urdf.to_str().expect("path"), "--json"]);
+    assert!(ok, "{err}");
+    assert!(!out.contains("mass properties from mesh"), "{out}");
+    let exact = G * 0.5 / (1.0 / 12.0 + 0.25 + tool_iyy);
+    let got = lowest_omega_sq(&out);
+    assert!((got - exact).abs() <= 1e-10 * exact, "{got} vs {exact}");
+    std::fs::write(&urdf, declared(-tool_iyy)).expect("urdf");
+    let (ok, _, err) = mechanica(&["run", urdf.to_str().expect("path")]);
+    assert!(!ok && err.contains("tool0") && err.contains("semidefinite"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -111,13 +111,19 @@ pub struct TreeMass {
     columns: Vec<(Vector3<f64>, Vector3<f64>)>,
 }
 
-/// The union of two bodies in one frame; zero-mass parts (massless links) are allowed.
+/// The union of two bodies in one frame; zero-mass parts are allowed: a massless link, or a
+/// rotor whose tensor is the same about every point (no Steiner term without mass) and adds to
+/// the other part's.
 fn union(a: &MassProperties, b: &MassProperties) -> MassProperties {
+    let with_rotor = |massive: &MassProperties, rotor: &MassProperties| MassProperties {
+        inertia_c: massive.inertia_c + rotor.inertia_c,
+        ..*massive
+    };
     if b.mass == 0.0 {
-        return *a;
+        return with_rotor(a, b);
     }
     if a.mass == 0.0 {
-        return *b;
+        return with_rotor(b, a);
     }
     let mass = a.mass + b.mass;
     let c = a.p_oc + (b.p_oc - a.p_oc) * (b.mass / mass);
@@ -141,11 +147,14 @@ struct MomentsAbout {
 
 impl MomentsAbout {
     /// The moments about r of a body of mass `mass`, centre `centre` and central tensor `j`
-    /// (symmetric; world components). A massless body has none, whatever its tensor (as in the
-    /// unions of [`TreeMass`]'s composites).
+    /// (symmetric; world components). A massless body has only its tensor (a rotor; zero for a
+    /// massless link), about every point.
     fn of_body(mass: f64, centre: &Vector3<f64>, j: &Matrix3<f64>, r: &Vector3<f64>) -> Self {
         if mass == 0.0 {
-            return Self::default();
+            return Self {
+                second: *j,
+                ..Self::default()
+            };
         }
         let y = centre - r;
         let h = y * mass;
@@ -408,7 +417,7 @@ impl TreeMass {
         let mut t0 = 0.0;
         for i in 0..tree.body_count() {
             let c = self.composite[i];
-            if c.mass == 0.0 {
+            if c.mass == 0.0 && c.inertia_c == Matrix3::zeros() {
                 // A massless subtree carries no energy (as in mass_matrix).
                 b_out[tree.dof_range(i)].fill(0.0);
                 continue;

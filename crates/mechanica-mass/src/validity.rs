@@ -187,6 +187,18 @@ pub fn check(props: &MassProperties, tol: &ValidityTolerance) -> Result<Validity
     Ok(report)
 }
 
+/// [`check`] for mass properties whose mass may be zero while the tensor is not: a part whose
+/// mass is negligible but whose rotational inertia is not (a rotor, or a robot file's link
+/// written with a zero mass and a tensor, which Pinocchio, Drake and MuJoCo keep as given).
+/// Every other issue of [`check`] still fails; the tensor is judged as for a massive body.
+pub fn check_allowing_zero_mass(props: &MassProperties, tol: &ValidityTolerance) -> Result<(), MassError> {
+    match check(props, tol) {
+        Ok(_) => Ok(()),
+        Err(MassError::InvalidInertia(issues)) if issues == [InertiaIssue::ZeroMassWithInertia] => Ok(()),
+        Err(other) => Err(other),
+    }
+}
+
 /// The NaN and infinities of `props`, one issue per part (mass, centre, tensor).
 fn non_finite_issues(props: &MassProperties) -> Vec<InertiaIssue> {
     let mut issues = Vec::new();

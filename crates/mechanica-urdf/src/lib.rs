@@ -10,9 +10,11 @@
 //!   (trace about the link's frame origin, over physical tensors) is off by the file's
 //!   rounding (exporters write zero moments as ±1e-20): it is replaced by that tensor with a
 //!   note, without the option.
-//! - A link without `<inertial>` (or with a zero mass there) whose collision (or else visual)
-//!   geometry is a mesh gets the mesh's mass properties at [`MESH_DENSITY`] (water; URDF gives
-//!   no density); the file name, with `package://` and `file://` prefixes stripped, is resolved
+//! - A link without `<inertial>` whose collision (or else visual) geometry is a mesh gets the
+//!   mesh's mass properties at [`MESH_DENSITY`] (water; URDF gives no density); a declared
+//!   `<inertial>` is followed even with a zero mass (as in Pinocchio, Drake and MuJoCo: a
+//!   massless link, or, with a tensor, a rotor whose rotational inertia counts without mass;
+//!   the tensor must be one a body could have); the file name, with `package://` and `file://` prefixes stripped, is resolved
 //!   in the mesh directory (the URDF file's directory for [`read_file`]), then relative to the
 //!   working directory; a `package://PKG/rest` URI also under each ancestor of the mesh
 //!   directory named PKG and under `PKG` in each ancestor and each `ROS_PACKAGE_PATH` entry. A mesh that cannot be used (missing file, a format other than STL or

@@ -1,12 +1,14 @@
 //! Link mass properties: from `<inertial>`, or from a mesh when a link has none, checked for
-//! physical validity (and repaired on request).
+//! physical validity (and repaired on request). A declared `<inertial>` is followed even with a
+//! zero mass (a massless link, as the file says).
 
 use crate::robot::{UrdfOptions, rotation};
 use mechanica_kinematics::nalgebra::{Isometry3, Matrix3, Vector3};
 use mechanica_mass::MassProperties;
 use mechanica_mass::mesh::MeshOptions;
 use mechanica_mass::primitives::Amount;
-use mechanica_mass::validity::{ValidityTolerance, check, repair};
+use mechanica_mass::validity::{ValidityTolerance, check, check_allowing_zero_mass, repair};
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 /// Density used for mesh-only links (kg/m³).
@@ -31,13 +33,15 @@ pub(crate) struct LinkProblems {
 pub(crate) fn link_masses(
     mesh_dir: &Path,
     links: &[urdf_rs::Link],
+    links_with_inertial: &HashSet<String>,
     options: UrdfOptions,
     notes: &mut Vec<String>,
 ) -> (Vec<MassProperties>, LinkProblems) {
     let mut problems = LinkProblems::default();
     let mut masses = Vec::with_capacity(links.len());
     for link in links {
-        masses.push(match link_mass_properties(mesh_dir, link, notes) {
+        let declared = links_with_inertial.contains(&link.name);
+        masses.push(match link_mass_properties(mesh_dir, link, declared, notes) {
             Ok(props) => props,
             Err(problem) if options.allow_missing_mesh => {
                 notes.push(format!("warning: {problem}; the link is massless"));
@@ -95,10 +99,14 @@ fn checked_inertia(
             link.name, props.mass
         ));
     }
-    if props.mass == 0.0 {
-        return Ok(*props);
-    }
     let tolerance = ValidityTolerance::default();
+    if props.mass == 0.0 {
+        // A massless link, or one written with a zero mass and a tensor (kept as given, as the
+        // peers do, when the tensor is one a body could have).
+        return check_allowing_zero_mass(props, &tolerance)
+            .map(|()| *props)
+            .map_err(|e| format!("link \"{}\": {e}", link.name));
+    }
     let Err(error) = check(props, &tolerance) else {
         return Ok(*props);
     };
@@ -123,12 +131,14 @@ fn checked_inertia(
     }
 }
 
-/// A link's mass properties in the link frame: from `<inertial>` (tensor rotated by its rpy),
-/// or, for a massless one, from its mesh at [`MESH_DENSITY`] when it has one (noted in
-/// `notes`). A mesh that cannot be used is an error naming the link and the mesh.
+/// A link's mass properties in the link frame: from its `<inertial>` (tensor rotated by its
+/// rpy) when it `declared` one, even with a zero mass, or else from its mesh at
+/// [`MESH_DENSITY`] when it has one (noted in `notes`). A mesh that cannot be used is an error
+/// naming the link and the mesh.
 fn link_mass_properties(
     mesh_dir: &Path,
     link: &urdf_rs::Link,
+    declared: bool,
     notes: &mut Vec<String>,
 ) -> Result<MassProperties, String> {
     let inertial = &link.inertial;
@@ -140,7 +150,7 @@ fn link_mass_properties(
         p_oc: Vector3::from(inertial.origin.xyz.0),
         inertia_c: r.matrix() * tensor * r.matrix().transpose(),
     };
-    if props.mass != 0.0 {
+    if declared || props.mass != 0.0 {
         return Ok(props);
     }
     let Some(mesh) = first_mesh(link) else {

@@ -7,6 +7,7 @@ use crate::links::link_masses;
 use mechanica_kinematics::nalgebra::{Isometry3, Rotation3, UnitQuaternion, Vector3};
 use mechanica_kinematics::tree::Joint;
 use mechanica_mass::MassProperties;
+use std::collections::HashSet;
 use std::path::Path;
 
 /// R = R_z(yaw) R_y(pitch) R_x(roll) of a URDF `rpy`.
@@ -115,6 +116,7 @@ pub struct UrdfRobot {
 /// A parsed URDF text, before its links and joints are checked.
 pub struct UrdfDocument {
     robot: urdf_rs::Robot,
+    links_with_inertial: HashSet<String>,
 }
 
 impl UrdfDocument {
@@ -126,9 +128,13 @@ impl UrdfDocument {
                 limit: MAX_URDF_BYTES,
             });
         }
-        let text = crate::xml_scan::prepared(text)?;
-        let robot = urdf_rs::read_from_string(&text).map_err(|e| UrdfError::Parse { message: e.to_string() })?;
-        Ok(Self { robot })
+        let prepared = crate::xml_scan::prepared(text)?;
+        let robot =
+            urdf_rs::read_from_string(&prepared.text).map_err(|e| UrdfError::Parse { message: e.to_string() })?;
+        Ok(Self {
+            robot,
+            links_with_inertial: prepared.links_with_inertial,
+        })
     }
 
     /// Reads and parses the file at `path` (at most [`MAX_URDF_BYTES`] bytes).
@@ -155,7 +161,7 @@ impl UrdfDocument {
     pub fn robot(&self, mesh_dir: &Path, options: UrdfOptions) -> Result<UrdfRobot, UrdfError> {
         let robot = &self.robot;
         let mut notes = Vec::new();
-        let (masses, problems) = link_masses(mesh_dir, &robot.links, options, &mut notes);
+        let (masses, problems) = link_masses(mesh_dir, &robot.links, &self.links_with_inertial, options, &mut notes);
         if !problems.meshes.is_empty() {
             return Err(UrdfError::UnusableMeshes {
                 problems: problems.meshes,

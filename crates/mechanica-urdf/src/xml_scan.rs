@@ -2,7 +2,8 @@
 //! [`MAX_NESTING`] are refused (the XML parsers underneath recurse once per level, so a deep
 //! hostile file would overflow the stack), and `<texture>` elements without a `filename`
 //! attribute are dropped (some exporters write `<texture/>` in materials, which the parser
-//! refuses; materials only concern rendering).
+//! refuses; materials only concern rendering). The same pass notes which links declare an
+//! `<inertial>` element, which the parsed robot does not tell apart from a zero one.
 //!
 //! The scan knows XML's lexical structure: comments, CDATA sections, processing instructions
 //! and declarations are skipped whole, and a tag ends at the first `>` outside quotes (`>` is
@@ -11,14 +12,22 @@
 
 use crate::UrdfError;
 use std::borrow::Cow;
+use std::collections::HashSet;
 
 /// The deepest element nesting accepted; URDF needs six levels (robot, link, visual,
 /// geometry, mesh) and simulator extensions a few more.
 pub const MAX_NESTING: usize = 64;
 
-/// `text` without its bare `<texture>` elements, or an error when elements nest deeper than
-/// [`MAX_NESTING`].
-pub(crate) fn prepared(text: &str) -> Result<Cow<'_, str>, UrdfError> {
+/// A URDF text ready for the parser, and what the scan learnt on the way.
+pub(crate) struct Prepared<'a> {
+    /// The text without its bare `<texture>` elements.
+    pub text: Cow<'a, str>,
+    /// The names of the links (children of the root element) with an `<inertial>` child.
+    pub links_with_inertial: HashSet<String>,
+}
+
+/// `text` prepared for the parser, or an error when elements nest deeper than [`MAX_NESTING`].
+pub(crate) fn prepared(text: &str) -> Result<Prepared<'_>, UrdfError> {
     let mut scan = Scan::default();
     let mut at = 0;
     while let Some(offset) = text[at..].find('<') {
@@ -29,17 +38,22 @@ pub(crate) fn prepared(text: &str) -> Result<Cow<'_, str>, UrdfError> {
         scan.tag(&text[start..end], start, end)?;
         at = end;
     }
-    if scan.removed.is_empty() {
-        return Ok(Cow::Borrowed(text));
-    }
-    let mut kept = String::with_capacity(text.len());
-    let mut from = 0;
-    for &(start, end) in &scan.removed {
-        kept.push_str(&text[from..start]);
-        from = end;
-    }
-    kept.push_str(&text[from..]);
-    Ok(Cow::Owned(kept))
+    let text = if scan.removed.is_empty() {
+        Cow::Borrowed(text)
+    } else {
+        let mut kept = String::with_capacity(text.len());
+        let mut from = 0;
+        for &(start, end) in &scan.removed {
+            kept.push_str(&text[from..start]);
+            from = end;
+        }
+        kept.push_str(&text[from..]);
+        Cow::Owned(kept)
+    };
+    Ok(Prepared {
+        text,
+        links_with_inertial: scan.links_with_inertial,
+    })
 }
 
 /// The end (one past the last byte) of the markup that starts with `<` at `start`: a comment,
@@ -76,13 +90,15 @@ fn markup_end(text: &str, start: usize) -> Option<usize> {
     }
 }
 
-/// The state of the scan: the current depth, the open bare texture (its start and depth) and
-/// the spans to remove.
+/// The state of the scan: the current depth, the open bare texture (its start and depth), the
+/// spans to remove, the name of the open link and the links seen with an `<inertial>`.
 #[derive(Default)]
 struct Scan {
     depth: usize,
     open_texture: Option<(usize, usize)>,
     removed: Vec<(usize, usize)>,
+    open_link: Option<String>,
+    links_with_inertial: HashSet<String>,
 }
 
 impl Scan {
@@ -103,7 +119,10 @@ impl Scan {
         }
         let inner = markup.trim_start_matches('<').trim_end_matches('>');
         let self_closing = inner.ends_with('/');
-        let bare_texture = self.open_texture.is_none() && is_bare_texture(inner.trim_end_matches('/'));
+        let (name, attributes) = split_tag(inner.trim_end_matches('/'));
+        self.note_inertial(name, attributes, self_closing);
+        let bare_texture =
+            self.open_texture.is_none() && name == "texture" && attribute(attributes, "filename").is_none();
         if self_closing {
             if bare_texture {
                 self.removed.push((start, end));
@@ -123,29 +142,65 @@ impl Scan {
     }
 }
 
-/// Whether the tag body `inner` (name and attributes) is a `texture` without a `filename`
-/// attribute; an attribute list it cannot read counts as having one (the tag is kept).
-fn is_bare_texture(inner: &str) -> bool {
-    let name_end = inner.find(|c: char| c.is_whitespace()).unwrap_or(inner.len());
-    if &inner[..name_end] != "texture" {
-        return false;
+impl Scan {
+    /// Follows the opening tag `name` at the current depth: a link (a child of the root
+    /// element) opens, or an `<inertial>` inside the open link marks it.
+    fn note_inertial(&mut self, name: &str, attributes: &str, self_closing: bool) {
+        match (self.depth, name) {
+            (1, "link") => self.open_link = (!self_closing).then(|| attribute(attributes, "name")).flatten(),
+            (1, _) => self.open_link = None,
+            (2, "inertial") => {
+                if let Some(link) = &self.open_link {
+                    self.links_with_inertial.insert(link.clone());
+                }
+            }
+            _ => {}
+        }
     }
-    let mut rest = inner[name_end..].trim_start();
+}
+
+/// The tag body `inner` split into its name and its attribute list.
+fn split_tag(inner: &str) -> (&str, &str) {
+    let name_end = inner.find(|c: char| c.is_whitespace()).unwrap_or(inner.len());
+    (&inner[..name_end], &inner[name_end..])
+}
+
+/// The value of the attribute `wanted` in the attribute list `attributes` (as written, entities
+/// not expanded); an attribute list it cannot read counts as having the attribute with an empty
+/// value (so that a bare texture it cannot read is kept).
+fn attribute(attributes: &str, wanted: &str) -> Option<String> {
+    let mut rest = attributes.trim_start();
     while !rest.is_empty() {
         let Some((name, after)) = rest.split_once('=') else {
-            return false;
+            return Some(String::new());
         };
-        if name.trim() == "filename" {
-            return false;
-        }
         let after = after.trim_start();
         let Some(quote) = after.chars().next().filter(|c| *c == '"' || *c == '\'') else {
-            return false;
+            return Some(String::new());
         };
         let Some(close) = after[1..].find(quote) else {
-            return false;
+            return Some(String::new());
         };
+        if name.trim() == wanted {
+            return Some(unescaped(&after[1..1 + close]));
+        }
         rest = after[1 + close + 1..].trim_start();
     }
-    true
+    None
+}
+
+/// `value` with XML's predefined entities replaced (character references are left as written).
+fn unescaped(value: &str) -> String {
+    if !value.contains('&') {
+        return value.to_string();
+    }
+    [
+        ("&lt;", "<"),
+        ("&gt;", ">"),
+        ("&quot;", "\""),
+        ("&apos;", "'"),
+        ("&amp;", "&"),
+    ]
+    .iter()
+    .fold(value.to_string(), |text, (entity, plain)| text.replace(entity, plain))
 }

@@ -1,6 +1,7 @@
 //! What real robot files contain besides mechanics: `<texture/>` elements without a file,
 //! inertia tensors off by rounding (zero moments written as ±1e-20), `package://` mesh URIs
-//! resolved against the package's directory, and empty robots.
+//! resolved against the package's directory, declared zero-mass `<inertial>` elements, and empty
+//! robots.
 
 use mechanica_mass::validity::{ValidityTolerance, check};
 use mechanica_urdf::{UrdfError, UrdfOptions, read_file, read_str};
@@ -206,4 +207,57 @@ fn deep_nesting_is_refused_and_markup_is_read_as_xml() {
     let plain = read_str(&arm("", ROD), here, UrdfOptions::default()).expect("plain");
     assert_eq!(robot.links, plain.links);
     assert_eq!(robot.joints, plain.joints);
+}
+
+#[test]
+fn a_declared_inertial_of_zero_mass_is_followed_and_only_a_missing_one_takes_the_mesh() {
+    // Four tool links with the same mesh: one declares a zero-mass <inertial> (with a small
+    // tensor, as exporters write for massless feet), one whose name needs an entity declares
+    // it too, one has an <inertial> only inside a comment and one only inside a <gazebo>
+    // block naming it. Only the last two take the mesh's mass.
+    let dir = scratch("declared");
+    let edge = 0.2;
+    std::fs::write(dir.join("tool.stl"), corner_tetrahedron_stl(edge)).expect("mesh");
+    let mesh = r#"<collision><geometry><mesh filename="tool.stl"/></geometry></collision>"#;
+    let zero = r#"<inertial><origin xyz="0 0 1e-3" rpy="0 0 0"/><mass value="0.0"/>
+        <inertia ixx="5.7e-7" ixy="0" ixz="0" iyy="8.4e-7" iyz="0" izz="5.3e-7"/></inertial>"#;
+    let mut text = String::from("<robot name=\"r\">\n<link name=\"base\"/>\n");
+    let links = [
+        ("foot", format!("{zero}{mesh}")),
+        ("foot&amp;toe", format!("\n  {zero}\n  {mesh}")),
+        ("commented", format!("<!-- {zero} -->{mesh}")),
+        ("gazebo_only", mesh.to_string()),
+    ];
+    for (i, (name, body)) in links.iter().enumerate() {
+        text.push_str(&format!(
+            "<link name=\"{name}\">{body}</link>\n<joint name=\"j{i}\" type=\"revolute\"><parent link=\"base\"/>\
+             <child link=\"{name}\"/><axis xyz=\"0 0 1\"/></joint>\n"
+        ));
+    }
+    text.push_str(&format!(
+        "<gazebo reference=\"gazebo_only\"><link name=\"gazebo_only\">{zero}</link></gazebo>\n"
+    ));
+    text.push_str("</robot>\n");
+    let urdf = dir.join("robot.urdf");
+    std::fs::write(&urdf, &text).expect("urdf");
+    let robot = read_file(&urdf, UrdfOptions::default()).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    let mass_of = |name: &str| {
+        let link = robot
+            .links
+            .iter()
+            .find(|l| l.name == name)
+            .unwrap_or_else(|| panic!("{name}"));
+        link.mass
+    };
+    for name in ["foot", "foot&toe"] {
+        let props = mass_of(name);
+        assert_eq!(props.mass, 0.0, "{name}");
+        assert_eq!(props.inertia_c[(1, 1)], 8.4e-7, "{name}: the declared tensor is kept");
+    }
+    let mesh_mass = 1000.0 * edge * edge * edge / 6.0;
+    for name in ["commented", "gazebo_only"] {
+        let props = mass_of(name);
+        assert!((props.mass - mesh_mass).abs() <= 1e-6 * mesh_mass, "{name}: {props:?}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
