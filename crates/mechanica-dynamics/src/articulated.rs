@@ -68,9 +68,10 @@ pub(crate) fn motion_vector(w: &Vector3<f64>, v: &Vector3<f64>) -> Vector6<f64> 
 
 /// The inverse of the symmetric positive definite top-left `dim`×`dim` block of `d` by
 /// Cholesky, in the same block of the result. Fails with (pivot, scale) when a pivot is not
-/// above 8u times the largest diagonal entry (the block is singular to working precision).
-pub(crate) fn invert_spd_block(d: &Matrix6<f64>, dim: usize) -> Result<Matrix6<f64>, (f64, f64)> {
-    let scale = (0..dim).map(|i| d[(i, i)].abs()).fold(0.0, f64::max);
+/// above 8u times `scale`, the magnitude the block's entries were computed from (below it the
+/// block is singular to working precision), or the largest diagonal entry if that is larger.
+pub(crate) fn invert_spd_block(d: &Matrix6<f64>, dim: usize, scale: f64) -> Result<Matrix6<f64>, (f64, f64)> {
+    let scale = (0..dim).map(|i| d[(i, i)].abs()).fold(scale, f64::max);
     let mut l = Matrix6::zeros();
     for j in 0..dim {
         let mut pivot = d[(j, j)];

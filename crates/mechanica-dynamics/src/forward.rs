@@ -23,7 +23,12 @@
 //! random trees), up to articulated inertias that lose definiteness. The composite-rigid-body
 //! route with Cholesky is backward stable at every grading. So [`Dynamics::forward_dynamics`]
 //! accepts the recursion's q̈ only when its backward error is at the rounding level of the
-//! check, 16·(d + 4)·u, and otherwise solves by the mass matrix; [`ForwardMethod`] says which.
+//! check, 16·(d + 4)·u, and no joint's articulated pivot is below √u times the inertia of the
+//! subtree it moves (a point mass on or near its joint's axis, or joints that together move
+//! nothing: A(q) is then ill-conditioned and the backward error says nothing of the forward
+//! one), and otherwise solves by the mass matrix, whose report gives κ∞(A) and the forward
+//! error estimate; [`ForwardMethod`] says which. Both recursions refuse a pivot below 8u times
+//! |s|ᵀ|Iᴬ||s|, the magnitude it was summed from.
 
 use crate::articulated::{
     body_inertia, invert_spd_block, motion_vector, shifted_inertia, shifted_motion, shifted_wrench, wrench_vector,
@@ -31,6 +36,12 @@ use crate::articulated::{
 use crate::error::{DynamicsError, check_result, check_vector};
 use crate::model::{Dynamics, State};
 use nalgebra::{Vector3, Vector6};
+
+/// The smallest ratio of an articulated pivot to the subtree inertia behind it
+/// ([`Dynamics::has_weak_pivot`]) at which the checked forward dynamics keeps the articulated
+/// body's q̈: √u. Below it A(q) has a condition number above 1/√u, and the mass-matrix route
+/// reports it with a forward error estimate.
+const WEAK_PIVOT: f64 = 1.490_116_119_384_765_6e-8;
 
 /// The route that produced q̈.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,10 +121,13 @@ impl Dynamics {
             let ia = self.articulated.inertia[i];
             let pa = self.articulated.bias[i];
             let mut d = nalgebra::Matrix6::zeros();
+            // |s|ᵀ|Iᴬ||s|: what sᵀIᴬs is summed from, the size of its rounding.
+            let mut magnitude = 0.0_f64;
             for (a, k) in range.clone().enumerate() {
                 let (w, v) = self.ws.motion_column(k)?;
                 let s = motion_vector(&w, &v);
                 let u = ia * s;
+                magnitude = magnitude.max(s.abs().dot(&(ia.abs() * s.abs())));
                 self.articulated.u_columns[k] = u;
                 self.articulated.u_force[k] = tau[k] + self.joint_loads[k] - s.dot(&pa);
                 for (b, l) in range.clone().enumerate() {
@@ -121,13 +135,14 @@ impl Dynamics {
                     d[(b, a)] = motion_vector(&wl, &vl).dot(&u);
                 }
             }
-            let d_inv =
-                invert_spd_block(&d, dim).map_err(|(pivot, scale)| DynamicsError::SingularArticulatedInertia {
+            let d_inv = invert_spd_block(&d, dim, magnitude).map_err(|(pivot, scale)| {
+                DynamicsError::SingularArticulatedInertia {
                     body: i,
                     first_coordinate: start,
                     pivot,
                     scale,
-                })?;
+                }
+            })?;
             self.articulated.d_inverse[i] = d_inv;
             let Some(p) = self.mechanism.tree().parent(i) else {
                 continue;
@@ -242,8 +257,8 @@ impl Dynamics {
     }
 
     /// q̈ for the applied forces `tau` at `state`: by the articulated-body algorithm when the
-    /// inverse dynamics confirms it to the rounding level, by the mass matrix otherwise (module
-    /// docs). Fails with [`DynamicsError::SingularMassMatrix`] when A(q) is singular.
+    /// inverse dynamics confirms it to the rounding level and A(q) is not ill-conditioned by
+    /// the articulated pivots' measure, by the mass matrix otherwise (module docs). Fails with [`DynamicsError::SingularMassMatrix`] when A(q) is singular.
     pub fn forward_dynamics(&mut self, state: &State<'_>, tau: &[f64]) -> Result<ForwardDynamics, DynamicsError> {
         let n = self.dof();
         check_vector(tau, n, "tau")?;
@@ -251,7 +266,7 @@ impl Dynamics {
         match self.aba_state(state, tau, &mut q_ddot) {
             Ok(dissipation) => {
                 let (residual, backward_error, _) = self.residual_of(state, tau, &q_ddot)?;
-                if backward_error <= self.estimate_factor() {
+                if backward_error <= self.estimate_factor() && !self.has_weak_pivot()? {
                     return Ok(ForwardDynamics {
                         q_ddot,
                         method: ForwardMethod::ArticulatedBody,
@@ -267,6 +282,44 @@ impl Dynamics {
             Err(other) => return Err(other),
         }
         self.forward_dynamics_crba(state, tau)
+    }
+
+    /// Whether some joint's articulated pivot, 1/(D⁻¹)_aa of the last recursion, is below
+    /// [`WEAK_PIVOT`] times the inertia of the subtree it moves along that motion column,
+    /// T|w|² + 2|h||w||v| + M|v|² with M, h and T the subtree's mass, first moment and trace of
+    /// its rotational inertia about the joint's body origin (each bounds its part of sᵀIᶜs for
+    /// the composite inertia Iᶜ, and D ⪯ SᵀIᶜS). A pivot that small makes A(q) at least as
+    /// ill-conditioned as its ratio's inverse (a point mass near its joint's axis), where a
+    /// small backward error says nothing of the forward error.
+    fn has_weak_pivot(&self) -> Result<bool, DynamicsError> {
+        let tree = self.mechanism.tree();
+        let mut mass: Vec<f64> = self.world.iter().map(|w| w.mass).collect();
+        let mut moment: Vec<Vector3<f64>> = self.world.iter().map(|w| w.c * w.mass).collect();
+        let mut trace: Vec<f64> = self
+            .world
+            .iter()
+            .map(|w| w.inertia_c.trace() + 2.0 * w.mass * w.c.norm_squared())
+            .collect();
+        for &i in tree.topological_order().iter().rev() {
+            let d_inverse = &self.articulated.d_inverse[i];
+            for (a, k) in tree.dof_range(i).enumerate() {
+                let (w, v) = self.ws.motion_column(k)?;
+                let (w, v) = (w.norm(), v.norm());
+                let scale = trace[i] * w * w + 2.0 * moment[i].norm() * w * v + mass[i] * v * v;
+                let pivot = 1.0 / d_inverse[(a, a)];
+                if pivot.is_nan() || pivot <= WEAK_PIVOT * scale {
+                    return Ok(true);
+                }
+            }
+            if let Some(p) = tree.parent(i) {
+                let d = self.ws.parent_offset(i)?;
+                trace[p] += trace[i] + 4.0 * moment[i].dot(&d) + 2.0 * mass[i] * d.norm_squared();
+                let shifted = moment[i] + d * mass[i];
+                moment[p] += shifted;
+                mass[p] += mass[i];
+            }
+        }
+        Ok(false)
     }
 
     /// r = τ − RNEA(q, q̇, q̈), the backward error ‖r‖∞ / max scale, and the largest rounding

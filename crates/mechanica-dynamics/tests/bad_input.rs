@@ -258,3 +258,103 @@ fn tiny_loads_keep_their_rounding_estimate() {
         }
     }
 }
+
+/// A joint about a random axis a carrying only a point mass at L·a (stored rounded): the mass
+/// matrix is singular to working precision, since the joint moves the mass by the rounding of
+/// its position alone. The articulated-body pivot sᵀIᴬs is then rounding noise against
+/// |s|ᵀ|Iᴬ||s|; the forward dynamics must say so (an error, or the mass-matrix route with an
+/// error estimate as large as q̈), never return the noise's q̈ as accurate.
+#[test]
+fn a_point_mass_on_its_joint_axis_is_not_solved_silently() {
+    let mut rng = Rng::new(77);
+    for case in 0..200 {
+        let axis = rng.unit();
+        let mut builder = TreeBuilder::new();
+        let root = builder.add_body(None, Joint::Revolute { axis: Vector3::z() }, Isometry3::identity());
+        let offset = rng.vector(1.0);
+        builder.add_body(
+            Some(root),
+            Joint::Revolute { axis },
+            Isometry3::translation(offset.x, offset.y, offset.z),
+        );
+        let tree = builder.build().expect("tree");
+        let heavy = MassProperties::new(2.0, rng.vector(0.5), Matrix3::identity()).expect("mass");
+        let length = 10f64.powf(rng.uniform(-2.0, 2.0));
+        let point = MassProperties {
+            mass: 10f64.powf(rng.uniform(-3.0, 3.0)),
+            p_oc: axis * length,
+            inertia_c: Matrix3::zeros(),
+        };
+        let dynamics = Dynamics::new(Mechanism::new(tree, vec![heavy, point]).expect("mechanism")).expect("dynamics");
+        assert_singular_is_said(dynamics, &mut rng, case, false);
+    }
+}
+
+/// Two joints about random axes a₁, a₂ through one point, the second carrying only a point mass
+/// at x·a₁ + y·a₂ (the inner link massless or a point mass at the joint, as iCub's neck): the
+/// combination of the two rotations about the axis along the mass moves nothing, so A(q) is
+/// singular, although no single joint's articulated pivot cancels against its own terms (the
+/// cancellation happens when the outer joint is condensed onto the inner one). The outer
+/// joint stays at 0, where its body frame carries a₁ unchanged.
+#[test]
+fn two_joints_that_together_move_nothing_are_not_solved_silently() {
+    let mut rng = Rng::new(78);
+    for case in 0..200 {
+        let (first, second) = (rng.unit(), rng.unit());
+        let mut builder = TreeBuilder::new();
+        let root = builder.add_body(None, Joint::Revolute { axis: Vector3::z() }, Isometry3::identity());
+        let offset = rng.vector(1.0);
+        let inner = builder.add_body(
+            Some(root),
+            Joint::Revolute { axis: first },
+            Isometry3::translation(offset.x, offset.y, offset.z),
+        );
+        builder.add_body(Some(inner), Joint::Revolute { axis: second }, Isometry3::identity());
+        let tree = builder.build().expect("tree");
+        let heavy = MassProperties::new(2.0, rng.vector(0.5), Matrix3::identity()).expect("mass");
+        let at_joint = MassProperties {
+            mass: if case % 2 == 0 { 0.0 } else { 0.1 },
+            p_oc: Vector3::zeros(),
+            inertia_c: Matrix3::zeros(),
+        };
+        let scale = 10f64.powf(rng.uniform(-2.0, 1.0));
+        let point = MassProperties {
+            mass: 10f64.powf(rng.uniform(-3.0, 3.0)),
+            p_oc: (first * rng.uniform(-1.0, 1.0) + second * rng.uniform(-1.0, 1.0)) * scale,
+            inertia_c: Matrix3::zeros(),
+        };
+        let dynamics =
+            Dynamics::new(Mechanism::new(tree, vec![heavy, at_joint, point]).expect("mechanism")).expect("dynamics");
+        assert_singular_is_said(dynamics, &mut rng, case, true);
+    }
+}
+
+/// The checked forward dynamics of a mechanism whose A(q) is singular to working precision, at
+/// a random state (the last coordinate 0 when `last_at_zero`): an error, or a q̈ whose error
+/// estimate admits that it has no correct digit.
+fn assert_singular_is_said(mut dynamics: Dynamics, rng: &mut Rng, case: usize, last_at_zero: bool) {
+    let n = dynamics.dof();
+    let mut q: Vec<f64> = (0..n).map(|_| rng.uniform(-3.0, 3.0)).collect();
+    if last_at_zero {
+        q[n - 1] = 0.0;
+    }
+    let v: Vec<f64> = (0..n)
+        .map(|k| if k == 0 { rng.uniform(-1.0, 1.0) } else { 0.0 })
+        .collect();
+    let tau: Vec<f64> = (0..n).map(|_| rng.uniform(-1.0, 1.0)).collect();
+    match dynamics.forward_dynamics(&State::new(&q, &v), &tau) {
+        Err(DynamicsError::SingularMassMatrix { .. } | DynamicsError::SingularArticulatedInertia { .. }) => {}
+        Err(other) => panic!("case {case}: {other}"),
+        Ok(forward) => {
+            let largest = forward.q_ddot.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+            let estimate = forward.error_estimate.unwrap_or(0.0);
+            assert!(
+                estimate >= 0.5 * largest,
+                "case {case}: q̈ = {:?} by {:?} with error estimate {:?}",
+                forward.q_ddot,
+                forward.method,
+                forward.error_estimate
+            );
+        }
+    }
+}

@@ -134,9 +134,11 @@ unsafe fn forward_with(
 /// Writes q̈ (n values) for the applied forces `tau` at (`q`, `q_dot`) and time `t` (s) to
 /// `q_ddot_out`, and its accuracy report to `*report_out` (may be NULL). The articulated-body
 /// recursion's q̈ is checked by the inverse dynamics and accepted when its backward error is
-/// at the rounding level of the check, 16·(d + 4)·u (d the depth of the tree); otherwise the
-/// equations are solved by the mass matrix and Cholesky (as mech_dynamics_forward_crba).
-/// `report_out->method` says which.
+/// at the rounding level of the check, 16·(d + 4)·u (d the depth of the tree), and no joint's
+/// articulated pivot is below √u times the inertia of the subtree it moves (then A(q) is
+/// ill-conditioned, and a small backward error says nothing of q̈'s accuracy); otherwise the
+/// equations are solved by the mass matrix and Cholesky (as mech_dynamics_forward_crba), whose
+/// report carries κ∞(A) and the error estimate. `report_out->method` says which.
 ///
 /// Errors: as mech_dynamics_aba, and MECH_STATUS_NON_FINITE for a NaN or infinite `t`.
 ///
