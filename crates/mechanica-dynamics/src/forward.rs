@@ -121,13 +121,16 @@ impl Dynamics {
             let ia = self.articulated.inertia[i];
             let pa = self.articulated.bias[i];
             let mut d = nalgebra::Matrix6::zeros();
-            // |s|ᵀ|Iᴬ||s|: what sᵀIᴬs is summed from, the size of its rounding.
-            let mut magnitude = 0.0_f64;
+            // The pivots are refused below 8u·|s|ᵀ|Iᴬ||s|, the size of their rounding (what
+            // sᵀIᴬs is summed from). That magnitude is formed only when a pivot fails against
+            // its cheap bound ‖s‖₁²·max_k Iᴬ_kk (|Iᴬ_kl| ≤ max_k Iᴬ_kk for a semidefinite Iᴬ).
+            let diagonal_largest = (0..6).map(|k| ia[(k, k)].abs()).fold(0.0_f64, f64::max);
+            let mut bound = 0.0_f64;
             for (a, k) in range.clone().enumerate() {
                 let (w, v) = self.ws.motion_column(k)?;
                 let s = motion_vector(&w, &v);
                 let u = ia * s;
-                magnitude = magnitude.max(s.abs().dot(&(ia.abs() * s.abs())));
+                bound = bound.max(s.lp_norm(1).powi(2) * diagonal_largest);
                 self.articulated.u_columns[k] = u;
                 self.articulated.u_force[k] = tau[k] + self.joint_loads[k] - s.dot(&pa);
                 for (b, l) in range.clone().enumerate() {
@@ -135,14 +138,17 @@ impl Dynamics {
                     d[(b, a)] = motion_vector(&wl, &vl).dot(&u);
                 }
             }
-            let d_inv = invert_spd_block(&d, dim, magnitude).map_err(|(pivot, scale)| {
-                DynamicsError::SingularArticulatedInertia {
-                    body: i,
-                    first_coordinate: start,
-                    pivot,
-                    scale,
-                }
-            })?;
+            let d_inv = match invert_spd_block(&d, dim, bound) {
+                Ok(d_inv) => d_inv,
+                Err(_) => invert_spd_block(&d, dim, self.pivot_magnitude(i, &ia)?).map_err(|(pivot, scale)| {
+                    DynamicsError::SingularArticulatedInertia {
+                        body: i,
+                        first_coordinate: start,
+                        pivot,
+                        scale,
+                    }
+                })?,
+            };
             self.articulated.d_inverse[i] = d_inv;
             let Some(p) = self.mechanism.tree().parent(i) else {
                 continue;
@@ -170,6 +176,18 @@ impl Dynamics {
             self.articulated.bias[p] += shifted_wrench(&p_small, &r);
         }
         Ok(())
+    }
+
+    /// max_a |s_a|ᵀ|Iᴬ||s_a| over the motion columns s_a of body `i`'s joint, for its
+    /// articulated inertia `ia`: the magnitude its pivots are summed from.
+    fn pivot_magnitude(&self, i: usize, ia: &nalgebra::Matrix6<f64>) -> Result<f64, DynamicsError> {
+        let mut magnitude = 0.0_f64;
+        for k in self.mechanism.tree().dof_range(i) {
+            let (w, v) = self.ws.motion_column(k)?;
+            let s = motion_vector(&w, &v).abs();
+            magnitude = magnitude.max(s.dot(&(ia.abs() * s)));
+        }
+        Ok(magnitude)
     }
 
     /// Root to leaves: q̈ of every joint and the spatial accelerations.
