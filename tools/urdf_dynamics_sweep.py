@@ -61,21 +61,14 @@ import sys
 import numpy as np
 import pinocchio as pin
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from urdf_pinocchio_sweep import pinocchio_state, robots_dir  # noqa: E402
+
 SEED = 20261130
 STATES = 3
 TIME_LIMIT = 120  # seconds per robot
 U = 2.0 ** -53  # unit roundoff of double precision
 GRAVITY = np.array([0.0, 0.0, -9.81])  # mechanica's URDF gravity (base-frame components)
-
-
-def robots_dir():
-    """The robots of the example-robot-data package: <prefix>/share/example-robot-data/robots,
-    with <prefix> the cmeel.prefix that holds Pinocchio."""
-    prefix = os.path.normpath(os.path.join(os.path.dirname(pin.__file__), '..', '..', '..', '..'))
-    robots = os.path.join(prefix, 'share', 'example-robot-data', 'robots')
-    if not os.path.isdir(robots):
-        raise SystemExit(f'example-robot-data not found under {prefix}: pip install example-robot-data')
-    return robots
 
 
 # ---------------------------------------------------------------------------------------------
@@ -195,18 +188,6 @@ class Robot:
 # Pinocchio and the comparison
 
 
-def pinocchio_q(model, names, q_mech):
-    """Pinocchio's q (continuous joints as cos, sin) for mechanica's joint angles by name."""
-    q = pin.neutral(model)
-    for name, value in zip(names, q_mech):
-        joint = model.joints[model.getJointId(name)]
-        if joint.nq == 2:
-            q[joint.idx_q:joint.idx_q + 2] = [math.cos(value), math.sin(value)]
-        else:
-            q[joint.idx_q] = value
-    return q
-
-
 def random_q(model, names, rng):
     """As tools/urdf_pinocchio_sweep.py: uniform in the joint's limits, else in [-pi, pi]."""
     q = []
@@ -250,7 +231,7 @@ def compare(lib_path, urdf, seed_sequence):
         for _ in range(STATES if robot.n else 0):
             q_mech = random_q(model, names, rng)
             qd, qdd, b = (rng.uniform(-2.0, 2.0, robot.n) for _ in range(3))
-            q_pin = pinocchio_q(model, names, q_mech)
+            q_pin = pinocchio_state(model, names, q_mech)
             v_pin, a_pin, b_pin = (np.zeros(model.nv) for _ in range(3))
             v_pin[index], a_pin[index], b_pin[index] = qd, qdd, b
             tau_pin = pin.rnea(model, data, q_pin, v_pin, b_pin).copy()
