@@ -7,7 +7,7 @@ use mechanica_kinematics::nalgebra::{Isometry3, Matrix3, Vector3};
 use mechanica_mass::MassProperties;
 use mechanica_mass::mesh::MeshOptions;
 use mechanica_mass::primitives::Amount;
-use mechanica_mass::validity::{ValidityTolerance, check, check_allowing_zero_mass, repair};
+use mechanica_mass::validity::{ValidityTolerance, check, repair};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
@@ -99,18 +99,26 @@ fn checked_inertia(
             link.name, props.mass
         ));
     }
+    // A zero mass with a tensor is a rotor (kept as the peers keep it): its tensor is judged,
+    // and set to the nearest physical one, as a massive link's would be.
+    let zero_mass = props.mass == 0.0;
+    let judged = if zero_mass {
+        MassProperties { mass: 1.0, ..*props }
+    } else {
+        *props
+    };
+    let as_given = |p: MassProperties| {
+        if zero_mass {
+            MassProperties { mass: 0.0, ..p }
+        } else {
+            p
+        }
+    };
     let tolerance = ValidityTolerance::default();
-    if props.mass == 0.0 {
-        // A massless link, or one written with a zero mass and a tensor (kept as given, as the
-        // peers do, when the tensor is one a body could have).
-        return check_allowing_zero_mass(props, &tolerance)
-            .map(|()| *props)
-            .map_err(|e| format!("link \"{}\": {e}", link.name));
-    }
-    let Err(error) = check(props, &tolerance) else {
+    let Err(error) = check(&judged, &tolerance) else {
         return Ok(*props);
     };
-    match repair(props, &tolerance) {
+    match repair(&judged, &tolerance).map(|(fixed, report)| (as_given(fixed), report)) {
         Ok((fixed, report)) if report.change_norm <= rounding => {
             notes.push(format!(
                 "link \"{}\": inertia off by rounding ({:.1e} kg·m², below {ROBOT_ROUNDING:.0e} of the robot's \

@@ -189,18 +189,42 @@ fn attribute(attributes: &str, wanted: &str) -> Option<String> {
     None
 }
 
-/// `value` with XML's predefined entities replaced (character references are left as written).
+/// `value` with XML's predefined entities and character references (`&#38;`, `&#x26;`)
+/// replaced; any other `&…;` is left as written.
 fn unescaped(value: &str) -> String {
-    if !value.contains('&') {
-        return value.to_string();
+    let mut text = String::with_capacity(value.len());
+    let mut rest = value;
+    while let Some(at) = rest.find('&') {
+        text.push_str(&rest[..at]);
+        let reference = &rest[at + 1..];
+        let decoded = reference.find(';').and_then(|end| {
+            let name = &reference[..end];
+            let character = match name {
+                "lt" => Some('<'),
+                "gt" => Some('>'),
+                "quot" => Some('"'),
+                "apos" => Some('\''),
+                "amp" => Some('&'),
+                _ => name
+                    .strip_prefix("#x")
+                    .map(|hex| u32::from_str_radix(hex, 16))
+                    .or_else(|| name.strip_prefix('#').map(str::parse))
+                    .and_then(Result::ok)
+                    .and_then(char::from_u32),
+            };
+            character.map(|c| (c, end))
+        });
+        match decoded {
+            Some((c, end)) => {
+                text.push(c);
+                rest = &reference[end + 1..];
+            }
+            None => {
+                text.push('&');
+                rest = reference;
+            }
+        }
     }
-    [
-        ("&lt;", "<"),
-        ("&gt;", ">"),
-        ("&quot;", "\""),
-        ("&apos;", "'"),
-        ("&amp;", "&"),
-    ]
-    .iter()
-    .fold(value.to_string(), |text, (entity, plain)| text.replace(entity, plain))
+    text.push_str(rest);
+    text
 }

@@ -3,6 +3,7 @@
 //! resolved against the package's directory, declared zero-mass `<inertial>` elements, and empty
 //! robots.
 
+use mechanica_mass::MassProperties;
 use mechanica_mass::validity::{ValidityTolerance, check};
 use mechanica_urdf::{UrdfError, UrdfOptions, read_file, read_str};
 use std::path::{Path, PathBuf};
@@ -211,20 +212,31 @@ fn deep_nesting_is_refused_and_markup_is_read_as_xml() {
 
 #[test]
 fn a_declared_inertial_of_zero_mass_is_followed_and_only_a_missing_one_takes_the_mesh() {
-    // Four tool links with the same mesh: one declares a zero-mass <inertial> (with a small
-    // tensor, as exporters write for massless feet), one whose name needs an entity declares
-    // it too, one has an <inertial> only inside a comment and one only inside a <gazebo>
-    // block naming it. Only the last two take the mesh's mass.
+    // Tool links with the same mesh: one declares a zero-mass <inertial> (with a small tensor,
+    // as exporters write for massless feet), so do two whose names need an entity or a
+    // character reference and one whose tensor has a product of inertia of 1e-20 (rounding
+    // noise, set to the nearest physical tensor); one has an <inertial> only inside a comment
+    // and one only inside a <gazebo> block naming it. Only the last two take the mesh's mass.
     let dir = scratch("declared");
     let edge = 0.2;
     std::fs::write(dir.join("tool.stl"), corner_tetrahedron_stl(edge)).expect("mesh");
     let mesh = r#"<collision><geometry><mesh filename="tool.stl"/></geometry></collision>"#;
     let zero = r#"<inertial><origin xyz="0 0 1e-3" rpy="0 0 0"/><mass value="0.0"/>
         <inertia ixx="5.7e-7" ixy="0" ixz="0" iyy="8.4e-7" iyz="0" izz="5.3e-7"/></inertial>"#;
-    let mut text = String::from("<robot name=\"r\">\n<link name=\"base\"/>\n");
+    let mut text = String::from(
+        "<robot name=\"r\">\n<link name=\"base\"><inertial><mass value=\"1\"/>\
+         <inertia ixx=\"1e-3\" ixy=\"0\" ixz=\"0\" iyy=\"1e-3\" iyz=\"0\" izz=\"1e-3\"/></inertial></link>\n",
+    );
     let links = [
         ("foot", format!("{zero}{mesh}")),
         ("foot&amp;toe", format!("\n  {zero}\n  {mesh}")),
+        ("foot&#38;heel", format!("{zero}{mesh}")),
+        (
+            "noisy",
+            format!(
+                r#"<inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="1e-20" iyy="0" iyz="0" izz="0"/></inertial>{mesh}"#
+            ),
+        ),
         ("commented", format!("<!-- {zero} -->{mesh}")),
         ("gazebo_only", mesh.to_string()),
     ];
@@ -249,11 +261,24 @@ fn a_declared_inertial_of_zero_mass_is_followed_and_only_a_missing_one_takes_the
             .unwrap_or_else(|| panic!("{name}"));
         link.mass
     };
-    for name in ["foot", "foot&toe"] {
+    for name in ["foot", "foot&toe", "foot&heel"] {
         let props = mass_of(name);
         assert_eq!(props.mass, 0.0, "{name}");
         assert_eq!(props.inertia_c[(1, 1)], 8.4e-7, "{name}: the declared tensor is kept");
     }
+    // Eigenvalues ±1e-20: no body has that tensor, but it is the file's rounding.
+    let noisy = mass_of("noisy");
+    assert_eq!(noisy.mass, 0.0);
+    assert!(check(&MassProperties { mass: 1.0, ..noisy }, &ValidityTolerance::default()).is_ok());
+    assert!(noisy.inertia_c.amax() <= 1e-19, "{noisy:?}");
+    assert!(
+        robot
+            .notes
+            .iter()
+            .any(|n| n.contains("\"noisy\"") && n.contains("rounding")),
+        "{:?}",
+        robot.notes
+    );
     let mesh_mass = 1000.0 * edge * edge * edge / 6.0;
     for name in ["commented", "gazebo_only"] {
         let props = mass_of(name);

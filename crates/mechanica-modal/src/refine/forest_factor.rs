@@ -12,8 +12,8 @@
 //! [`GROWTH_LIMIT`] times the row sum Σ_j |k_ij|, since the factorization is the exact one of
 //! a K + ΔK with |ΔK| ≤ γ_n |L||D||Lᵀ| (Higham, *Accuracy and Stability of Numerical
 //! Algorithms*, 2nd ed., Theorem 9.3 for LU without pivoting, with U = DLᵀ; no definiteness is
-//! needed) and that growth is the diagonal of |L||D||Lᵀ|. The caller then uses the LU with partial pivoting. The
-//! factor only drives Newton steps whose residuals are measured in double-double, so its
+//! needed), and that growth is what |L||D||Lᵀ| adds to |d_i| on its diagonal. The caller
+//! then uses the LU with partial pivoting. The factor only drives Newton steps whose residuals are measured in double-double, so its
 //! accuracy decides how fast they converge, never what they converge to.
 
 use faer::sparse::SymbolicSparseColMatRef;
@@ -32,7 +32,8 @@ pub(crate) struct ForestPattern {
 }
 
 impl ForestPattern {
-    /// None when the off-diagonal pattern has a cycle or is not symmetric.
+    /// None when the off-diagonal pattern has a cycle or an odd number of entries. The pattern
+    /// is read as symmetric (each coupling serves L and Lᵀ): A and B are symmetrised before.
     pub(crate) fn of(pattern: SymbolicSparseColMatRef<'_, usize>) -> Option<Self> {
         let n = pattern.ncols();
         let mut starts = Vec::with_capacity(n + 1);
