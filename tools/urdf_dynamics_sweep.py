@@ -37,6 +37,14 @@ Printed per robot, the worst over its three states of
              may cause. A rel_aba of the order of sens (or below) is the conditioning of the
              problem, not a disagreement: with tau dominated by gravity (|tau| >> |A qdd|) and
              light distal links, sens reaches 1e-11 and more.
+and, at the zero configuration at rest under gravity alone (q = 0 in mechanica's
+coordinates, where files often place singular configurations: iCub's neck at q = 0 leaves
+point masses that its joints together do not move),
+  q0_route   the route mech_dynamics_forward took there (aba, or crba: the mass matrix)
+  q0_rel     |qdd - qdd_pin|_inf / |qdd_pin|_inf of that route's answer
+  q0_est     its reported error estimate / |qdd|_inf (crba route only; '-' for aba, which
+             reports a backward error alone): above q0_rel wherever the report is true,
+             above 1 where it says that q-ddot has no correct digit
 with |.| the Euclidean norm (2-norm for matrices). Each robot runs in a child process with a
 time limit, so a crash or a hang is reported on its line instead of stopping the sweep. Links
 without <inertial> whose mesh gives them mass in mechanica (1000 kg/m^3) are massless in
@@ -173,11 +181,11 @@ class Robot:
         return self._evaluate(self.mech.lib.mech_dynamics_aba, q, qd, tau)
 
     def forward(self, q, qd, tau):
-        """q-ddot of the checked route (t = 0) and the route's method (0 ABA, 1 mass matrix)."""
+        """q-ddot of the checked route (t = 0) and its report (method 0 ABA, 1 mass matrix)."""
         report = ForwardReport()
         qdd = self._evaluate(self.mech.lib.mech_dynamics_forward, q, qd, tau, ctypes.c_double(0.0),
                              ctypes.byref(report))
-        return qdd, report.method
+        return qdd, report
 
     def close(self):
         self.mech.lib.mech_dynamics_destroy(self.dynamics)
@@ -245,8 +253,8 @@ def compare(lib_path, urdf, seed_sequence):
 
             rnea_mech = robot.rnea(q_mech, qd, qdd)
             aba_mech = robot.aba(q_mech, qd, tau)
-            fwd_mech, method = robot.forward(q_mech, qd, tau)
-            methods.add(method)
+            fwd_mech, report = robot.forward(q_mech, qd, tau)
+            methods.add(report.method)
             for value in (rnea_mech, aba_mech, fwd_mech):
                 if not np.all(np.isfinite(value)):
                     return {'error': 'non-finite result with status OK'}
@@ -266,12 +274,30 @@ def compare(lib_path, urdf, seed_sequence):
             sens = U / singular_values[-1] * (singular_values[0] * np.linalg.norm(aba_ref) + bias)
             worst['sens'] = max(worst['sens'], sens / np.linalg.norm(aba_ref))
         worst['nv'] = robot.n
-        worst['route'] = '+'.join({0: 'aba', 1: 'crba'}.get(m, str(m)) for m in sorted(methods)) or '-'
+        worst['route'] = '+'.join(ROUTES.get(m, str(m)) for m in sorted(methods)) or '-'
+        worst.update(at_zero(robot, model, data, names, index))
         return worst
     except MechanicaError as error:
         return {'error': str(error).splitlines()[0]}
     finally:
         robot.close()
+
+
+ROUTES = {0: 'aba', 1: 'crba'}
+
+
+def at_zero(robot, model, data, names, index):
+    """The checked forward dynamics at q = 0, at rest, under gravity alone, against pin.aba."""
+    if not robot.n:
+        return dict(q0_route='-', q0_rel=0.0, q0_est=None)
+    zero = np.zeros(robot.n)
+    qdd, report = robot.forward(zero, zero, zero)
+    q_pin = pinocchio_state(model, names, zero)
+    reference = pin.aba(model, data, q_pin, np.zeros(model.nv), np.zeros(model.nv)).copy()[index]
+    scale = max(np.abs(reference).max(), 1e-300)
+    estimate = report.error_estimate / max(np.abs(qdd).max(), 1e-300) if report.method == 1 else None
+    return dict(q0_route=ROUTES.get(report.method, str(report.method)),
+                q0_rel=float(np.abs(qdd - reference).max() / scale), q0_est=estimate)
 
 
 def mesh_mass(exe, urdf):
@@ -300,7 +326,7 @@ def main():
           f'{STATES} random states per robot, seed {SEED}')
     print('# worst over the states of |x - x_pin| / |x_pin| (2-norms); bwd_*: |rnea_pin(q, v, qdd) - tau| / |tau|; '
           'sens: forward error from rounding the data (see the docstring)')
-    print('# robot nv rel_rnea rel_aba rel_fwd bwd_aba bwd_pin sens fwd_route note')
+    print('# robot nv rel_rnea rel_aba rel_fwd bwd_aba bwd_pin sens fwd_route q0_route q0_rel q0_est note')
     for number, urdf in enumerate(sorted(glob.glob(os.path.join(robots_dir(), '**', '*.urdf'), recursive=True))):
         name = os.path.relpath(urdf, robots_dir())
         # Each robot draws from its own stream (SEED, file number): adding a file does not
@@ -309,23 +335,25 @@ def main():
         try:
             run = subprocess.run(command, capture_output=True, text=True, timeout=TIME_LIMIT)
         except subprocess.TimeoutExpired:
-            print(f'{name} - - - - - - - - HANG: no answer in {TIME_LIMIT} s')
+            print(f'{name} - - - - - - - - - - - HANG: no answer in {TIME_LIMIT} s')
             continue
         lines = run.stdout.strip().splitlines()
         if run.returncode != 0 or not lines:
             why = (run.stderr.strip().splitlines() or [f'exit status {run.returncode}'])[-1]
-            print(f'{name} - - - - - - - - CRASH: {why[:120]}')
+            print(f'{name} - - - - - - - - - - - CRASH: {why[:120]}')
             continue
         result = json.loads(lines[-1])
         if 'refused' in result:
-            print(f'{name} - - - - - - - - refused: {result["refused"].split(urdf + ": ", 1)[-1][:110]}')
+            print(f'{name} - - - - - - - - - - - refused: {result["refused"].split(urdf + ": ", 1)[-1][:110]}')
             continue
         if 'error' in result:
-            print(f'{name} - - - - - - - - ERROR: {result["error"][:120]}')
+            print(f'{name} - - - - - - - - - - - ERROR: {result["error"][:120]}')
             continue
         note = 'mesh mass' if os.path.exists(exe) and mesh_mass(exe, urdf) else ''
+        estimate = '-' if result['q0_est'] is None else f'{result["q0_est"]:.1e}'
         print(f'{name} {result["nv"]} {result["rnea"]:.1e} {result["aba"]:.1e} {result["fwd"]:.1e} '
-              f'{result["bwd_aba"]:.1e} {result["bwd_pin"]:.1e} {result["sens"]:.1e} {result["route"]} {note}'.rstrip())
+              f'{result["bwd_aba"]:.1e} {result["bwd_pin"]:.1e} {result["sens"]:.1e} {result["route"]} '
+              f'{result["q0_route"]} {result["q0_rel"]:.1e} {estimate} {note}'.rstrip())
 
 
 if __name__ == '__main__':
