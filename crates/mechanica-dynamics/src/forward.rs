@@ -35,7 +35,7 @@ use crate::articulated::{
 };
 use crate::error::{DynamicsError, check_result, check_vector};
 use crate::model::{Dynamics, State};
-use nalgebra::{Matrix3, Vector3, Vector6};
+use nalgebra::{Vector3, Vector6};
 
 /// The smallest ratio of an articulated pivot to the subtree inertia behind it
 /// ([`Dynamics::has_weak_pivot`]) at which the checked forward dynamics keeps the articulated
@@ -276,7 +276,8 @@ impl Dynamics {
 
     /// q̈ for the applied forces `tau` at `state`: by the articulated-body algorithm when the
     /// inverse dynamics confirms it to the rounding level and A(q) is not ill-conditioned by
-    /// the articulated pivots' measure, by the mass matrix otherwise (module docs). Fails with [`DynamicsError::SingularMassMatrix`] when A(q) is singular.
+    /// the articulated pivots' measure, by the mass matrix otherwise (module docs). Fails with
+    /// [`DynamicsError::SingularMassMatrix`] when A(q) is singular.
     pub fn forward_dynamics(&mut self, state: &State<'_>, tau: &[f64]) -> Result<ForwardDynamics, DynamicsError> {
         let n = self.dof();
         check_vector(tau, n, "tau")?;
@@ -304,41 +305,28 @@ impl Dynamics {
 
     /// Whether some joint's articulated pivot, 1/(D⁻¹)_aa of the last recursion, is below
     /// [`WEAK_PIVOT`] times sᵀIᶜs, the composite rigid inertia of the subtree it moves along
-    /// that motion column s = (w, v): wᵀI_o w + 2v·(w × h) + M|v|², with M, h and I_o the
-    /// subtree's mass, first moment and rotational inertia about the joint's body origin, which
-    /// is the diagonal entry A_kk of the mass matrix. The pivots are those of an LDLᵀ of A(q)
+    /// that motion column s = (w, v), with Iᶜ the subtree's spatial inertia about the joint's
+    /// body origin (the bodies' inertias shifted and summed, as the composite-rigid-body
+    /// algorithm does): the diagonal entry A_kk of the mass matrix. The pivots are those of an LDLᵀ of A(q)
     /// (eliminated from the leaves), each at least λ_min(A), and A_kk ≤ λ_max(A): a ratio below
     /// √u means κ₂(A) above 1/√u (a point mass near its joint's axis, or joints that together
     /// move nothing), where a small backward error says nothing of the forward error.
     fn has_weak_pivot(&self) -> Result<bool, DynamicsError> {
         let tree = self.mechanism.tree();
-        let mut mass: Vec<f64> = self.world.iter().map(|w| w.mass).collect();
-        let mut moment: Vec<Vector3<f64>> = self.world.iter().map(|w| w.c * w.mass).collect();
-        let mut inertia: Vec<Matrix3<f64>> = self
-            .world
-            .iter()
-            .map(|w| w.inertia_c + point_inertia(&w.c) * w.mass)
-            .collect();
+        let mut composite: Vec<nalgebra::Matrix6<f64>> = self.world.iter().map(body_inertia).collect();
         for &i in tree.topological_order().iter().rev() {
             let d_inverse = &self.articulated.d_inverse[i];
             for (a, k) in tree.dof_range(i).enumerate() {
                 let (w, v) = self.ws.motion_column(k)?;
-                let composite =
-                    w.dot(&(inertia[i] * w)) + 2.0 * v.dot(&w.cross(&moment[i])) + mass[i] * v.norm_squared();
+                let s = motion_vector(&w, &v);
                 let pivot = 1.0 / d_inverse[(a, a)];
-                if pivot.is_nan() || pivot <= WEAK_PIVOT * composite {
+                if pivot.is_nan() || pivot <= WEAK_PIVOT * s.dot(&(composite[i] * s)) {
                     return Ok(true);
                 }
             }
             if let Some(p) = tree.parent(i) {
-                // About the parent's origin, d = o_i − o_p: I + 2(h·d)1 − (h dᵀ + d hᵀ) + M S(d).
-                let (d, h, m) = (self.ws.parent_offset(i)?, moment[i], mass[i]);
-                let shifted = inertia[i] + Matrix3::identity() * (2.0 * h.dot(&d))
-                    - (h * d.transpose() + d * h.transpose())
-                    + point_inertia(&d) * m;
-                inertia[p] += shifted;
-                moment[p] += h + d * m;
-                mass[p] += m;
+                let shifted = shifted_inertia(&composite[i], &self.ws.parent_offset(i)?);
+                composite[p] += shifted;
             }
         }
         Ok(false)
@@ -368,9 +356,4 @@ impl Dynamics {
         let rounding = check_estimate.iter().fold(0.0f64, |m, e| m.max(*e));
         Ok((residual, eta, rounding))
     }
-}
-
-/// S(y) = |y|²1 − y yᵀ: the inertia tensor of a unit point mass at y about the origin.
-fn point_inertia(y: &Vector3<f64>) -> Matrix3<f64> {
-    Matrix3::identity() * y.norm_squared() - y * y.transpose()
 }
