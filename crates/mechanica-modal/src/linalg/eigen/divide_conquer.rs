@@ -26,6 +26,7 @@
 //! root finder is scalar, so that most of its time goes outside the matrix products (measured
 //! in docs/benchmarks.md).
 
+use crate::linalg::norms::fast_hypot;
 use crate::runtime::fork_join::join;
 use crate::tuning::Tuning;
 use faer::linalg::matmul::matmul;
@@ -290,7 +291,7 @@ impl Deflation<'_, '_> {
                 continue;
             }
             if let Some(&j) = kept.last() {
-                let tau = z[j].hypot(z[c]);
+                let tau = fast_hypot(z[j], z[c]);
                 let (cos, sin) = (z[c] / tau, -z[j] / tau);
                 if ((d[c] - d[j]) * cos * sin).abs() <= tol {
                     // Rotate columns j and c so that z_j = 0: G = [cos sin; −sin cos] on (j, c).
@@ -925,14 +926,14 @@ fn solve_leaf(d: &mut [f64], e: &[f64], mut u: MatMut<'_, f64>, order: &mut [usi
             }
             // Wilkinson's shift from the leading 2×2 block, as an implicit QL sweep from m to l.
             let g0 = (d[l + 1] - d[l]) / (2.0 * off[l]);
-            let r0 = g0.hypot(1.0);
+            let r0 = fast_hypot(g0, 1.0);
             let mut g = d[m] - d[l] + off[l] / (g0 + r0.copysign(g0));
             let (mut sin, mut cos, mut p) = (1.0, 1.0, 0.0);
             let mut deflated_early = false;
             for i in (l..m).rev() {
                 let f = sin * off[i];
                 let b = cos * off[i];
-                let r = f.hypot(g);
+                let r = fast_hypot(f, g);
                 off[i + 1] = r;
                 if r == 0.0 {
                     d[i + 1] -= p;
