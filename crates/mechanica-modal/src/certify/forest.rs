@@ -32,6 +32,7 @@
 use faer::MatRef;
 
 use crate::dd::Dd;
+use crate::linalg::forest_order::leaves_first;
 use crate::linalg::powers_of_two::{exponent, times_power_of_two};
 
 /// Scaled entries below this magnitude are not squared (their squares would be subnormal).
@@ -268,38 +269,11 @@ impl Forest {
             neighbours[i].push((j, value));
             neighbours[j].push((i, value));
         }
-        let mut parent: Vec<Option<(usize, f64)>> = vec![None; n];
-        let mut seen = vec![false; n];
-        let mut order = Vec::with_capacity(n);
-        for root in 0..n {
-            if seen[root] {
-                continue;
-            }
-            seen[root] = true;
-            let start = order.len();
-            order.push(root);
-            let mut next = start;
-            while next < order.len() {
-                let node = order[next];
-                next += 1;
-                for &(other, value) in &neighbours[node] {
-                    if parent[node].is_some_and(|(p, _)| p == other) {
-                        continue;
-                    }
-                    if seen[other] {
-                        return None; // a second path to `other`: a cycle
-                    }
-                    seen[other] = true;
-                    parent[other] = Some((node, value));
-                    order.push(other);
-                }
-            }
-        }
-        order.reverse();
+        let (leaves_first, parent) = leaves_first(n, std::iter::empty(), |v| &neighbours[v])?;
         Some(Self {
             edges,
             parent,
-            leaves_first: order,
+            leaves_first,
         })
     }
 

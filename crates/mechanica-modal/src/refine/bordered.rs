@@ -61,18 +61,19 @@ pub(crate) fn refine_pair_sparse(
 }
 
 /// K = B − sA for a pencil whose A and B both have few nonzeros: the union of their patterns
-/// with both values on it, its LU symbolic analysis (column ordering, structure) and, when the
-/// pattern is a forest, its tree structure, found once for every shift of a refinement stage.
+/// with both values on it, its LU symbolic analysis (column ordering, structure; formed at the
+/// first LU, which a forest whose factors all succeed never needs) and, when the pattern is a
+/// forest, its tree structure, found once for every shift of a refinement stage.
 pub(crate) struct SparseShifts {
     pattern: faer::sparse::SymbolicSparseColMat<usize>,
     b_values: Vec<f64>,
     a_values: Vec<f64>,
-    symbolic: faer::sparse::linalg::solvers::SymbolicLu<usize>,
+    symbolic: std::sync::OnceLock<Option<faer::sparse::linalg::solvers::SymbolicLu<usize>>>,
     forest: Option<ForestPattern>,
 }
 
 impl SparseShifts {
-    /// None when A or B is dense, or the symbolic analysis fails.
+    /// None when A or B is dense.
     pub(crate) fn new(a: &Operand<'_>, b: &Operand<'_>) -> Option<Self> {
         let n = a.matrix().nrows();
         let mut column_starts = Vec::with_capacity(n + 1);
@@ -95,18 +96,18 @@ impl SparseShifts {
             column_starts.push(rows.len());
         }
         let pattern = faer::sparse::SymbolicSparseColMat::new_checked(n, n, column_starts, None, rows);
-        let symbolic = faer::sparse::linalg::solvers::SymbolicLu::try_new(pattern.as_ref()).ok()?;
         let forest = ForestPattern::of(pattern.as_ref());
         Some(Self {
             pattern,
             b_values,
             a_values,
-            symbolic,
+            symbolic: std::sync::OnceLock::new(),
             forest,
         })
     }
 
-    /// The LU factorization with partial pivoting of B − shift·A; None if it fails.
+    /// The LU factorization with partial pivoting of B − shift·A; None if it or the symbolic
+    /// analysis fails.
     fn lu(&self, shift: f64) -> Option<ShiftedFactor> {
         let values: Vec<f64> = self
             .b_values
@@ -115,7 +116,11 @@ impl SparseShifts {
             .map(|(b, a)| b - shift * a)
             .collect();
         let k = faer::sparse::SparseColMatRef::new(self.pattern.as_ref(), &values);
-        let lu = faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(self.symbolic.clone(), k).ok()?;
+        let symbolic = self
+            .symbolic
+            .get_or_init(|| faer::sparse::linalg::solvers::SymbolicLu::try_new(self.pattern.as_ref()).ok())
+            .clone()?;
+        let lu = faer::sparse::linalg::solvers::Lu::try_new_with_symbolic(symbolic, k).ok()?;
         Some(ShiftedFactor::Lu(Box::new(lu)))
     }
 

@@ -16,6 +16,7 @@
 //! then uses the LU with partial pivoting. The factor only drives Newton steps whose residuals are measured in double-double, so its
 //! accuracy decides how fast they converge, never what they converge to.
 
+use crate::linalg::forest_order::{ForestOrder, leaves_first};
 use faer::sparse::SymbolicSparseColMatRef;
 
 /// Largest element growth, relative to the row sums of |K|, of an accepted factor: 2²⁰, a
@@ -107,37 +108,8 @@ impl ForestPattern {
     /// An elimination order with every coordinate before its parent, the tree of `root` rooted
     /// there, and each coordinate's parent with the position of their coupling; None when a
     /// coordinate is reached twice (a cycle).
-    #[allow(clippy::type_complexity)]
-    fn leaves_first(&self, root: usize) -> Option<(Vec<usize>, Vec<Option<(usize, usize)>>)> {
-        let n = self.diagonal.len();
-        let mut parent: Vec<Option<(usize, usize)>> = vec![None; n];
-        let mut seen = vec![false; n];
-        let mut order = Vec::with_capacity(n);
-        for start in std::iter::once(root).chain(0..n).filter(|&s| s < n) {
-            if seen[start] {
-                continue;
-            }
-            seen[start] = true;
-            let mut next = order.len();
-            order.push(start);
-            while next < order.len() {
-                let node = order[next];
-                next += 1;
-                for &(other, p) in self.neighbours_of(node) {
-                    if parent[node].is_some_and(|(up, _)| up == other) {
-                        continue;
-                    }
-                    if seen[other] {
-                        return None;
-                    }
-                    seen[other] = true;
-                    parent[other] = Some((node, p));
-                    order.push(other);
-                }
-            }
-        }
-        order.reverse();
-        Some((order, parent))
+    fn leaves_first(&self, root: usize) -> Option<ForestOrder<usize>> {
+        leaves_first(self.diagonal.len(), std::iter::once(root), |i| self.neighbours_of(i))
     }
 }
 
