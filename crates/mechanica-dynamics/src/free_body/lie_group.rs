@@ -84,7 +84,8 @@ pub struct LieEstimate {
     /// The run with 2n steps.
     pub solution: LieSolution,
     /// The estimated geodesic angle ‖log(R_exactᵀ R_2n)‖ (rad), at most π plus the rounding
-    /// allowance 2n·ε; see [`super::estimate`] for how it is formed.
+    /// allowance 2n·ε·(1 + θ), θ the largest angle the body can sweep; see [`super::estimate`]
+    /// for how it is formed.
     pub attitude_error: f64,
     /// The estimated ‖ω_2n − ω_exact‖/‖ω_exact‖.
     pub omega_error: f64,
@@ -177,7 +178,7 @@ impl LieIntegrator {
         let half = self.half_run(r0, omega0, duration, steps);
         let coarse = self.run(r0, omega0, duration, steps)?;
         let fine = self.run(r0, omega0, duration, 2 * steps)?;
-        Ok(self.estimate(half_of(&half), &coarse, fine, omega0))
+        Ok(self.estimate(half_of(&half), &coarse, fine, omega0, duration))
     }
 
     /// The runs with n₀, 2n₀, 4n₀, … steps until the estimate of [`Self::integrate_with_estimate`]
@@ -212,7 +213,7 @@ impl LieIntegrator {
         let (mut previous, mut stalled, mut doublings) = (f64::INFINITY, 0, 0);
         loop {
             let fine = self.run(r0, omega0, duration, 2 * steps)?;
-            let estimate = self.estimate(half_of(&half), &coarse, fine.clone(), omega0);
+            let estimate = self.estimate(half_of(&half), &coarse, fine.clone(), omega0, duration);
             let worst = estimate.attitude_error.max(estimate.omega_error);
             if worst <= tolerance {
                 return Ok(estimate);
@@ -262,9 +263,10 @@ impl LieIntegrator {
         coarse: &LieSolution,
         fine: LieSolution,
         omega0: &Vector3<f64>,
+        duration: f64,
     ) -> LieEstimate {
         let runs = Runs { half, coarse, fine };
-        estimate(runs, self.method.order(), &self.moments, omega0)
+        estimate(runs, self.method.order(), &self.moments, omega0, duration)
     }
 
     /// `steps` equal steps over `duration` from a validated state.
