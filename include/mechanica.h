@@ -320,8 +320,10 @@ typedef struct mech_forward_report_t {
      */
     double condition;
     /**
-     * A first-order estimate of the ∞-norm error of q̈, ‖A⁻¹‖∞ (‖r‖∞ + ρ) with ρ the rounding
-     * estimate of the check, when the mass matrix was formed; else −1. An estimate, not a bound.
+     * A first-order estimate of the ∞-norm error of q̈, ‖A⁻¹‖∞ (‖r‖∞ + ρ) / (1 − n·κ∞·u) with
+     * ρ the rounding estimate of the check, when the mass matrix was formed; else −1. +∞
+     * (HUGE_VAL) when n·κ∞·u ≥ 1/2: A is singular to working precision and q̈ may have no
+     * correct digit. An estimate, not a bound.
      */
     double error_estimate;
     /**

@@ -68,9 +68,11 @@ pub struct ForwardDynamics {
     pub backward_error: f64,
     /// κ∞(A) = ‖A‖∞ ‖A⁻¹‖∞, when the mass matrix was formed (the CRBA route).
     pub condition: Option<f64>,
-    /// The first-order estimate ‖A⁻¹‖∞ (‖r‖∞ + ρ) of the error of q̈ (∞-norm), ρ the largest
-    /// rounding estimate of the inverse dynamics that evaluated r; when the mass matrix was
-    /// formed.
+    /// The first-order estimate ‖A⁻¹‖∞ (‖r‖∞ + ρ) / (1 − n·κ∞·u) of the error of q̈ (∞-norm),
+    /// ρ the largest rounding estimate of the inverse dynamics that evaluated r and ‖A⁻¹‖∞ that
+    /// of the computed Cholesky factor (the division allows for its error); when the mass
+    /// matrix was formed. +∞ when n·κ∞·u ≥ 1/2: A is singular to working precision and q̈
+    /// may have no correct digit.
     pub error_estimate: Option<f64>,
     /// The dissipation function D of the dampers, W.
     pub dissipation: f64,
@@ -343,7 +345,7 @@ impl Dynamics {
         // τ and its rounding estimate only: the split of the full inverse dynamics is not needed.
         self.update_state(state)?;
         self.rnea_state(state, q_ddot, false)?;
-        let (_, check_tau, check_estimate) = self.joint_forces_with_estimate()?;
+        let (_, check_tau, check_estimate) = self.joint_forces_with_estimate(q_ddot)?;
         let residual: Vec<f64> = tau.iter().zip(&check_tau).map(|(t, c)| t - c).collect();
         let scale = check_estimate
             .iter()

@@ -179,7 +179,7 @@ impl Dynamics {
         let velocity_product = self.velocity_product_terms()?;
         let gravity = self.gravity_terms()?;
         let (dissipation, loads) = self.rnea_state(state, q_ddot, true)?;
-        let (transmitted, tau, error_estimate) = self.joint_forces_with_estimate()?;
+        let (transmitted, tau, error_estimate) = self.joint_forces_with_estimate(q_ddot)?;
         let reactions = transmitted
             .iter()
             .enumerate()
@@ -203,13 +203,13 @@ impl Dynamics {
         16.0 * (depth as f64 + 4.0) * f64::EPSILON
     }
 
-    /// From the body wrenches of the last `rnea_state`: the transmitted wrenches, τ and its
-    /// rounding estimate per coordinate (see [`InverseDynamics::error_estimate`]).
-    pub(crate) fn joint_forces_with_estimate(&self) -> Result<JointForces, DynamicsError> {
+    /// From the body wrenches of the last `rnea_state` at `q_ddot`: the transmitted wrenches, τ
+    /// and its rounding estimate per coordinate (see [`InverseDynamics::error_estimate`]).
+    pub(crate) fn joint_forces_with_estimate(&self, q_ddot: &[f64]) -> Result<JointForces, DynamicsError> {
         let mut transmitted = self.wrenches.clone();
         let mut tau = vec![0.0; self.dof()];
         self.accumulate_to_joints(&mut transmitted, &mut tau)?;
-        let magnitudes = self.magnitudes()?;
+        let magnitudes = self.magnitudes(q_ddot)?;
         for (t, j) in tau.iter_mut().zip(&self.joint_loads) {
             *t -= j;
         }
@@ -248,19 +248,21 @@ impl Dynamics {
     }
 
     /// Per coordinate, the scale of τ_k's rounding: the products of the norms of everything the
-    /// transmitted wrench is summed from (a running-error estimate). The norms are 1-norms: they
-    /// bound the Euclidean ones and, unlike a sum of squares, neither underflow for forces near
-    /// 1e-300 nor overflow near 1e200. Needs the accelerations of the last `rnea_state` in the
-    /// workspace and the loads in `self.loads`.
-    fn magnitudes(&self) -> Result<Vec<f64>, DynamicsError> {
+    /// transmitted wrench is summed from (a running-error estimate). Body motions enter by the
+    /// sums of magnitudes of the terms they are accumulated from ([`Dynamics::motion_magnitudes`]),
+    /// not by their computed values, which cancel when joint rates or accelerations of opposite
+    /// signs nearly annul each other. The norms are 1-norms: they bound the Euclidean ones and,
+    /// unlike a sum of squares, neither underflow for forces near 1e-300 nor overflow near
+    /// 1e200. Needs the accelerations of the last `rnea_state` at `q_ddot` in the workspace and
+    /// the loads in `self.loads`.
+    fn magnitudes(&self, q_ddot: &[f64]) -> Result<Vec<f64>, DynamicsError> {
         let tree = self.mechanism.tree();
         let g = self.gravity().lp_norm(1);
+        let motion = self.motion_magnitudes(q_ddot)?;
         let bodies = self.world.len();
         let (mut f_mag, mut m_mag) = (vec![0.0; bodies], vec![0.0; bodies]);
         for (i, body) in self.world.iter().enumerate() {
-            let w = self.ws.angular_velocity(i)?.lp_norm(1);
-            let wd = self.ws.angular_acceleration(i)?.lp_norm(1);
-            let a = self.ws.origin_acceleration(i)?.lp_norm(1);
+            let MotionMagnitude { w, wd, a, .. } = motion[i];
             let c = body.c.lp_norm(1);
             f_mag[i] = body.mass * (a + (wd + w * w) * c + g) + self.loads[i].force.lp_norm(1);
             m_mag[i] = body.inertia_c.lp_norm(1) * (wd + w * w) + c * f_mag[i] + self.loads[i].moment.lp_norm(1);
@@ -279,6 +281,57 @@ impl Dynamics {
         }
         Ok(out)
     }
+
+    /// Per body, the sums of the 1-norms of the terms that the forward recursion adds into its
+    /// angular velocity ω, origin velocity v, angular acceleration ω̇ and origin acceleration a
+    /// (the base's own motion, each joint's columns times |q̇_k| and |q̈_k|, and the transport
+    /// terms ω̇_P × r and ω_P × (v − v_P)), using |x × y|₁ ≤ |x|₁|y|₁. They bound the computed
+    /// vectors' sizes and set the scale of their rounding.
+    fn motion_magnitudes(&self, q_ddot: &[f64]) -> Result<Vec<MotionMagnitude>, DynamicsError> {
+        let tree = self.mechanism.tree();
+        let base = self.ws.base();
+        let at_base = MotionMagnitude {
+            w: base.omega.lp_norm(1),
+            v: base.velocity.lp_norm(1),
+            wd: base.omega_dot.lp_norm(1),
+            a: base.acceleration.lp_norm(1),
+        };
+        let q_dot = self.ws.q_dot();
+        let mut out = vec![at_base; self.world.len()];
+        for &b in tree.topological_order() {
+            let parent = tree.parent(b).map_or(at_base, |p| out[p]);
+            let r = self.ws.parent_offset(b)?.lp_norm(1);
+            let mut m = MotionMagnitude {
+                w: parent.w,
+                v: parent.v + parent.w * r,
+                wd: parent.wd,
+                a: parent.a + parent.wd * r,
+            };
+            for k in tree.dof_range(b) {
+                let (cw, cv) = self.ws.motion_column(k)?;
+                let (dw, dv) = self.ws.motion_column_rate(k)?;
+                let (rate, acceleration) = (q_dot[k].abs(), q_ddot[k].abs());
+                m.w += cw.lp_norm(1) * rate;
+                m.v += cv.lp_norm(1) * rate;
+                m.wd += dw.lp_norm(1) * rate + cw.lp_norm(1) * acceleration;
+                m.a += dv.lp_norm(1) * rate + cv.lp_norm(1) * acceleration;
+            }
+            // ω_P × (v − v_P), with v − v_P formed from the two computed velocities.
+            m.a += parent.w * (m.v + parent.v);
+            out[b] = m;
+        }
+        Ok(out)
+    }
+}
+
+/// Sums of the magnitudes of the terms of one body's ω, v, ω̇ and a
+/// ([`Dynamics::motion_magnitudes`]).
+#[derive(Debug, Clone, Copy)]
+struct MotionMagnitude {
+    w: f64,
+    v: f64,
+    wd: f64,
+    a: f64,
 }
 
 impl JointReaction {

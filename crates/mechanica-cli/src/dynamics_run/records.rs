@@ -27,7 +27,8 @@ pub struct ForwardRecord {
     pub backward_error: f64,
     /// κ∞(A), when estimated.
     pub condition: Option<f64>,
-    /// Estimated relative error of q̈ (κ times the backward error), when estimated.
+    /// Estimated ∞-norm error of q̈ (‖A⁻¹‖∞ times the residual and its rounding), when the
+    /// mass matrix was formed; +∞ (JSON null) where A is singular to working precision.
     pub error_estimate: Option<f64>,
     /// τ − RNEA(q, q̇, q̈), N·m | N.
     pub residual: Vec<f64>,
@@ -37,7 +38,13 @@ pub struct ForwardRecord {
 
 impl ForwardRecord {
     pub(crate) fn write_text(&self, out: &mut Text) {
-        let precision = Precision::Relative(self.error_estimate.unwrap_or(self.backward_error));
+        // The estimate is of the ∞-norm error (absolute); the articulated route has none, and
+        // its backward error says nothing of q̈'s digits when A is ill-conditioned.
+        let precision = match self.error_estimate {
+            Some(estimate) if estimate.is_finite() => Precision::Absolute(estimate),
+            Some(_) => Precision::Relative(f64::INFINITY),
+            None => Precision::Exact,
+        };
         out.named(
             "q̈ (forward dynamics)",
             &self.coordinates,
@@ -48,11 +55,16 @@ impl ForwardRecord {
         out.line(
             "method",
             &format!(
-                "{}; backward error {}{}",
+                "{}; backward error {}{}{}",
                 name_of(&self.method),
                 bound(self.backward_error),
                 self.condition
-                    .map_or(String::new(), |c| format!("; κ∞(A) = {}", bound(c)))
+                    .map_or(String::new(), |c| format!("; κ∞(A) = {}", bound(c))),
+                match self.error_estimate {
+                    Some(e) if e.is_finite() => format!("; estimated error of q̈ {}", bound(e)),
+                    Some(_) => "; A is singular to working precision: no digit of q̈ is assured".to_string(),
+                    None => "; forward error not estimated".to_string(),
+                }
             ),
         );
         out.values(

@@ -31,8 +31,10 @@ pub struct mech_forward_report_t {
     pub backward_error: f64,
     /// κ∞(A) = ‖A‖∞ ‖A⁻¹‖∞ when the mass matrix was formed (MECH_FORWARD_MASS_MATRIX), else −1.
     pub condition: f64,
-    /// A first-order estimate of the ∞-norm error of q̈, ‖A⁻¹‖∞ (‖r‖∞ + ρ) with ρ the rounding
-    /// estimate of the check, when the mass matrix was formed; else −1. An estimate, not a bound.
+    /// A first-order estimate of the ∞-norm error of q̈, ‖A⁻¹‖∞ (‖r‖∞ + ρ) / (1 − n·κ∞·u) with
+    /// ρ the rounding estimate of the check, when the mass matrix was formed; else −1. +∞
+    /// (HUGE_VAL) when n·κ∞·u ≥ 1/2: A is singular to working precision and q̈ may have no
+    /// correct digit. An estimate, not a bound.
     pub error_estimate: f64,
     /// The dampers' dissipation function D = ½ q̇ᵀ C q̇ at the state (W; 2D is the power they
     /// take out of the mechanism).
