@@ -336,7 +336,58 @@ static void rejected_arguments(void) {
     mech_dynamics_destroy(NULL);
 }
 
+/* A point mass d = 1e-6 … 1e-9 m from the second joint's axis, behind a 1 kg link: A is
+ * ill-conditioned up to singular to working precision. Every answer of the mass-matrix route
+ * has κ∞ ≥ 1 and an estimate that is finite, or +∞ (HUGE_VAL) exactly where n·κ∞·u ≥ 1/2; a
+ * refusal is MECH_STATUS_SINGULAR; and some d gives the +∞ answer through the boundary. */
+static mech_dynamics_t *near_axis_mass(double d) {
+    mech_tree_t *tree = NULL;
+    CHECK_STATUS(mech_tree_create(&tree), MECH_STATUS_OK);
+    const mech_vec3_t z = {0.0, 0.0, 1.0}, x = {1.0, 0.0, 0.0}, offset = {0.5, 0.0, 0.0};
+    size_t root = 99, tip = 99;
+    CHECK_STATUS(mech_tree_add_body(tree, -1, MECH_JOINT_REVOLUTE, &z, &IDENTITY, &ZERO, &root), MECH_STATUS_OK);
+    CHECK_STATUS(mech_tree_add_body(tree, (int64_t)root, MECH_JOINT_REVOLUTE, &x, &IDENTITY, &offset, &tip),
+                 MECH_STATUS_OK);
+    mech_mass_properties_t bodies[2];
+    memset(bodies, 0, sizeof bodies);
+    bodies[0].mass = 1.0;
+    bodies[0].center_of_mass.x = 0.25;
+    bodies[0].inertia_about_com.m[0] = bodies[0].inertia_about_com.m[4] = bodies[0].inertia_about_com.m[8] = 0.01;
+    bodies[1].mass = 0.5;
+    bodies[1].center_of_mass.x = 0.3;
+    bodies[1].center_of_mass.y = d;
+    const mech_vec3_t gravity = {0.0, 0.0, -9.81};
+    return dynamics_of(tree, bodies, 2, gravity);
+}
+
+static void singular_to_working_precision(void) {
+    const double q[2] = {0.3, 0.7}, qd[2] = {0.2, -0.1}, tau[2] = {0.4, 0.1};
+    const double u = 2.220446049250313e-16;
+    int infinite = 0;
+    for (int step = 0; step <= 60; ++step) {
+        mech_dynamics_t *d = near_axis_mass(pow(10.0, -6.0 - 0.05 * step));
+        double qdd[2] = {0.0, 0.0};
+        mech_forward_report_t report;
+        const mech_status_t status = mech_dynamics_forward_crba(d, q, qd, tau, 0.0, 2, qdd, &report);
+        CHECK(status == MECH_STATUS_OK || status == MECH_STATUS_SINGULAR);
+        if (status == MECH_STATUS_OK) {
+            CHECK(report.method == MECH_FORWARD_MASS_MATRIX && report.condition >= 1.0);
+            CHECK(isfinite(qdd[0]) && isfinite(qdd[1]));
+            if (report.error_estimate == HUGE_VAL) {
+                CHECK(2.0 * report.condition * u >= 0.5);
+                ++infinite;
+            } else {
+                CHECK(isfinite(report.error_estimate) && report.error_estimate >= 0.0);
+                CHECK(2.0 * report.condition * u < 0.5);
+            }
+        }
+        mech_dynamics_destroy(d);
+    }
+    CHECK(infinite > 0);
+}
+
 int main(void) {
+    singular_to_working_precision();
     pendulum_closed_forms();
     charge_in_fields();
     chain_round_trips();

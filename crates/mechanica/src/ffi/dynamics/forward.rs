@@ -116,12 +116,13 @@ unsafe fn forward_with(
         let report = Out::optional(report_out, "report_out")?;
         let result = solve(d, &State::new(q, q_dot).at_time(t), tau)?;
         let summary = mech_forward_report_t::of(&result);
-        let numbers = [
-            summary.backward_error,
-            summary.condition,
-            summary.error_estimate,
-            summary.dissipation,
-        ];
+        // The error estimate alone may be +∞ (A singular to working precision, documented).
+        let estimate = if summary.error_estimate == f64::INFINITY {
+            0.0
+        } else {
+            summary.error_estimate
+        };
+        let numbers = [summary.backward_error, summary.condition, estimate, summary.dissipation];
         finite_result(numbers.as_slice(), "forward-dynamics accuracy report")?;
         // SAFETY: caller's contract.
         unsafe { out.write(&result.q_ddot) };
