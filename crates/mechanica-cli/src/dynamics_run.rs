@@ -116,7 +116,7 @@ fn forward_record(result: &ForwardDynamics, names: &[String]) -> ForwardRecord {
         },
         backward_error: result.backward_error,
         condition: result.condition,
-        error_estimate: result.error_estimate,
+        error_estimate: result.error_estimate.filter(|e| e.is_finite()),
         residual: result.residual.clone(),
         dissipation: result.dissipation,
     }

@@ -91,11 +91,14 @@ pub enum DynamicsError {
         scale: f64,
     },
     /// The mass matrix A(q) is not positive definite (massless coordinates).
-    #[error("the mass matrix is not positive definite: pivot {pivot} = {value:e} (coordinate {pivot})")]
+    #[error(
+        "the mass matrix is not positive definite to working precision: its Cholesky factorization fails at coordinate {pivot} (diagonal entry {value:e})"
+    )]
     SingularMassMatrix {
         /// The coordinate whose pivot failed.
         pivot: usize,
-        /// The pivot value.
+        /// That coordinate's diagonal entry A_kk (the failed pivot is A_kk less the
+        /// contributions of the earlier coordinates, at or below rounding level).
         value: f64,
     },
     /// A dissipation element cannot be evaluated at this state.

@@ -28,7 +28,8 @@ pub struct ForwardRecord {
     /// κ∞(A), when estimated.
     pub condition: Option<f64>,
     /// Estimated ∞-norm error of q̈ (‖A⁻¹‖∞ times the residual and its rounding), when the
-    /// mass matrix was formed; +∞ (JSON null) where A is singular to working precision.
+    /// mass matrix was formed and is not singular to working precision (then absent beside a
+    /// condition number: no digit of q̈ is assured).
     pub error_estimate: Option<f64>,
     /// τ − RNEA(q, q̇, q̈), N·m | N.
     pub residual: Vec<f64>,
@@ -40,10 +41,10 @@ impl ForwardRecord {
     pub(crate) fn write_text(&self, out: &mut Text) {
         // The estimate is of the ∞-norm error (absolute); the articulated route has none, and
         // its backward error says nothing of q̈'s digits when A is ill-conditioned.
-        let precision = match self.error_estimate {
-            Some(estimate) if estimate.is_finite() => Precision::Absolute(estimate),
-            Some(_) => Precision::Relative(f64::INFINITY),
-            None => Precision::Exact,
+        let precision = match (self.error_estimate, self.condition) {
+            (Some(estimate), _) => Precision::Absolute(estimate),
+            (None, Some(_)) => Precision::Relative(f64::INFINITY),
+            (None, None) => Precision::Exact,
         };
         out.named(
             "q̈ (forward dynamics)",
@@ -60,10 +61,10 @@ impl ForwardRecord {
                 bound(self.backward_error),
                 self.condition
                     .map_or(String::new(), |c| format!("; κ∞(A) = {}", bound(c))),
-                match self.error_estimate {
-                    Some(e) if e.is_finite() => format!("; estimated error of q̈ {}", bound(e)),
-                    Some(_) => "; A is singular to working precision: no digit of q̈ is assured".to_string(),
-                    None => "; forward error not estimated".to_string(),
+                match (self.error_estimate, self.condition) {
+                    (Some(e), _) => format!("; estimated error of q̈ {}", bound(e)),
+                    (None, Some(_)) => "; A is singular to working precision: no digit of q̈ is assured".to_string(),
+                    (None, None) => "; forward error not estimated".to_string(),
                 }
             ),
         );
