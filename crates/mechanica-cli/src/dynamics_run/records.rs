@@ -41,10 +41,13 @@ impl ForwardRecord {
     pub(crate) fn write_text(&self, out: &mut Text) {
         // The estimate is of the ∞-norm error (absolute); the articulated route has none, and
         // its backward error says nothing of q̈'s digits when A is ill-conditioned.
-        let precision = match (self.error_estimate, self.condition) {
-            (Some(estimate), _) => Precision::Absolute(estimate),
-            (None, Some(_)) => Precision::Relative(f64::INFINITY),
-            (None, None) => Precision::Exact,
+        let (precision, accuracy) = match (self.error_estimate, self.condition) {
+            (Some(e), _) => (Precision::Absolute(e), format!("estimated error of q̈ {}", bound(e))),
+            (None, Some(_)) => (
+                Precision::Relative(f64::INFINITY),
+                "A is singular to working precision: no digit of q̈ is assured".to_string(),
+            ),
+            (None, None) => (Precision::Exact, "forward error not estimated".to_string()),
         };
         out.named(
             "q̈ (forward dynamics)",
@@ -56,16 +59,11 @@ impl ForwardRecord {
         out.line(
             "method",
             &format!(
-                "{}; backward error {}{}{}",
+                "{}; backward error {}{}; {accuracy}",
                 name_of(&self.method),
                 bound(self.backward_error),
                 self.condition
                     .map_or(String::new(), |c| format!("; κ∞(A) = {}", bound(c))),
-                match (self.error_estimate, self.condition) {
-                    (Some(e), _) => format!("; estimated error of q̈ {}", bound(e)),
-                    (None, Some(_)) => "; A is singular to working precision: no digit of q̈ is assured".to_string(),
-                    (None, None) => "; forward error not estimated".to_string(),
-                }
             ),
         );
         out.values(
