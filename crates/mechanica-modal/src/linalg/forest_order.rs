@@ -64,13 +64,8 @@ mod tests {
     /// its own; adding any edge inside a tree makes a cycle, which is refused.
     #[test]
     fn random_forests_are_ordered_leaves_first_and_cycles_refused() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = |m: usize| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % m as u64) as usize
-        };
+        let mut rng = crate::testing::graded::SplitMix::new(0x9e37_79b9_7f4a_7c15);
+        let mut next = |m: usize| rng.below(m);
         for _ in 0..300 {
             let n = 1 + next(40);
             let mut label: Vec<usize> = (0..n).collect();
